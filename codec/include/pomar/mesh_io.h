@@ -1,0 +1,60 @@
+// Reading and writing triangle meshes as PLY, OBJ, OFF and STL files.
+//
+// The format is chosen by the file extension (case-insensitive): .ply, .obj, .off, .stl.
+// Only positions and triangles are kept; everything else a file may carry (normals, colors,
+// texture coordinates, ...) is dropped and named in LoadReport::ignored_attributes.
+// PLY, OFF and STL are read through vcglib's importers (so a file loads as it does in
+// MeshLab), OBJ through tinyobjloader. Every failure throws pomar::Error with a one-line
+// message that starts with the file's path.
+//
+// Numbers are printed and parsed in the "C" convention (decimal point). Writing is
+// locale-independent; the vcglib readers use the C library and therefore expect the
+// process's LC_NUMERIC to be "C" (the default unless the program calls setlocale).
+#pragma once
+
+#include <pomar/pomar.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace pomar {
+
+/// What load_mesh found in a file besides the mesh it returns.
+struct LoadReport {
+  std::string format;             ///< "ply", "obj", "off" or "stl"
+  size_t file_vertices = 0;       ///< vertices stored in the file (STL: 3 per facet)
+  size_t file_faces = 0;          ///< faces/polygons in the file (PLY tristrips: triangles)
+  size_t unreferenced_vertices = 0; ///< dropped because no face uses them
+  size_t welded_vertices = 0;     ///< STL only: corners merged with an identical position
+  size_t polygons_triangulated = 0; ///< faces with more than 3 vertices, split into triangles
+  /// Data present in the file that is not kept, e.g. "normals", "colors",
+  /// "texture coordinates", "quality", "materials", "flags", "radius", "edges", "camera".
+  std::vector<std::string> ignored_attributes;
+};
+
+/// Read a triangle mesh. Polygons are split into triangles (PLY/OBJ: fan from the first
+/// vertex; OFF: vcglib's rule, which picks the better diagonal of a quad), STL corners with
+/// exactly equal positions are welded, unreferenced vertices are dropped. Vertex and face
+/// order of the file is kept otherwise. Throws pomar::Error if the file is missing,
+/// unreadable, malformed, has a NaN/Inf coordinate or contains no triangles.
+Mesh load_mesh(const std::string &path, LoadReport *report = nullptr);
+
+/// Write a triangle mesh, replacing `path` atomically (see write_file_atomic). `binary`
+/// selects binary little-endian PLY / binary STL (default) or ASCII PLY / ASCII STL; OBJ and
+/// OFF are always text. Coordinates are written so that load_mesh reads back bit-identical
+/// floats. Throws pomar::Error on an unknown extension, an invalid mesh (index out of
+/// range, NaN/Inf coordinate) or an I/O failure; the destination is then left untouched.
+void save_mesh(const std::string &path, const Mesh &mesh, bool binary = true);
+
+/// Write `size` bytes to `path` atomically: they go to a temporary file in the same
+/// directory (".<name>.tmp.<pid>.<n>"), which is fsync'ed and renamed over `path`. On
+/// failure the temporary file is removed and pomar::Error is thrown naming the path and
+/// the system error.
+void write_file_atomic(const std::string &path, const void *data, size_t size);
+
+/// Read a whole file. Throws pomar::Error naming the path and the system error text.
+std::vector<uint8_t> read_file(const std::string &path);
+
+} // namespace pomar

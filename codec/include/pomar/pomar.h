@@ -1,0 +1,99 @@
+// pomar: progressive, randomly accessible compression of manifold triangle meshes.
+//
+// This is the core API on flat arrays (positions + 32-bit triangle indices). It has no
+// dependency on vcglib; `pomar/vcg_adapter.h` converts from/to vcglib meshes and
+// `pomar/mesh_io.h` reads and writes PLY/OBJ/OFF/STL files.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace pomar {
+
+/// Every failure of the library is reported as a pomar::Error whose what() is one line
+/// naming the problem (and, for invalid meshes, where: counts and one example).
+class Error : public std::runtime_error {
+public:
+  using std::runtime_error::runtime_error;
+};
+
+/// A triangle mesh as flat arrays: x,y,z per vertex and three vertex indices per
+/// triangle, counter-clockwise seen from outside.
+struct Mesh {
+  std::vector<float> positions;    // 3 * vertex_count()
+  std::vector<uint32_t> triangles; // 3 * triangle_count()
+  size_t vertex_count() const { return positions.size() / 3; }
+  size_t triangle_count() const { return triangles.size() / 3; }
+};
+
+/// Progress callback: fraction in [0,1] and a short stage name ("decimate", "encode", ...).
+using Progress = std::function<void(double fraction, const char *stage)>;
+
+struct EncodeOptions {
+  int bits = 12;     ///< quantization bits per coordinate, 4..24
+  Progress progress; ///< optional
+};
+
+/// One refinement level of a file: the mesh it produces and what it costs.
+struct LevelInfo {
+  uint32_t vertices = 0;          ///< vertex count after decoding this level
+  uint32_t faces = 0;             ///< face count after decoding this level
+  uint64_t connectivity_bytes = 0;
+  uint64_t geometry_bytes = 0;
+};
+
+/// What a .pomar file holds (read from its header and level table only).
+struct FileInfo {
+  uint32_t version = 0;
+  int bits = 0;
+  float bbox_min[3] = {0, 0, 0};
+  float bbox_max[3] = {0, 0, 0};
+  uint32_t vertices = 0; ///< at full resolution
+  uint32_t faces = 0;
+  uint32_t base_vertices = 0;
+  uint32_t base_faces = 0;
+  std::vector<LevelInfo> levels; ///< levels[i] = refinement level i+1
+  uint64_t total_bytes = 0;
+  uint64_t header_bytes = 0; ///< header + level table
+  uint64_t base_bytes = 0;   ///< the stored base mesh
+  uint64_t connectivity_bytes = 0; ///< sum over levels
+  uint64_t geometry_bytes = 0;     ///< sum over levels
+};
+
+/// Facts about one encode, beyond what the file itself says.
+struct EncodeReport {
+  FileInfo info;
+  size_t input_vertices = 0;
+  size_t unreferenced_vertices = 0; ///< dropped: no triangle uses them
+  double quantize_seconds = 0, decimate_seconds = 0, encode_seconds = 0;
+  /// decoded vertex i (in a full decode) is input vertex decoded_to_input[i].
+  std::vector<uint32_t> decoded_to_input;
+};
+
+/// Encode a manifold, consistently oriented triangle mesh. Throws pomar::Error on invalid
+/// input (non-manifold, inconsistent orientation, repeated vertex in a face, NaN, empty...).
+std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options = {},
+                            EncodeReport *report = nullptr);
+
+/// Read the header, base mesh and level table of a .pomar image (checks their checksums).
+FileInfo inspect(const uint8_t *data, size_t size);
+
+/// Decode the mesh after `level` refinement levels (0 = base mesh, -1 = full resolution).
+/// Throws pomar::Error if the image is damaged or truncated (checked per block).
+Mesh decode(const uint8_t *data, size_t size, int level = -1, const Progress &progress = {});
+
+/// Quantization grid shared by encoder and decoder: a cube of side `extent` from `origin`,
+/// 2^bits - 1 steps. Dequantization is defined here so everybody gets the same floats.
+struct Quantizer {
+  float origin[3] = {0, 0, 0};
+  float extent = 0;
+  int bits = 12;
+  double step() const;
+  float dequantize(int axis, uint32_t q) const;
+};
+
+} // namespace pomar

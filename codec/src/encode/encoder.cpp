@@ -1,0 +1,265 @@
+// Encoder: mesh -> quantize -> decimate (levels) -> encode global levels -> file.
+//
+// After decimation the encoder rebuilds the mesh from the base mesh exactly as the
+// decoder will (same traversal, same splits, same vertex numbering), and at each vertex
+// writes what the decoder needs to repeat the step: the encoder is a decoder that knows
+// the answers.
+#include <chrono>
+#include <optional>
+#include <cmath>
+#include <string>
+
+#include "decimate/decimate.h"
+#include "entropy/models.h"
+#include "format/file_format.h"
+#include "geometry/quantize.h"
+#include "refine/level_traversal.h"
+
+namespace pomar {
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// The traversal policy of the encoder: it knows every collapse of the level.
+class EncoderCodec {
+public:
+  EncoderCodec(Models &models, const std::vector<int32_t> &input_q,
+               std::vector<uint32_t> &dec_to_input, std::vector<uint32_t> &input_to_dec)
+      : m_(models), input_q_(input_q), dec_to_input_(dec_to_input), input_to_dec_(input_to_dec),
+        collapse_at_(input_to_dec.size(), kNone) {}
+
+  void begin_level(const std::vector<Collapse> &level, std::vector<uint8_t> *conn,
+                   std::vector<uint8_t> *geom) {
+    level_ = &level;
+    for (uint32_t i = 0; i < level.size(); ++i)
+      collapse_at_[level[i].v_to] = i;
+    conn_.emplace(conn);
+    geom_.emplace(geom);
+    emitted_ = 0;
+  }
+  void end_level() {
+    for (const Collapse &c : *level_)
+      collapse_at_[c.v_to] = kNone;
+    conn_->finish();
+    geom_->finish();
+    if (emitted_ != level_->size())
+      corrupt("a collapse of the level was not reached by the traversal");
+  }
+
+  int split_flag(uint32_t v, int context) {
+    current_ = collapse_at_[dec_to_input_[v]];
+    const int flag = current_ != kNone;
+    conn_->encode_bit(m_.conn.sv[context], flag);
+    emitted_ += flag;
+    return flag;
+  }
+
+  void split_symbols(uint32_t v, const Ring &ring, const uint32_t *ranked, SplitSymbols &s) {
+    (void)v;
+    const Collapse &c = (*level_)[current_];
+    const uint32_t m = ring.size();
+    const uint32_t il = ring_index(ring, c.v_l), ir = ring_index(ring, c.v_r);
+    // Vertices strictly inside the patch (they get a new edge to v_to at the collapse).
+    auto inside = [&](uint32_t i) {
+      if (ring.closed)
+        return (i + m - il) % m != 0 && (i + m - il) % m < (ir + m - il) % m;
+      const uint32_t lo = il == kNone ? 0 : il + 1, hi = ir == kNone ? m - 1 : ir - 1;
+      return i >= lo && i <= hi && hi != kNone;
+    };
+    uint32_t e = kNone;
+    for (uint32_t r = 0; r < m && e == kNone; ++r)
+      if (inside(ranked[r]))
+        e = r;
+    for (uint32_t r = 0; r < m && e == kNone; ++r)
+      if (ranked[r] == il || ranked[r] == ir)
+        e = r;
+    const uint32_t j = ranked[e];
+    s.s_e = e;
+    s.s_l = ring.closed ? (j + m - il) % m : (il == kNone ? j + 1 : j - il);
+    s.s_r = ring.closed ? (ir + m - j) % m : (ir == kNone ? m - j : ir - j);
+    put_small(*conn_, m_.conn.se, s.s_e);
+    put_small(*conn_, m_.conn.sl, s.s_l);
+    put_small(*conn_, m_.conn.sr[std::min<uint32_t>(s.s_l, kSrContexts - 1)], s.s_r);
+  }
+
+  void geometry(uint32_t v_to, const int32_t b[3], const FrenetFrame &frame, int context,
+                int32_t position[3]) {
+    (void)v_to;
+    const uint32_t v_from = (*level_)[current_].v_from;
+    int64_t r[3];
+    for (int k = 0; k < 3; ++k) {
+      position[k] = input_q_[3 * v_from + k];
+      r[k] = int64_t(position[k]) - b[k];
+    }
+    to_local(frame, r);
+    put_residual(*geom_, m_.geom, 0, context, r[0]);
+    put_residual(*geom_, m_.geom, 0, context, r[1]);
+    put_residual(*geom_, m_.geom, 1, context, r[2]);
+    new_vertices_.push_back(v_from);
+  }
+
+  [[noreturn]] void corrupt(const char *what) {
+    throw Error(std::string("internal encoder error: ") + what);
+  }
+
+  /// Number the vertices created by the level's splits (traversal order).
+  void number_new_vertices() {
+    for (uint32_t v : new_vertices_) {
+      input_to_dec_[v] = static_cast<uint32_t>(dec_to_input_.size());
+      dec_to_input_.push_back(v);
+    }
+    new_vertices_.clear();
+  }
+
+private:
+  uint32_t ring_index(const Ring &ring, uint32_t input_vertex) {
+    if (input_vertex == kNone)
+      return kNone;
+    const int i = ring.index_of(input_to_dec_[input_vertex]);
+    if (i < 0)
+      corrupt("v_l/v_r is not a neighbour of v_to");
+    return static_cast<uint32_t>(i);
+  }
+
+  Models &m_;
+  const std::vector<int32_t> &input_q_;
+  std::vector<uint32_t> &dec_to_input_, &input_to_dec_;
+  std::vector<uint32_t> collapse_at_; // input vertex -> index of its collapse as v_to
+  const std::vector<Collapse> *level_ = nullptr;
+  std::optional<RangeEncoder> conn_, geom_;
+  uint32_t current_ = kNone;
+  size_t emitted_ = 0;
+  std::vector<uint32_t> new_vertices_;
+};
+
+/// Drop unreferenced vertices; returns the compact positions and fills the index maps.
+std::vector<float> compact_vertices(const Mesh &mesh, std::vector<uint32_t> &triangles,
+                                    std::vector<uint32_t> &compact_to_input) {
+  const size_t nv = mesh.vertex_count();
+  std::vector<uint32_t> remap(nv, kNone);
+  triangles = mesh.triangles;
+  for (uint32_t &i : triangles) {
+    if (i >= nv)
+      throw Error("a triangle refers to vertex " + std::to_string(i) + " but the mesh has only " +
+                  std::to_string(nv) + " vertices");
+    if (remap[i] == kNone) {
+      remap[i] = 0; // mark used; numbered below in input order
+    }
+  }
+  std::vector<float> positions;
+  for (uint32_t v = 0; v < nv; ++v) {
+    if (remap[v] == kNone)
+      continue;
+    remap[v] = static_cast<uint32_t>(compact_to_input.size());
+    compact_to_input.push_back(v);
+    positions.insert(positions.end(), &mesh.positions[3 * v], &mesh.positions[3 * v] + 3);
+  }
+  for (uint32_t &i : triangles)
+    i = remap[i];
+  return positions;
+}
+
+void check_input(const Mesh &mesh, const EncodeOptions &options) {
+  if (options.bits < 4 || options.bits > 24)
+    throw Error("quantization bits must be between 4 and 24 (got " + std::to_string(options.bits) +
+                ")");
+  if (mesh.positions.size() % 3 || mesh.triangles.size() % 3)
+    throw Error("position and triangle arrays must hold multiples of 3 values");
+  if (mesh.triangle_count() == 0)
+    throw Error("the mesh contains no triangles");
+  for (size_t i = 0; i < mesh.positions.size(); ++i)
+    if (!std::isfinite(mesh.positions[i]))
+      throw Error("vertex " + std::to_string(i / 3) + " has a non-finite coordinate");
+}
+
+} // namespace
+
+std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, EncodeReport *report) {
+  auto t0 = std::chrono::steady_clock::now();
+  check_input(mesh, options);
+  std::vector<uint32_t> triangles, compact_to_input;
+  const std::vector<float> positions = compact_vertices(mesh, triangles, compact_to_input);
+  const uint32_t nv = static_cast<uint32_t>(compact_to_input.size());
+  const uint32_t nf = static_cast<uint32_t>(triangles.size() / 3);
+  CornerTable ct;
+  build_corner_table(triangles.data(), nf, nv, ct);
+  const Quantizer grid = make_quantizer(positions.data(), nv, options.bits);
+  const std::vector<int32_t> q = quantize(grid, positions.data(), nv);
+  const double t_quantize = seconds_since(t0);
+
+  auto t1 = std::chrono::steady_clock::now();
+  const Decimation dec = decimate(std::move(ct), q, DecimationOptions{}, options.progress);
+  const double t_decimate = seconds_since(t1);
+
+  // Base mesh, vertices numbered in input order.
+  auto t2 = std::chrono::steady_clock::now();
+  std::vector<uint32_t> dec_to_input, input_to_dec(nv, kNone);
+  BaseMesh base;
+  for (uint32_t i : dec.base_triangles)
+    input_to_dec[i] = 0;
+  for (uint32_t v = 0; v < nv; ++v)
+    if (input_to_dec[v] != kNone) {
+      input_to_dec[v] = static_cast<uint32_t>(dec_to_input.size());
+      dec_to_input.push_back(v);
+      base.q.insert(base.q.end(), &q[3 * v], &q[3 * v] + 3);
+    }
+  for (uint32_t i : dec.base_triangles)
+    base.triangles.push_back(input_to_dec[i]);
+
+  LevelMesh lm;
+  lm.q = base.q;
+  lm.seed_faces = static_cast<uint32_t>(base.triangles.size() / 3);
+  build_corner_table(base.triangles.data(), lm.seed_faces, dec_to_input.size(), lm.ct);
+
+  FileHeader header;
+  header.grid = grid;
+  header.vertices = nv;
+  header.faces = nf;
+  header.base_vertices = static_cast<uint32_t>(dec_to_input.size());
+  header.base_faces = lm.seed_faces;
+  Models models;
+  EncoderCodec codec(models, q, dec_to_input, input_to_dec);
+  TraversalScratch scratch;
+  std::vector<PendingSplit> splits;
+  std::vector<std::vector<uint8_t>> blocks;
+  const size_t L = dec.levels.size();
+  for (size_t r = 0; r < L; ++r) {
+    std::vector<uint8_t> conn, geom;
+    codec.begin_level(dec.levels[L - 1 - r], &conn, &geom);
+    traverse_level(lm, codec, scratch, splits);
+    codec.end_level();
+    apply_splits(lm, splits);
+    codec.number_new_vertices();
+    LevelEntry e;
+    e.vertices = lm.vertex_count();
+    e.faces = lm.ct.face_count();
+    e.connectivity_bytes = static_cast<uint32_t>(conn.size());
+    e.geometry_bytes = static_cast<uint32_t>(geom.size());
+    header.levels.push_back(e);
+    conn.insert(conn.end(), geom.begin(), geom.end());
+    blocks.push_back(std::move(conn));
+    if (options.progress)
+      options.progress(double(r + 1) / double(L), "encode");
+  }
+  if (lm.vertex_count() != nv || lm.ct.face_count() != nf)
+    throw Error("internal encoder error: the refined mesh does not match the input");
+
+  std::vector<uint8_t> file = write_file(header, pack_base_mesh(base, grid.bits), blocks);
+  if (report) {
+    const FileLayout layout = read_layout(file.data(), file.size());
+    report->info = file_info(layout, file.size());
+    report->input_vertices = mesh.vertex_count();
+    report->unreferenced_vertices = mesh.vertex_count() - nv;
+    report->quantize_seconds = t_quantize;
+    report->decimate_seconds = t_decimate;
+    report->encode_seconds = seconds_since(t2);
+    report->decoded_to_input.resize(nv);
+    for (uint32_t i = 0; i < nv; ++i)
+      report->decoded_to_input[i] = compact_to_input[dec_to_input[i]];
+  }
+  return file;
+}
+
+} // namespace pomar

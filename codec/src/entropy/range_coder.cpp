@@ -1,0 +1,181 @@
+#include "entropy/range_coder.h"
+
+#include <cassert>
+
+namespace pomar {
+
+// ---------------------------------------------------------------- FrequencyModel
+
+FrequencyModel::FrequencyModel(int symbols) : n_(symbols), total_(0) {
+  assert(symbols >= 2 && symbols <= kMaxSymbols);
+  for (int i = 0; i < n_; ++i)
+    freq_[i] = 1;
+  total_ = static_cast<uint32_t>(n_);
+}
+
+uint32_t FrequencyModel::cumulative(int s) const {
+  uint32_t c = 0;
+  for (int i = 0; i < s; ++i)
+    c += freq_[i];
+  return c;
+}
+
+int FrequencyModel::find(uint32_t target, uint32_t *start) const {
+  uint32_t c = 0;
+  int s = 0;
+  while (s < n_ - 1 && c + freq_[s] <= target)
+    c += freq_[s++];
+  *start = c;
+  return s;
+}
+
+void FrequencyModel::update(int s) {
+  freq_[s] = static_cast<uint16_t>(freq_[s] + kIncrement);
+  total_ += kIncrement;
+  if (total_ > kMaxTotal) {
+    total_ = 0;
+    for (int i = 0; i < n_; ++i) {
+      freq_[i] = static_cast<uint16_t>((freq_[i] + 1) >> 1);
+      total_ += freq_[i];
+    }
+  }
+}
+
+// ---------------------------------------------------------------- RangeEncoder
+
+void RangeEncoder::shift_low() {
+  // Bytes are held back while they could still be changed by a carry: cache_ plus a run
+  // of 0xFF bytes. Once the top of low_ is known, they are written (incremented on carry).
+  if (static_cast<uint32_t>(low_) < 0xFF000000u || (low_ >> 32) != 0) {
+    const uint8_t carry = static_cast<uint8_t>(low_ >> 32);
+    uint8_t byte = cache_;
+    do {
+      if (!first_)
+        out_->push_back(static_cast<uint8_t>(byte + carry));
+      first_ = false;
+      byte = 0xFF;
+    } while (--pending_ != 0);
+    cache_ = static_cast<uint8_t>(low_ >> 24);
+  }
+  ++pending_;
+  low_ = (low_ & 0x00FFFFFFu) << 8;
+}
+
+void RangeEncoder::normalize() {
+  while (range_ < kRangeTop) {
+    range_ <<= 8;
+    shift_low();
+  }
+}
+
+void RangeEncoder::encode(uint32_t start, uint32_t size, uint32_t total) {
+  const uint32_t r = range_ / total;
+  low_ += static_cast<uint64_t>(r) * start;
+  range_ = r * size;
+  normalize();
+}
+
+void RangeEncoder::encode(FrequencyModel &m, int symbol) {
+  encode(m.cumulative(symbol), m.freq(symbol), m.total());
+  m.update(symbol);
+}
+
+void RangeEncoder::encode_bit(BitModel &m, int bit) {
+  const uint32_t bound = (range_ >> kBitModelBits) * m.p0;
+  if (bit) {
+    low_ += bound;
+    range_ -= bound;
+  } else {
+    range_ = bound;
+  }
+  m.update(bit);
+  normalize();
+}
+
+void RangeEncoder::encode_bypass(uint32_t value, int nbits) {
+  for (int i = nbits - 1; i >= 0; --i) {
+    range_ >>= 1;
+    if ((value >> i) & 1)
+      low_ += range_;
+    normalize();
+  }
+}
+
+void RangeEncoder::finish() {
+  for (int i = 0; i < 5; ++i)
+    shift_low();
+}
+
+// ---------------------------------------------------------------- RangeDecoder
+
+void RangeDecoder::reset(const uint8_t *data, size_t size) {
+  data_ = data;
+  size_ = size;
+  pos_ = 0;
+  overrun_ = 0;
+  range_ = 0xFFFFFFFFu;
+  code_ = 0;
+  for (int i = 0; i < 4; ++i)
+    code_ = (code_ << 8) | next_byte();
+}
+
+uint8_t RangeDecoder::next_byte() {
+  if (pos_ < size_)
+    return data_[pos_++];
+  ++overrun_;
+  return 0;
+}
+
+void RangeDecoder::normalize() {
+  while (range_ < kRangeTop) {
+    range_ <<= 8;
+    code_ = (code_ << 8) | next_byte();
+  }
+}
+
+int RangeDecoder::decode(FrequencyModel &m) {
+  const uint32_t r = range_ / m.total();
+  uint32_t target = code_ / r;
+  if (target >= m.total())
+    target = m.total() - 1; // only reachable on corrupt data
+  uint32_t start;
+  const int s = m.find(target, &start);
+  code_ -= r * start;
+  range_ = r * m.freq(s);
+  m.update(s);
+  normalize();
+  return s;
+}
+
+int RangeDecoder::decode_bit(BitModel &m) {
+  const uint32_t bound = (range_ >> kBitModelBits) * m.p0;
+  int bit;
+  if (code_ < bound) {
+    range_ = bound;
+    bit = 0;
+  } else {
+    code_ -= bound;
+    range_ -= bound;
+    bit = 1;
+  }
+  m.update(bit);
+  normalize();
+  return bit;
+}
+
+uint32_t RangeDecoder::decode_bypass(int nbits) {
+  uint32_t v = 0;
+  for (int i = 0; i < nbits; ++i) {
+    range_ >>= 1;
+    uint32_t bit = 0;
+    if (code_ >= range_) {
+      code_ -= range_;
+      bit = 1;
+    }
+    v = (v << 1) | bit;
+    normalize();
+  }
+  return v;
+}
+
+} // namespace pomar

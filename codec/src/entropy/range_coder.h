@@ -1,0 +1,94 @@
+// Adaptive range coder (byte-wise renormalisation, carry propagation through a cached
+// byte) plus the probability models the codec uses. Encoder and decoder are mirror images:
+// every function of RangeEncoder has a counterpart in RangeDecoder that consumes exactly
+// the same state changes.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace pomar {
+
+constexpr uint32_t kRangeTop = 1u << 24; // renormalise when range drops below this
+constexpr int kBitModelBits = 12;        // binary probabilities are 12-bit fixed point
+constexpr int kBitModelShift = 5;        // adaptation speed of binary models
+
+/// Adaptive probability of a binary event (probability of 0, 12-bit fixed point).
+struct BitModel {
+  uint16_t p0 = 1u << (kBitModelBits - 1);
+  void update(int bit) {
+    if (bit)
+      p0 -= p0 >> kBitModelShift;
+    else
+      p0 += ((1u << kBitModelBits) - p0) >> kBitModelShift;
+  }
+};
+
+/// Adaptive frequency model over a small alphabet (<= kMaxSymbols). Counts grow by
+/// kIncrement per coded symbol and are halved when the total exceeds kMaxTotal, so the
+/// model follows slow drifts in the statistics.
+class FrequencyModel {
+public:
+  static constexpr int kMaxSymbols = 64;
+  static constexpr uint32_t kIncrement = 24;
+  static constexpr uint32_t kMaxTotal = 1u << 16;
+
+  explicit FrequencyModel(int symbols = 2);
+  int symbols() const { return n_; }
+  uint32_t total() const { return total_; }
+  uint32_t freq(int s) const { return freq_[s]; }
+  uint32_t cumulative(int s) const; // sum of freq of symbols < s
+  /// Find the symbol whose cumulative interval holds `target`; sets its cumulative start.
+  int find(uint32_t target, uint32_t *start) const;
+  void update(int s);
+
+private:
+  int n_;
+  uint32_t total_;
+  uint16_t freq_[kMaxSymbols];
+};
+
+class RangeEncoder {
+public:
+  explicit RangeEncoder(std::vector<uint8_t> *out) : out_(out) {}
+  void encode(uint32_t start, uint32_t size, uint32_t total);
+  void encode(FrequencyModel &m, int symbol);
+  void encode_bit(BitModel &m, int bit);
+  void encode_bypass(uint32_t value, int nbits); // nbits <= 24, equiprobable bits
+  /// Write the final bytes; the stream is complete after this.
+  void finish();
+
+private:
+  void normalize();
+  void shift_low();
+  std::vector<uint8_t> *out_;
+  uint64_t low_ = 0;
+  uint32_t range_ = 0xFFFFFFFFu;
+  uint8_t cache_ = 0;
+  uint64_t pending_ = 1; // bytes held back: cache_ plus a run of 0xFF bytes
+  bool first_ = true;    // the very first cached byte is always 0 and is not written
+};
+
+class RangeDecoder {
+public:
+  RangeDecoder() = default;
+  RangeDecoder(const uint8_t *data, size_t size) { reset(data, size); }
+  void reset(const uint8_t *data, size_t size);
+  int decode(FrequencyModel &m);
+  int decode_bit(BitModel &m);
+  uint32_t decode_bypass(int nbits);
+  /// True when the decoder has asked for more bytes than the stream holds by more than
+  /// the final flush can explain: the stream is truncated or corrupt.
+  bool overrun() const { return overrun_ > 4; }
+
+private:
+  uint8_t next_byte();
+  void normalize();
+  const uint8_t *data_ = nullptr;
+  size_t size_ = 0, pos_ = 0;
+  uint32_t range_ = 0xFFFFFFFFu, code_ = 0;
+  size_t overrun_ = 0;
+};
+
+} // namespace pomar

@@ -1,0 +1,214 @@
+#include "format/file_format.h"
+
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <xxhash.h>
+
+#include "entropy/models.h"
+#include "format/bit_io.h"
+
+namespace pomar {
+
+uint32_t checksum(const uint8_t *data, size_t size) { return XXH32(data, size, 0); }
+
+namespace {
+
+int index_bits(uint32_t vertices) { return std::max(1, bit_length(vertices - 1)); }
+
+void write_header(const FileHeader &h, std::vector<uint8_t> &out) {
+  ByteWriter w(out);
+  w.bytes(kMagic, 8);
+  w.u16(h.version);
+  w.u16(h.flags);
+  w.u8(static_cast<uint8_t>(h.grid.bits));
+  w.u8(0);
+  w.u8(0);
+  w.u8(0);
+  for (int k = 0; k < 3; ++k)
+    w.f32(h.grid.origin[k]);
+  w.f32(h.grid.extent);
+  w.u32(h.vertices);
+  w.u32(h.faces);
+  w.u32(h.base_vertices);
+  w.u32(h.base_faces);
+  w.u32(static_cast<uint32_t>(h.levels.size()));
+  w.u32(h.base_bytes);
+  w.u32(h.base_checksum);
+  for (const LevelEntry &e : h.levels) {
+    w.u32(e.vertices);
+    w.u32(e.faces);
+    w.u32(e.connectivity_bytes);
+    w.u32(e.geometry_bytes);
+    w.u32(e.checksum);
+  }
+  w.u32(checksum(out.data(), out.size()));
+}
+
+[[noreturn]] void bad(const std::string &what) { throw Error("not a valid .pomar file: " + what); }
+
+} // namespace
+
+std::vector<uint8_t> pack_base_mesh(const BaseMesh &base, int bits) {
+  std::vector<uint8_t> out;
+  BitWriter w(out);
+  for (int32_t v : base.q)
+    w.put(static_cast<uint32_t>(v), bits);
+  const int ib = index_bits(static_cast<uint32_t>(base.q.size() / 3));
+  for (uint32_t i : base.triangles)
+    w.put(i, ib);
+  w.flush();
+  return out;
+}
+
+std::vector<uint8_t> write_file(FileHeader header, const std::vector<uint8_t> &base_block,
+                                const std::vector<std::vector<uint8_t>> &level_blocks) {
+  header.base_bytes = static_cast<uint32_t>(base_block.size());
+  header.base_checksum = checksum(base_block.data(), base_block.size());
+  for (size_t i = 0; i < level_blocks.size(); ++i)
+    header.levels[i].checksum = checksum(level_blocks[i].data(), level_blocks[i].size());
+  std::vector<uint8_t> out;
+  write_header(header, out);
+  out.insert(out.end(), base_block.begin(), base_block.end());
+  for (const auto &b : level_blocks)
+    out.insert(out.end(), b.begin(), b.end());
+  return out;
+}
+
+FileLayout read_layout(const uint8_t *data, size_t size) {
+  if (size < 8 || std::memcmp(data, kMagic, 8) != 0)
+    bad("the file does not start with the POMAR signature");
+  ByteReader r(data, size, "the .pomar header");
+  for (int i = 0; i < 8; ++i)
+    r.u8();
+  FileLayout L;
+  FileHeader &h = L.header;
+  h.version = r.u16();
+  if (h.version != kFormatVersion)
+    throw Error("unsupported .pomar version " + std::to_string(h.version) +
+                " (this build reads version " + std::to_string(kFormatVersion) + ")");
+  h.flags = r.u16();
+  h.grid.bits = r.u8();
+  r.u8();
+  r.u8();
+  r.u8();
+  for (int k = 0; k < 3; ++k)
+    h.grid.origin[k] = r.f32();
+  h.grid.extent = r.f32();
+  h.vertices = r.u32();
+  h.faces = r.u32();
+  h.base_vertices = r.u32();
+  h.base_faces = r.u32();
+  const uint32_t levels = r.u32();
+  h.base_bytes = r.u32();
+  h.base_checksum = r.u32();
+  if (levels > kMaxLevels)
+    bad("level count " + std::to_string(levels) + " exceeds " + std::to_string(kMaxLevels));
+  L.header_bytes = kFixedHeaderBytes + kLevelEntryBytes * levels + 4;
+  if (size < L.header_bytes)
+    bad("header is truncated");
+  const uint32_t stored = [&] {
+    ByteReader c(data + L.header_bytes - 4, 4, "header checksum");
+    return c.u32();
+  }();
+  if (checksum(data, L.header_bytes - 4) != stored)
+    bad("header checksum mismatch (the file is damaged)");
+  h.levels.resize(levels);
+  for (LevelEntry &e : h.levels) {
+    e.vertices = r.u32();
+    e.faces = r.u32();
+    e.connectivity_bytes = r.u32();
+    e.geometry_bytes = r.u32();
+    e.checksum = r.u32();
+  }
+  // Sanity of the counts before anybody allocates from them.
+  if (h.grid.bits < 1 || h.grid.bits > 24)
+    bad("quantization bits " + std::to_string(h.grid.bits) + " outside 1..24");
+  if (!std::isfinite(h.grid.extent) || h.grid.extent < 0 || !std::isfinite(h.grid.origin[0]) ||
+      !std::isfinite(h.grid.origin[1]) || !std::isfinite(h.grid.origin[2]))
+    bad("bounding box is not finite");
+  if (h.base_faces == 0 || h.base_vertices < 3 || h.base_vertices > h.vertices ||
+      h.base_faces > h.faces || h.vertices > (1u << 31) || h.faces > (1u << 31))
+    bad("inconsistent vertex/face counts");
+  uint32_t nv = h.base_vertices, nf = h.base_faces;
+  for (const LevelEntry &e : h.levels) {
+    if (e.vertices <= nv || e.vertices > 2 * uint64_t(nv) || e.faces < nf)
+      bad("level table counts do not grow like vertex splits");
+    nv = e.vertices;
+    nf = e.faces;
+  }
+  if (nv != h.vertices || nf != h.faces)
+    bad("level table does not end at the announced vertex/face counts");
+  const uint64_t base_needed =
+      (uint64_t(h.base_vertices) * 3 * h.grid.bits +
+       uint64_t(h.base_faces) * 3 * index_bits(h.base_vertices) + 7) / 8;
+  if (h.base_bytes != base_needed)
+    bad("base mesh block size does not match its counts");
+  uint64_t offset = L.header_bytes;
+  L.base_offset = offset;
+  offset += h.base_bytes;
+  for (const LevelEntry &e : h.levels) {
+    L.level_offset.push_back(offset);
+    offset += uint64_t(e.connectivity_bytes) + e.geometry_bytes;
+  }
+  if (offset > size)
+    throw Error("truncated .pomar file: " + std::to_string(size) + " bytes, the header announces " +
+                std::to_string(offset));
+  if (h.vertices > 512 * uint64_t(size) + 64)
+    bad("the announced vertex count is implausible for the file size");
+  return L;
+}
+
+BaseMesh read_base_mesh(const uint8_t *data, const FileLayout &L) {
+  const FileHeader &h = L.header;
+  const uint8_t *p = data + L.base_offset;
+  if (checksum(p, h.base_bytes) != h.base_checksum)
+    throw Error("damaged .pomar file: base mesh checksum mismatch");
+  BaseMesh b;
+  BitReader r(p, h.base_bytes);
+  b.q.resize(size_t(h.base_vertices) * 3);
+  for (auto &v : b.q)
+    v = static_cast<int32_t>(r.get(h.grid.bits));
+  const int ib = index_bits(h.base_vertices);
+  b.triangles.resize(size_t(h.base_faces) * 3);
+  for (auto &i : b.triangles) {
+    i = r.get(ib);
+    if (i >= h.base_vertices)
+      throw Error("damaged .pomar file: base mesh face refers to a missing vertex");
+  }
+  return b;
+}
+
+void check_level(const uint8_t *data, const FileLayout &L, size_t i) {
+  const LevelEntry &e = L.header.levels[i];
+  const size_t n = size_t(e.connectivity_bytes) + e.geometry_bytes;
+  if (checksum(data + L.level_offset[i], n) != e.checksum)
+    throw Error("damaged .pomar file: checksum mismatch in level " + std::to_string(i + 1) +
+                " block");
+}
+
+FileInfo file_info(const FileLayout &L, size_t file_size) {
+  const FileHeader &h = L.header;
+  FileInfo info;
+  info.version = h.version;
+  info.bits = h.grid.bits;
+  for (int k = 0; k < 3; ++k) {
+    info.bbox_min[k] = h.grid.origin[k];
+    info.bbox_max[k] = static_cast<float>(double(h.grid.origin[k]) + h.grid.extent);
+  }
+  info.vertices = h.vertices;
+  info.faces = h.faces;
+  info.base_vertices = h.base_vertices;
+  info.base_faces = h.base_faces;
+  for (const LevelEntry &e : h.levels) {
+    info.levels.push_back({e.vertices, e.faces, e.connectivity_bytes, e.geometry_bytes});
+    info.connectivity_bytes += e.connectivity_bytes;
+    info.geometry_bytes += e.geometry_bytes;
+  }
+  info.total_bytes = file_size;
+  info.header_bytes = L.header_bytes;
+  info.base_bytes = h.base_bytes;
+  return info;
+}
+
+} // namespace pomar

@@ -1,0 +1,110 @@
+#include "geometry/frenet_frame.h"
+
+#include <cmath>
+#include <cstdlib>
+
+// This translation unit must be compiled without floating-point contraction or fast-math
+// (see codec/CMakeLists.txt): the coefficients below are part of the bitstream.
+
+namespace pomar {
+namespace {
+
+constexpr int kShift = 16;
+constexpr int64_t kHalf = int64_t(1) << (kShift - 1);
+
+int64_t fixed_round(double x) { return static_cast<int64_t>(std::floor(x * 65536.0 + 0.5)); }
+
+// round(c * y / 2^16) with floor semantics on the shifted sum, identical on both sides.
+int64_t shear(int64_t c, int64_t y) { return (c * y + kHalf) >> kShift; }
+
+void quarter_turn(int64_t &x, int64_t &y) { // (x,y) -> (y,-x)
+  const int64_t t = x;
+  x = y;
+  y = -t;
+}
+void quarter_turn_back(int64_t &x, int64_t &y) { // (x,y) -> (-y,x)
+  const int64_t t = x;
+  x = -y;
+  y = t;
+}
+
+/// Rotation in plane (i,j) that maps direction (a,b) onto the positive i axis.
+Givens givens_from_pair(int i, int j, double a, double b) {
+  Givens g;
+  g.i = static_cast<uint8_t>(i);
+  g.j = static_cast<uint8_t>(j);
+  if (a == 0.0 && b == 0.0)
+    return g;
+  // Quarter turns bring the direction within 45 degrees of +i.
+  int k;
+  if (std::fabs(a) >= std::fabs(b))
+    k = a >= 0 ? 0 : 2;
+  else
+    k = b > 0 ? 1 : 3;
+  for (int q = 0; q < k; ++q) { // same map as quarter_turn, in doubles (exact: sign swaps)
+    const double t = a;
+    a = b;
+    b = -t;
+  }
+  g.quarter_turns = static_cast<uint8_t>(k);
+  if (b == 0.0)
+    return g;
+  const double r = std::sqrt(a * a + b * b);
+  g.t = fixed_round(b / (r + a)); // tan(beta/2)
+  g.s = fixed_round(-b / r);      // -sin(beta)
+  g.active = true;
+  return g;
+}
+
+void apply(const Givens &g, int64_t v[3]) {
+  int64_t &x = v[g.i], &y = v[g.j];
+  for (int q = 0; q < g.quarter_turns; ++q)
+    quarter_turn(x, y);
+  if (g.active) {
+    x += shear(g.t, y);
+    y += shear(g.s, x);
+    x += shear(g.t, y);
+  }
+}
+
+void unapply(const Givens &g, int64_t v[3]) {
+  int64_t &x = v[g.i], &y = v[g.j];
+  if (g.active) {
+    x -= shear(g.t, y);
+    y -= shear(g.s, x);
+    x -= shear(g.t, y);
+  }
+  for (int q = 0; q < g.quarter_turns; ++q)
+    quarter_turn_back(x, y);
+}
+
+} // namespace
+
+FrenetFrame make_frenet_frame(const int64_t normal[3], const int64_t edge[3]) {
+  FrenetFrame f;
+  const double nx = static_cast<double>(normal[0]);
+  const double ny = static_cast<double>(normal[1]);
+  const double nz = static_cast<double>(normal[2]);
+  // 1) about z: bring the normal into the xz half-plane x >= 0.
+  f.g[0] = givens_from_pair(0, 1, nx, ny);
+  // 2) in the (z,x) plane: bring it onto +z. After step 1 it is (hypot(nx,ny), 0, nz).
+  f.g[1] = givens_from_pair(2, 0, nz, std::sqrt(nx * nx + ny * ny));
+  // 3) about the new z: bring the edge's tangential part onto +x (integer-rotated edge).
+  int64_t e[3] = {edge[0], edge[1], edge[2]};
+  apply(f.g[0], e);
+  apply(f.g[1], e);
+  f.g[2] = givens_from_pair(0, 1, static_cast<double>(e[0]), static_cast<double>(e[1]));
+  return f;
+}
+
+void to_local(const FrenetFrame &f, int64_t v[3]) {
+  for (int k = 0; k < 3; ++k)
+    apply(f.g[k], v);
+}
+
+void to_global(const FrenetFrame &f, int64_t v[3]) {
+  for (int k = 2; k >= 0; --k)
+    unapply(f.g[k], v);
+}
+
+} // namespace pomar

@@ -1,0 +1,41 @@
+// Exact integer bijection between the global (x,y,z) frame and the local Frenet frame
+// (t1, t2, n) of a vertex split (paper section 5.1, Figure 6).
+//
+// The rotation R^T that maps the global axes onto the local frame is written as three
+// plane (Givens) rotations. Each one is a number of exact quarter turns followed by a
+// residual rotation of at most 45 degrees, and that residual is applied as three integer
+// lifting shears (x += round(T*y); y += round(S*x); x += round(T*y)). Every step is
+// undone exactly by subtracting the same rounded value, so the map is a bijection on Z^3
+// whatever the coefficients are. The coefficients are derived only from integer inputs
+// with IEEE-754 basic operations (+ - * / sqrt, no FMA contraction) and then rounded to
+// Q16 fixed point, so encoder and decoder rebuild them bit for bit.
+#pragma once
+
+#include <cstdint>
+
+namespace pomar {
+
+/// One plane rotation: `quarter_turns` times (x,y) -> (y,-x) on axes (i,j), then shears.
+struct Givens {
+  uint8_t i = 0, j = 1;
+  uint8_t quarter_turns = 0;
+  bool active = false;   // residual shears present
+  int64_t t = 0, s = 0;  // Q16 shear coefficients
+};
+
+/// The local frame of one vertex split, as three Givens rotations.
+struct FrenetFrame {
+  Givens g[3];
+};
+
+/// Build the frame whose third axis is along `normal` and whose first axis is along the
+/// projection of `edge` (v_ref - v_to) on the tangent plane. Degenerate inputs (zero
+/// normal, edge parallel to the normal) leave the corresponding rotations at identity.
+FrenetFrame make_frenet_frame(const int64_t normal[3], const int64_t edge[3]);
+
+/// Global residual -> local (t1, t2, n) components. Exact inverse of to_global().
+void to_local(const FrenetFrame &f, int64_t v[3]);
+/// Local components -> global residual.
+void to_global(const FrenetFrame &f, int64_t v[3]);
+
+} // namespace pomar

@@ -1,0 +1,267 @@
+// The deterministic breadth-first traversal of one level (paper section 5.1, Figure 3),
+// shared by the encoder and the decoder so that both walk the mesh identically.
+//
+// Starting from the first halfedge of the first base face, a vertex is processed when the
+// first halfedge pointing to it leaves the FIFO; then its outgoing halfedges are queued in
+// clockwise order, starting from the one back to where it came from. For each vertex the
+// codec codes s_v; for a split vertex (v_to) also s_e, s_l, s_r and the position of
+// v_from as a residual to the patch barycentre in the local Frenet frame. The splits are
+// only collected here; the caller applies them after the traversal (Figure 3, step 4).
+//
+// The Codec policy provides (encoder: writes what it knows; decoder: reads):
+//   int  split_flag(uint32_t v, int context);
+//   void split_symbols(uint32_t v, const Ring& ring, const uint32_t* ranked,
+//                      SplitSymbols& s);      // ranked = ring indices, longest edge first
+//   void geometry(uint32_t v_to, const int32_t barycentre[3], const FrenetFrame& frame,
+//                 int context, int32_t position[3]);
+//   [[noreturn]] void corrupt(const char* what);
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+#include "entropy/models.h"
+#include "geometry/frenet_frame.h"
+#include "mesh/corner_table.h"
+#include "refine/vertex_split.h"
+
+namespace pomar {
+
+/// The mesh being refined: what the decoder holds, and what the encoder replicates.
+struct LevelMesh {
+  CornerTable ct;
+  std::vector<int32_t> q; // quantized xyz per vertex
+  uint32_t seed_faces = 0; // faces of the base mesh (traversal seeds, never removed)
+  uint32_t vertex_count() const { return ct.vertex_count(); }
+};
+
+struct SplitSymbols {
+  uint32_t s_e = 0, s_l = 0, s_r = 0;
+};
+
+struct PendingSplit {
+  SplitOp op;
+  int32_t position[3];
+};
+
+/// Where the patch of a split lies in v_to's ring (indices; kNone = the open fan's gap).
+struct PatchRange {
+  uint32_t j;      // v_ref
+  uint32_t il, ir; // v_l, v_r
+  uint32_t first_face, faces;
+};
+
+inline int64_t squared_distance(const std::vector<int32_t> &q, uint32_t a, uint32_t b) {
+  const int64_t dx = q[3 * a] - q[3 * b], dy = q[3 * a + 1] - q[3 * b + 1],
+                dz = q[3 * a + 2] - q[3 * b + 2];
+  return dx * dx + dy * dy + dz * dz;
+}
+
+/// Ring indices sorted by decreasing edge length (ties: smaller vertex id first).
+inline void rank_edges(const LevelMesh &mesh, uint32_t v, const Ring &ring,
+                       std::vector<uint32_t> &ranked, std::vector<int64_t> &len2) {
+  const uint32_t m = ring.size();
+  ranked.resize(m);
+  len2.resize(m);
+  for (uint32_t i = 0; i < m; ++i) {
+    ranked[i] = i;
+    len2[i] = squared_distance(mesh.q, v, ring.neighbour[i]);
+  }
+  std::sort(ranked.begin(), ranked.end(), [&](uint32_t a, uint32_t b) {
+    if (len2[a] != len2[b])
+      return len2[a] > len2[b];
+    return ring.neighbour[a] < ring.neighbour[b];
+  });
+}
+
+/// Turn (s_e, s_l, s_r) into ring positions; false if they do not describe a valid patch.
+inline bool resolve_patch(const Ring &ring, const uint32_t *ranked, const SplitSymbols &s,
+                          PatchRange &p) {
+  const uint32_t m = ring.size();
+  if (s.s_e >= m)
+    return false;
+  p.j = ranked[s.s_e];
+  if (ring.closed) {
+    if (s.s_l >= m || s.s_r >= m || s.s_l + s.s_r == 0 || s.s_l + s.s_r > m - 1)
+      return false;
+    p.il = (p.j + m - s.s_l) % m;
+    p.ir = (p.j + s.s_r) % m;
+    p.first_face = p.il;
+    p.faces = s.s_l + s.s_r;
+    return true;
+  }
+  if (s.s_l <= p.j)
+    p.il = p.j - s.s_l;
+  else if (s.s_l == p.j + 1)
+    p.il = kNone;
+  else
+    return false;
+  if (uint64_t(p.j) + s.s_r <= m - 1)
+    p.ir = p.j + s.s_r;
+  else if (uint64_t(p.j) + s.s_r == m)
+    p.ir = kNone;
+  else
+    return false;
+  if (p.il == kNone && p.ir == kNone)
+    return false;
+  p.first_face = p.il == kNone ? 0 : p.il;
+  const uint32_t end = p.ir == kNone ? m - 1 : p.ir;
+  if (end <= p.first_face)
+    return false;
+  p.faces = end - p.first_face;
+  return true;
+}
+
+/// Integer normal of face k of the ring (v, n_k, n_k+1).
+inline void add_face_normal(const LevelMesh &mesh, uint32_t v, const Ring &ring, uint32_t k,
+                            int64_t n[3]) {
+  const auto &q = mesh.q;
+  const uint32_t a = ring.neighbour[k], b = ring.neighbour[(k + 1) % ring.size()];
+  int64_t u[3], w[3];
+  for (int i = 0; i < 3; ++i) {
+    u[i] = int64_t(q[3 * a + i]) - q[3 * v + i];
+    w[i] = int64_t(q[3 * b + i]) - q[3 * v + i];
+  }
+  n[0] += u[1] * w[2] - u[2] * w[1];
+  n[1] += u[2] * w[0] - u[0] * w[2];
+  n[2] += u[0] * w[1] - u[1] * w[0];
+}
+
+/// Prediction of v_from: barycentre of its future neighbours (v_to and the patch ring
+/// from v_l to v_r), and the Frenet frame from edge v_to-v_ref and the normals of the
+/// (one or two) faces along that edge.
+inline void predict(const LevelMesh &mesh, uint32_t v_to, const Ring &ring, const PatchRange &p,
+                    int32_t barycentre[3], FrenetFrame &frame, int64_t &ref_length2) {
+  const auto &q = mesh.q;
+  const uint32_t m = ring.size();
+  int64_t sum[3] = {q[3 * v_to], q[3 * v_to + 1], q[3 * v_to + 2]};
+  int64_t count = 1;
+  for (uint32_t t = 0, i = p.first_face; t <= p.faces; ++t, i = (i + 1) % m) {
+    const uint32_t n = ring.neighbour[i];
+    for (int k = 0; k < 3; ++k)
+      sum[k] += q[3 * n + k];
+    ++count;
+  }
+  for (int k = 0; k < 3; ++k) // round to nearest; sums are non-negative
+    barycentre[k] = static_cast<int32_t>((2 * sum[k] + count) / (2 * count));
+  int64_t normal[3] = {0, 0, 0};
+  const uint32_t j = p.j;
+  if (ring.closed || j < ring.faces())
+    add_face_normal(mesh, v_to, ring, j, normal);
+  if (ring.closed || j > 0)
+    add_face_normal(mesh, v_to, ring, (j + m - 1) % m, normal);
+  const uint32_t ref = ring.neighbour[j];
+  int64_t edge[3];
+  for (int k = 0; k < 3; ++k)
+    edge[k] = int64_t(q[3 * ref + k]) - q[3 * v_to + k];
+  frame = make_frenet_frame(normal, edge);
+  ref_length2 = edge[0] * edge[0] + edge[1] * edge[1] + edge[2] * edge[2];
+}
+
+/// Per-vertex marks of one traversal (level stamps, reused across levels).
+struct TraversalScratch {
+  std::vector<uint32_t> queued, split, in_patch;
+  std::vector<uint32_t> claimed; // per face: stamp of the level whose patch holds it
+  uint32_t stamp = 0;
+  std::vector<std::pair<uint32_t, uint32_t>> queue; // (vertex, came from)
+  Ring ring;
+  std::vector<uint32_t> ranked;
+  std::vector<int64_t> len2;
+  void begin(uint32_t vertices, uint32_t faces) {
+    if (queued.size() < vertices) {
+      queued.resize(vertices, 0);
+      split.resize(vertices, 0);
+      in_patch.resize(vertices, 0);
+    }
+    if (claimed.size() < faces)
+      claimed.resize(faces, 0);
+    ++stamp;
+    queue.clear();
+  }
+};
+
+/// s_v context: already processed split neighbours (0,1,2+) x "in a coded patch".
+inline int sv_context(const TraversalScratch &s, uint32_t v, const Ring &ring) {
+  int split_neighbours = 0;
+  for (uint32_t n : ring.neighbour)
+    split_neighbours += s.split[n] == s.stamp;
+  return (s.in_patch[v] == s.stamp ? 3 : 0) + std::min(split_neighbours, 2);
+}
+
+template <class Codec>
+void process_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v,
+                    uint32_t from, std::vector<PendingSplit> &splits) {
+  Ring &ring = s.ring;
+  get_ring(mesh.ct, v, ring);
+  if (codec.split_flag(v, sv_context(s, v, ring))) {
+    s.split[v] = s.stamp;
+    rank_edges(mesh, v, ring, s.ranked, s.len2);
+    SplitSymbols sym;
+    codec.split_symbols(v, ring, s.ranked.data(), sym);
+    PatchRange p;
+    if (!resolve_patch(ring, s.ranked.data(), sym, p))
+      codec.corrupt("split symbols do not fit the vertex's neighbourhood");
+    // Patches of one level must not share faces (that is what makes the splits
+    // independent); a stream that says otherwise is damaged.
+    for (uint32_t t = 0; t < p.faces; ++t) {
+      uint32_t &claim = s.claimed[ring.corner[(p.first_face + t) % ring.size()] / 3];
+      if (claim == s.stamp)
+        codec.corrupt("two vertex splits of one level share a face");
+      claim = s.stamp;
+    }
+    PendingSplit ps;
+    ps.op = {v, ring.corner[p.first_face], p.faces, p.il != kNone, p.ir != kNone};
+    int32_t barycentre[3];
+    FrenetFrame frame;
+    int64_t ref_length2;
+    predict(mesh, v, ring, p, barycentre, frame, ref_length2);
+    codec.geometry(v, barycentre, frame, geometry_context(ref_length2), ps.position);
+    splits.push_back(ps);
+    for (uint32_t t = 0, i = p.first_face; t <= p.faces; ++t, i = (i + 1) % ring.size())
+      s.in_patch[ring.neighbour[i]] = s.stamp;
+  }
+  // Queue the outgoing halfedges clockwise, starting with the one back to `from`.
+  const uint32_t m = ring.size();
+  int start = ring.index_of(from);
+  if (start < 0)
+    start = 0;
+  for (uint32_t t = 0; t < m; ++t) {
+    const uint32_t n = ring.neighbour[(uint32_t(start) + m - t) % m];
+    if (s.queued[n] != s.stamp) {
+      s.queued[n] = s.stamp;
+      s.queue.emplace_back(n, v);
+    }
+  }
+}
+
+/// Traverse the whole mesh once (all components, seeded by the base faces in order).
+template <class Codec>
+void traverse_level(LevelMesh &mesh, Codec &codec, TraversalScratch &s,
+                    std::vector<PendingSplit> &splits) {
+  s.begin(mesh.vertex_count(), mesh.ct.face_count());
+  splits.clear();
+  size_t head = 0;
+  for (uint32_t f = 0; f < mesh.seed_faces; ++f) {
+    const uint32_t a = mesh.ct.V[3 * f], b = mesh.ct.V[3 * f + 1];
+    if (s.queued[b] == s.stamp)
+      continue;
+    s.queued[b] = s.stamp;
+    s.queue.emplace_back(b, a);
+    while (head < s.queue.size()) {
+      const auto [v, from] = s.queue[head++];
+      process_vertex(mesh, codec, s, v, from, splits);
+    }
+  }
+}
+
+/// Apply the collected splits in traversal order; new vertices get consecutive ids.
+inline void apply_splits(LevelMesh &mesh, const std::vector<PendingSplit> &splits) {
+  for (const PendingSplit &ps : splits) {
+    const uint32_t v_from = mesh.vertex_count();
+    apply_split(mesh.ct, ps.op, v_from);
+    mesh.q.insert(mesh.q.end(), ps.position, ps.position + 3);
+  }
+}
+
+} // namespace pomar

@@ -1,0 +1,604 @@
+// Tests for pomar/mesh_io.h: lossless round trips in every format, the importer traps
+// (OBJ faces, PLY tristrips, STL welding, unreferenced vertices) and error reporting.
+#include <pomar/mesh_io.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <dirent.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+namespace {
+
+using pomar::LoadReport;
+using pomar::Mesh;
+
+// ------------------------------------------------------------------------------------
+// Helpers
+// ------------------------------------------------------------------------------------
+
+/// A fresh directory under ::testing::TempDir(), removed with its files afterwards.
+class MeshIoTest : public ::testing::Test {
+protected:
+  void SetUp() override {
+    std::string pattern = ::testing::TempDir() + "/pomar_mesh_io_XXXXXX";
+    ASSERT_NE(mkdtemp(&pattern[0]), nullptr);
+    dir_ = pattern;
+  }
+  void TearDown() override {
+    for (const std::string &name : list_dir())
+      std::remove((dir_ + "/" + name).c_str());
+    rmdir(dir_.c_str());
+  }
+
+  std::string path(const std::string &name) const { return dir_ + "/" + name; }
+
+  std::string write(const std::string &name, const std::string &bytes) const {
+    std::ofstream out(path(name), std::ios::binary);
+    out << bytes;
+    return path(name);
+  }
+
+  std::vector<std::string> list_dir() const {
+    std::vector<std::string> names;
+    if (DIR *d = opendir(dir_.c_str())) {
+      while (dirent *e = readdir(d))
+        if (std::strcmp(e->d_name, ".") != 0 && std::strcmp(e->d_name, "..") != 0)
+          names.push_back(e->d_name);
+      closedir(d);
+    }
+    return names;
+  }
+
+  std::string dir_;
+};
+
+std::string read_text(const std::string &path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+/// The message of the pomar::Error that `f` throws (fails the test if it does not).
+template <class F>
+std::string error_of(F f) {
+  try {
+    f();
+  } catch (const pomar::Error &e) {
+    return e.what();
+  } catch (const std::exception &e) {
+    ADD_FAILURE() << "expected pomar::Error, got: " << e.what();
+    return "";
+  }
+  ADD_FAILURE() << "expected pomar::Error, nothing thrown";
+  return "";
+}
+
+std::string load_error(const std::string &path) {
+  return error_of([&] { pomar::load_mesh(path); });
+}
+
+bool same_bits(const std::vector<float> &a, const std::vector<float> &b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
+}
+
+/// Eight vertices with awkward floats, each first used in index order by the triangles
+/// (so STL's welding gives back the same numbering).
+Mesh awkward_mesh() {
+  Mesh m;
+  m.positions = {0.1f,        1e-7f,          123456.789f,    // 0
+                 -0.0f,       0.0f,           1.0f,           // 1
+                 1e-40f,      -3.4028235e38f, 0.333333343f,   // 2 (denormal, -FLT_MAX)
+                 16777216.0f, -1.17549435e-38f, 2.71828175f,  // 3
+                 -7.5f,       1.0e30f,        -2.0e-30f,      // 4
+                 3.14159274f, -0.0f,          -0.0f,          // 5
+                 1.4e-45f,    65504.0f,       -123.456f,      // 6 (smallest denormal)
+                 0.5f,        0.25f,          -1e-7f};        // 7
+  m.triangles = {0, 1, 2, 0, 2, 3, 3, 2, 4, 4, 5, 6, 6, 7, 0, 7, 1, 5};
+  return m;
+}
+
+/// A mesh with random finite float bit patterns over the whole range.
+Mesh random_mesh(size_t vertices, uint32_t seed) {
+  std::mt19937 rng(seed);
+  Mesh m;
+  while (m.positions.size() < 3 * vertices) {
+    const uint32_t bits = rng();
+    float f;
+    std::memcpy(&f, &bits, sizeof f);
+    if (std::isfinite(f))
+      m.positions.push_back(f);
+  }
+  for (uint32_t v = 0; v + 2 < vertices; ++v)
+    m.triangles.insert(m.triangles.end(), {v, v + 1, v + 2});
+  return m;
+}
+
+const char *const kTetraPly = "ply\nformat ascii 1.0\nelement vertex 4\n"
+                              "property float x\nproperty float y\nproperty float z\n"
+                              "element face 4\nproperty list uchar int vertex_indices\nend_header\n"
+                              "0 0 0\n1 0 0\n0 1 0\n0 0 1\n"
+                              "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+
+// ------------------------------------------------------------------------------------
+// Lossless round trips
+// ------------------------------------------------------------------------------------
+
+struct Case {
+  const char *name;
+  bool binary;
+};
+
+class RoundTrip : public MeshIoTest, public ::testing::WithParamInterface<Case> {};
+
+TEST_P(RoundTrip, AwkwardFloatsAreBitIdentical) {
+  const Mesh in = awkward_mesh();
+  const std::string file = path(GetParam().name);
+  pomar::save_mesh(file, in, GetParam().binary);
+  LoadReport report;
+  const Mesh out = pomar::load_mesh(file, &report);
+  EXPECT_TRUE(same_bits(in.positions, out.positions));
+  EXPECT_EQ(in.triangles, out.triangles);
+  EXPECT_EQ(report.unreferenced_vertices, 0u);
+  EXPECT_EQ(report.polygons_triangulated, 0u);
+  EXPECT_TRUE(report.ignored_attributes.empty());
+}
+
+TEST_P(RoundTrip, RandomFloatsAreBitIdentical) {
+  const Mesh in = random_mesh(3000, 1234);
+  const std::string file = path(GetParam().name);
+  pomar::save_mesh(file, in, GetParam().binary);
+  const Mesh out = pomar::load_mesh(file);
+  ASSERT_EQ(in.positions.size(), out.positions.size());
+  for (size_t i = 0; i < in.positions.size(); ++i)
+    ASSERT_EQ(std::memcmp(&in.positions[i], &out.positions[i], sizeof(float)), 0)
+        << "value " << i << ": wrote " << in.positions[i] << ", read " << out.positions[i];
+  EXPECT_EQ(in.triangles, out.triangles);
+}
+
+INSTANTIATE_TEST_SUITE_P(AllFormats, RoundTrip,
+                         ::testing::Values(Case{"m.ply", true}, Case{"m_ascii.ply", false},
+                                           Case{"m.obj", true}, Case{"m.off", true},
+                                           Case{"m.stl", true}, Case{"m_ascii.stl", false}),
+                         [](const ::testing::TestParamInfo<Case> &info) {
+                           std::string n = info.param.name;
+                           for (char &c : n)
+                             if (c == '.')
+                               c = '_';
+                           return n;
+                         });
+
+TEST_F(MeshIoTest, ReportDescribesFile) {
+  pomar::save_mesh(path("a.ply"), awkward_mesh());
+  LoadReport r;
+  pomar::load_mesh(path("a.ply"), &r);
+  EXPECT_EQ(r.format, "ply");
+  EXPECT_EQ(r.file_vertices, 8u);
+  EXPECT_EQ(r.file_faces, 6u);
+}
+
+TEST_F(MeshIoTest, ExtensionIsCaseInsensitive) {
+  pomar::save_mesh(path("UPPER.PLY"), awkward_mesh());
+  LoadReport r;
+  EXPECT_EQ(pomar::load_mesh(path("UPPER.PLY"), &r).triangle_count(), 6u);
+  EXPECT_EQ(r.format, "ply");
+  EXPECT_TRUE(read_text(path("UPPER.PLY")).find("binary_little_endian") != std::string::npos);
+}
+
+TEST_F(MeshIoTest, AsciiPlyIsAscii) {
+  pomar::save_mesh(path("a.ply"), awkward_mesh(), false);
+  EXPECT_EQ(read_text(path("a.ply")).compare(0, 21, "ply\nformat ascii 1.0\n"), 0);
+}
+
+// ------------------------------------------------------------------------------------
+// OBJ
+// ------------------------------------------------------------------------------------
+
+TEST_F(MeshIoTest, ObjTetrahedronKeepsAllFourFaces) {
+  const std::string file = write("tetra.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+                                              "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
+  LoadReport r;
+  const Mesh m = pomar::load_mesh(file, &r);
+  EXPECT_EQ(m.vertex_count(), 4u);
+  EXPECT_EQ(m.triangles, (std::vector<uint32_t>{0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3}));
+  EXPECT_EQ(r.file_faces, 4u);
+  EXPECT_EQ(r.format, "obj");
+}
+
+TEST_F(MeshIoTest, ObjQuadIsFanTriangulated) {
+  const std::string file = write("quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n");
+  LoadReport r;
+  const Mesh m = pomar::load_mesh(file, &r);
+  EXPECT_EQ(m.triangles, (std::vector<uint32_t>{0, 1, 2, 0, 2, 3}));
+  EXPECT_EQ(r.polygons_triangulated, 1u);
+  EXPECT_EQ(r.file_faces, 1u);
+}
+
+TEST_F(MeshIoTest, ObjRelativeIndicesSlashesGroupsAndIgnoredAttributes) {
+  const std::string file = write("rel.obj", "mtllib x.mtl\r\no a\r\nv 0 0 0 1 0 0\r\nv 1 0 0 1 0 0\r\n"
+                                            "v 0 1 0 1 0 0\r\nvn 0 0 1\r\nvt 0 0\r\n"
+                                            "g first\r\nusemtl red\r\nf -3/1/1 -2/1/1 -1/1/1\r\n"
+                                            "v 1 1 0 1 0 0\r\ng second\r\nf 2//1 4//1 3//1\r\n");
+  LoadReport r;
+  const Mesh m = pomar::load_mesh(file, &r);
+  EXPECT_EQ(m.triangles, (std::vector<uint32_t>{0, 1, 2, 1, 3, 2}));
+  for (const char *a : {"normals", "texture coordinates", "colors", "materials"})
+    EXPECT_NE(std::find(r.ignored_attributes.begin(), r.ignored_attributes.end(), a),
+              r.ignored_attributes.end())
+        << a;
+}
+
+TEST_F(MeshIoTest, ObjBadFacesAreErrors) {
+  EXPECT_NE(load_error(write("short.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2\n"))
+                .find("line 5: face with 2 vertices"),
+            std::string::npos);
+  EXPECT_NE(load_error(write("range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n"))
+                .find("references vertex 4"),
+            std::string::npos);
+  EXPECT_NE(load_error(write("rel.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -4\n")).find(path("rel.obj")),
+            std::string::npos);
+  EXPECT_NE(load_error(write("zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n")).find("zero.obj"),
+            std::string::npos);
+}
+
+TEST_F(MeshIoTest, ObjNonFiniteAndBadCoordinates) {
+  const std::string nan_msg = load_error(write("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n"));
+  EXPECT_NE(nan_msg.find("vertex 1"), std::string::npos) << nan_msg;
+  EXPECT_NE(nan_msg.find("non-finite"), std::string::npos) << nan_msg;
+  const std::string bad = load_error(write("bad.obj", "v 0 0 0\nv 1,5 0 0\nv 0 1 0\nf 1 2 3\n"));
+  EXPECT_NE(bad.find("bad coordinate '1,5'"), std::string::npos) << bad;
+}
+
+// ------------------------------------------------------------------------------------
+// PLY
+// ------------------------------------------------------------------------------------
+
+TEST_F(MeshIoTest, PlyTristrips) {
+  // Strip 0 1 2 3 gives (0,1,2) and (2,1,3) (every other triangle flipped to keep the
+  // orientation); -1 restarts: strip 1 3 4 gives (1,3,4).
+  const std::string file = write("strips.ply", "ply\nformat ascii 1.0\nelement vertex 5\n"
+                                               "property float x\nproperty float y\nproperty float z\n"
+                                               "element tristrips 1\nproperty list int int vertex_indices\n"
+                                               "end_header\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n2 1 0\n"
+                                               "8 0 1 2 3 -1 1 3 4\n");
+  LoadReport r;
+  const Mesh m = pomar::load_mesh(file, &r);
+  EXPECT_EQ(m.triangles, (std::vector<uint32_t>{0, 1, 2, 2, 1, 3, 1, 3, 4}));
+  EXPECT_EQ(r.file_faces, 3u);
+}
+
+TEST_F(MeshIoTest, PlyTristripsBadIndexIsError) {
+  const std::string file = write("strips.ply", "ply\nformat ascii 1.0\nelement vertex 3\n"
+                                               "property float x\nproperty float y\nproperty float z\n"
+                                               "element tristrips 1\nproperty list int int vertex_indices\n"
+                                               "end_header\n0 0 0\n1 0 0\n0 1 0\n4 0 1 2 7\n");
+  EXPECT_NE(load_error(file).find("references vertex 7"), std::string::npos);
+}
+
+TEST_F(MeshIoTest, PlyPolygonsAndIgnoredAttributes) {
+  const std::string file = write("quad.ply", "ply\nformat ascii 1.0\nelement vertex 5\n"
+                                             "property float x\nproperty float y\nproperty float z\n"
+                                             "property float nx\nproperty float ny\nproperty float nz\n"
+                                             "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+                                             "element face 2\nproperty list uchar int vertex_indices\n"
+                                             "property float quality\nend_header\n"
+                                             "0 0 0 0 0 1 255 0 0\n1 0 0 0 0 1 255 0 0\n1 1 0 0 0 1 255 0 0\n"
+                                             "0 1 0 0 0 1 255 0 0\n2 2 2 0 0 1 255 0 0\n"
+                                             "4 0 1 2 3 0.5\n3 1 4 2 1\n");
+  LoadReport r;
+  const Mesh m = pomar::load_mesh(file, &r);
+  EXPECT_EQ(m.triangles, (std::vector<uint32_t>{0, 1, 2, 0, 2, 3, 1, 4, 2}));
+  EXPECT_EQ(r.polygons_triangulated, 1u);
+  EXPECT_EQ(r.file_faces, 2u);
+  for (const char *a : {"normals", "colors", "quality"})
+    EXPECT_NE(std::find(r.ignored_attributes.begin(), r.ignored_attributes.end(), a),
+              r.ignored_attributes.end())
+        << a;
+}
+
+TEST_F(MeshIoTest, PlyUnreferencedVerticesAreDroppedAndCounted) {
+  const std::string file = write("unref.ply", "ply\nformat ascii 1.0\nelement vertex 5\n"
+                                              "property float x\nproperty float y\nproperty float z\n"
+                                              "element face 1\nproperty list uchar int vertex_indices\n"
+                                              "end_header\n0 0 0\n9 9 9\n1 0 0\n8 8 8\n0 1 0\n3 4 0 2\n");
+  LoadReport r;
+  const Mesh m = pomar::load_mesh(file, &r);
+  EXPECT_EQ(m.positions, (std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0}));
+  EXPECT_EQ(m.triangles, (std::vector<uint32_t>{2, 0, 1}));
+  EXPECT_EQ(r.unreferenced_vertices, 2u);
+  EXPECT_EQ(r.file_vertices, 5u);
+}
+
+TEST_F(MeshIoTest, UnreferencedVerticesInObjAndOff) {
+  LoadReport r;
+  const Mesh obj = pomar::load_mesh(write("u.obj", "v 9 9 9\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 2 3 4\n"), &r);
+  EXPECT_EQ(obj.triangles, (std::vector<uint32_t>{0, 1, 2}));
+  EXPECT_EQ(r.unreferenced_vertices, 1u);
+  const Mesh off = pomar::load_mesh(write("u.off", "OFF\n4 1 0\n0 0 0\n1 0 0\n9 9 9\n0 1 0\n3 0 1 3\n"), &r);
+  EXPECT_EQ(off.positions, (std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0}));
+  EXPECT_EQ(r.unreferenced_vertices, 1u);
+}
+
+TEST_F(MeshIoTest, PlyLastPolygonCornerOutOfRangeIsError) {
+  // vcglib does not range-check the last corner of a polygon; we must.
+  const std::string file = write("bad.ply", "ply\nformat ascii 1.0\nelement vertex 4\n"
+                                            "property float x\nproperty float y\nproperty float z\n"
+                                            "element face 1\nproperty list uchar int vertex_indices\n"
+                                            "end_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 100000\n");
+  const std::string msg = load_error(file);
+  EXPECT_NE(msg.find("references vertex 100000"), std::string::npos) << msg;
+  EXPECT_NE(msg.find(file), std::string::npos) << msg;
+}
+
+TEST_F(MeshIoTest, PlyHugePolygonIsError) {
+  std::string text = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                     "property float z\nelement face 1\nproperty list int int vertex_indices\n"
+                     "end_header\n0 0 0\n1 0 0\n0 1 0\n600";
+  for (int i = 0; i < 600; ++i)
+    text += " " + std::to_string(i % 3);
+  const std::string msg = load_error(write("huge.ply", text + "\n"));
+  EXPECT_NE(msg.find("600 vertices"), std::string::npos) << msg;
+}
+
+TEST_F(MeshIoTest, PlyEdgesAreIgnored) {
+  const std::string file = write("edge.ply", "ply\nformat ascii 1.0\nelement vertex 3\n"
+                                             "property float x\nproperty float y\nproperty float z\n"
+                                             "element face 1\nproperty list uchar int vertex_indices\n"
+                                             "element edge 1\nproperty int vertex1\nproperty int vertex2\n"
+                                             "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n0 1\n");
+  LoadReport r;
+  EXPECT_EQ(pomar::load_mesh(file, &r).triangle_count(), 1u);
+  EXPECT_NE(std::find(r.ignored_attributes.begin(), r.ignored_attributes.end(), "edges"),
+            r.ignored_attributes.end());
+}
+
+TEST_F(MeshIoTest, PlyNaNNamesVertex) {
+  const std::string file = write("nan.ply", "ply\nformat ascii 1.0\nelement vertex 3\n"
+                                            "property float x\nproperty float y\nproperty float z\n"
+                                            "element face 1\nproperty list uchar int vertex_indices\n"
+                                            "end_header\n0 0 0\n1 0 0\n0 nan 0\n3 0 1 2\n");
+  const std::string msg = load_error(file);
+  EXPECT_NE(msg.find("vertex 2 has a non-finite coordinate"), std::string::npos) << msg;
+}
+
+TEST_F(MeshIoTest, PlyTruncatedIsError) {
+  pomar::save_mesh(path("full.ply"), awkward_mesh());
+  const std::string bytes = read_text(path("full.ply"));
+  const std::string file = write("cut.ply", bytes.substr(0, bytes.size() - 5));
+  EXPECT_NE(load_error(file).find("truncated"), std::string::npos);
+}
+
+// ------------------------------------------------------------------------------------
+// OFF
+// ------------------------------------------------------------------------------------
+
+TEST_F(MeshIoTest, OffQuadAndPolygon) {
+  const std::string file = write("poly.off", "OFF\n# comment\n6 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n"
+                                             "2 0 0\n2 1 0\n4 0 1 2 3\n5 1 4 5 2 0\n");
+  LoadReport r;
+  const Mesh m = pomar::load_mesh(file, &r);
+  EXPECT_EQ(m.triangle_count(), 2u + 3u);
+  EXPECT_EQ(r.polygons_triangulated, 2u);
+  EXPECT_EQ(r.file_faces, 2u);
+}
+
+TEST_F(MeshIoTest, OffTruncatedFaceListIsError) {
+  // vcglib reads a token of an empty line here (out of bounds); we must stop first.
+  const std::string msg = load_error(write("cut.off", "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"));
+  EXPECT_NE(msg.find("truncated"), std::string::npos) << msg;
+}
+
+TEST_F(MeshIoTest, OffBadIndexAndNaN) {
+  EXPECT_NE(load_error(write("i.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n"))
+                .find("references vertex '3'"),
+            std::string::npos);
+  const std::string msg = load_error(write("n.off", "OFF\n3 1 0\n0 0 0\n1 inf 0\n0 1 0\n3 0 1 2\n"));
+  EXPECT_NE(msg.find("vertex 1 has a non-finite coordinate"), std::string::npos) << msg;
+}
+
+// ------------------------------------------------------------------------------------
+// STL
+// ------------------------------------------------------------------------------------
+
+std::string binary_stl(const std::vector<std::vector<float>> &facets) {
+  std::string s(80, ' ');
+  const uint32_t n = static_cast<uint32_t>(facets.size());
+  s.append(reinterpret_cast<const char *>(&n), 4);
+  for (const auto &f : facets) {
+    const float normal[3] = {0, 0, 0};
+    s.append(reinterpret_cast<const char *>(normal), 12);
+    s.append(reinterpret_cast<const char *>(f.data()), 36);
+    s.append(2, '\0');
+  }
+  return s;
+}
+
+const std::vector<std::vector<float>> kTetraFacets = {{0, 0, 0, 0, 1, 0, 1, 0, 0},
+                                                      {0, 0, 0, 1, 0, 0, 0, 0, 1},
+                                                      {0, 0, 0, 0, 0, 1, 0, 1, 0},
+                                                      {1, 0, 0, 0, 1, 0, 0, 0, 1}};
+
+TEST_F(MeshIoTest, StlBinaryIsWelded) {
+  LoadReport r;
+  const Mesh m = pomar::load_mesh(write("t.stl", binary_stl(kTetraFacets)), &r);
+  EXPECT_EQ(m.positions, (std::vector<float>{0, 0, 0, 0, 1, 0, 1, 0, 0, 0, 0, 1}));
+  EXPECT_EQ(m.triangles, (std::vector<uint32_t>{0, 1, 2, 0, 2, 3, 0, 3, 1, 2, 1, 3}));
+  EXPECT_EQ(r.welded_vertices, 8u);
+  EXPECT_EQ(r.file_vertices, 12u);
+  EXPECT_EQ(r.file_faces, 4u);
+}
+
+TEST_F(MeshIoTest, StlAsciiIsWeldedAndMinusZeroEqualsZero) {
+  const std::string file = write("t.stl", "solid t\n"
+                                          "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"
+                                          "vertex 0 1 0\nendloop\nendfacet\n"
+                                          "facet normal 0 0 1\nouter loop\nvertex 1 0 0\nvertex 1 1 0\n"
+                                          "vertex -0 1 -0\nendloop\nendfacet\nendsolid t\n");
+  LoadReport r;
+  const Mesh m = pomar::load_mesh(file, &r);
+  EXPECT_EQ(m.triangles, (std::vector<uint32_t>{0, 1, 2, 1, 3, 2}));
+  EXPECT_EQ(m.vertex_count(), 4u);
+  EXPECT_EQ(r.welded_vertices, 2u);
+}
+
+TEST_F(MeshIoTest, StlBrokenFiles) {
+  std::string cut = binary_stl(kTetraFacets);
+  cut[84] = char(0xff); // still looks binary
+  EXPECT_NE(load_error(write("cut.stl", cut.substr(0, cut.size() - 10))).find("truncated"),
+            std::string::npos);
+  // vcglib would loop forever looking for the end of the first line.
+  EXPECT_NE(load_error(write("noline.stl", std::string(200, 'a'))).find("line breaks"),
+            std::string::npos);
+  EXPECT_NE(load_error(write("short.stl", "solid x\nendsolid x\n")).find("too short"),
+            std::string::npos);
+  EXPECT_NE(load_error(write("text.stl", std::string(100, 'x') + "\nhello world\n"))
+                .find("contains no triangles"),
+            std::string::npos);
+  auto nan_facets = kTetraFacets;
+  nan_facets[1][4] = NAN;
+  const std::string msg = load_error(write("nan.stl", binary_stl(nan_facets)));
+  EXPECT_NE(msg.find("vertex 4 (facet 1) has a non-finite coordinate"), std::string::npos) << msg;
+}
+
+// ------------------------------------------------------------------------------------
+// General errors
+// ------------------------------------------------------------------------------------
+
+TEST_F(MeshIoTest, MissingFileNamesPath) {
+  for (const char *name : {"missing.ply", "missing.obj", "missing.off", "missing.stl"}) {
+    const std::string msg = load_error(path(name));
+    EXPECT_NE(msg.find(path(name)), std::string::npos) << msg;
+    EXPECT_NE(msg.find("No such file"), std::string::npos) << msg;
+  }
+}
+
+TEST_F(MeshIoTest, DirectoryIsError) {
+  ASSERT_EQ(mkdir(path("d.ply").c_str(), 0700), 0);
+  EXPECT_NE(load_error(path("d.ply")).find("is a directory"), std::string::npos);
+  EXPECT_NE(error_of([&] { pomar::read_file(path("d.ply")); }).find("is a directory"),
+            std::string::npos);
+  rmdir(path("d.ply").c_str());
+}
+
+TEST_F(MeshIoTest, UnknownExtensionListsSupported) {
+  const std::string msg = load_error(write("mesh.xyz", "1 2 3\n"));
+  EXPECT_NE(msg.find(".xyz"), std::string::npos) << msg;
+  EXPECT_NE(msg.find(".ply, .obj, .off, .stl"), std::string::npos) << msg;
+  EXPECT_NE(error_of([&] { pomar::save_mesh(path("out.xyz"), awkward_mesh()); }).find(".xyz"),
+            std::string::npos);
+  EXPECT_NE(load_error(path("noext")).find("no file extension"), std::string::npos);
+}
+
+TEST_F(MeshIoTest, GarbageAndEmptyFiles) {
+  std::mt19937 rng(7);
+  std::string garbage;
+  for (int i = 0; i < 4000; ++i)
+    garbage.push_back(static_cast<char>(rng()));
+  for (const char *name : {"g.ply", "g.obj", "g.off", "g.stl"}) {
+    const std::string msg = load_error(write(name, garbage));
+    EXPECT_NE(msg.find(path(name)), std::string::npos) << msg;
+    const std::string empty = std::string("empty_") + name;
+    const std::string msg2 = load_error(write(empty, ""));
+    EXPECT_NE(msg2.find(path(empty)), std::string::npos) << msg2;
+  }
+  EXPECT_NE(load_error(write("e.obj", "# nothing\n")).find("contains no triangles"), std::string::npos);
+  EXPECT_NE(load_error(write("e.off", "OFF\n0 0 0\n")).find("contains no triangles"), std::string::npos);
+  EXPECT_NE(load_error(write("e.ply", "ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\n"
+                                      "property float y\nproperty float z\nend_header\n"))
+                .find("contains no triangles"),
+            std::string::npos);
+  EXPECT_NE(load_error(write("h.ply", "ply\nformat ascii 1.0\nelement vertex\nend_header\n"))
+                .find("invalid PLY header"),
+            std::string::npos);
+}
+
+/// Truncated and bit-flipped versions of valid files must load or throw pomar::Error,
+/// never crash, hang or throw anything else.
+TEST_F(MeshIoTest, DamagedFilesNeverCrash) {
+  const Mesh mesh = random_mesh(40, 99);
+  std::mt19937 rng(3);
+  for (const Case c : {Case{"d.ply", true}, Case{"d_ascii.ply", false}, Case{"d.obj", true},
+                       Case{"d.off", true}, Case{"d_ascii.stl", false}}) {
+    pomar::save_mesh(path(c.name), mesh, c.binary);
+    const std::string good = read_text(path(c.name));
+    for (int trial = 0; trial < 150; ++trial) {
+      std::string bad = good;
+      if (trial % 2)
+        bad.resize(rng() % bad.size());
+      for (int flips = trial % 4; flips > 0 && !bad.empty(); --flips)
+        bad[rng() % bad.size()] = static_cast<char>(rng());
+      write(c.name, bad);
+      try {
+        pomar::load_mesh(path(c.name));
+      } catch (const pomar::Error &) {
+      }
+    }
+  }
+}
+
+TEST_F(MeshIoTest, TetrahedronPlyLoads) {
+  EXPECT_EQ(pomar::load_mesh(write("t.ply", kTetraPly)).triangle_count(), 4u);
+}
+
+// ------------------------------------------------------------------------------------
+// Writing
+// ------------------------------------------------------------------------------------
+
+TEST_F(MeshIoTest, SaveReplacesAtomicallyAndLeavesNoTemporaryFiles) {
+  for (const char *name : {"x.ply", "x.stl", "x.obj", "x.off"}) {
+    write(name, "old contents");
+    pomar::save_mesh(path(name), awkward_mesh());
+    EXPECT_EQ(pomar::load_mesh(path(name)).triangle_count(), 6u);
+  }
+  for (const std::string &n : list_dir())
+    EXPECT_EQ(n.find(".tmp."), std::string::npos) << n;
+}
+
+TEST_F(MeshIoTest, SaveRejectsInvalidMeshAndKeepsDestination) {
+  write("keep.ply", "old");
+  Mesh bad = awkward_mesh();
+  bad.triangles.back() = 99;
+  EXPECT_NE(error_of([&] { pomar::save_mesh(path("keep.ply"), bad); }).find("references vertex 99"),
+            std::string::npos);
+  Mesh nan = awkward_mesh();
+  nan.positions[4] = NAN;
+  EXPECT_NE(error_of([&] { pomar::save_mesh(path("keep.ply"), nan); }).find("vertex 1"),
+            std::string::npos);
+  EXPECT_EQ(read_text(path("keep.ply")), "old");
+  EXPECT_EQ(list_dir().size(), 1u);
+}
+
+TEST_F(MeshIoTest, SaveIntoMissingDirectoryNamesPath) {
+  for (bool binary : {true, false}) {
+    const std::string target = path("no/such/dir/m.ply");
+    const std::string msg = error_of([&] { pomar::save_mesh(target, awkward_mesh(), binary); });
+    EXPECT_NE(msg.find(target), std::string::npos) << msg;
+  }
+  const std::string target = path("no/such/dir/m.stl");
+  EXPECT_NE(error_of([&] { pomar::save_mesh(target, awkward_mesh()); }).find(target), std::string::npos);
+}
+
+TEST_F(MeshIoTest, WriteAndReadFile) {
+  const std::string data = std::string("abc\0def", 7);
+  pomar::write_file_atomic(path("f.bin"), data.data(), data.size());
+  const std::vector<uint8_t> back = pomar::read_file(path("f.bin"));
+  EXPECT_EQ(std::string(back.begin(), back.end()), data);
+  const std::string msg = error_of([&] { pomar::read_file(path("nope.bin")); });
+  EXPECT_NE(msg.find(path("nope.bin")), std::string::npos);
+  EXPECT_NE(msg.find("No such file or directory"), std::string::npos);
+  EXPECT_TRUE(pomar::read_file(write("empty.bin", "")).empty());
+}
+
+} // namespace
