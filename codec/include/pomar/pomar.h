@@ -46,12 +46,24 @@ struct LevelInfo {
   uint64_t geometry_bytes = 0;
 };
 
+/// Quantization grid shared by encoder and decoder: a cube of side `extent` from `origin`,
+/// 2^bits - 1 steps. Dequantization is defined here so everybody gets the same floats.
+struct Quantizer {
+  float origin[3] = {0, 0, 0};
+  float extent = 0;
+  int bits = 12;
+  double step() const;
+  float dequantize(int axis, uint32_t q) const;
+  uint32_t quantize(int axis, float x) const; ///< nearest grid index, clamped to the grid
+};
+
 /// What a .pomar file holds (read from its header and level table only).
 struct FileInfo {
   uint32_t version = 0;
   int bits = 0;
-  float bbox_min[3] = {0, 0, 0};
-  float bbox_max[3] = {0, 0, 0};
+  Quantizer grid;                  ///< the exact grid of the file
+  float bbox_min[3] = {0, 0, 0};   ///< grid origin
+  float bbox_max[3] = {0, 0, 0};   ///< grid origin + extent (the grid is a cube)
   uint32_t vertices = 0; ///< at full resolution
   uint32_t faces = 0;
   uint32_t base_vertices = 0;
@@ -70,6 +82,9 @@ struct EncodeReport {
   size_t input_vertices = 0;
   size_t unreferenced_vertices = 0; ///< dropped: no triangle uses them
   double quantize_seconds = 0, decimate_seconds = 0, encode_seconds = 0;
+  /// Ideal code length per symbol kind, in bits (from the adaptive models' states):
+  /// s_v, s_e, s_l + s_r, s_l, tangential and normal residual components.
+  double symbol_bits[6] = {0, 0, 0, 0, 0, 0};
   /// decoded vertex i (in a full decode) is input vertex decoded_to_input[i].
   std::vector<uint32_t> decoded_to_input;
 };
@@ -85,15 +100,5 @@ FileInfo inspect(const uint8_t *data, size_t size);
 /// Decode the mesh after `level` refinement levels (0 = base mesh, -1 = full resolution).
 /// Throws pomar::Error if the image is damaged or truncated (checked per block).
 Mesh decode(const uint8_t *data, size_t size, int level = -1, const Progress &progress = {});
-
-/// Quantization grid shared by encoder and decoder: a cube of side `extent` from `origin`,
-/// 2^bits - 1 steps. Dequantization is defined here so everybody gets the same floats.
-struct Quantizer {
-  float origin[3] = {0, 0, 0};
-  float extent = 0;
-  int bits = 12;
-  double step() const;
-  float dequantize(int axis, uint32_t q) const;
-};
 
 } // namespace pomar

@@ -44,8 +44,9 @@ struct Candidate {
 class Decimator {
 public:
   Decimator(CornerTable &ct, const std::vector<int32_t> &q, const DecimationOptions &opt)
-      : ct_(ct), q_(q), opt_(opt), face_mark_(ct.face_count(), 0),
-        target_mark_(ct.vertex_count(), 0), nb_stamp_(ct.vertex_count(), 0) {}
+      : ct_(ct), q_(q), opt_(opt),
+        target_mark_(ct.vertex_count(), 0), dirty_(ct.vertex_count(), 0),
+        nb_stamp_(ct.vertex_count(), 0) {}
 
   /// Run one level; returns its collapses.
   std::vector<Collapse> run_level(std::vector<uint32_t> &alive);
@@ -68,18 +69,17 @@ private:
     return k != i && k != (from_.closed ? (i + m - 1) % m : i - 1);
   }
   bool allowed_direction(uint32_t i) const;
-  int64_t metric(uint32_t v_from, uint32_t i) const;
+  int64_t metric(uint32_t i) const;
   bool link_ok(uint32_t v_from, uint32_t i);
   bool normals_ok(uint32_t v_from, uint32_t i) const;
   bool best_option(uint32_t v_from, Candidate &out);
-  bool untouched(uint32_t v_from) const;
   Collapse collapse(uint32_t v_from, uint32_t i);
 
   CornerTable &ct_;
   const std::vector<int32_t> &q_;
   const DecimationOptions &opt_;
-  std::vector<uint32_t> face_mark_;   // level stamp of faces modified in that level
   std::vector<uint32_t> target_mark_; // level stamp of vertices already used as v_to
+  std::vector<uint32_t> dirty_;       // level stamp of vertices whose ring changed
   std::vector<uint32_t> nb_stamp_;    // scratch marks for the link condition
   uint32_t level_stamp_ = 0, nb_counter_ = 0;
   Ring from_, to_;
@@ -97,8 +97,7 @@ bool Decimator::allowed_direction(uint32_t i) const {
 
 // Length^2 of v_to-v_ref, v_ref being the farthest vertex that gets a new edge to v_to.
 // With no new edge (v_from of valence 3), v_ref is v_l (or v_r on a boundary).
-int64_t Decimator::metric(uint32_t v_from, uint32_t i) const {
-  (void)v_from;
+int64_t Decimator::metric(uint32_t i) const {
   const uint32_t v_to = from_.neighbour[i];
   const uint32_t il = v_l_index(i), ir = v_r_index(i);
   int64_t best = -1;
@@ -161,7 +160,7 @@ bool Decimator::best_option(uint32_t v_from, Candidate &out) {
   options_.clear();
   for (uint32_t i = 0; i < from_.size(); ++i)
     if (allowed_direction(i))
-      options_.push_back({metric(v_from, i), i});
+      options_.push_back({metric(i), i});
   std::sort(options_.begin(), options_.end(), [](const Option &a, const Option &b) {
     return a.metric != b.metric ? a.metric < b.metric : a.i < b.i;
   });
@@ -172,13 +171,6 @@ bool Decimator::best_option(uint32_t v_from, Candidate &out) {
     }
   }
   return false;
-}
-
-bool Decimator::untouched(uint32_t v_from) const {
-  for (uint32_t c : from_.corner)
-    if (face_mark_[c / 3] == level_stamp_)
-      return false;
-  return true;
 }
 
 // Halfedge collapse v_from -> v_to = from_.neighbour[i] on the corner table.
@@ -192,12 +184,11 @@ Collapse Decimator::collapse(uint32_t v_from, uint32_t i) {
   const uint32_t dead_l = il != kNone ? from_.corner[i] : kNone;
   const uint32_t dead_r = ir != kNone ? from_.corner[from_.closed ? (i + m - 1) % m : i - 1]
                                       : kNone;
-  // Relabel the surviving faces of v_from and mark them as this level's patch.
+  // Relabel the surviving faces of v_from (the patch).
   for (uint32_t k = 0; k < from_.faces(); ++k) {
     if (!face_survives(k, i))
       continue;
     ct_.V[from_.corner[k]] = v_to;
-    face_mark_[from_.corner[k] / 3] = level_stamp_;
     ct_.VC[v_to] = from_.corner[k];
   }
   if (dead_l != kNone) { // stitch the faces across (v_to,v_l) and (v_l,v_from)
@@ -214,7 +205,6 @@ Collapse Decimator::collapse(uint32_t v_from, uint32_t i) {
     if (d == kNone)
       continue;
     const uint32_t f = d / 3;
-    face_mark_[f] = level_stamp_;
     for (uint32_t c = 3 * f; c < 3 * f + 3; ++c) {
       ct_.O[c] = kNone;
       ct_.V[c] = kNone;
@@ -222,6 +212,9 @@ Collapse Decimator::collapse(uint32_t v_from, uint32_t i) {
   }
   ct_.VC[v_from] = kNone;
   target_mark_[v_to] = level_stamp_;
+  dirty_[v_from] = level_stamp_;
+  for (uint32_t n : from_.neighbour)
+    dirty_[n] = level_stamp_;
   return op;
 }
 
@@ -236,15 +229,16 @@ std::vector<Collapse> Decimator::run_level(std::vector<uint32_t> &alive) {
       candidates.push_back(c);
   }
   std::sort(candidates.begin(), candidates.end());
+  // Greedy pass, shortest first. A candidate whose v_from has an unchanged ring still has
+  // untouched faces (a collapse touching one of them would have changed that ring) and an
+  // unchanged metric and normal test; only the link condition depends on v_to's ring.
   std::vector<Collapse> done;
   for (const Candidate &c : candidates) {
-    if (target_mark_[c.v_to] == level_stamp_ || ct_.VC[c.v_to] == kNone)
+    if (dirty_[c.v_from] == level_stamp_ || target_mark_[c.v_to] == level_stamp_)
       continue;
     get_ring(ct_, c.v_from, from_);
-    if (!untouched(c.v_from))
-      continue;
     const int i = from_.index_of(c.v_to);
-    if (i < 0 || !link_ok(c.v_from, static_cast<uint32_t>(i)))
+    if (i < 0 || (dirty_[c.v_to] == level_stamp_ && !link_ok(c.v_from, static_cast<uint32_t>(i))))
       continue;
     done.push_back(collapse(c.v_from, static_cast<uint32_t>(i)));
   }

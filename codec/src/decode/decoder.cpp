@@ -26,10 +26,15 @@ public:
 
   int split_flag(uint32_t, int context) { return conn_.decode_bit(m_.conn.sv[context]); }
 
-  void split_symbols(uint32_t, const Ring &, const uint32_t *, SplitSymbols &s) {
-    s.s_e = get_small(conn_, m_.conn.se);
-    s.s_l = get_small(conn_, m_.conn.sl);
-    s.s_r = get_small(conn_, m_.conn.sr[std::min<uint32_t>(s.s_l, kSrContexts - 1)]);
+  void split_symbols(uint32_t, const Ring &ring, const uint32_t *, SplitSymbols &s) {
+    s.s_e = get_small(conn_, m_.conn.se[valence_context(ring.size())]);
+    const uint32_t faces = get_small(conn_, m_.conn.faces[faces_context(ring.size(), ring.closed)]);
+    if (faces > ring.size())
+      corrupt("split symbols do not fit the vertex's neighbourhood");
+    s.s_l = get_small(conn_, m_.conn.sl[sl_context(faces)]);
+    if (s.s_l > faces)
+      corrupt("split symbols do not fit the vertex's neighbourhood");
+    s.s_r = faces - s.s_l;
   }
 
   void geometry(uint32_t, const int32_t b[3], const FrenetFrame &frame, int context,

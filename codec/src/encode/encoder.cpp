@@ -51,6 +51,7 @@ public:
   int split_flag(uint32_t v, int context) {
     current_ = collapse_at_[dec_to_input_[v]];
     const int flag = current_ != kNone;
+    bits[0] += cost_bits(m_.conn.sv[context], flag);
     conn_->encode_bit(m_.conn.sv[context], flag);
     emitted_ += flag;
     return flag;
@@ -79,9 +80,10 @@ public:
     s.s_e = e;
     s.s_l = ring.closed ? (j + m - il) % m : (il == kNone ? j + 1 : j - il);
     s.s_r = ring.closed ? (ir + m - j) % m : (ir == kNone ? m - j : ir - j);
-    put_small(*conn_, m_.conn.se, s.s_e);
-    put_small(*conn_, m_.conn.sl, s.s_l);
-    put_small(*conn_, m_.conn.sr[std::min<uint32_t>(s.s_l, kSrContexts - 1)], s.s_r);
+    const uint32_t faces = s.s_l + s.s_r;
+    bits[1] += put_small(*conn_, m_.conn.se[valence_context(m)], s.s_e);
+    bits[2] += put_small(*conn_, m_.conn.faces[faces_context(m, ring.closed)], faces);
+    bits[3] += put_small(*conn_, m_.conn.sl[sl_context(faces)], s.s_l);
   }
 
   void geometry(uint32_t v_to, const int32_t b[3], const FrenetFrame &frame, int context,
@@ -94,11 +96,13 @@ public:
       r[k] = int64_t(position[k]) - b[k];
     }
     to_local(frame, r);
-    put_residual(*geom_, m_.geom, 0, context, r[0]);
-    put_residual(*geom_, m_.geom, 0, context, r[1]);
-    put_residual(*geom_, m_.geom, 1, context, r[2]);
+    bits[4] += put_residual(*geom_, m_.geom, 0, context, r[0]);
+    bits[4] += put_residual(*geom_, m_.geom, 0, context, r[1]);
+    bits[5] += put_residual(*geom_, m_.geom, 1, context, r[2]);
     new_vertices_.push_back(v_from);
   }
+
+  double bits[6] = {0, 0, 0, 0, 0, 0}; // ideal code lengths per symbol kind
 
   [[noreturn]] void corrupt(const char *what) {
     throw Error(std::string("internal encoder error: ") + what);
@@ -255,6 +259,8 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
     report->quantize_seconds = t_quantize;
     report->decimate_seconds = t_decimate;
     report->encode_seconds = seconds_since(t2);
+    for (int k = 0; k < 6; ++k)
+      report->symbol_bits[k] = codec.bits[k];
     report->decoded_to_input.resize(nv);
     for (uint32_t i = 0; i < nv; ++i)
       report->decoded_to_input[i] = compact_to_input[dec_to_input[i]];

@@ -1,10 +1,13 @@
 // Probability models of the POMAR symbols and how values are binarised onto them.
 // One Models object lives for a whole decode (models adapt across levels).
 //
-//  s_v  split count of a vertex (0/1)  binary model, context: split neighbours & patch flag
-//  s_e  rank of v_ref among v_to's edges (longest first)   17-symbol model (16 = escape)
-//  s_l  steps from v_ref to v_l                            17-symbol model
-//  s_r  steps from v_ref to v_r                            17-symbol model per min(s_l,8)
+//  s_v  split count of a vertex (0/1): binary model; context: faces of the vertex already
+//       held by this level's patches, split neighbours (see sv_context)
+//  s_e  rank of v_ref among v_to's edges (longest first): 17-symbol model (16 = escape)
+//       per valence of v_to
+//  s_l, s_r  steps from v_ref to v_l / v_r, coded as their sum (the number of faces
+//       that move to v_from; context: valence of v_to, open/closed fan), then s_l
+//       (context: that sum); s_r follows.
 //  geometry residual components (t1,t2 share a model; n has its own), each coded as a
 //  magnitude class (bit length) with a context from the local edge length, then sign and
 //  mantissa bits (the top one modelled, the rest equiprobable).
@@ -17,20 +20,37 @@
 
 namespace pomar {
 
-constexpr int kSvContexts = 6;
+constexpr int kSvContexts = 12;
 constexpr int kSmallSymbols = 16;         // values 0..15 coded directly, 16 = escape
-constexpr int kSrContexts = 9;
-constexpr int kGeomContexts = 26;         // edge-length classes
+constexpr int kValenceContexts = 16;      // ring sizes 0..14, 15+
+constexpr int kSlContexts = 12;
+constexpr int kGeomContexts = 26;         // edge-length classes (octaves)
 constexpr int kMagnitudeSymbols = 40;     // bit length of a residual component (<= 39)
 
 inline int bit_length(uint64_t x) { return x ? 64 - __builtin_clzll(x) : 0; }
 
+/// Ideal code length in bits of coding `s` with model `m` in its current state (for the
+/// encoder's per-symbol statistics; never part of the bitstream).
+double cost_bits(const FrequencyModel &m, int s);
+double cost_bits(const BitModel &m, int bit);
+
 struct ConnectivityModels {
   BitModel sv[kSvContexts];
-  FrequencyModel se{kSmallSymbols + 1};
-  FrequencyModel sl{kSmallSymbols + 1};
-  std::vector<FrequencyModel> sr{kSrContexts, FrequencyModel(kSmallSymbols + 1)};
+  std::vector<FrequencyModel> se{kValenceContexts, FrequencyModel(kSmallSymbols + 1)};
+  std::vector<FrequencyModel> faces{2 * kValenceContexts, FrequencyModel(kSmallSymbols + 1)};
+  std::vector<FrequencyModel> sl{kSlContexts, FrequencyModel(kSmallSymbols + 1)};
 };
+
+/// Contexts of the split symbols, from v_to's ring (known to the decoder).
+inline int valence_context(uint32_t ring_size) {
+  return static_cast<int>(ring_size < kValenceContexts ? ring_size : kValenceContexts - 1);
+}
+inline int faces_context(uint32_t ring_size, bool closed) {
+  return valence_context(ring_size) * 2 + (closed ? 1 : 0);
+}
+inline int sl_context(uint32_t faces) {
+  return static_cast<int>(faces < kSlContexts ? faces : kSlContexts - 1);
+}
 
 struct GeometryModels {
   // [0] tangential (t1,t2), [1] normal
@@ -54,14 +74,19 @@ inline int geometry_context(int64_t edge_length2) {
 
 // ---------------------------------------------------------------- encoding side
 
-inline void put_small(RangeEncoder &rc, FrequencyModel &m, uint32_t v) {
+/// Each put_* returns the ideal number of bits it spent (statistics only).
+inline double put_small(RangeEncoder &rc, FrequencyModel &m, uint32_t v) {
+  double bits;
   if (v < kSmallSymbols) {
+    bits = cost_bits(m, static_cast<int>(v));
     rc.encode(m, static_cast<int>(v));
-    return;
+    return bits;
   }
+  bits = cost_bits(m, kSmallSymbols);
   rc.encode(m, kSmallSymbols);
   const uint32_t x = v - kSmallSymbols + 1; // >= 1
   const int n = bit_length(x);
+  bits += 6 + n;
   rc.encode_bypass(static_cast<uint32_t>(n), 6);
   if (n > 24) {
     rc.encode_bypass(x >> 24, n - 24);
@@ -69,26 +94,31 @@ inline void put_small(RangeEncoder &rc, FrequencyModel &m, uint32_t v) {
   } else {
     rc.encode_bypass(x, n);
   }
+  return bits;
 }
 
-inline void put_residual(RangeEncoder &rc, GeometryModels &g, int kind, int ctx, int64_t v) {
+inline double put_residual(RangeEncoder &rc, GeometryModels &g, int kind, int ctx, int64_t v) {
   const uint64_t a = static_cast<uint64_t>(v < 0 ? -v : v);
   const int n = bit_length(a);
+  double bits = cost_bits(g.magnitude[kind][ctx], n);
   rc.encode(g.magnitude[kind][ctx], n);
   if (n == 0)
-    return;
+    return bits;
   rc.encode_bypass(v < 0 ? 1 : 0, 1);
+  bits += 1 + (n >= 2 ? n - 2 : 0);
   if (n >= 2) {
+    bits += cost_bits(g.mantissa[kind][n], static_cast<int>((a >> (n - 2)) & 1));
     rc.encode_bit(g.mantissa[kind][n], static_cast<int>((a >> (n - 2)) & 1));
     const int rest = n - 2;
-    const uint64_t bits = a & ((uint64_t(1) << rest) - 1);
+    const uint64_t low = a & ((uint64_t(1) << rest) - 1);
     if (rest > 24) {
-      rc.encode_bypass(static_cast<uint32_t>(bits >> 24), rest - 24);
-      rc.encode_bypass(static_cast<uint32_t>(bits & 0xFFFFFF), 24);
+      rc.encode_bypass(static_cast<uint32_t>(low >> 24), rest - 24);
+      rc.encode_bypass(static_cast<uint32_t>(low & 0xFFFFFF), 24);
     } else if (rest > 0) {
-      rc.encode_bypass(static_cast<uint32_t>(bits), rest);
+      rc.encode_bypass(static_cast<uint32_t>(low), rest);
     }
   }
+  return bits;
 }
 
 // ---------------------------------------------------------------- decoding side

@@ -1,6 +1,9 @@
 #include "entropy/range_coder.h"
 
 #include <cassert>
+#include <cmath>
+
+#include "entropy/models.h"
 
 namespace pomar {
 
@@ -39,6 +42,15 @@ void FrequencyModel::update(int s) {
       total_ += freq_[i];
     }
   }
+}
+
+double cost_bits(const FrequencyModel &m, int s) {
+  return std::log2(double(m.total()) / double(m.freq(s)));
+}
+
+double cost_bits(const BitModel &m, int bit) {
+  const double p0 = double(m.p0) / double(1u << kBitModelBits);
+  return -std::log2(bit ? 1.0 - p0 : p0);
 }
 
 // ---------------------------------------------------------------- RangeEncoder

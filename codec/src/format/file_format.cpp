@@ -192,6 +192,7 @@ FileInfo file_info(const FileLayout &L, size_t file_size) {
   FileInfo info;
   info.version = h.version;
   info.bits = h.grid.bits;
+  info.grid = h.grid;
   for (int k = 0; k < 3; ++k) {
     info.bbox_min[k] = h.grid.origin[k];
     info.bbox_max[k] = static_cast<float>(double(h.grid.origin[k]) + h.grid.extent);

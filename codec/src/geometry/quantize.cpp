@@ -13,6 +13,13 @@ float Quantizer::dequantize(int axis, uint32_t q) const {
   return static_cast<float>(double(origin[axis]) + double(q) * step());
 }
 
+uint32_t Quantizer::quantize(int axis, float x) const {
+  const double s = step();
+  const double t = s > 0 ? (double(x) - double(origin[axis])) / s : 0.0;
+  const double top = double((uint32_t(1) << bits) - 1);
+  return static_cast<uint32_t>(std::clamp(std::floor(t + 0.5), 0.0, top));
+}
+
 Quantizer make_quantizer(const float *p, size_t n, int bits) {
   Quantizer g;
   g.bits = bits;
@@ -35,14 +42,8 @@ Quantizer make_quantizer(const float *p, size_t n, int bits) {
 
 std::vector<int32_t> quantize(const Quantizer &g, const float *p, size_t n) {
   std::vector<int32_t> q(3 * n);
-  const double step = g.step();
-  const double inv = step > 0 ? 1.0 / step : 0.0;
-  const int32_t top = static_cast<int32_t>((uint32_t(1) << g.bits) - 1);
-  for (size_t i = 0; i < 3 * n; ++i) {
-    const double t = (double(p[i]) - double(g.origin[i % 3])) * inv;
-    const int32_t v = static_cast<int32_t>(std::floor(t + 0.5));
-    q[i] = std::clamp(v, int32_t(0), top);
-  }
+  for (size_t i = 0; i < 3 * n; ++i)
+    q[i] = static_cast<int32_t>(g.quantize(static_cast<int>(i % 3), p[i]));
   return q;
 }
 

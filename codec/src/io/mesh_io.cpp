@@ -416,7 +416,10 @@ class IoEdge;
 class IoFace;
 struct IoTypes : vcg::UsedTypes<vcg::Use<IoVertex>::AsVertexType, vcg::Use<IoEdge>::AsEdgeType,
                                 vcg::Use<IoFace>::AsFaceType> {};
-class IoVertex : public vcg::Vertex<IoTypes, vcg::vertex::Coord3f, vcg::vertex::BitFlags> {};
+// The normal is only there because ImporterOFF stores the normals of an NOFF file without
+// asking whether the vertex type has them (EmptyCore::N() asserts). They are dropped.
+class IoVertex
+    : public vcg::Vertex<IoTypes, vcg::vertex::Coord3f, vcg::vertex::Normal3f, vcg::vertex::BitFlags> {};
 // Edges only so that the PLY importer has somewhere to put an "edge" element: without an
 // edge container it asserts. They are dropped.
 class IoEdge : public vcg::Edge<IoTypes, vcg::edge::VertexRef, vcg::edge::BitFlags> {};
@@ -500,13 +503,23 @@ struct PlyElement {
   std::string name;
   uint64_t count = 0;
   std::vector<PlyProperty> props;
-  const PlyProperty *find_list(const char *prop) const {
+  /// The first property with that name, as plylib's FindProp picks it.
+  const PlyProperty *find(const char *prop) const {
     for (const auto &p : props)
-      if (p.is_list && p.name == prop)
+      if (p.name == prop)
         return &p;
     return nullptr;
   }
 };
+
+/// Whether plylib would accept property p for a descriptor with these types: it demands
+/// exactly the declared types (no conversion).
+bool is_list_of(const PlyProperty *p, PlyType item, PlyType count) {
+  return p && p->is_list && p->type == item && p->count_type == count;
+}
+bool is_scalar_of(const PlyProperty *p, PlyType type) {
+  return p && !p->is_list && p->type == type;
+}
 
 struct PlyHeader {
   enum Encoding { Ascii, BinaryLittle, BinaryBig } encoding = Ascii;
@@ -665,9 +678,11 @@ public:
   bool skip(PlyType t, uint64_t count) {
     if (enc_ != PlyHeader::Ascii)
       return count <= UINT64_MAX / 8 && in_.skip(count * type_size(t));
-    for (uint64_t i = 0; i < count; ++i)
+    for (uint64_t i = 0; i < count; ++i) {
       if (!in_.token(tok_))
         return false;
+      check_ascii_number(t);
+    }
     return true;
   }
 
@@ -691,6 +706,19 @@ public:
   }
 
 private:
+  /// plylib reads ASCII values with fscanf("%d"/"%f"), which stops inside a malformed
+  /// token and then reads the rest as the next value. Requiring every token to be a whole
+  /// number of the property's kind keeps vcglib's reading aligned with this walk.
+  void check_ascii_number(PlyType t) {
+    int64_t i = 0;
+    float f = 0;
+    const bool ok = t == PlyType::F32 || t == PlyType::F64
+                        ? tok_.find('(') == std::string::npos && parse_float(tok_, f)
+                        : parse_int(tok_, i);
+    if (!ok)
+      fail(path_, "bad number '" + tok_ + "' in PLY data");
+  }
+
   /// Little-endian bytes to an integer of type t.
   static int64_t decode(PlyType t, const unsigned char *b) {
     const uint32_t u = b[0] | (type_size(t) > 1 ? uint32_t(b[1]) << 8 : 0) |
@@ -728,29 +756,65 @@ public:
   }
 
 private:
-  /// Finds the vertex element and the element vcglib will take faces from: a "face"
-  /// element's vertex_indices or vertex_index list, else "tristrips".
+  /// Finds the vertex element and the list vcglib will take faces from, trying the
+  /// property types in the order of ImporterPLY::Open. vcglib reads a "face", "tristrips",
+  /// "range_grid" or "edge" element even when it registered none of its properties, into
+  /// uninitialized memory; such files are refused.
   void choose_elements() {
-    const PlyElement *vertex = nullptr;
-    for (const PlyElement &e : h_.elements) {
-      if (e.name == "vertex") {
-        if (vertex)
-          fail(path_, "PLY file has two vertex elements");
-        vertex = &e;
-        layout_.vertices = static_cast<size_t>(e.count);
-      }
-      if (!conn_ && e.name == "face" &&
-          ((conn_prop_ = e.find_list("vertex_indices")) || (conn_prop_ = e.find_list("vertex_index"))))
-        conn_ = &e;
-    }
-    for (const PlyElement &e : h_.elements)
-      if (!conn_ && e.name == "tristrips" && (conn_prop_ = e.find_list("vertex_indices")))
-        conn_ = &e;
-    for (const PlyElement &e : h_.elements)
-      if (!conn_ && e.name == "range_grid")
-        fail(path_, "PLY range grids (range_grid element) are not supported");
+    const PlyElement *vertex = single("vertex"), *face = single("face"),
+                     *strips = single("tristrips"), *edge = single("edge");
+    single("camera");
+    if (single("range_grid"))
+      fail(path_, "PLY range grids (range_grid element) are not supported");
+    layout_.vertices = vertex ? static_cast<size_t>(vertex->count) : 0;
+    conn_ = face, conn_prop_ = face ? face_index_list(*face) : nullptr;
+    if (!conn_prop_ && strips)
+      conn_ = strips, conn_prop_ = strips->find("vertex_indices");
+    if (conn_ == strips && !is_list_of(conn_prop_, PlyType::I32, PlyType::I32))
+      conn_prop_ = nullptr;
+    for (const PlyElement *e : {face, strips})
+      if (e && e->count > 0 && (e != conn_ || !conn_prop_))
+        fail(path_, "PLY " + e->name + " element without a vertex index list of a type vcglib reads");
+    // plylib reads binary index lists with a one-byte count unless the items are int.
+    if (conn_prop_ && h_.encoding != PlyHeader::Ascii && conn_prop_->type != PlyType::I32 &&
+        type_size(conn_prop_->count_type) != 1)
+      fail(path_, "PLY " + conn_->name + " list with a count wider than a byte and non-int indices, "
+                  "which vcglib misreads in binary files");
     if (conn_ && (!vertex || conn_ < vertex))
       fail(path_, "PLY " + conn_->name + " element comes before the vertex element");
+    if (edge && edge->count > 0 &&
+        !(is_scalar_of(edge->find("vertex1"), PlyType::I32) && is_scalar_of(edge->find("vertex2"), PlyType::I32)))
+      fail(path_, "PLY edge element without int vertex1/vertex2 properties");
+  }
+
+  /// The element with that name, or null; refuses a second one (vcglib reads it without
+  /// its properties registered).
+  const PlyElement *single(const char *name) {
+    const PlyElement *found = nullptr;
+    for (const PlyElement &e : h_.elements)
+      if (e.name == name) {
+        if (found)
+          fail(path_, std::string("PLY file has two '") + name + "' elements");
+        found = &e;
+      }
+    return found;
+  }
+
+  /// The face's index list if its types are among those vcglib reads (FaceDesc 0, 13-24).
+  static const PlyProperty *face_index_list(const PlyElement &face) {
+    using T = PlyType;
+    static const struct { const char *name; T item, count; } kinds[] = {
+        {"vertex_indices", T::I32, T::U8},  {"vertex_index", T::I32, T::U8},
+        {"vertex_index", T::I32, T::I8},    {"vertex_index", T::I32, T::I32},
+        {"vertex_indices", T::I32, T::I8},  {"vertex_indices", T::I32, T::I32},
+        {"vertex_indices", T::U32, T::U8},  {"vertex_indices", T::U32, T::I8},
+        {"vertex_indices", T::U32, T::I32}, {"vertex_indices", T::U32, T::U16},
+        {"vertex_indices", T::I16, T::I8},  {"vertex_indices", T::I16, T::U8},
+        {"vertex_indices", T::I16, T::I32}};
+    for (const auto &k : kinds)
+      if (is_list_of(face.find(k.name), k.item, k.count))
+        return face.find(k.name);
+    return nullptr;
   }
 
   [[noreturn]] void truncated(const PlyElement &e, uint64_t item) {
@@ -770,8 +834,24 @@ private:
     }
     for (uint64_t i = 0; i < e.count; ++i)
       for (const auto &p : e.props)
-        if (!values_.skip(p))
+        if (!skip_unstored(p))
           truncated(e, i);
+  }
+
+  /// Skips a property vcglib does not store (for our mesh type: every list except the
+  /// face/strip indices). plylib skips a binary list by reading a one-byte count, whatever
+  /// the declared count type, into a 512-byte stack buffer; refuse lists it would misread.
+  bool skip_unstored(const PlyProperty &p) {
+    if (!p.is_list || h_.encoding == PlyHeader::Ascii)
+      return values_.skip(p);
+    if (type_size(p.count_type) != 1)
+      fail(path_, "PLY list '" + p.name + "' has a count wider than a byte, which vcglib misreads in binary files");
+    int64_t n = 0;
+    if (!values_.integer(p.count_type, n))
+      return false;
+    if (n < 0 || static_cast<uint64_t>(n) * type_size(p.type) > 512)
+      fail(path_, "PLY list '" + p.name + "' of " + std::to_string(n) + " items is too long for vcglib");
+    return values_.skip(p.type, static_cast<uint64_t>(n));
   }
 
   /// Reads every item of the connectivity element and checks its index list.
@@ -779,7 +859,7 @@ private:
     for (uint64_t i = 0; i < e.count; ++i)
       for (const auto &p : e.props) {
         if (&p != conn_prop_) {
-          if (!values_.skip(p))
+          if (!skip_unstored(p))
             truncated(e, i);
           continue;
         }
@@ -1074,15 +1154,17 @@ Mesh load_off(const std::string &path, LoadReport &report) {
 
 using StlImporter = vcg::tri::io::ImporterSTL<IoMesh>;
 
-/// How vcglib will read an STL file, decided with its own rule (exact binary size, else a
-/// byte > 127 among the first 1000 after the header means binary), and the facet count.
+/// Binary or ASCII, and the facet count of a binary file.
 struct StlKind {
   bool binary = false;
   uint64_t facets = 0; // binary only
 };
 
-/// Classifies an STL file, refusing what vcglib would hang on (no line break in an ASCII
-/// file), read past the end of (a truncated binary file) or misjudge (files over 2 GiB).
+/// Tells binary from ASCII STL: binary if the size is exactly what the facet count in the
+/// header says (binary headers may start with "solid" too), else ASCII if it starts with
+/// "solid", else binary if a byte > 127 follows the header (vcglib's rule, which without
+/// the "solid" test takes an ASCII file with a non-ASCII name for binary). Refuses a
+/// truncated binary file and an ASCII one vcglib would hang on.
 StlKind classify_stl(const std::string &path) {
   FileReader in(path);
   const uint64_t size = in.remaining();
@@ -1094,13 +1176,16 @@ StlKind classify_stl(const std::string &path) {
   kind.facets = uint64_t(head[80]) | uint64_t(head[81]) << 8 | uint64_t(head[82]) << 16 |
                 uint64_t(head[83]) << 24;
   const uint64_t expected = 84 + 50 * kind.facets;
-  kind.binary = size == expected || std::any_of(head + 84, head + probe, [](unsigned char b) { return b > 127; });
+  const unsigned char *text = std::find_if(head, head + probe, [](unsigned char c) { return !std::isspace(c); });
+  const bool solid = head + probe - text >= 5 && std::memcmp(text, "solid", 5) == 0;
+  kind.binary = size == expected ||
+                (!solid && std::any_of(head + 84, head + probe, [](unsigned char b) { return b > 127; }));
   if (kind.binary) {
-    if (expected > INT_MAX)
-      fail(path, "binary STL with " + num(kind.facets) + " facets is too large for vcglib");
     if (size < expected)
       fail(path, "truncated binary STL (header says " + num(kind.facets) +
                      " facets, file has room for " + num((size - 84) / 50) + ")");
+    if (3 * kind.facets > UINT32_MAX)
+      fail(path, "binary STL with " + num(kind.facets) + " facets exceeds 32-bit indices");
     return kind;
   }
   // vcglib skips the first line with a getc() loop that never ends without a '\n'.

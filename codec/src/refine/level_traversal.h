@@ -161,7 +161,7 @@ inline void predict(const LevelMesh &mesh, uint32_t v_to, const Ring &ring, cons
 
 /// Per-vertex marks of one traversal (level stamps, reused across levels).
 struct TraversalScratch {
-  std::vector<uint32_t> queued, split, in_patch;
+  std::vector<uint32_t> queued, split;
   std::vector<uint32_t> claimed; // per face: stamp of the level whose patch holds it
   uint32_t stamp = 0;
   std::vector<std::pair<uint32_t, uint32_t>> queue; // (vertex, came from)
@@ -172,7 +172,6 @@ struct TraversalScratch {
     if (queued.size() < vertices) {
       queued.resize(vertices, 0);
       split.resize(vertices, 0);
-      in_patch.resize(vertices, 0);
     }
     if (claimed.size() < faces)
       claimed.resize(faces, 0);
@@ -181,12 +180,19 @@ struct TraversalScratch {
   }
 };
 
-/// s_v context: already processed split neighbours (0,1,2+) x "in a coded patch".
-inline int sv_context(const TraversalScratch &s, uint32_t v, const Ring &ring) {
-  int split_neighbours = 0;
+/// s_v context from what the decoder already knows at v: how many of v's faces earlier
+/// patches of this level hold (0..3+) and how many neighbours were split (0..2+).
+/// Returns -1 when every face is held: v cannot be split, s_v is not coded at all.
+inline int sv_context(const TraversalScratch &s, const Ring &ring) {
+  uint32_t claimed = 0;
+  for (uint32_t c : ring.corner)
+    claimed += s.claimed[c / 3] == s.stamp;
+  if (claimed == ring.faces())
+    return -1;
+  uint32_t split_neighbours = 0;
   for (uint32_t n : ring.neighbour)
     split_neighbours += s.split[n] == s.stamp;
-  return (s.in_patch[v] == s.stamp ? 3 : 0) + std::min(split_neighbours, 2);
+  return static_cast<int>(std::min(claimed, 3u) * 3 + std::min(split_neighbours, 2u));
 }
 
 template <class Codec>
@@ -194,7 +200,8 @@ void process_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t
                     uint32_t from, std::vector<PendingSplit> &splits) {
   Ring &ring = s.ring;
   get_ring(mesh.ct, v, ring);
-  if (codec.split_flag(v, sv_context(s, v, ring))) {
+  const int context = sv_context(s, ring);
+  if (context >= 0 && codec.split_flag(v, context)) {
     s.split[v] = s.stamp;
     rank_edges(mesh, v, ring, s.ranked, s.len2);
     SplitSymbols sym;
@@ -218,8 +225,6 @@ void process_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t
     predict(mesh, v, ring, p, barycentre, frame, ref_length2);
     codec.geometry(v, barycentre, frame, geometry_context(ref_length2), ps.position);
     splits.push_back(ps);
-    for (uint32_t t = 0, i = p.first_face; t <= p.faces; ++t, i = (i + 1) % ring.size())
-      s.in_patch[ring.neighbour[i]] = s.stamp;
   }
   // Queue the outgoing halfedges clockwise, starting with the one back to `from`.
   const uint32_t m = ring.size();

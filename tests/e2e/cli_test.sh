@@ -1,0 +1,315 @@
+#!/usr/bin/env bash
+# End-to-end tests of the pomar command-line tool.
+#
+#   bash tests/e2e/cli_test.sh PATH/TO/pomar PATH/TO/samples
+#
+# Registered in ctest as "cli_end_to_end" (tests/CMakeLists.txt). Each check is an explicit assertion:
+# the first failing one prints what failed (with the command's stderr) and exits 1.
+# Needs bash, coreutils and python3 (for JSON parsing). Runs in a few seconds.
+set -euo pipefail
+
+if [ $# -ne 2 ]; then
+  echo "usage: $0 POMAR_EXECUTABLE SAMPLES_DIR" >&2
+  exit 2
+fi
+POMAR="$(cd "$(dirname "$1")" && pwd)/$(basename "$1")"
+SAMPLES="$(cd "$2" && pwd)"
+BUNNY="$SAMPLES/bunny.ply"
+NONMANIFOLD="$SAMPLES/tetra_nonmanifold.off"
+[ -x "$POMAR" ] || { echo "FAIL: pomar executable not found: $POMAR" >&2; exit 1; }
+[ -f "$BUNNY" ] || { echo "FAIL: sample not found: $BUNNY" >&2; exit 1; }
+[ -f "$NONMANIFOLD" ] || { echo "FAIL: sample not found: $NONMANIFOLD" >&2; exit 1; }
+
+WORK="$(mktemp -d "${TMPDIR:-/tmp}/pomar-e2e.XXXXXX")"
+trap 'rm -rf "$WORK"' EXIT
+
+CHECKS=0
+CUR="(setup)"
+
+# ---- helpers -------------------------------------------------------------------------------------
+
+section() { CUR="$*"; printf -- '--- %s\n' "$*"; }
+
+fail() {
+  {
+    printf 'FAIL [%s]: %s\n' "$CUR" "$*"
+    if [ -n "${LAST_CMD:-}" ]; then
+      printf '  last command: %s\n' "$LAST_CMD"
+      printf '  exit status : %s\n' "$RC"
+      printf '  stdout      :\n'; sed 's/^/    /' "$WORK/.out" 2>/dev/null | head -20
+      printf '  stderr      :\n'; sed 's/^/    /' "$WORK/.err" 2>/dev/null | head -20
+    fi
+  } >&2
+  exit 1
+}
+
+pass() { CHECKS=$((CHECKS + 1)); }
+
+# run CMD...: runs pomar with the arguments; sets RC, OUT, ERR (never aborts the script).
+run() {
+  LAST_CMD="pomar $*"
+  set +e
+  "$POMAR" "$@" >"$WORK/.out" 2>"$WORK/.err"
+  RC=$?
+  set -e
+  OUT="$(cat "$WORK/.out")"
+  ERR="$(cat "$WORK/.err")"
+}
+
+expect_rc() { # expect_rc N
+  [ "$RC" -eq "$1" ] || fail "expected exit status $1, got $RC"
+  pass
+}
+expect_nonzero() {
+  [ "$RC" -ne 0 ] || fail "expected a non-zero exit status, got 0"
+  pass
+}
+expect_file() { [ -s "$1" ] || fail "expected a non-empty file at $1"; pass; }
+expect_no_file() { [ ! -e "$1" ] || fail "expected no file at $1, but it exists"; pass; }
+expect_contains() { # expect_contains HAYSTACK NEEDLE WHAT
+  case "$1" in
+    *"$2"*) pass ;;
+    *) fail "$3 does not contain '$2'" ;;
+  esac
+}
+expect_dir_only() { # expect_dir_only DIR [NAME...]: DIR holds exactly these entries (no stray temp files)
+  local dir="$1"; shift
+  local got want
+  got="$(find "$dir" -mindepth 1 -maxdepth 1 -printf '%f\n' | LC_ALL=C sort | tr '\n' ' ')"
+  want="$(printf '%s\n' "$@" | LC_ALL=C sort | tr '\n' ' ')"
+  [ "$#" -gt 0 ] || want=""
+  [ "$got" = "$want" ] || fail "directory $dir holds '$got', expected exactly '$want'"
+  pass
+}
+expect_one_line_error() { # stderr is exactly one line starting with "pomar: error:"
+  local n
+  n="$(printf '%s\n' "$ERR" | grep -c . || true)"
+  [ "$n" -eq 1 ] || fail "expected a one-line error message on stderr, got $n lines"
+  case "$ERR" in
+    "pomar: error: "*) pass ;;
+    *) fail "stderr does not start with 'pomar: error: '" ;;
+  esac
+}
+
+filesize() { wc -c <"$1" | tr -d ' '; }
+
+# Vertex count announced in a PLY header ("element vertex N"); the header of a binary PLY is ASCII.
+ply_vertex_count() {
+  LC_ALL=C sed -n -e '/^end_header/q' -e 's/^element vertex \([0-9][0-9]*\).*/\1/p' "$1"
+}
+
+# json_get FILE PYTHON_EXPR: evaluates the expression on the parsed object `d`.
+json_get() {
+  python3 -c 'import json, sys
+d = json.load(open(sys.argv[1]))
+print(eval(sys.argv[2]))' "$1" "$2"
+}
+
+# ---- encode / verify / decode ----------------------------------------------------------------------
+
+section "encode bunny.ply"
+run encode "$BUNNY" "$WORK/bunny.pomar"
+expect_rc 0
+expect_file "$WORK/bunny.pomar"
+expect_dir_only "$WORK" .err .out bunny.pomar
+
+section "verify bunny.pomar (decode in memory)"
+run verify "$BUNNY" "$WORK/bunny.pomar"
+expect_rc 0
+expect_contains "$OUT" "OK" "stdout of verify"
+
+for ext in ply obj off stl; do
+  section "decode to .$ext and verify the decoded file"
+  run decode -q "$WORK/bunny.pomar" "$WORK/decoded.$ext"
+  expect_rc 0
+  expect_file "$WORK/decoded.$ext"
+  run verify "$BUNNY" "$WORK/bunny.pomar" "$WORK/decoded.$ext"
+  expect_rc 0
+  expect_contains "$OUT" "OK" "stdout of verify"
+done
+
+section "decode --ascii and verify"
+run decode -q --ascii "$WORK/bunny.pomar" "$WORK/decoded_ascii.ply"
+expect_rc 0
+head -n 2 "$WORK/decoded_ascii.ply" | grep -qx 'format ascii 1.0' || fail "decoded_ascii.ply is not an ASCII PLY"
+pass
+run verify "$BUNNY" "$WORK/bunny.pomar" "$WORK/decoded_ascii.ply"
+expect_rc 0
+
+section "verify reports a mismatch with exit 3"
+run decode -q --level 0 "$WORK/bunny.pomar" "$WORK/base.ply"
+expect_rc 0
+run verify "$BUNNY" "$WORK/bunny.pomar" "$WORK/base.ply"
+expect_rc 3
+
+# ---- info --json -------------------------------------------------------------------------------------
+
+section "info --json"
+run info --json "$WORK/bunny.pomar"
+expect_rc 0
+cp "$WORK/.out" "$WORK/info.json"
+python3 -c 'import json, sys; json.load(open(sys.argv[1]))' "$WORK/info.json" 2>"$WORK/.err" ||
+  fail "info --json output is not valid JSON: $(cat "$WORK/.err")"
+pass
+for key in vertices faces bits levels connectivity_bits geometry_bits total_bytes; do
+  [ "$(json_get "$WORK/info.json" "'$key' in d")" = "True" ] || fail "info --json lacks key '$key'"
+  pass
+done
+v="$(json_get "$WORK/info.json" "d['vertices']")"
+[ "$v" = 34834 ] || fail "info --json: vertices = $v, expected 34834 (35947 minus 1113 unreferenced)"
+pass
+f="$(json_get "$WORK/info.json" "d['faces']")"
+[ "$f" = 69451 ] || fail "info --json: faces = $f, expected 69451"
+pass
+b="$(json_get "$WORK/info.json" "d['bits']")"
+[ "$b" = 12 ] || fail "info --json: bits = $b, expected 12"
+pass
+tb="$(json_get "$WORK/info.json" "d['total_bytes']")"
+[ "$tb" = "$(filesize "$WORK/bunny.pomar")" ] ||
+  fail "info --json: total_bytes = $tb, but the file has $(filesize "$WORK/bunny.pomar") bytes"
+pass
+
+# ---- --bits ------------------------------------------------------------------------------------------
+
+section "--bits 16 gives a larger file than the default"
+run encode -q --bits 16 "$BUNNY" "$WORK/bunny16.pomar"
+expect_rc 0
+s12="$(filesize "$WORK/bunny.pomar")"
+s16="$(filesize "$WORK/bunny16.pomar")"
+[ "$s16" -gt "$s12" ] || fail "--bits 16 file ($s16 bytes) is not larger than the default ($s12 bytes)"
+pass
+[ "$(json_get <("$POMAR" info --json "$WORK/bunny16.pomar") "d['bits']")" = 16 ] ||
+  fail "info --json of the --bits 16 file does not say bits = 16"
+pass
+run verify "$BUNNY" "$WORK/bunny16.pomar"
+expect_rc 0
+
+for bad in 3 25; do
+  section "--bits $bad is rejected"
+  mkdir "$WORK/bits$bad"
+  run encode --bits "$bad" "$BUNNY" "$WORK/bits$bad/out.pomar"
+  expect_nonzero
+  expect_no_file "$WORK/bits$bad/out.pomar"
+  expect_dir_only "$WORK/bits$bad"
+done
+
+# ---- --level -----------------------------------------------------------------------------------------
+
+for level in 0 5; do
+  section "decode --level $level has the vertex count info announces"
+  want="$(json_get "$WORK/info.json" "[l['vertices'] for l in d['levels'] if l['level'] == $level][0]")" ||
+    fail "info --json has no entry for level $level in 'levels'"
+  run decode -q --level "$level" "$WORK/bunny.pomar" "$WORK/level$level.ply"
+  expect_rc 0
+  got="$(ply_vertex_count "$WORK/level$level.ply")"
+  [ -n "$got" ] || fail "no 'element vertex' line in the header of level$level.ply"
+  [ "$got" = "$want" ] || fail "level $level: decoded PLY has $got vertices, info --json announces $want"
+  pass
+done
+[ "$(ply_vertex_count "$WORK/level0.ply")" -lt "$(ply_vertex_count "$WORK/level5.ply")" ] ||
+  fail "level 5 does not have more vertices than level 0"
+pass
+
+section "decode --level 9999 fails and names the level"
+mkdir "$WORK/level9999"
+run decode --level 9999 "$WORK/bunny.pomar" "$WORK/level9999/out.ply"
+expect_rc 1
+expect_one_line_error
+expect_contains "$ERR" "9999" "stderr"
+expect_dir_only "$WORK/level9999"
+
+# ---- non-manifold input ----------------------------------------------------------------------------
+
+section "non-manifold input is refused without creating the output"
+mkdir "$WORK/nm"
+run encode "$NONMANIFOLD" "$WORK/nm/out.pomar"
+expect_rc 1
+expect_one_line_error
+expect_contains "$ERR" "non-manifold" "stderr"
+expect_no_file "$WORK/nm/out.pomar"
+expect_dir_only "$WORK/nm"
+
+section "non-manifold input leaves a pre-existing output file byte-identical"
+printf 'precious bytes that must survive a failed encode\n' >"$WORK/nm/existing.pomar"
+sum_before="$(sha256sum <"$WORK/nm/existing.pomar")"
+run encode "$NONMANIFOLD" "$WORK/nm/existing.pomar"
+expect_rc 1
+expect_contains "$ERR" "non-manifold" "stderr"
+sum_after="$(sha256sum <"$WORK/nm/existing.pomar")"
+[ "$sum_before" = "$sum_after" ] || fail "the pre-existing output file was modified by a failed encode"
+pass
+expect_dir_only "$WORK/nm" existing.pomar
+
+# ---- corrupt .pomar input ---------------------------------------------------------------------------
+
+section "truncated .pomar fails to decode"
+mkdir "$WORK/trunc"
+half=$(($(filesize "$WORK/bunny.pomar") / 2))
+head -c "$half" "$WORK/bunny.pomar" >"$WORK/truncated.pomar"
+run decode "$WORK/truncated.pomar" "$WORK/trunc/out.ply"
+expect_rc 1
+expect_one_line_error
+expect_no_file "$WORK/trunc/out.ply"
+expect_dir_only "$WORK/trunc"
+
+section "garbage file fails to decode"
+mkdir "$WORK/garbage"
+# deterministic pseudo-random bytes (no /dev/urandom: keep failures reproducible)
+python3 -c 'import random, sys
+r = random.Random(1234)
+sys.stdout.buffer.write(bytes(r.randrange(256) for _ in range(4096)))' >"$WORK/garbage.pomar"
+run decode "$WORK/garbage.pomar" "$WORK/garbage/out.ply"
+expect_rc 1
+expect_one_line_error
+expect_no_file "$WORK/garbage/out.ply"
+expect_dir_only "$WORK/garbage"
+
+section "info on a truncated .pomar fails"
+run info "$WORK/truncated.pomar"
+expect_rc 1
+expect_one_line_error
+
+# ---- missing input ---------------------------------------------------------------------------------
+
+section "nonexistent input file"
+mkdir "$WORK/missing"
+missing="$WORK/no/such/input.ply"
+run encode "$missing" "$WORK/missing/out.pomar"
+expect_rc 1
+expect_one_line_error
+expect_contains "$ERR" "$missing" "stderr"
+expect_dir_only "$WORK/missing"
+run decode "$WORK/no/such/input.pomar" "$WORK/missing/out.ply"
+expect_rc 1
+expect_one_line_error
+expect_contains "$ERR" "$WORK/no/such/input.pomar" "stderr"
+expect_dir_only "$WORK/missing"
+run info "$WORK/no/such/input.pomar"
+expect_rc 1
+expect_contains "$ERR" "$WORK/no/such/input.pomar" "stderr"
+run verify "$missing" "$WORK/bunny.pomar"
+expect_rc 1
+expect_contains "$ERR" "$missing" "stderr"
+
+# ---- --help ------------------------------------------------------------------------------------------
+
+section "--help"
+run --help
+expect_rc 0
+for sub in encode decode info verify; do expect_contains "$OUT" "$sub" "pomar --help"; done
+
+help_mentions() { # help_mentions SUBCOMMAND OPTION...
+  local sub="$1"; shift
+  section "$sub --help"
+  run "$sub" --help
+  expect_rc 0
+  local opt
+  for opt in "$@"; do expect_contains "$OUT" "$opt" "pomar $sub --help"; done
+}
+help_mentions encode --bits --progressive --quiet input output
+help_mentions decode --level --ascii --quiet input output
+help_mentions info --json input
+help_mentions verify original pomar decoded
+
+LAST_CMD=""
+printf 'cli_end_to_end: all %d checks passed\n' "$CHECKS"
