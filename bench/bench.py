@@ -306,7 +306,7 @@ def markdown_table(headers, rows, right_from=1):
     return "\n".join(out)
 
 
-def machine_lines(tools):
+def machine_lines(load_at_start):
     cpu = "unknown CPU"
     try:
         with open("/proc/cpuinfo") as f:
@@ -329,7 +329,9 @@ def machine_lines(tools):
                             capture_output=True, text=True).stdout.strip() or "unknown"
     draco = subprocess.run(["dpkg-query", "-W", "-f", "${Version}", "draco"],
                            capture_output=True, text=True).stdout.strip() or "unknown version"
-    load = ", load average %.2f at start" % os.getloadavg()[0] if hasattr(os, "getloadavg") else ""
+    load = ""
+    if load_at_start is not None:
+        load = ", 1-min load average %.2f at start, %.2f at end" % (load_at_start, os.getloadavg()[0])
     return ["- Machine: %s, nproc %s%s%s" % (cpu, nproc, mem, load),
             "- Date: %s; pomar at git %s; Draco %s (Debian)" % (now, commit, draco)]
 
@@ -351,6 +353,7 @@ def main():
     p.add_argument("--no-draco", action="store_true", help="skip the Draco columns")
     args = p.parse_args()
     t_start = time.perf_counter()
+    load_at_start = os.getloadavg()[0] if hasattr(os, "getloadavg") else None
 
     with tempfile.TemporaryDirectory(prefix="pomar-bench.") as workdir:
         # Snapshot the executables so a rebuild during the run cannot mix two versions.
@@ -430,12 +433,13 @@ def main():
 
         # ---- report ----
         print("## pomar benchmark (%d-bit quantization)\n" % args.bits)
-        print("\n".join(machine_lines(tools)))
+        print("\n".join(machine_lines(load_at_start)))
         print("- Timings: wall-clock median of %d runs%s; peak MB = max resident set size "
               "(GNU time %%M, MiB); bpv = bits per referenced vertex.\n"
               % (args.runs, " (1 run for %s)" % ", ".join(single) if single else ""))
-        print(markdown_table([c[0] for c in COLUMNS],
-                             [[fmt(r.get(k), f) for _, k, f in COLUMNS] for r in rows]))
+        columns = [c for c in COLUMNS if not (args.no_draco and "draco" in c[0])]
+        print(markdown_table([c[0] for c in columns],
+                             [[fmt(r.get(k), f) for _, k, f in columns] for r in rows]))
         if notes:
             print("\nNotes:")
             for n in notes:

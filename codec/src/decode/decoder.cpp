@@ -37,18 +37,17 @@ public:
     s.s_r = faces - s.s_l;
   }
 
-  void geometry(uint32_t, const int32_t b[3], const FrenetFrame &frame, int context,
-                int32_t position[3]) {
+  void geometry(uint32_t, const Prediction &p, int32_t position[3]) {
     int64_t r[3];
-    r[0] = get_residual(geom_, m_.geom, 0, context);
-    r[1] = get_residual(geom_, m_.geom, 0, context);
-    r[2] = get_residual(geom_, m_.geom, 1, context);
-    to_global(frame, r);
+    r[0] = get_residual(geom_, m_.geom, 0, p.context) + p.offset[0];
+    r[1] = get_residual(geom_, m_.geom, 0, p.context) + p.offset[1];
+    r[2] = get_residual(geom_, m_.geom, 1, p.context) + p.offset[2];
+    to_global(p.frame, r);
     for (int k = 0; k < 3; ++k) {
-      const int64_t p = b[k] + r[k];
-      if (p < 0 || p > top_)
+      const int64_t v = p.barycentre[k] + r[k];
+      if (v < 0 || v > top_)
         corrupt("a decoded position lies outside the quantization grid");
-      position[k] = static_cast<int32_t>(p);
+      position[k] = static_cast<int32_t>(v);
     }
   }
 

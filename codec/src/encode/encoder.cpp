@@ -13,6 +13,7 @@
 #include "entropy/models.h"
 #include "format/file_format.h"
 #include "geometry/quantize.h"
+#include "mesh/reorder.h"
 #include "refine/level_traversal.h"
 
 namespace pomar {
@@ -86,19 +87,18 @@ public:
     bits[3] += put_small(*conn_, m_.conn.sl[sl_context(faces)], s.s_l);
   }
 
-  void geometry(uint32_t v_to, const int32_t b[3], const FrenetFrame &frame, int context,
-                int32_t position[3]) {
+  void geometry(uint32_t v_to, const Prediction &p, int32_t position[3]) {
     (void)v_to;
     const uint32_t v_from = (*level_)[current_].v_from;
     int64_t r[3];
     for (int k = 0; k < 3; ++k) {
       position[k] = input_q_[3 * v_from + k];
-      r[k] = int64_t(position[k]) - b[k];
+      r[k] = int64_t(position[k]) - p.barycentre[k];
     }
-    to_local(frame, r);
-    bits[4] += put_residual(*geom_, m_.geom, 0, context, r[0]);
-    bits[4] += put_residual(*geom_, m_.geom, 0, context, r[1]);
-    bits[5] += put_residual(*geom_, m_.geom, 1, context, r[2]);
+    to_local(p.frame, r);
+    bits[4] += put_residual(*geom_, m_.geom, 0, p.context, r[0] - p.offset[0]);
+    bits[4] += put_residual(*geom_, m_.geom, 0, p.context, r[1] - p.offset[1]);
+    bits[5] += put_residual(*geom_, m_.geom, 1, p.context, r[2] - p.offset[2]);
     new_vertices_.push_back(v_from);
   }
 
@@ -187,10 +187,25 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
   const std::vector<float> positions = compact_vertices(mesh, triangles, compact_to_input);
   const uint32_t nv = static_cast<uint32_t>(compact_to_input.size());
   const uint32_t nf = static_cast<uint32_t>(triangles.size() / 3);
-  CornerTable ct;
-  build_corner_table(triangles.data(), nf, nv, ct);
   const Quantizer grid = make_quantizer(positions.data(), nv, options.bits);
-  const std::vector<int32_t> q = quantize(grid, positions.data(), nv);
+  std::vector<int32_t> q = quantize(grid, positions.data(), nv);
+  // Renumber for memory locality, then build (and validate) the connectivity. An invalid
+  // mesh is validated again in the caller's numbering so that the message names its indices.
+  const std::vector<uint32_t> input_triangles = triangles;
+  const std::vector<uint32_t> old_to_new = reorder_for_locality(q, triangles);
+  {
+    std::vector<uint32_t> c2i(nv);
+    for (uint32_t v = 0; v < nv; ++v)
+      c2i[old_to_new[v]] = compact_to_input[v];
+    compact_to_input.swap(c2i);
+  }
+  CornerTable ct;
+  try {
+    build_corner_table(triangles.data(), nf, nv, ct);
+  } catch (const Error &) {
+    build_corner_table(input_triangles.data(), nf, nv, ct); // throws with input indices
+    throw;
+  }
   const double t_quantize = seconds_since(t0);
 
   auto t1 = std::chrono::steady_clock::now();

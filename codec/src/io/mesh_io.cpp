@@ -772,15 +772,21 @@ private:
       conn_ = strips, conn_prop_ = strips->find("vertex_indices");
     if (conn_ == strips && !is_list_of(conn_prop_, PlyType::I32, PlyType::I32))
       conn_prop_ = nullptr;
+    if (!conn_prop_)
+      conn_ = nullptr;
     for (const PlyElement *e : {face, strips})
-      if (e && e->count > 0 && (e != conn_ || !conn_prop_))
+      if (e && e->count > 0 && e != conn_)
         fail(path_, "PLY " + e->name + " element without a vertex index list of a type vcglib reads");
+    // plylib cannot byte-swap doubles (SwapDouble() is an assert(0)); these it would store.
+    for (const char *name : {"x", "y", "z", "nx", "ny", "nz"})
+      if (h_.encoding == PlyHeader::BinaryBig && vertex && is_scalar_of(vertex->find(name), PlyType::F64))
+        fail(path_, "big-endian PLY with double vertex data, which vcglib cannot read");
     // plylib reads binary index lists with a one-byte count unless the items are int.
     if (conn_prop_ && h_.encoding != PlyHeader::Ascii && conn_prop_->type != PlyType::I32 &&
         type_size(conn_prop_->count_type) != 1)
       fail(path_, "PLY " + conn_->name + " list with a count wider than a byte and non-int indices, "
                   "which vcglib misreads in binary files");
-    if (conn_ && (!vertex || conn_ < vertex))
+    if (conn_ && conn_->count > 0 && (!vertex || conn_ < vertex))
       fail(path_, "PLY " + conn_->name + " element comes before the vertex element");
     if (edge && edge->count > 0 &&
         !(is_scalar_of(edge->find("vertex1"), PlyType::I32) && is_scalar_of(edge->find("vertex2"), PlyType::I32)))

@@ -12,8 +12,7 @@
 //   int  split_flag(uint32_t v, int context);
 //   void split_symbols(uint32_t v, const Ring& ring, const uint32_t* ranked,
 //                      SplitSymbols& s);      // ranked = ring indices, longest edge first
-//   void geometry(uint32_t v_to, const int32_t barycentre[3], const FrenetFrame& frame,
-//                 int context, int32_t position[3]);
+//   void geometry(uint32_t v_to, const Prediction& prediction, int32_t position[3]);
 //   [[noreturn]] void corrupt(const char* what);
 #pragma once
 
@@ -128,11 +127,21 @@ inline void add_face_normal(const LevelMesh &mesh, uint32_t v, const Ring &ring,
   n[2] += u[0] * w[1] - u[1] * w[0];
 }
 
-/// Prediction of v_from: barycentre of its future neighbours (v_to and the patch ring
-/// from v_l to v_r), and the Frenet frame from edge v_to-v_ref and the normals of the
-/// (one or two) faces along that edge.
+/// Prediction of v_from: the barycentre of its future neighbours (v_to and the patch ring
+/// from v_l to v_r) plus, along the normal, a curvature term; residuals are expressed in
+/// the Frenet frame built from edge v_to-v_ref and the normals of the (one or two) faces
+/// along that edge. The curvature term: on a curved surface v_from sits off the plane of
+/// its ring the same way v_to sits off its own ring, so half of v_to's umbrella vector
+/// (the barycentre of v_to's ring minus v_to, along the normal) is subtracted.
+struct Prediction {
+  int32_t barycentre[3];
+  FrenetFrame frame;
+  int64_t offset[3]; // expected residual in the local frame
+  int context;       // geometry model context (local edge length class)
+};
+
 inline void predict(const LevelMesh &mesh, uint32_t v_to, const Ring &ring, const PatchRange &p,
-                    int32_t barycentre[3], FrenetFrame &frame, int64_t &ref_length2) {
+                    Prediction &out) {
   const auto &q = mesh.q;
   const uint32_t m = ring.size();
   int64_t sum[3] = {q[3 * v_to], q[3 * v_to + 1], q[3 * v_to + 2]};
@@ -144,7 +153,7 @@ inline void predict(const LevelMesh &mesh, uint32_t v_to, const Ring &ring, cons
     ++count;
   }
   for (int k = 0; k < 3; ++k) // round to nearest; sums are non-negative
-    barycentre[k] = static_cast<int32_t>((2 * sum[k] + count) / (2 * count));
+    out.barycentre[k] = static_cast<int32_t>((2 * sum[k] + count) / (2 * count));
   int64_t normal[3] = {0, 0, 0};
   const uint32_t j = p.j;
   if (ring.closed || j < ring.faces())
@@ -155,8 +164,19 @@ inline void predict(const LevelMesh &mesh, uint32_t v_to, const Ring &ring, cons
   int64_t edge[3];
   for (int k = 0; k < 3; ++k)
     edge[k] = int64_t(q[3 * ref + k]) - q[3 * v_to + k];
-  frame = make_frenet_frame(normal, edge);
-  ref_length2 = edge[0] * edge[0] + edge[1] * edge[1] + edge[2] * edge[2];
+  out.frame = make_frenet_frame(normal, edge);
+  out.context = geometry_context(edge[0] * edge[0] + edge[1] * edge[1] + edge[2] * edge[2]);
+  // v_to's umbrella vector (integer mean, truncated), in the local frame.
+  int64_t umbrella[3] = {0, 0, 0};
+  for (uint32_t n : ring.neighbour)
+    for (int k = 0; k < 3; ++k)
+      umbrella[k] += int64_t(q[3 * n + k]) - q[3 * v_to + k];
+  for (int k = 0; k < 3; ++k)
+    umbrella[k] /= int64_t(m);
+  to_local(out.frame, umbrella);
+  out.offset[0] = 0;
+  out.offset[1] = 0;
+  out.offset[2] = (1 - umbrella[2]) >> 1; // round(-umbrella_n / 2)
 }
 
 /// Per-vertex marks of one traversal (level stamps, reused across levels).
@@ -219,11 +239,9 @@ void process_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t
     }
     PendingSplit ps;
     ps.op = {v, ring.corner[p.first_face], p.faces, p.il != kNone, p.ir != kNone};
-    int32_t barycentre[3];
-    FrenetFrame frame;
-    int64_t ref_length2;
-    predict(mesh, v, ring, p, barycentre, frame, ref_length2);
-    codec.geometry(v, barycentre, frame, geometry_context(ref_length2), ps.position);
+    Prediction prediction;
+    predict(mesh, v, ring, p, prediction);
+    codec.geometry(v, prediction, ps.position);
     splits.push_back(ps);
   }
   // Queue the outgoing halfedges clockwise, starting with the one back to `from`.
