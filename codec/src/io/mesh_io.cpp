@@ -606,6 +606,8 @@ PlyHeader read_ply_header(FileReader &in, const std::string &path) {
       bad("no end_header");
     if (line.size() > 500) // plylib reads header lines in 511-byte pieces
       bad("line longer than 500 characters");
+    if (line.find('\0') != std::string::npos) // plylib's strtok would stop there
+      bad("NUL byte");
     const std::vector<std::string> tok = split_ws(line);
     if (tok.empty())
       bad("empty line");
