@@ -110,7 +110,8 @@ Mesh from_vcg(const MeshType &m, size_t *unreferenced = nullptr) {
 /// Clear() alone would leave the per-vertex/per-face attribute arrays holding stale values),
 /// so attribute handles obtained from m before the call become invalid. Mesh-level data that
 /// Clear() does not touch (textures, shot) is left as it is. Vertices and faces are then
-/// added with vcg::tri::Allocator in the order of `src`, and the bounding box is updated.
+/// added with vcg::tri::Allocator in the order of `src`, and the bounding box is updated;
+/// normals and adjacency are not computed (call vcg::tri::UpdateNormal/UpdateTopology).
 /// Throws pomar::Error (leaving m untouched) if `src` is malformed: array sizes not a
 /// multiple of 3, an index out of range, or more elements than vcglib's int counters hold.
 template <class MeshType>

@@ -179,9 +179,12 @@ inline void predict(const LevelMesh &mesh, uint32_t v_to, const Ring &ring, cons
   out.offset[2] = (1 - umbrella[2]) >> 1; // round(-umbrella_n / 2)
 }
 
-/// Per-vertex marks of one traversal (level stamps, reused across levels).
+/// Per-vertex and per-face marks of one traversal (level stamps, reused across levels).
 struct TraversalScratch {
-  std::vector<uint32_t> queued, split;
+  struct VertexMarks {
+    uint32_t queued = 0, split = 0; // together: one cache line per vertex visit
+  };
+  std::vector<VertexMarks> marks;
   std::vector<uint32_t> claimed; // per face: stamp of the level whose patch holds it
   uint32_t stamp = 0;
   std::vector<std::pair<uint32_t, uint32_t>> queue; // (vertex, came from)
@@ -189,29 +192,32 @@ struct TraversalScratch {
   std::vector<uint32_t> ranked;
   std::vector<int64_t> len2;
   void begin(uint32_t vertices, uint32_t faces) {
-    if (queued.size() < vertices) {
-      queued.resize(vertices, 0);
-      split.resize(vertices, 0);
-    }
+    if (marks.size() < vertices)
+      marks.resize(vertices);
     if (claimed.size() < faces)
       claimed.resize(faces, 0);
     ++stamp;
     queue.clear();
   }
+  bool queued(uint32_t v) const { return marks[v].queued == stamp; }
+  bool split(uint32_t v) const { return marks[v].split == stamp; }
 };
 
 /// s_v context from what the decoder already knows at v: how many of v's faces earlier
 /// patches of this level hold (0..3+) and how many neighbours were split (0..2+).
 /// Returns -1 when every face is held: v cannot be split, s_v is not coded at all.
 inline int sv_context(const TraversalScratch &s, const Ring &ring) {
-  uint32_t claimed = 0;
-  for (uint32_t c : ring.corner)
-    claimed += s.claimed[c / 3] == s.stamp;
-  if (claimed == ring.faces())
-    return -1;
   uint32_t split_neighbours = 0;
   for (uint32_t n : ring.neighbour)
-    split_neighbours += s.split[n] == s.stamp;
+    split_neighbours += s.split(n);
+  // Every patch face contains its v_to: without a split neighbour no face is held.
+  uint32_t claimed = 0;
+  if (split_neighbours) {
+    for (uint32_t c : ring.corner)
+      claimed += s.claimed[c / 3] == s.stamp;
+    if (claimed == ring.faces())
+      return -1;
+  }
   return static_cast<int>(std::min(claimed, 3u) * 3 + std::min(split_neighbours, 2u));
 }
 
@@ -222,7 +228,7 @@ void process_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t
   get_ring(mesh.ct, v, ring);
   const int context = sv_context(s, ring);
   if (context >= 0 && codec.split_flag(v, context)) {
-    s.split[v] = s.stamp;
+    s.marks[v].split = s.stamp;
     rank_edges(mesh, v, ring, s.ranked, s.len2);
     SplitSymbols sym;
     codec.split_symbols(v, ring, s.ranked.data(), sym);
@@ -251,8 +257,8 @@ void process_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t
     start = 0;
   for (uint32_t t = 0; t < m; ++t) {
     const uint32_t n = ring.neighbour[(uint32_t(start) + m - t) % m];
-    if (s.queued[n] != s.stamp) {
-      s.queued[n] = s.stamp;
+    if (!s.queued(n)) {
+      s.marks[n].queued = s.stamp;
       s.queue.emplace_back(n, v);
     }
   }
@@ -267,11 +273,23 @@ void traverse_level(LevelMesh &mesh, Codec &codec, TraversalScratch &s,
   size_t head = 0;
   for (uint32_t f = 0; f < mesh.seed_faces; ++f) {
     const uint32_t a = mesh.ct.V[3 * f], b = mesh.ct.V[3 * f + 1];
-    if (s.queued[b] == s.stamp)
+    if (s.queued(b))
       continue;
-    s.queued[b] = s.stamp;
+    s.marks[b].queued = s.stamp;
     s.queue.emplace_back(b, a);
     while (head < s.queue.size()) {
+      // The walk is memory bound: fetch the corners of a vertex a few steps ahead.
+      if (head + 8 < s.queue.size()) {
+        const uint32_t ahead = mesh.ct.VC[s.queue[head + 8].first];
+        if (ahead != kNone) {
+          __builtin_prefetch(&mesh.ct.O[ahead]);
+          __builtin_prefetch(&mesh.ct.V[ahead]);
+        }
+      }
+      if (head + 16 < s.queue.size())
+        __builtin_prefetch(&mesh.ct.VC[s.queue[head + 16].first]);
+      if (head + 4 < s.queue.size())
+        __builtin_prefetch(&mesh.q[3 * size_t(s.queue[head + 4].first)]);
       const auto [v, from] = s.queue[head++];
       process_vertex(mesh, codec, s, v, from, splits);
     }
