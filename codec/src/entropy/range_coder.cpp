@@ -114,7 +114,19 @@ void RangeEncoder::encode_bypass(uint32_t value, int nbits) {
 }
 
 void RangeEncoder::finish() {
-  for (int i = 0; i < 5; ++i)
+  // Emit as few bytes as possible: pick the value in [low, low + range) with the most
+  // trailing zero bytes; the decoder reads zeros past the end of a stream.
+  for (int keep = 1; keep <= 4; ++keep) {
+    const uint64_t mask = (uint64_t(1) << (32 - 8 * keep)) - 1;
+    const uint64_t value = (low_ + mask) & ~mask;
+    if (value < low_ + range_) {
+      low_ = value;
+      for (int i = 0; i <= keep; ++i)
+        shift_low();
+      return;
+    }
+  }
+  for (int i = 0; i < 5; ++i) // unreachable: keep = 4 always fits (range >= 2^24)
     shift_low();
 }
 

@@ -56,7 +56,8 @@ public:
   void encode(FrequencyModel &m, int symbol);
   void encode_bit(BitModel &m, int bit);
   void encode_bypass(uint32_t value, int nbits); // nbits <= 24, equiprobable bits
-  /// Write the final bytes; the stream is complete after this.
+  /// Write the final bytes (as few as disambiguate the stream: 1 to 4); the stream is
+  /// complete after this.
   void finish();
 
 private:
@@ -80,7 +81,7 @@ public:
   uint32_t decode_bypass(int nbits);
   /// True when the decoder has asked for more bytes than the stream holds by more than
   /// the final flush can explain: the stream is truncated or corrupt.
-  bool overrun() const { return overrun_ > 4; }
+  bool overrun() const { return overrun_ > 8; }
 
 private:
   uint8_t next_byte();

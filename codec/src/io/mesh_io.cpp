@@ -848,7 +848,8 @@ private:
 
   /// Skips a property vcglib does not store (for our mesh type: every list except the
   /// face/strip indices). plylib skips a binary list by reading a one-byte count, whatever
-  /// the declared count type, into a 512-byte stack buffer; refuse lists it would misread.
+  /// the declared count type, into a 512-byte stack buffer, and takes an empty list for the
+  /// end of the file (fread of 0 items); refuse lists it would misread.
   bool skip_unstored(const PlyProperty &p) {
     if (!p.is_list || h_.encoding == PlyHeader::Ascii)
       return values_.skip(p);
@@ -859,6 +860,8 @@ private:
       return false;
     if (n < 0 || static_cast<uint64_t>(n) * type_size(p.type) > 512)
       fail(path_, "PLY list '" + p.name + "' of " + std::to_string(n) + " items is too long for vcglib");
+    if (n == 0)
+      fail(path_, "PLY list '" + p.name + "' is empty, which vcglib cannot skip in binary files");
     return values_.skip(p.type, static_cast<uint64_t>(n));
   }
 
