@@ -96,6 +96,7 @@ Mesh decode(const uint8_t *data, size_t size, int level, const Progress &progres
   } catch (const Error &e) {
     throw Error(std::string("damaged .pomar file: invalid base mesh: ") + e.what());
   }
+  lm.init_lineage();
   Models models;
   DecoderCodec codec(models, h.grid.bits);
   TraversalScratch scratch;
@@ -106,11 +107,11 @@ Mesh decode(const uint8_t *data, size_t size, int level, const Progress &progres
     const uint8_t *conn = data + layout.level_offset[i];
     codec.begin_level(i, conn, e.connectivity_bytes, conn + e.connectivity_bytes,
                       e.geometry_bytes);
-    traverse_level(lm, codec, scratch, splits);
+    traverse_level(lm, codec, scratch, static_cast<uint32_t>(i + 1), splits);
     codec.end_level();
     if (lm.vertex_count() + splits.size() != e.vertices)
       codec.corrupt("the number of vertex splits differs from the level table");
-    apply_splits(lm, splits);
+    apply_splits(lm, splits, static_cast<uint32_t>(i + 1));
     if (lm.ct.face_count() != e.faces)
       codec.corrupt("the face count differs from the level table");
     if (progress)

@@ -231,6 +231,7 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
   lm.q = base.q;
   lm.seed_faces = static_cast<uint32_t>(base.triangles.size() / 3);
   build_corner_table(base.triangles.data(), lm.seed_faces, dec_to_input.size(), lm.ct);
+  lm.init_lineage();
 
   FileHeader header;
   header.grid = grid;
@@ -247,9 +248,9 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
   for (size_t r = 0; r < L; ++r) {
     std::vector<uint8_t> conn, geom;
     codec.begin_level(dec.levels[L - 1 - r], &conn, &geom);
-    traverse_level(lm, codec, scratch, splits);
+    traverse_level(lm, codec, scratch, static_cast<uint32_t>(r + 1), splits);
     codec.end_level();
-    apply_splits(lm, splits);
+    apply_splits(lm, splits, static_cast<uint32_t>(r + 1));
     codec.number_new_vertices();
     LevelEntry e;
     e.vertices = lm.vertex_count();

@@ -65,6 +65,25 @@ struct Models {
   GeometryModels geom;
 };
 
+/// Visit every model of a set in a fixed order (the order of the static tables).
+template <class OnFrequency, class OnBit>
+void for_each_model(Models &m, OnFrequency &&on_frequency, OnBit &&on_bit) {
+  for (BitModel &b : m.conn.sv)
+    on_bit(b);
+  for (FrequencyModel &f : m.conn.se)
+    on_frequency(f);
+  for (FrequencyModel &f : m.conn.faces)
+    on_frequency(f);
+  for (FrequencyModel &f : m.conn.sl)
+    on_frequency(f);
+  for (auto &kind : m.geom.magnitude)
+    for (FrequencyModel &f : kind)
+      on_frequency(f);
+  for (auto &kind : m.geom.mantissa)
+    for (BitModel &b : kind)
+      on_bit(b);
+}
+
 /// Context of a geometry residual: the bit length of the squared v_to-v_ref length / 2,
 /// i.e. roughly log2 of the local edge length.
 inline int geometry_context(int64_t edge_length2) {
@@ -75,7 +94,7 @@ inline int geometry_context(int64_t edge_length2) {
 // ---------------------------------------------------------------- encoding side
 
 /// Each put_* returns the ideal number of bits it spent (statistics only).
-inline double put_small(RangeEncoder &rc, FrequencyModel &m, uint32_t v) {
+template <class Encoder> double put_small(Encoder &rc, FrequencyModel &m, uint32_t v) {
   double bits;
   if (v < kSmallSymbols) {
     bits = cost_bits(m, static_cast<int>(v));
@@ -97,7 +116,8 @@ inline double put_small(RangeEncoder &rc, FrequencyModel &m, uint32_t v) {
   return bits;
 }
 
-inline double put_residual(RangeEncoder &rc, GeometryModels &g, int kind, int ctx, int64_t v) {
+template <class Encoder>
+double put_residual(Encoder &rc, GeometryModels &g, int kind, int ctx, int64_t v) {
   const uint64_t a = static_cast<uint64_t>(v < 0 ? -v : v);
   const int n = bit_length(a);
   double bits = cost_bits(g.magnitude[kind][ctx], n);

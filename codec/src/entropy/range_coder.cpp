@@ -32,7 +32,40 @@ int FrequencyModel::find(uint32_t target, uint32_t *start) const {
   return s;
 }
 
+void FrequencyModel::freeze_from_counts(const uint32_t *counts) {
+  uint64_t sum = 0;
+  for (int i = 0; i < n_; ++i)
+    sum += counts[i];
+  frozen_ = true;
+  total_ = 0;
+  for (int i = 0; i < n_; ++i) {
+    uint32_t f = 1; // uniform when nothing was counted
+    if (sum) {
+      f = static_cast<uint32_t>((uint64_t(counts[i]) << kStaticBits) / sum);
+      if (counts[i] && f == 0)
+        f = 1;
+    }
+    freq_[i] = static_cast<uint16_t>(f);
+    total_ += f;
+  }
+}
+
+bool FrequencyModel::freeze_with(const uint16_t *freq) {
+  uint32_t total = 0;
+  for (int i = 0; i < n_; ++i)
+    total += freq[i];
+  if (total == 0 || total > kMaxTotal)
+    return false;
+  for (int i = 0; i < n_; ++i)
+    freq_[i] = freq[i];
+  total_ = total;
+  frozen_ = true;
+  return true;
+}
+
 void FrequencyModel::update(int s) {
+  if (frozen_)
+    return;
   freq_[s] = static_cast<uint16_t>(freq_[s] + kIncrement);
   total_ += kIncrement;
   if (total_ > kMaxTotal) {

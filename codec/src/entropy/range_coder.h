@@ -15,9 +15,13 @@ constexpr int kBitModelBits = 12;        // binary probabilities are 12-bit fixe
 constexpr int kBitModelShift = 5;        // adaptation speed of binary models
 
 /// Adaptive probability of a binary event (probability of 0, 12-bit fixed point).
+/// A frozen model keeps its probability (static model of a clustered level).
 struct BitModel {
   uint16_t p0 = 1u << (kBitModelBits - 1);
+  bool frozen = false;
   void update(int bit) {
+    if (frozen)
+      return;
     if (bit)
       p0 -= p0 >> kBitModelShift;
     else
@@ -27,7 +31,8 @@ struct BitModel {
 
 /// Adaptive frequency model over a small alphabet (<= kMaxSymbols). Counts grow by
 /// kIncrement per coded symbol and are halved when the total exceeds kMaxTotal, so the
-/// model follows slow drifts in the statistics.
+/// model follows slow drifts in the statistics. A frozen model is static: it keeps the
+/// frequencies it was given (symbols of frequency 0 cannot be coded).
 class FrequencyModel {
 public:
   static constexpr int kMaxSymbols = 64;
@@ -42,10 +47,18 @@ public:
   /// Find the symbol whose cumulative interval holds `target`; sets its cumulative start.
   int find(uint32_t target, uint32_t *start) const;
   void update(int s);
+  /// Make the model static with frequencies proportional to `counts` (total about
+  /// 2^kStaticBits, every counted symbol at least 1); all-zero counts give a uniform model.
+  void freeze_from_counts(const uint32_t *counts);
+  /// Make the model static with exactly these frequencies; false if they are unusable.
+  bool freeze_with(const uint16_t *freq);
+  bool frozen() const { return frozen_; }
+  static constexpr int kStaticBits = 12;
 
 private:
   int n_;
   uint32_t total_;
+  bool frozen_ = false;
   uint16_t freq_[kMaxSymbols];
 };
 

@@ -32,7 +32,24 @@ struct LevelMesh {
   CornerTable ct;
   std::vector<int32_t> q; // quantized xyz per vertex
   uint32_t seed_faces = 0; // faces of the base mesh (traversal seeds, never removed)
+  // Lineage of every vertex: the level that created it (0 = base mesh) and its parent
+  // (the v_to it was split from; itself for base vertices).
+  std::vector<uint16_t> level;
+  std::vector<uint32_t> parent;
+  // Clustered levels only: the cluster of each vertex (the base clustered mesh vertex it
+  // descends from) and its rank of creation inside the cluster. (cluster, local) names a
+  // vertex the same way whatever clusters were decoded in whatever order.
+  std::vector<uint32_t> cluster, local;
+  std::vector<uint16_t> face_claim; // per face: last level whose patch held it
   uint32_t vertex_count() const { return ct.vertex_count(); }
+  uint64_t key(uint32_t v) const { return (uint64_t(cluster[v]) << 32) | local[v]; }
+  void init_lineage() {
+    level.assign(vertex_count(), 0);
+    parent.resize(vertex_count());
+    for (uint32_t v = 0; v < vertex_count(); ++v)
+      parent[v] = v;
+    face_claim.assign(ct.face_count(), 0);
+  }
 };
 
 struct SplitSymbols {
@@ -57,9 +74,10 @@ inline int64_t squared_distance(const std::vector<int32_t> &q, uint32_t a, uint3
   return dx * dx + dy * dy + dz * dz;
 }
 
-/// Ring indices sorted by decreasing edge length (ties: smaller vertex id first).
-inline void rank_edges(const LevelMesh &mesh, uint32_t v, const Ring &ring,
-                       std::vector<uint32_t> &ranked, std::vector<int64_t> &len2) {
+/// Ring indices sorted by decreasing edge length (ties: smaller key first).
+template <class Key>
+void rank_edges(const LevelMesh &mesh, uint32_t v, const Ring &ring, std::vector<uint32_t> &ranked,
+                std::vector<int64_t> &len2, const Key &key) {
   const uint32_t m = ring.size();
   ranked.resize(m);
   len2.resize(m);
@@ -70,7 +88,7 @@ inline void rank_edges(const LevelMesh &mesh, uint32_t v, const Ring &ring,
   std::sort(ranked.begin(), ranked.end(), [&](uint32_t a, uint32_t b) {
     if (len2[a] != len2[b])
       return len2[a] > len2[b];
-    return ring.neighbour[a] < ring.neighbour[b];
+    return key(ring.neighbour[a]) < key(ring.neighbour[b]);
   });
 }
 
@@ -221,55 +239,98 @@ inline int sv_context(const TraversalScratch &s, const Ring &ring) {
   return static_cast<int>(std::min(claimed, 3u) * 3 + std::min(split_neighbours, 2u));
 }
 
-template <class Codec>
-void process_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v,
-                    uint32_t from, std::vector<PendingSplit> &splits) {
-  Ring &ring = s.ring;
-  get_ring(mesh.ct, v, ring);
-  const int context = sv_context(s, ring);
-  if (context >= 0 && codec.split_flag(v, context)) {
-    s.marks[v].split = s.stamp;
-    rank_edges(mesh, v, ring, s.ranked, s.len2);
-    SplitSymbols sym;
-    codec.split_symbols(v, ring, s.ranked.data(), sym);
-    PatchRange p;
-    if (!resolve_patch(ring, s.ranked.data(), sym, p))
-      codec.corrupt("split symbols do not fit the vertex's neighbourhood");
-    // Patches of one level must not share faces (that is what makes the splits
-    // independent); a stream that says otherwise is damaged.
-    for (uint32_t t = 0; t < p.faces; ++t) {
-      uint32_t &claim = s.claimed[ring.corner[(p.first_face + t) % ring.size()] / 3];
-      if (claim == s.stamp)
-        codec.corrupt("two vertex splits of one level share a face");
-      claim = s.stamp;
+/// The level-(l-1) view of v's one-ring while level l is being decoded: neighbours created
+/// at level l or later (by splits of neighbouring clusters already applied) stand for
+/// their parents, and the faces those splits added (degenerate in the view) are skipped.
+/// The view is the same whatever clusters were decoded before, which is what makes
+/// selective and incremental decoding equal to a full decode.
+inline uint32_t view_of(const LevelMesh &mesh, uint32_t v, uint32_t level) {
+  while (mesh.level[v] >= level && mesh.parent[v] != v)
+    v = mesh.parent[v];
+  return v;
+}
+
+inline void get_view_ring(const LevelMesh &mesh, uint32_t v, uint32_t level, Ring &actual,
+                          Ring &view) {
+  get_ring(mesh.ct, v, actual);
+  view.neighbour.clear();
+  view.corner.clear();
+  view.closed = actual.closed;
+  if (actual.neighbour.empty())
+    return;
+  const uint32_t m = actual.size();
+  uint32_t prev = view_of(mesh, actual.neighbour[0], level);
+  view.neighbour.push_back(prev);
+  for (uint32_t i = 0; i < actual.faces(); ++i) {
+    const uint32_t next = view_of(mesh, actual.neighbour[(i + 1) % m], level);
+    if (next != prev) {
+      view.corner.push_back(actual.corner[i]);
+      view.neighbour.push_back(next);
     }
-    PendingSplit ps;
-    ps.op = {v, ring.corner[p.first_face], p.faces, p.il != kNone, p.ir != kNone};
-    Prediction prediction;
-    predict(mesh, v, ring, p, prediction);
-    codec.geometry(v, prediction, ps.position);
-    splits.push_back(ps);
+    prev = next;
   }
-  // Queue the outgoing halfedges clockwise, starting with the one back to `from`.
+  if (view.closed && view.neighbour.size() > 1)
+    view.neighbour.pop_back(); // the wrap-around repeats the first neighbour
+}
+
+/// Code (or decode) s_v at v and, for a split vertex, the split: symbols, patch, claim of
+/// its faces, prediction and position. `ring` is v's ring as the level sees it.
+template <class Codec, class Key>
+void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v, const Ring &ring,
+                 uint32_t level, const Key &key, std::vector<PendingSplit> &splits) {
+  const int context = sv_context(s, ring);
+  if (context < 0 || !codec.split_flag(v, context))
+    return;
+  s.marks[v].split = s.stamp;
+  rank_edges(mesh, v, ring, s.ranked, s.len2, key);
+  SplitSymbols sym;
+  codec.split_symbols(v, ring, s.ranked.data(), sym);
+  PatchRange p;
+  if (!resolve_patch(ring, s.ranked.data(), sym, p))
+    codec.corrupt("split symbols do not fit the vertex's neighbourhood");
+  // Patches of one level must not share faces (that is what makes the splits
+  // independent); a stream that says otherwise is damaged.
+  for (uint32_t t = 0; t < p.faces; ++t) {
+    const uint32_t f = ring.corner[(p.first_face + t) % ring.size()] / 3;
+    if (mesh.face_claim[f] == level)
+      codec.corrupt("two vertex splits of one level share a face");
+    mesh.face_claim[f] = static_cast<uint16_t>(level);
+    s.claimed[f] = s.stamp;
+  }
+  PendingSplit ps;
+  ps.op = {v, ring.corner[p.first_face], p.faces, p.il != kNone, p.ir != kNone};
+  Prediction prediction;
+  predict(mesh, v, ring, p, prediction);
+  codec.geometry(v, prediction, ps.position);
+  splits.push_back(ps);
+}
+
+/// Queue v's neighbours clockwise, starting with the one back to `from`.
+template <class Accept>
+void queue_neighbours(TraversalScratch &s, uint32_t v, uint32_t from, const Ring &ring,
+                      const Accept &accept) {
   const uint32_t m = ring.size();
   int start = ring.index_of(from);
   if (start < 0)
     start = 0;
   for (uint32_t t = 0; t < m; ++t) {
     const uint32_t n = ring.neighbour[(uint32_t(start) + m - t) % m];
-    if (!s.queued(n)) {
+    if (!s.queued(n) && accept(n)) {
       s.marks[n].queued = s.stamp;
       s.queue.emplace_back(n, v);
     }
   }
 }
 
-/// Traverse the whole mesh once (all components, seeded by the base faces in order).
+/// Traverse the whole mesh once for global level `level` (all components, seeded by the
+/// base faces in order).
 template <class Codec>
-void traverse_level(LevelMesh &mesh, Codec &codec, TraversalScratch &s,
+void traverse_level(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t level,
                     std::vector<PendingSplit> &splits) {
   s.begin(mesh.vertex_count(), mesh.ct.face_count());
   splits.clear();
+  const auto id = [](uint32_t v) { return uint64_t(v); };
+  const auto all = [](uint32_t) { return true; };
   size_t head = 0;
   for (uint32_t f = 0; f < mesh.seed_faces; ++f) {
     const uint32_t a = mesh.ct.V[3 * f], b = mesh.ct.V[3 * f + 1];
@@ -288,21 +349,60 @@ void traverse_level(LevelMesh &mesh, Codec &codec, TraversalScratch &s,
       }
       if (head + 16 < s.queue.size())
         __builtin_prefetch(&mesh.ct.VC[s.queue[head + 16].first]);
-      if (head + 4 < s.queue.size())
-        __builtin_prefetch(&mesh.q[3 * size_t(s.queue[head + 4].first)]);
       const auto [v, from] = s.queue[head++];
-      process_vertex(mesh, codec, s, v, from, splits);
+      get_ring(mesh.ct, v, s.ring);
+      code_vertex(mesh, codec, s, v, s.ring, level, id, splits);
+      queue_neighbours(s, v, from, s.ring, all);
     }
   }
 }
 
+/// Traverse one cluster for clustered level `level` (paper section 5.2): breadth-first
+/// from the cluster's root (its base clustered mesh vertex), starting clockwise from the
+/// root's neighbour of smallest key, visiting only the cluster's vertices, on the
+/// level-(l-1) view of the mesh.
+template <class Codec>
+void traverse_cluster(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t root,
+                      uint32_t level, std::vector<PendingSplit> &splits) {
+  s.begin(mesh.vertex_count(), mesh.ct.face_count());
+  splits.clear();
+  const uint32_t cluster = mesh.cluster[root];
+  const auto key = [&](uint32_t v) { return mesh.key(v); };
+  const auto mine = [&](uint32_t v) { return mesh.cluster[v] == cluster; };
+  Ring actual;
+  get_view_ring(mesh, root, level, actual, s.ring);
+  if (s.ring.neighbour.empty())
+    return;
+  uint32_t from = s.ring.neighbour[0];
+  for (uint32_t n : s.ring.neighbour)
+    if (mesh.key(n) < mesh.key(from))
+      from = n;
+  s.marks[root].queued = s.stamp;
+  s.queue.emplace_back(root, from);
+  for (size_t head = 0; head < s.queue.size();) {
+    const auto [v, came_from] = s.queue[head++];
+    get_view_ring(mesh, v, level, actual, s.ring);
+    code_vertex(mesh, codec, s, v, s.ring, level, key, splits);
+    queue_neighbours(s, v, came_from, s.ring, mine);
+  }
+}
+
 /// Apply the collected splits in traversal order; new vertices get consecutive ids.
-inline void apply_splits(LevelMesh &mesh, const std::vector<PendingSplit> &splits) {
+/// For a cluster's splits, `cluster`/`next_local` number them inside the cluster.
+inline void apply_splits(LevelMesh &mesh, const std::vector<PendingSplit> &splits, uint32_t level,
+                         uint32_t cluster = kNone, uint32_t *next_local = nullptr) {
   for (const PendingSplit &ps : splits) {
     const uint32_t v_from = mesh.vertex_count();
     apply_split(mesh.ct, ps.op, v_from);
     mesh.q.insert(mesh.q.end(), ps.position, ps.position + 3);
+    mesh.level.push_back(static_cast<uint16_t>(level));
+    mesh.parent.push_back(ps.op.v_to);
+    if (cluster != kNone) {
+      mesh.cluster.push_back(cluster);
+      mesh.local.push_back((*next_local)++);
+    }
   }
+  mesh.face_claim.resize(mesh.ct.face_count(), 0);
 }
 
 } // namespace pomar
