@@ -3,9 +3,9 @@
 // The format is chosen by the file extension (case-insensitive): .ply, .obj, .off, .stl.
 // Only positions and triangles are kept; everything else a file may carry (normals, colors,
 // texture coordinates, ...) is dropped and named in LoadReport::ignored_attributes.
-// PLY, OFF and STL are read through vcglib's importers (so a file loads as it does in
-// MeshLab), OBJ through tinyobjloader. Every failure throws pomar::Error with a one-line
-// message that starts with the file's path.
+// PLY, OFF and ASCII STL are read through vcglib's importers (so a file loads as it does
+// in MeshLab), binary STL directly, OBJ through tinyobjloader. Every failure throws
+// pomar::Error with a one-line message that starts with the file's path.
 //
 // Numbers are printed and parsed in the "C" convention (decimal point). Writing is
 // locale-independent; the vcglib readers use the C library and therefore expect the
@@ -37,15 +37,18 @@ struct LoadReport {
 /// Read a triangle mesh. Polygons are split into triangles (PLY/OBJ: fan from the first
 /// vertex; OFF: vcglib's rule, which picks the better diagonal of a quad), STL corners with
 /// exactly equal positions are welded, unreferenced vertices are dropped. Vertex and face
-/// order of the file is kept otherwise. Throws pomar::Error if the file is missing,
-/// unreadable, malformed, has a NaN/Inf coordinate or contains no triangles.
+/// order of the file is kept otherwise. `*report` is reset first. Throws pomar::Error if
+/// the file is missing, unreadable, malformed, has a NaN/Inf coordinate or contains no
+/// triangles, and for files vcglib would misread (see mesh_io.cpp).
 Mesh load_mesh(const std::string &path, LoadReport *report = nullptr);
 
 /// Write a triangle mesh, replacing `path` atomically (see write_file_atomic). `binary`
 /// selects binary little-endian PLY / binary STL (default) or ASCII PLY / ASCII STL; OBJ and
 /// OFF are always text. Coordinates are written so that load_mesh reads back bit-identical
-/// floats. Throws pomar::Error on an unknown extension, an invalid mesh (index out of
-/// range, NaN/Inf coordinate) or an I/O failure; the destination is then left untouched.
+/// floats and the same triangles; STL has no shared vertices, so a mesh read back from
+/// STL has its vertices in order of first use and loses unreferenced ones. Throws
+/// pomar::Error on an unknown extension, an invalid mesh (index out of range, NaN/Inf
+/// coordinate) or an I/O failure; the destination is then left untouched.
 void save_mesh(const std::string &path, const Mesh &mesh, bool binary = true);
 
 /// Write `size` bytes to `path` atomically: they go to a temporary file in the same

@@ -34,8 +34,13 @@ struct Mesh {
 using Progress = std::function<void(double fraction, const char *stage)>;
 
 struct EncodeOptions {
-  int bits = 12;     ///< quantization bits per coordinate, 4..24
-  Progress progress; ///< optional
+  int bits = 12; ///< quantization bits per coordinate, 4..24
+  /// Random access: the number of clusters is about `clusters` if non-zero, else
+  /// `cluster_ratio` x vertices (default 2%, inside the paper's advised 1-5%).
+  uint32_t clusters = 0;
+  double cluster_ratio = 0.02;
+  bool progressive = false; ///< pure progressive mode: global levels only, no clusters
+  Progress progress;        ///< optional
 };
 
 /// One refinement level of a file: the mesh it produces and what it costs.
@@ -72,8 +77,15 @@ struct FileInfo {
   uint64_t total_bytes = 0;
   uint64_t header_bytes = 0; ///< header + level table
   uint64_t base_bytes = 0;   ///< the stored base mesh
-  uint64_t connectivity_bytes = 0; ///< sum over levels
-  uint64_t geometry_bytes = 0;     ///< sum over levels
+  uint64_t connectivity_bytes = 0; ///< sum over levels (clustered part: encoder's estimate)
+  uint64_t geometry_bytes = 0;     ///< sum over levels (clustered part: encoder's estimate)
+  // Random access (clustered files; zero/absent in pure progressive files).
+  uint32_t global_levels = 0; ///< levels decoded for the whole mesh (= levels.size() if progressive)
+  uint32_t clusters = 0;      ///< vertices of the base clustered mesh = clusters
+  uint64_t global_bytes = 0;  ///< header, base mesh, global levels, tables, index
+  uint64_t tables_bytes = 0, index_bytes = 0, cluster_bytes = 0;
+  std::vector<uint32_t> cluster_block_bytes; ///< filled by inspect()
+  bool clustered() const { return clusters != 0; }
 };
 
 /// Facts about one encode, beyond what the file itself says.
@@ -82,7 +94,7 @@ struct EncodeReport {
   size_t input_vertices = 0;
   size_t unreferenced_vertices = 0; ///< dropped: no triangle uses them
   double quantize_seconds = 0, decimate_seconds = 0, encode_seconds = 0;
-  /// Ideal code length per symbol kind, in bits (from the adaptive models' states):
+  /// Ideal code length per symbol kind of the global levels, in bits (adaptive models):
   /// s_v, s_e, s_l + s_r, s_l, tangential and normal residual components.
   double symbol_bits[6] = {0, 0, 0, 0, 0, 0};
   /// decoded vertex i (in a full decode) is input vertex decoded_to_input[i].

@@ -5,12 +5,12 @@
 // writes what the decoder needs to repeat the step: the encoder is a decoder that knows
 // the answers.
 #include <chrono>
-#include <optional>
 #include <cmath>
 #include <string>
 
 #include "decimate/decimate.h"
 #include "entropy/models.h"
+#include "entropy/static_tables.h"
 #include "format/file_format.h"
 #include "geometry/quantize.h"
 #include "mesh/reorder.h"
@@ -23,28 +23,29 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-/// The traversal policy of the encoder: it knows every collapse of the level.
-class EncoderCodec {
+/// The traversal policy of the encoder: it knows every collapse of the level. `Sink` is a
+/// RangeEncoder (global levels) or a RecorderStream (clustered levels, coded later).
+template <class Sink> class EncoderCodec {
 public:
-  EncoderCodec(Models &models, const std::vector<int32_t> &input_q,
-               std::vector<uint32_t> &dec_to_input, std::vector<uint32_t> &input_to_dec)
-      : m_(models), input_q_(input_q), dec_to_input_(dec_to_input), input_to_dec_(input_to_dec),
+  EncoderCodec(const std::vector<int32_t> &input_q, std::vector<uint32_t> &dec_to_input,
+               std::vector<uint32_t> &input_to_dec)
+      : input_q_(input_q), dec_to_input_(dec_to_input), input_to_dec_(input_to_dec),
         collapse_at_(input_to_dec.size(), kNone) {}
 
-  void begin_level(const std::vector<Collapse> &level, std::vector<uint8_t> *conn,
-                   std::vector<uint8_t> *geom) {
+  void begin_level(const std::vector<Collapse> &level, Models *models) {
     level_ = &level;
+    m_ = models;
     for (uint32_t i = 0; i < level.size(); ++i)
       collapse_at_[level[i].v_to] = i;
-    conn_.emplace(conn);
-    geom_.emplace(geom);
     emitted_ = 0;
+  }
+  void set_sinks(Sink *conn, Sink *geom) {
+    conn_ = conn;
+    geom_ = geom;
   }
   void end_level() {
     for (const Collapse &c : *level_)
       collapse_at_[c.v_to] = kNone;
-    conn_->finish();
-    geom_->finish();
     if (emitted_ != level_->size())
       corrupt("a collapse of the level was not reached by the traversal");
   }
@@ -52,8 +53,8 @@ public:
   int split_flag(uint32_t v, int context) {
     current_ = collapse_at_[dec_to_input_[v]];
     const int flag = current_ != kNone;
-    bits[0] += cost_bits(m_.conn.sv[context], flag);
-    conn_->encode_bit(m_.conn.sv[context], flag);
+    bits[0] += cost_bits(m_->conn.sv[context], flag);
+    conn_->encode_bit(m_->conn.sv[context], flag);
     emitted_ += flag;
     return flag;
   }
@@ -82,9 +83,9 @@ public:
     s.s_l = ring.closed ? (j + m - il) % m : (il == kNone ? j + 1 : j - il);
     s.s_r = ring.closed ? (ir + m - j) % m : (ir == kNone ? m - j : ir - j);
     const uint32_t faces = s.s_l + s.s_r;
-    bits[1] += put_small(*conn_, m_.conn.se[valence_context(m)], s.s_e);
-    bits[2] += put_small(*conn_, m_.conn.faces[faces_context(m, ring.closed)], faces);
-    bits[3] += put_small(*conn_, m_.conn.sl[sl_context(faces)], s.s_l);
+    bits[1] += put_small(*conn_, m_->conn.se[valence_context(m)], s.s_e);
+    bits[2] += put_small(*conn_, m_->conn.faces[faces_context(m, ring.closed)], faces);
+    bits[3] += put_small(*conn_, m_->conn.sl[sl_context(faces)], s.s_l);
   }
 
   void geometry(uint32_t v_to, const Prediction &p, int32_t position[3]) {
@@ -96,9 +97,9 @@ public:
       r[k] = int64_t(position[k]) - p.barycentre[k];
     }
     to_local(p.frame, r);
-    bits[4] += put_residual(*geom_, m_.geom, 0, p.context, r[0] - p.offset[0]);
-    bits[4] += put_residual(*geom_, m_.geom, 0, p.context, r[1] - p.offset[1]);
-    bits[5] += put_residual(*geom_, m_.geom, 1, p.context, r[2] - p.offset[2]);
+    bits[4] += put_residual(*geom_, m_->geom, 0, p.context, r[0] - p.offset[0]);
+    bits[4] += put_residual(*geom_, m_->geom, 0, p.context, r[1] - p.offset[1]);
+    bits[5] += put_residual(*geom_, m_->geom, 1, p.context, r[2] - p.offset[2]);
     new_vertices_.push_back(v_from);
   }
 
@@ -108,7 +109,7 @@ public:
     throw Error(std::string("internal encoder error: ") + what);
   }
 
-  /// Number the vertices created by the level's splits (traversal order).
+  /// Number the vertices created by the splits applied since the last call.
   void number_new_vertices() {
     for (uint32_t v : new_vertices_) {
       input_to_dec_[v] = static_cast<uint32_t>(dec_to_input_.size());
@@ -127,16 +128,38 @@ private:
     return static_cast<uint32_t>(i);
   }
 
-  Models &m_;
+  Models *m_ = nullptr;
   const std::vector<int32_t> &input_q_;
   std::vector<uint32_t> &dec_to_input_, &input_to_dec_;
   std::vector<uint32_t> collapse_at_; // input vertex -> index of its collapse as v_to
   const std::vector<Collapse> *level_ = nullptr;
-  std::optional<RangeEncoder> conn_, geom_;
+  Sink *conn_ = nullptr, *geom_ = nullptr;
   uint32_t current_ = kNone;
   size_t emitted_ = 0;
   std::vector<uint32_t> new_vertices_;
 };
+
+/// How many levels stay global: the level whose vertex count is closest (in ratio) to the
+/// wanted number of clusters. Returns `levels` when no level would be clustered.
+size_t choose_global_levels(const Decimation &dec, uint32_t base_vertices, uint32_t vertices,
+                            const EncodeOptions &o) {
+  const size_t L = dec.levels.size();
+  if (o.progressive || L == 0)
+    return L;
+  double wanted = o.clusters ? double(o.clusters) : o.cluster_ratio * double(vertices);
+  wanted = std::max(wanted, 1.0);
+  size_t best = 0;
+  double count = base_vertices, best_err = std::fabs(std::log(count / wanted));
+  for (size_t g = 1; g <= L; ++g) {
+    count += double(dec.levels[L - g].size()); // refinement level g re-inserts these
+    const double err = std::fabs(std::log(count / wanted));
+    if (err < best_err) {
+      best_err = err;
+      best = g;
+    }
+  }
+  return best;
+}
 
 /// Drop unreferenced vertices; returns the compact positions and fills the index maps.
 std::vector<float> compact_vertices(const Mesh &mesh, std::vector<uint32_t> &triangles,
@@ -239,34 +262,94 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
   header.faces = nf;
   header.base_vertices = static_cast<uint32_t>(dec_to_input.size());
   header.base_faces = lm.seed_faces;
+  const size_t L = dec.levels.size();
+  const size_t G = choose_global_levels(dec, header.base_vertices, nv, options);
+
+  // Global levels: one adaptive model set for the whole file, two streams per level.
   Models models;
-  EncoderCodec codec(models, q, dec_to_input, input_to_dec);
+  EncoderCodec<RangeEncoder> codec(q, dec_to_input, input_to_dec);
   TraversalScratch scratch;
   std::vector<PendingSplit> splits;
   std::vector<std::vector<uint8_t>> blocks;
-  const size_t L = dec.levels.size();
-  for (size_t r = 0; r < L; ++r) {
-    std::vector<uint8_t> conn, geom;
-    codec.begin_level(dec.levels[L - 1 - r], &conn, &geom);
-    traverse_level(lm, codec, scratch, static_cast<uint32_t>(r + 1), splits);
-    codec.end_level();
-    apply_splits(lm, splits, static_cast<uint32_t>(r + 1));
-    codec.number_new_vertices();
+  auto add_level_entry = [&](uint32_t conn_bytes, uint32_t geom_bytes) {
     LevelEntry e;
     e.vertices = lm.vertex_count();
     e.faces = lm.ct.face_count();
-    e.connectivity_bytes = static_cast<uint32_t>(conn.size());
-    e.geometry_bytes = static_cast<uint32_t>(geom.size());
+    e.connectivity_bytes = conn_bytes;
+    e.geometry_bytes = geom_bytes;
     header.levels.push_back(e);
+  };
+  for (size_t r = 0; r < G; ++r) {
+    std::vector<uint8_t> conn, geom;
+    RangeEncoder conn_rc(&conn), geom_rc(&geom);
+    codec.begin_level(dec.levels[L - 1 - r], &models);
+    codec.set_sinks(&conn_rc, &geom_rc);
+    traverse_level(lm, codec, scratch, static_cast<uint32_t>(r + 1), splits);
+    codec.end_level();
+    conn_rc.finish();
+    geom_rc.finish();
+    apply_splits(lm, splits, static_cast<uint32_t>(r + 1));
+    codec.number_new_vertices();
+    add_level_entry(static_cast<uint32_t>(conn.size()), static_cast<uint32_t>(geom.size()));
     conn.insert(conn.end(), geom.begin(), geom.end());
     blocks.push_back(std::move(conn));
     if (options.progress)
       options.progress(double(r + 1) / double(L), "encode");
   }
+  double symbol_bits[6];
+  std::copy(codec.bits, codec.bits + 6, symbol_bits);
+
+  // Clustered levels: every vertex of the base clustered mesh roots a cluster; each
+  // cluster's splits of every clustered level are recorded, the level models frozen on
+  // all clusters' symbols, then every cluster is coded into its own block.
+  std::vector<uint8_t> tables;
+  std::vector<std::vector<uint8_t>> cluster_blocks;
+  if (G < L) {
+    header.flags |= kFlagClustered;
+    header.global_levels = static_cast<uint32_t>(G);
+    const uint32_t clusters = lm.vertex_count();
+    lm.cluster.resize(clusters);
+    lm.local.assign(clusters, 0);
+    for (uint32_t c = 0; c < clusters; ++c)
+      lm.cluster[c] = c;
+    std::vector<uint32_t> next_local(clusters, 1);
+    std::vector<Models> level_models(L - G);
+    std::vector<SymbolRecorder> recordings(clusters);
+    EncoderCodec<RecorderStream> ccodec(q, dec_to_input, input_to_dec);
+    for (size_t r = G; r < L; ++r) {
+      const uint32_t level = static_cast<uint32_t>(r + 1);
+      ccodec.begin_level(dec.levels[L - 1 - r], &level_models[r - G]);
+      for (uint32_t c = 0; c < clusters; ++c) {
+        RecorderStream conn{&recordings[c], 0}, geom{&recordings[c], 1};
+        ccodec.set_sinks(&conn, &geom);
+        traverse_cluster(lm, ccodec, scratch, c, level, splits);
+        apply_splits(lm, splits, level, c, &next_local[c]);
+        ccodec.number_new_vertices();
+      }
+      ccodec.end_level();
+      add_level_entry(0, 0);
+      if (options.progress)
+        options.progress(double(r + 1) / double(L), "encode");
+    }
+    freeze_on_recordings(level_models, recordings);
+    tables = write_tables(level_models);
+    double bits[2] = {0, 0};
+    cluster_blocks.reserve(clusters);
+    for (const SymbolRecorder &rec : recordings)
+      cluster_blocks.push_back(code_recording(rec, bits));
+    uint64_t cluster_bytes = 0;
+    for (const auto &b : cluster_blocks)
+      cluster_bytes += b.size();
+    header.cluster_connectivity_bytes =
+        bits[0] + bits[1] > 0
+            ? static_cast<uint64_t>(double(cluster_bytes) * bits[0] / (bits[0] + bits[1]))
+            : 0;
+  }
   if (lm.vertex_count() != nv || lm.ct.face_count() != nf)
     throw Error("internal encoder error: the refined mesh does not match the input");
 
-  std::vector<uint8_t> file = write_file(header, pack_base_mesh(base, grid.bits), blocks);
+  std::vector<uint8_t> file =
+      write_file(header, pack_base_mesh(base, grid.bits), blocks, tables, cluster_blocks);
   if (report) {
     const FileLayout layout = read_layout(file.data(), file.size());
     report->info = file_info(layout, file.size());
@@ -276,7 +359,7 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
     report->decimate_seconds = t_decimate;
     report->encode_seconds = seconds_since(t2);
     for (int k = 0; k < 6; ++k)
-      report->symbol_bits[k] = codec.bits[k];
+      report->symbol_bits[k] = symbol_bits[k];
     report->decoded_to_input.resize(nv);
     for (uint32_t i = 0; i < nv; ++i)
       report->decoded_to_input[i] = compact_to_input[dec_to_input[i]];

@@ -6,6 +6,7 @@
 #include <xxhash.h>
 
 #include "entropy/models.h"
+#include "entropy/range_coder.h"
 #include "format/bit_io.h"
 
 namespace pomar {
@@ -42,7 +43,36 @@ void write_header(const FileHeader &h, std::vector<uint8_t> &out) {
     w.u32(e.geometry_bytes);
     w.u32(e.checksum);
   }
+  if (h.clustered()) {
+    w.u32(h.global_levels);
+    w.u32(h.clusters);
+    w.u32(h.tables_bytes);
+    w.u32(h.tables_checksum);
+    w.u32(h.index_bytes);
+    w.u32(h.index_checksum);
+    w.u32(static_cast<uint32_t>(h.cluster_bytes));
+    w.u32(static_cast<uint32_t>(h.cluster_bytes >> 32));
+    w.u32(static_cast<uint32_t>(h.cluster_connectivity_bytes));
+    w.u32(static_cast<uint32_t>(h.cluster_connectivity_bytes >> 32));
+  }
   w.u32(checksum(out.data(), out.size()));
+}
+
+/// The cluster index: block sizes (adaptive Elias-gamma) and check bytes, range coded.
+std::vector<uint8_t> pack_cluster_index(const std::vector<std::vector<uint8_t>> &blocks) {
+  std::vector<uint8_t> out;
+  RangeEncoder rc(&out);
+  FrequencyModel length(33);
+  for (const auto &b : blocks) {
+    const uint32_t n = static_cast<uint32_t>(b.size());
+    const int nb = bit_length(n);
+    rc.encode(length, nb);
+    if (nb > 1)
+      rc.encode_bypass(n & ((1u << (nb - 1)) - 1), nb - 1);
+    rc.encode_bypass(checksum(b.data(), b.size()) & 0xFF, 8);
+  }
+  rc.finish();
+  return out;
 }
 
 [[noreturn]] void bad(const std::string &what) { throw Error("not a valid .pomar file: " + what); }
@@ -62,20 +92,56 @@ std::vector<uint8_t> pack_base_mesh(const BaseMesh &base, int bits) {
 }
 
 std::vector<uint8_t> write_file(FileHeader header, const std::vector<uint8_t> &base_block,
-                                const std::vector<std::vector<uint8_t>> &level_blocks) {
+                                const std::vector<std::vector<uint8_t>> &level_blocks,
+                                const std::vector<uint8_t> &tables,
+                                const std::vector<std::vector<uint8_t>> &cluster_blocks) {
   header.base_bytes = static_cast<uint32_t>(base_block.size());
   header.base_checksum = checksum(base_block.data(), base_block.size());
   for (size_t i = 0; i < level_blocks.size(); ++i)
     header.levels[i].checksum = checksum(level_blocks[i].data(), level_blocks[i].size());
+  std::vector<uint8_t> index;
+  if (header.clustered()) {
+    header.version = kClusteredFormatVersion;
+    header.clusters = static_cast<uint32_t>(cluster_blocks.size());
+    header.tables_bytes = static_cast<uint32_t>(tables.size());
+    header.tables_checksum = checksum(tables.data(), tables.size());
+    index = pack_cluster_index(cluster_blocks);
+    header.index_bytes = static_cast<uint32_t>(index.size());
+    header.index_checksum = checksum(index.data(), index.size());
+    header.cluster_bytes = 0;
+    for (const auto &b : cluster_blocks)
+      header.cluster_bytes += b.size();
+  }
   std::vector<uint8_t> out;
   write_header(header, out);
   out.insert(out.end(), base_block.begin(), base_block.end());
   for (const auto &b : level_blocks)
     out.insert(out.end(), b.begin(), b.end());
+  if (header.clustered()) {
+    out.insert(out.end(), tables.begin(), tables.end());
+    out.insert(out.end(), index.begin(), index.end());
+    for (const auto &b : cluster_blocks)
+      out.insert(out.end(), b.begin(), b.end());
+  }
   return out;
 }
 
-FileLayout read_layout(const uint8_t *data, size_t size) {
+size_t header_size(const uint8_t *data, size_t size) {
+  if (size < kFixedHeaderBytes)
+    return kFixedHeaderBytes;
+  ByteReader r(data, size, "the .pomar header");
+  for (int i = 0; i < 10; ++i)
+    r.u8();
+  const uint16_t flags = r.u16();
+  ByteReader c(data + 48, 4, "the .pomar header");
+  const uint64_t levels = std::min<uint32_t>(c.u32(), kMaxLevels);
+  return kFixedHeaderBytes + kLevelEntryBytes * levels +
+         ((flags & kFlagClustered) ? kClusterHeaderBytes : 0) + 4;
+}
+
+FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size) {
+  if (file_size == 0)
+    file_size = size;
   if (size < 8 || std::memcmp(data, kMagic, 8) != 0)
     bad("the file does not start with the POMAR signature");
   ByteReader r(data, size, "the .pomar header");
@@ -84,10 +150,12 @@ FileLayout read_layout(const uint8_t *data, size_t size) {
   FileLayout L;
   FileHeader &h = L.header;
   h.version = r.u16();
-  if (h.version != kFormatVersion)
+  if (h.version != kFormatVersion && h.version != kClusteredFormatVersion)
     throw Error("unsupported .pomar version " + std::to_string(h.version) +
-                " (this build reads version " + std::to_string(kFormatVersion) + ")");
+                " (this build reads versions 1 and 2)");
   h.flags = r.u16();
+  if ((h.version == kClusteredFormatVersion) != h.clustered() || (h.flags & ~kFlagClustered))
+    bad("unknown flags " + std::to_string(h.flags) + " for version " + std::to_string(h.version));
   h.grid.bits = r.u8();
   r.u8();
   r.u8();
@@ -104,7 +172,8 @@ FileLayout read_layout(const uint8_t *data, size_t size) {
   h.base_checksum = r.u32();
   if (levels > kMaxLevels)
     bad("level count " + std::to_string(levels) + " exceeds " + std::to_string(kMaxLevels));
-  L.header_bytes = kFixedHeaderBytes + kLevelEntryBytes * levels + 4;
+  L.header_bytes = kFixedHeaderBytes + kLevelEntryBytes * levels +
+                   (h.clustered() ? kClusterHeaderBytes : 0) + 4;
   if (size < L.header_bytes)
     bad("header is truncated");
   const uint32_t stored = [&] {
@@ -120,6 +189,26 @@ FileLayout read_layout(const uint8_t *data, size_t size) {
     e.connectivity_bytes = r.u32();
     e.geometry_bytes = r.u32();
     e.checksum = r.u32();
+  }
+  if (h.clustered()) {
+    h.global_levels = r.u32();
+    h.clusters = r.u32();
+    h.tables_bytes = r.u32();
+    h.tables_checksum = r.u32();
+    h.index_bytes = r.u32();
+    h.index_checksum = r.u32();
+    h.cluster_bytes = r.u32();
+    h.cluster_bytes |= uint64_t(r.u32()) << 32;
+    h.cluster_connectivity_bytes = r.u32();
+    h.cluster_connectivity_bytes |= uint64_t(r.u32()) << 32;
+    if (h.cluster_connectivity_bytes > h.cluster_bytes)
+      bad("cluster connectivity share exceeds the cluster data");
+    if (h.global_levels >= levels)
+      bad("no clustered level after " + std::to_string(h.global_levels) + " global levels");
+    const uint32_t base_clustered =
+        h.global_levels == 0 ? h.base_vertices : h.levels[h.global_levels - 1].vertices;
+    if (h.clusters != base_clustered)
+      bad("cluster count differs from the base clustered mesh's vertex count");
   }
   // Sanity of the counts before anybody allocates from them.
   if (h.grid.bits < 1 || h.grid.bits > 24)
@@ -147,14 +236,29 @@ FileLayout read_layout(const uint8_t *data, size_t size) {
   uint64_t offset = L.header_bytes;
   L.base_offset = offset;
   offset += h.base_bytes;
-  for (const LevelEntry &e : h.levels) {
+  const size_t global = h.clustered() ? h.global_levels : h.levels.size();
+  for (size_t i = 0; i < global; ++i) {
     L.level_offset.push_back(offset);
-    offset += uint64_t(e.connectivity_bytes) + e.geometry_bytes;
+    offset += uint64_t(h.levels[i].connectivity_bytes) + h.levels[i].geometry_bytes;
   }
-  if (offset > size)
-    throw Error("truncated .pomar file: " + std::to_string(size) + " bytes, the header announces " +
-                std::to_string(offset));
-  if (h.vertices > 512 * uint64_t(size) + 64)
+  for (size_t i = global; i < h.levels.size(); ++i)
+    if (h.levels[i].connectivity_bytes || h.levels[i].geometry_bytes)
+      bad("a clustered level has global data");
+  if (h.clustered()) {
+    L.tables_offset = offset;
+    offset += h.tables_bytes;
+    L.index_offset = offset;
+    offset += h.index_bytes;
+    L.clusters_offset = offset;
+    L.global_bytes = offset;
+    offset += h.cluster_bytes;
+  } else {
+    L.global_bytes = offset;
+  }
+  if (offset > file_size)
+    throw Error("truncated .pomar file: " + std::to_string(file_size) +
+                " bytes, the header announces " + std::to_string(offset));
+  if (h.vertices > 512 * uint64_t(file_size) + 64)
     bad("the announced vertex count is implausible for the file size");
   return L;
 }
@@ -187,7 +291,40 @@ void check_level(const uint8_t *data, const FileLayout &L, size_t i) {
                 " block");
 }
 
-FileInfo file_info(const FileLayout &L, size_t file_size) {
+ClusterIndex read_cluster_index(const uint8_t *data, const FileLayout &L) {
+  const FileHeader &h = L.header;
+  check_block(data, h.index_bytes, h.index_checksum, "cluster index");
+  ClusterIndex index;
+  RangeDecoder rc(data, h.index_bytes);
+  FrequencyModel length(33);
+  uint64_t offset = L.clusters_offset, total = 0;
+  index.offset.resize(h.clusters);
+  index.size.resize(h.clusters);
+  index.check.resize(h.clusters);
+  for (uint32_t c = 0; c < h.clusters; ++c) {
+    const int nb = rc.decode(length);
+    uint32_t n = nb == 0 ? 0 : 1u;
+    if (nb > 1)
+      n = (n << (nb - 1)) | rc.decode_bypass(nb - 1);
+    index.offset[c] = offset;
+    index.size[c] = n;
+    index.check[c] = static_cast<uint8_t>(rc.decode_bypass(8));
+    offset += n;
+    total += n;
+    if (total > h.cluster_bytes)
+      throw Error("damaged .pomar file: cluster index exceeds the cluster data");
+  }
+  if (total != h.cluster_bytes || rc.overrun())
+    throw Error("damaged .pomar file: cluster index does not match the cluster data");
+  return index;
+}
+
+void check_block(const uint8_t *data, size_t size, uint32_t expected, const char *what) {
+  if (checksum(data, size) != expected)
+    throw Error(std::string("damaged .pomar file: ") + what + " checksum mismatch");
+}
+
+FileInfo file_info(const FileLayout &L, uint64_t file_size) {
   const FileHeader &h = L.header;
   FileInfo info;
   info.version = h.version;
@@ -206,6 +343,18 @@ FileInfo file_info(const FileLayout &L, size_t file_size) {
     info.connectivity_bytes += e.connectivity_bytes;
     info.geometry_bytes += e.geometry_bytes;
   }
+  if (h.clustered()) {
+    info.global_levels = h.global_levels;
+    info.clusters = h.clusters;
+    info.tables_bytes = h.tables_bytes;
+    info.index_bytes = h.index_bytes;
+    info.cluster_bytes = h.cluster_bytes;
+    info.connectivity_bytes += h.cluster_connectivity_bytes;
+    info.geometry_bytes += h.cluster_bytes - h.cluster_connectivity_bytes;
+  } else {
+    info.global_levels = static_cast<uint32_t>(h.levels.size());
+  }
+  info.global_bytes = L.global_bytes;
   info.total_bytes = file_size;
   info.header_bytes = L.header_bytes;
   info.base_bytes = h.base_bytes;

@@ -11,7 +11,10 @@
 namespace pomar {
 
 constexpr uint8_t kMagic[8] = {'P', 'O', 'M', 'A', 'R', '\r', '\n', 0x1A};
-constexpr uint16_t kFormatVersion = 1;
+constexpr uint16_t kFormatVersion = 1;          // pure progressive files
+constexpr uint16_t kClusteredFormatVersion = 2; // files with clustered levels
+constexpr uint16_t kFlagClustered = 1;
+constexpr size_t kClusterHeaderBytes = 40;
 constexpr size_t kFixedHeaderBytes = 60;
 constexpr size_t kLevelEntryBytes = 20;
 constexpr uint32_t kMaxLevels = 4096;
@@ -30,6 +33,24 @@ struct FileHeader {
   uint32_t base_vertices = 0, base_faces = 0;
   uint32_t base_bytes = 0, base_checksum = 0;
   std::vector<LevelEntry> levels;
+  // Clustered files (flags & kFlagClustered): levels 1..global_levels are global, the
+  // others live in one block per cluster; the base clustered mesh is the mesh after the
+  // global levels and each of its vertices is a cluster.
+  uint32_t global_levels = 0, clusters = 0;
+  uint32_t tables_bytes = 0, tables_checksum = 0;
+  uint32_t index_bytes = 0, index_checksum = 0;
+  uint64_t cluster_bytes = 0; // all cluster blocks together
+  // The encoder's split of cluster_bytes into connectivity and geometry (from the ideal
+  // code lengths; the blocks interleave both). Informative only.
+  uint64_t cluster_connectivity_bytes = 0;
+  bool clustered() const { return (flags & kFlagClustered) != 0; }
+};
+
+/// Where each cluster's block is, and its 8-bit check (low byte of its XXH32).
+struct ClusterIndex {
+  std::vector<uint64_t> offset; // absolute file offsets
+  std::vector<uint32_t> size;
+  std::vector<uint8_t> check;
 };
 
 /// The base mesh: quantized positions and triangles, stored bit-packed, uncompressed.
@@ -43,23 +64,37 @@ struct FileLayout {
   FileHeader header;
   size_t header_bytes = 0;
   size_t base_offset = 0;
-  std::vector<size_t> level_offset; // start of each level's connectivity bytes
+  std::vector<size_t> level_offset; // start of each global level's connectivity bytes
+  size_t tables_offset = 0, index_offset = 0, clusters_offset = 0;
+  size_t global_bytes = 0; // everything before the first cluster block
 };
 
 uint32_t checksum(const uint8_t *data, size_t size);
 
 std::vector<uint8_t> pack_base_mesh(const BaseMesh &base, int bits);
-/// Assemble a complete file image. `header.levels` must describe `level_blocks`.
+/// Assemble a complete file image. `header.levels` must describe `level_blocks` (the
+/// global levels); a clustered file also gets its tables, index and cluster blocks.
 std::vector<uint8_t> write_file(FileHeader header, const std::vector<uint8_t> &base_block,
-                                const std::vector<std::vector<uint8_t>> &level_blocks);
+                                const std::vector<std::vector<uint8_t>> &level_blocks,
+                                const std::vector<uint8_t> &tables = {},
+                                const std::vector<std::vector<uint8_t>> &cluster_blocks = {});
 
-/// Parse and check the header (magic, version, checksum, sizes against the file size).
-FileLayout read_layout(const uint8_t *data, size_t size);
+/// Bytes a header needs before it can be parsed: at least the fixed part; then
+/// header_size() tells the full size.
+size_t header_size(const uint8_t *data, size_t size);
+
+/// Parse and check the header (magic, version, checksum, sizes against `file_size`).
+/// `data` must hold at least the header; `file_size` is the size of the whole file.
+FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size = 0);
+/// Decode the cluster index block (`data` = the whole index block).
+ClusterIndex read_cluster_index(const uint8_t *data, const FileLayout &layout);
 /// Check the base block's checksum and unpack it.
 BaseMesh read_base_mesh(const uint8_t *data, const FileLayout &layout);
 /// Throw if level `i`'s checksum does not match.
 void check_level(const uint8_t *data, const FileLayout &layout, size_t i);
+/// Check a global block's checksum (tables or index); `what` names it in the error.
+void check_block(const uint8_t *data, size_t size, uint32_t expected, const char *what);
 
-FileInfo file_info(const FileLayout &layout, size_t file_size);
+FileInfo file_info(const FileLayout &layout, uint64_t file_size);
 
 } // namespace pomar

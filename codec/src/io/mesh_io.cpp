@@ -666,7 +666,7 @@ public:
         fail(path_, "bad integer '" + tok_ + "' in PLY data");
       return true;
     }
-    unsigned char b[4];
+    unsigned char b[4] = {0, 0, 0, 0};
     const size_t n = type_size(t);
     if (!in_.read(b, n))
       return false;
@@ -721,10 +721,9 @@ private:
       fail(path_, "bad number '" + tok_ + "' in PLY data");
   }
 
-  /// Little-endian bytes to an integer of type t.
+  /// Little-endian bytes (zero-padded to 4) to an integer of type t.
   static int64_t decode(PlyType t, const unsigned char *b) {
-    const uint32_t u = b[0] | (type_size(t) > 1 ? uint32_t(b[1]) << 8 : 0) |
-                       (type_size(t) > 2 ? uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24 : 0);
+    const uint32_t u = b[0] | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24;
     switch (t) {
     case PlyType::I8: return static_cast<int8_t>(u);
     case PlyType::I16: return static_cast<int16_t>(u);

@@ -1,0 +1,121 @@
+// Random access to clustered .pomar files (paper sections 5.2 and 6): decode the base
+// clustered mesh, then any clusters at any levels, reading only the blocks they need, and
+// refine further later without starting over.
+//
+//   pomar::SelectiveDecoder d(std::make_unique<pomar::FileSource>("dragon.pomar"));
+//   d.want_sphere({0.01f, 0.12f, 0.0f}, 0.02f);   // finest level by default
+//   d.update();                                   // completes the level map, decodes
+//   pomar::Mesh m = d.mesh();                     // + d.vertex_cluster(), d.vertex_level()
+//   d.want_cluster(17, d.finest_level());  d.update();   // delta refinement
+#pragma once
+
+#include <cstdint>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pomar/pomar.h"
+
+namespace pomar {
+
+/// Where the bytes of a .pomar file come from: a file, memory, or (one day) a network
+/// range request. The decoder asks for the header and global part once, then for single
+/// cluster blocks.
+class ByteSource {
+public:
+  virtual ~ByteSource() = default;
+  virtual uint64_t size() const = 0;
+  /// Read exactly n bytes at offset into out; throws pomar::Error on failure.
+  virtual void read(uint64_t offset, size_t n, uint8_t *out) = 0;
+};
+
+class MemorySource : public ByteSource {
+public:
+  MemorySource(const uint8_t *data, size_t size) : data_(data), size_(size) {}
+  uint64_t size() const override { return size_; }
+  void read(uint64_t offset, size_t n, uint8_t *out) override;
+
+private:
+  const uint8_t *data_;
+  size_t size_;
+};
+
+class FileSource : public ByteSource {
+public:
+  explicit FileSource(const std::string &path);
+  ~FileSource() override;
+  FileSource(const FileSource &) = delete;
+  FileSource &operator=(const FileSource &) = delete;
+  uint64_t size() const override { return size_; }
+  void read(uint64_t offset, size_t n, uint8_t *out) override;
+
+private:
+  std::string path_;
+  std::FILE *file_ = nullptr;
+  uint64_t size_ = 0;
+};
+
+/// Selective, incremental decoder of a .pomar file. Levels are numbered as everywhere
+/// else (0 = base mesh, info().levels.size() = full resolution); clusters can be refined
+/// from base_clustered_level() to finest_level(). A pure progressive file has no
+/// clusters: it decodes to one uniform level (want_level).
+class SelectiveDecoder {
+public:
+  explicit SelectiveDecoder(std::unique_ptr<ByteSource> source);
+  ~SelectiveDecoder();
+  SelectiveDecoder(const SelectiveDecoder &) = delete;
+  SelectiveDecoder &operator=(const SelectiveDecoder &) = delete;
+
+  const FileInfo &info() const;
+  uint32_t cluster_count() const;
+  int base_clustered_level() const; ///< levels decoded for the whole mesh
+  int finest_level() const;
+
+  // ----- requests: raise the wanted level of clusters (never lowers it) -----
+  void want_cluster(uint32_t cluster, int level);
+  void want_all(int level);
+  /// Clusters with a vertex of the current mesh inside the sphere / box.
+  void want_sphere(const float center[3], float radius, int level);
+  void want_box(const float lo[3], const float hi[3], int level);
+  /// Clusters of these vertices / faces of the current mesh (what MeshLab selects).
+  void want_vertices(const std::vector<uint32_t> &vertices, int level);
+  void want_faces(const std::vector<uint32_t> &faces, int level);
+  /// Forget every request (the next update() coarsens back to the base clustered mesh).
+  void clear_wanted();
+  /// Set the wanted levels exactly (one per cluster); lower values coarsen.
+  void set_wanted(const std::vector<int> &levels);
+  const std::vector<int> &wanted() const;
+
+  /// Complete the level map (at most one level between neighbouring clusters, section 6)
+  /// and bring the mesh to it: decode what is missing on top of the current state, or
+  /// re-decode from the base clustered mesh when some cluster must get coarser.
+  void update(const Progress &progress = {});
+
+  /// The level map after update(): the level of every cluster.
+  const std::vector<int> &levels() const;
+
+  // ----- the current mesh -----
+  Mesh mesh() const;
+  /// Per vertex of mesh(): its cluster and the level that created it.
+  std::vector<uint32_t> vertex_cluster() const;
+  std::vector<uint32_t> vertex_level() const;
+
+  // ----- statistics -----
+  uint64_t bytes_read() const;     ///< everything read from the source so far
+  uint32_t blocks_read() const;    ///< cluster blocks read so far
+  uint32_t clusters_decoded() const; ///< clusters above the base clustered level
+
+private:
+  struct State;
+  std::unique_ptr<State> s_;
+};
+
+/// Complete a level map (paper section 6): M(C) = max(wanted(C), max over C' of
+/// wanted(C') - d(C, C')), d = edge distance in the cluster graph; levels below `floor`
+/// are raised to it. `adjacency` is CSR: neighbours of c are adj[start[c]..start[c+1]).
+std::vector<int> complete_level_map(const std::vector<int> &wanted,
+                                    const std::vector<uint32_t> &start,
+                                    const std::vector<uint32_t> &adj, int floor);
+
+} // namespace pomar

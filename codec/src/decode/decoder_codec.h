@@ -1,0 +1,74 @@
+// The traversal policy of the decoder: every answer comes from range-coded streams.
+// Global levels read two streams (connectivity, geometry) with the file's adaptive models;
+// a cluster block is one stream read with its level's static models.
+#pragma once
+
+#include <string>
+
+#include "entropy/models.h"
+#include "format/file_format.h"
+#include "refine/level_traversal.h"
+
+namespace pomar {
+
+class DecoderCodec {
+public:
+  explicit DecoderCodec(int bits) : top_((int64_t(1) << bits) - 1) {}
+
+  void set(Models *models, RangeDecoder *conn, RangeDecoder *geom, const std::string &where) {
+    m_ = models;
+    conn_ = conn;
+    geom_ = geom;
+    where_ = where;
+  }
+
+  int split_flag(uint32_t, int context) { return conn_->decode_bit(m_->conn.sv[context]); }
+
+  void split_symbols(uint32_t, const Ring &ring, const uint32_t *, SplitSymbols &s) {
+    s.s_e = get_small(*conn_, m_->conn.se[valence_context(ring.size())]);
+    const uint32_t faces =
+        get_small(*conn_, m_->conn.faces[faces_context(ring.size(), ring.closed)]);
+    if (faces > ring.size())
+      corrupt("split symbols do not fit the vertex's neighbourhood");
+    s.s_l = get_small(*conn_, m_->conn.sl[sl_context(faces)]);
+    if (s.s_l > faces)
+      corrupt("split symbols do not fit the vertex's neighbourhood");
+    s.s_r = faces - s.s_l;
+  }
+
+  void geometry(uint32_t, const Prediction &p, int32_t position[3]) {
+    int64_t r[3];
+    r[0] = get_residual(*geom_, m_->geom, 0, p.context) + p.offset[0];
+    r[1] = get_residual(*geom_, m_->geom, 0, p.context) + p.offset[1];
+    r[2] = get_residual(*geom_, m_->geom, 1, p.context) + p.offset[2];
+    to_global(p.frame, r);
+    for (int k = 0; k < 3; ++k) {
+      const int64_t v = p.barycentre[k] + r[k];
+      if (v < 0 || v > top_)
+        corrupt("a decoded position lies outside the quantization grid");
+      position[k] = static_cast<int32_t>(v);
+    }
+  }
+
+  [[noreturn]] void corrupt(const char *what) {
+    throw Error("damaged .pomar file: " + where_ + ": " + what);
+  }
+
+private:
+  Models *m_ = nullptr;
+  RangeDecoder *conn_ = nullptr, *geom_ = nullptr;
+  int64_t top_;
+  std::string where_;
+};
+
+/// Decode global levels [from, to) of `mesh` (the file image must hold the global part).
+void decode_global_levels(const uint8_t *data, const FileLayout &layout, size_t from,
+                          size_t to, LevelMesh &mesh, Models &models, const Progress &progress);
+
+/// The base mesh of a file as a LevelMesh (lineage initialised).
+LevelMesh base_level_mesh(const uint8_t *data, const FileLayout &layout);
+
+/// Dequantized positions and triangles of a LevelMesh.
+Mesh to_mesh(const LevelMesh &lm, const Quantizer &grid);
+
+} // namespace pomar

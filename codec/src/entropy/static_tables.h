@@ -1,0 +1,70 @@
+// Static models of the clustered levels (our answer to the paper's Figure 11: every
+// cluster re-learning its models). The encoder records every cluster's symbols, counts
+// them per model over all clusters of a level, freezes each level's models on those
+// counts, stores the frozen frequencies once in the file's global part, and codes every
+// cluster block against them: no per-cluster learning cost, so bits per vertex hardly
+// depend on the number of clusters.
+#pragma once
+
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include "entropy/models.h"
+#include "entropy/range_coder.h"
+
+namespace pomar {
+
+/// Stands in for a RangeEncoder: records symbols (with their model) instead of coding.
+class SymbolRecorder {
+public:
+  struct Event {
+    void *model; // FrequencyModel* or BitModel*; null for bypass bits
+    uint32_t value;
+    uint8_t kind;  // 0 frequency symbol, 1 binary, 2 bypass bits
+    uint8_t nbits; // bypass only
+    uint8_t stream; // 0 connectivity, 1 geometry (statistics only)
+  };
+  void encode(FrequencyModel &m, int s) { events.push_back({&m, uint32_t(s), 0, 0, stream}); }
+  void encode_bit(BitModel &m, int bit) { events.push_back({&m, uint32_t(bit), 1, 0, stream}); }
+  void encode_bypass(uint32_t v, int nbits) {
+    events.push_back({nullptr, v, 2, uint8_t(nbits), stream});
+  }
+  void finish() {}
+  std::vector<Event> events;
+  uint8_t stream = 0;
+};
+
+/// A view of a recorder that tags its events with a stream (what EncoderCodec writes to).
+struct RecorderStream {
+  SymbolRecorder *recorder;
+  uint8_t stream;
+  void encode(FrequencyModel &m, int s) {
+    recorder->stream = stream;
+    recorder->encode(m, s);
+  }
+  void encode_bit(BitModel &m, int bit) {
+    recorder->stream = stream;
+    recorder->encode_bit(m, bit);
+  }
+  void encode_bypass(uint32_t v, int nbits) {
+    recorder->stream = stream;
+    recorder->encode_bypass(v, nbits);
+  }
+  void finish() {}
+};
+
+/// Freeze `models` (one Models per clustered level) on the symbols of `recordings`.
+void freeze_on_recordings(std::vector<Models> &models,
+                          const std::vector<SymbolRecorder> &recordings);
+
+/// Range-code a recording with the (frozen) models its events point to. Adds the ideal
+/// code lengths per stream to bits[0] (connectivity) and bits[1] (geometry).
+std::vector<uint8_t> code_recording(const SymbolRecorder &recording, double bits[2]);
+
+/// Serialize / read back the frozen models of every clustered level.
+std::vector<uint8_t> write_tables(std::vector<Models> &models);
+/// Throws pomar::Error on damaged tables.
+std::vector<Models> read_tables(const uint8_t *data, size_t size, size_t levels);
+
+} // namespace pomar
