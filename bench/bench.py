@@ -3,9 +3,10 @@
 
     python3 bench/bench.py [--quick] [--csv out.csv] [--data DIR] [--no-generated] [--bits N]
 
-Prints one markdown report on stdout (machine, main table, scaling table); progress goes to
-stderr. Python 3 standard library only. Needs a built tree (pomar and pomar_gen_mesh), the
-Debian `draco` package (draco_encoder/draco_decoder) and GNU time (/usr/bin/time).
+Prints one markdown report on stdout (machine, main table, scaling table, random-access
+tables from pomar_ra_bench unless --quick); progress goes to stderr. Python 3 standard library
+only. Needs a built tree (pomar, pomar_gen_mesh, pomar_ra_bench), the Debian `draco` package
+(draco_encoder/draco_decoder) and GNU time (/usr/bin/time).
 See bench/README.md for what every column means.
 """
 
@@ -28,6 +29,11 @@ CLEAN_DATA = ["bunny.ply", "horse.ply", "armadillo_50k.obj", "fertility_23k.off"
               "rocker_arm.off", "bimba_9k.off", "dragon.ply.xz"]
 GENERATED = [100_000, 300_000, 1_000_000]  # noisy_sphere target vertex counts
 SINGLE_RUN_VERTICES = 400_000  # meshes at least this large are timed once (dragon, 1M sphere)
+# Random-access section (pomar_ra_bench; skipped with --quick): (label, file, source) where
+# source is "samples", "data" (relative to --data) or "generated" (target vertex count).
+RA_CURVE = [("samples/bunny.ply", "bunny.ply", "samples"), ("data/horse.ply", "horse.ply", "data")]
+RA_ONE = [("data/dragon.ply", "dragon.ply.xz", "data"),
+          ("gen/noisy_sphere_100k", 100_000, "generated")]
 GNU_TIME = "/usr/bin/time"
 
 
@@ -269,6 +275,64 @@ def ply_vertex_count(path):
     return None
 
 
+def materialize(label, path, source, tools, mesh_dir):
+    """The mesh file to encode: generated meshes are written by pomar_gen_mesh, .xz files are
+    decompressed, into mesh_dir. Returns (path, None) or (None, note)."""
+    os.makedirs(mesh_dir, exist_ok=True)
+    if source == "generated":
+        out = os.path.join(mesh_dir, "sphere.ply")
+        g = subprocess.run([tools["pomar_gen_mesh"], "noisy_sphere", str(path), out],
+                           capture_output=True, text=True)
+        if g.returncode != 0:
+            return None, "%s: pomar_gen_mesh failed: %s" % (label, first_error_line(g.stderr))
+        return out, None
+    if path.endswith(".xz"):
+        out = os.path.join(mesh_dir, os.path.basename(path)[:-3])
+        with open(out, "wb") as f:
+            if subprocess.run(["xz", "-dc", path], stdout=f).returncode != 0:
+                return None, "%s: xz -d failed" % label
+        return out, None
+    return path, None
+
+
+def random_access(args, tools, workdir, data):
+    """Runs pomar_ra_bench curve / one on the RA_CURVE / RA_ONE meshes. Returns (list of
+    markdown blocks, list of notes)."""
+    blocks, notes = [], []
+    if "pomar_ra_bench" not in tools:
+        return blocks, ["pomar_ra_bench not found in the build folder: rebuild to get this section"]
+    jobs = [("curve", m) for m in RA_CURVE] + [("one", m) for m in RA_ONE]
+    for mode, (label, name, source) in jobs:
+        if source == "generated" and args.no_generated:
+            continue
+        if source == "samples":
+            path = os.path.join(REPO, "samples", name)
+        elif source == "data":
+            path = os.path.join(data, name)
+        else:
+            path = name
+        if source != "generated" and not os.path.exists(path):
+            notes.append("%s %s: %s not found" % (mode, label, path))
+            continue
+        mesh_dir = os.path.join(workdir, "ra_mesh")
+        path, note = materialize(label, path, source, tools, mesh_dir)
+        if note:
+            notes.append(note)
+            continue
+        log("bench: pomar_ra_bench %s %s ..." % (mode, label))
+        t0 = time.perf_counter()
+        r = subprocess.run([tools["pomar_ra_bench"], mode, path, "--bits", str(args.bits)],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        log("bench: pomar_ra_bench %s %s done in %.1f s" % (mode, label, time.perf_counter() - t0))
+        shutil.rmtree(mesh_dir, ignore_errors=True)
+        if r.returncode != 0:
+            notes.append("pomar_ra_bench %s %s failed (exit %d): %s"
+                         % (mode, label, r.returncode, first_error_line(r.stderr)))
+            continue
+        blocks.append(r.stdout.strip().replace(os.path.basename(path), label, 1))
+    return blocks, notes
+
+
 # --------------------------------------------------------------------------------------------
 # Report
 # --------------------------------------------------------------------------------------------
@@ -358,9 +422,12 @@ def main():
     with tempfile.TemporaryDirectory(prefix="pomar-bench.") as workdir:
         # Snapshot the executables so a rebuild during the run cannot mix two versions.
         tools = {}
-        for name, rel in (("pomar", "codec/pomar"), ("pomar_gen_mesh", "bench/pomar_gen_mesh")):
+        for name, rel in (("pomar", "codec/pomar"), ("pomar_gen_mesh", "bench/pomar_gen_mesh"),
+                          ("pomar_ra_bench", "bench/pomar_ra_bench")):
             src = os.path.join(args.build, rel)
             if not os.access(src, os.X_OK):
+                if name == "pomar_ra_bench":
+                    continue  # only the random-access section is skipped (with a note)
                 sys.exit("bench.py: %s not found; build first: cmake -S . -B build -G Ninja "
                          "-DCMAKE_BUILD_TYPE=Release && ninja -C build" % src)
             tools[name] = os.path.join(workdir, name)
@@ -398,22 +465,10 @@ def main():
         rows = []
         for label, path, source in inputs:
             mesh_dir = os.path.join(workdir, "mesh")
-            os.makedirs(mesh_dir, exist_ok=True)
-            if source == "generated":
-                out = os.path.join(mesh_dir, "sphere.ply")
-                g = subprocess.run([tools["pomar_gen_mesh"], "noisy_sphere", str(path), out],
-                                   capture_output=True, text=True)
-                if g.returncode != 0:
-                    notes.append("%s: pomar_gen_mesh failed: %s" % (label, first_error_line(g.stderr)))
-                    continue
-                path = out
-            elif path.endswith(".xz"):
-                out = os.path.join(mesh_dir, os.path.basename(path)[:-3])
-                with open(out, "wb") as f:
-                    if subprocess.run(["xz", "-dc", path], stdout=f).returncode != 0:
-                        notes.append("%s: xz -d failed" % label)
-                        continue
-                path = out
+            path, note = materialize(label, path, source, tools, mesh_dir)
+            if note:
+                notes.append(note)
+                continue
             log("bench: %s ..." % label)
             t0 = time.perf_counter()
             row = bench_mesh(label, path, args, tools, workdir, source)
@@ -427,6 +482,10 @@ def main():
                         notes.append("%s: %s" % (label, row[key]))
                 rows.append(row)
             shutil.rmtree(mesh_dir, ignore_errors=True)
+
+        ra_blocks, ra_notes = [], []
+        if not args.quick:
+            ra_blocks, ra_notes = random_access(args, tools, workdir, data)
 
         elapsed = time.perf_counter() - t_start
         single = [r["mesh"] for r in rows if r.get("runs") == 1 and args.runs != 1]
@@ -455,6 +514,13 @@ def main():
                   fmt(r.get("dec_s"), ".3f"), fmt(1e6 * r["enc_s"] / r["vertices"], ".2f"),
                   fmt(1e6 * r["dec_s"] / r["vertices"] if r.get("dec_s") else None, ".2f"),
                   fmt(r["enc_mb"], ".1f"), fmt(r.get("dec_mb"), ".1f")] for r in gen_rows]))
+        if ra_blocks or ra_notes:
+            print("\n### random access (pomar_ra_bench)\n")
+            print("\n\n".join(ra_blocks))
+            if ra_notes:
+                print("\nNotes:")
+                for n in ra_notes:
+                    print("- " + n)
         print("\nTotal benchmark run time: %.0f s" % elapsed)
 
         if args.csv:

@@ -9,11 +9,13 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <memory>
 #include <cstdio>
 #include <unistd.h>
 
 #include "pomar/mesh_io.h"
 #include "pomar/pomar.h"
+#include "pomar/random_access.h"
 
 namespace {
 
@@ -48,7 +50,9 @@ double bpv(uint64_t bytes, uint32_t vertices) {
 struct EncodeArgs {
   std::string in, out;
   int bits = 12;
-  bool progressive = true, quiet = false;
+  uint32_t clusters = 0;
+  double cluster_ratio = 0.02;
+  bool progressive = false, quiet = false;
 };
 
 int run_encode(const EncodeArgs &a) {
@@ -65,6 +69,9 @@ int run_encode(const EncodeArgs &a) {
   const double t_load = since(t0);
   pomar::EncodeOptions opt;
   opt.bits = a.bits;
+  opt.clusters = a.clusters;
+  opt.cluster_ratio = a.cluster_ratio;
+  opt.progressive = a.progressive;
   opt.progress = terminal_progress(a.quiet);
   pomar::EncodeReport r;
   const auto t1 = Clock::now();
@@ -84,6 +91,13 @@ int run_encode(const EncodeArgs &a) {
               a.out.c_str(), file.size(), bpv(file.size(), i.vertices),
               bpv(i.connectivity_bytes, i.vertices), bpv(i.geometry_bytes, i.vertices), i.bits,
               i.levels.size(), i.base_vertices);
+  if (i.clustered())
+    std::printf("random access: %u clusters from level %u (global part %lu bytes, cluster "
+                "blocks %lu bytes)\n",
+                i.clusters, i.global_levels, static_cast<unsigned long>(i.global_bytes),
+                static_cast<unsigned long>(i.cluster_bytes));
+  else
+    std::printf("pure progressive (no random access)\n");
   std::printf("time: read %.3f s, encode %.3f s (decimate %.3f s, code %.3f s)\n", t_load,
               t_encode, r.decimate_seconds, r.encode_seconds);
   return 0;
@@ -94,19 +108,108 @@ int run_encode(const EncodeArgs &a) {
 struct DecodeArgs {
   std::string in, out;
   int level = -1;
-  bool ascii = false, quiet = false;
+  std::vector<std::string> clusters, spheres, boxes;
+  bool ascii = false, quiet = false, stats = false;
+  bool selective() const { return !clusters.empty() || !spheres.empty() || !boxes.empty(); }
 };
 
+/// "a,b,c[:LEVEL]" -> numbers and level (default `finest`). Throws pomar::Error.
+std::vector<double> parse_spec(const std::string &spec, size_t count, int finest, int &level,
+                               const char *what) {
+  std::string body = spec;
+  level = finest;
+  const size_t colon = spec.find(':');
+  if (colon != std::string::npos) {
+    body = spec.substr(0, colon);
+    try {
+      size_t used = 0;
+      level = std::stoi(spec.substr(colon + 1), &used);
+      if (used != spec.size() - colon - 1)
+        throw std::invalid_argument("level");
+    } catch (const std::exception &) {
+      throw pomar::Error(std::string("bad ") + what + " '" + spec + "': the level after ':' must be an integer");
+    }
+  }
+  std::vector<double> v;
+  size_t pos = 0;
+  while (pos <= body.size()) {
+    const size_t comma = body.find(',', pos);
+    const std::string item = body.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
+    try {
+      size_t used = 0;
+      v.push_back(std::stod(item, &used));
+      if (used != item.size())
+        throw std::invalid_argument("number");
+    } catch (const std::exception &) {
+      throw pomar::Error(std::string("bad ") + what + " '" + spec + "': '" + item + "' is not a number");
+    }
+    if (comma == std::string::npos)
+      break;
+    pos = comma + 1;
+  }
+  if (v.size() != count)
+    throw pomar::Error(std::string("bad ") + what + " '" + spec + "': expected " +
+                       std::to_string(count) + " numbers");
+  return v;
+}
+
+int run_selective_decode(const DecodeArgs &a) {
+  const auto t0 = Clock::now();
+  pomar::SelectiveDecoder d(std::make_unique<pomar::FileSource>(a.in));
+  if (!d.info().clustered())
+    throw pomar::Error(a.in + " is a pure progressive file (encoded with --progressive): it has "
+                       "no clusters to select; use --level");
+  const int finest = d.finest_level();
+  if (a.level >= 0)
+    d.want_all(std::max(a.level, d.base_clustered_level()));
+  for (const std::string &spec : a.clusters) {
+    int level;
+    const std::vector<double> id = parse_spec(spec, 1, finest, level, "--cluster");
+    if (id[0] < 0 || id[0] != double(uint32_t(id[0])))
+      throw pomar::Error("bad --cluster '" + spec + "': the cluster id must be a non-negative integer");
+    d.want_cluster(static_cast<uint32_t>(id[0]), level);
+  }
+  for (const std::string &spec : a.spheres) {
+    int level;
+    const std::vector<double> v = parse_spec(spec, 4, finest, level, "--sphere");
+    const float c[3] = {float(v[0]), float(v[1]), float(v[2])};
+    d.want_sphere(c, float(v[3]), level);
+  }
+  for (const std::string &spec : a.boxes) {
+    int level;
+    const std::vector<double> v = parse_spec(spec, 6, finest, level, "--box");
+    const float lo[3] = {float(v[0]), float(v[1]), float(v[2])};
+    const float hi[3] = {float(v[3]), float(v[4]), float(v[5])};
+    d.want_box(lo, hi, level);
+  }
+  d.update(terminal_progress(a.quiet));
+  const pomar::Mesh mesh = d.mesh();
+  const double t_decode = since(t0);
+  pomar::save_mesh(a.out, mesh, !a.ascii);
+  if (a.stats || !a.quiet) {
+    const uint64_t file_size = d.info().total_bytes;
+    std::printf("%s: %zu vertices, %zu faces; %u of %u clusters refined (levels %d..%d), %u "
+                "blocks read, %lu of %lu bytes read (%.1f%%), %.3f s\n",
+                a.out.c_str(), mesh.vertex_count(), mesh.triangle_count(), d.clusters_decoded(),
+                d.cluster_count(), d.base_clustered_level(), finest, d.blocks_read(),
+                static_cast<unsigned long>(d.bytes_read()), static_cast<unsigned long>(file_size),
+                100.0 * double(d.bytes_read()) / double(file_size), t_decode);
+  }
+  return 0;
+}
+
 int run_decode(const DecodeArgs &a) {
+  if (a.selective())
+    return run_selective_decode(a);
   const auto t0 = Clock::now();
   const std::vector<uint8_t> data = pomar::read_file(a.in);
   const pomar::Mesh mesh =
       pomar::decode(data.data(), data.size(), a.level, terminal_progress(a.quiet));
   const double t_decode = since(t0);
   pomar::save_mesh(a.out, mesh, !a.ascii);
-  if (!a.quiet)
-    std::printf("%s: %zu vertices, %zu faces (decoded in %.3f s)\n", a.out.c_str(),
-                mesh.vertex_count(), mesh.triangle_count(), t_decode);
+  if (!a.quiet || a.stats)
+    std::printf("%s: %zu vertices, %zu faces (decoded in %.3f s, %zu bytes read)\n", a.out.c_str(),
+                mesh.vertex_count(), mesh.triangle_count(), t_decode, data.size());
   return 0;
 }
 
@@ -135,6 +238,13 @@ nlohmann::json info_json(const pomar::FileInfo &i) {
   j["level_count"] = i.levels.size();
   j["connectivity_bits"] = 8 * i.connectivity_bytes;
   j["geometry_bits"] = 8 * i.geometry_bytes;
+  j["clusters"] = i.clusters;
+  j["global_levels"] = i.global_levels;
+  j["global_bytes"] = i.global_bytes;
+  j["tables_bytes"] = i.tables_bytes;
+  j["index_bytes"] = i.index_bytes;
+  j["cluster_bytes"] = i.cluster_bytes;
+  j["cluster_block_bytes"] = i.cluster_block_bytes;
   j["header_bytes"] = i.header_bytes;
   j["base_bytes"] = i.base_bytes;
   j["total_bytes"] = i.total_bytes;
@@ -151,7 +261,12 @@ int run_info(const std::string &in, bool json) {
     std::printf("%s\n", info_json(i).dump(2).c_str());
     return 0;
   }
-  std::printf("%s: .pomar version %u, progressive (global levels only)\n", in.c_str(), i.version);
+  if (i.clustered())
+    std::printf("%s: .pomar version %u, random access: %u clusters, levels 1..%u global\n",
+                in.c_str(), i.version, i.clusters, i.global_levels);
+  else
+    std::printf("%s: .pomar version %u, pure progressive (global levels only)\n", in.c_str(),
+                i.version);
   std::printf("  vertices %u, faces %u, %d-bit grid from (%g, %g, %g), cell %.6g\n", i.vertices,
               i.faces, i.bits, i.bbox_min[0], i.bbox_min[1], i.bbox_min[2],
               (double(i.bbox_max[0]) - i.bbox_min[0]) / double((1u << i.bits) - 1));
@@ -160,13 +275,32 @@ int run_info(const std::string &in, bool json) {
               static_cast<unsigned long>(i.total_bytes), bpv(i.total_bytes, i.vertices),
               bpv(i.connectivity_bytes, i.vertices), bpv(i.geometry_bytes, i.vertices),
               bpv(i.base_bytes, i.vertices), bpv(i.header_bytes, i.vertices));
+  if (i.clustered()) {
+    std::vector<uint32_t> sizes = i.cluster_block_bytes;
+    std::sort(sizes.begin(), sizes.end());
+    std::printf("  global part %lu bytes (header, base mesh, %u global levels, model tables %lu, "
+                "cluster index %lu); cluster blocks %lu bytes\n",
+                static_cast<unsigned long>(i.global_bytes), i.global_levels,
+                static_cast<unsigned long>(i.tables_bytes),
+                static_cast<unsigned long>(i.index_bytes),
+                static_cast<unsigned long>(i.cluster_bytes));
+    if (!sizes.empty())
+      std::printf("  %u clusters, block bytes min %u, median %u, max %u (pomar info --json lists "
+                  "them all)\n",
+                  i.clusters, sizes.front(), sizes[sizes.size() / 2], sizes.back());
+  }
   std::printf("  level  vertices     faces  conn.bytes  geom.bytes\n");
   std::printf("  %5d %9u %9u  %10lu  (base mesh)\n", 0, i.base_vertices, i.base_faces,
               static_cast<unsigned long>(i.base_bytes));
-  for (size_t l = 0; l < i.levels.size(); ++l)
-    std::printf("  %5zu %9u %9u  %10lu  %10lu\n", l + 1, i.levels[l].vertices, i.levels[l].faces,
-                static_cast<unsigned long>(i.levels[l].connectivity_bytes),
-                static_cast<unsigned long>(i.levels[l].geometry_bytes));
+  for (size_t l = 0; l < i.levels.size(); ++l) {
+    if (l < i.global_levels)
+      std::printf("  %5zu %9u %9u  %10lu  %10lu\n", l + 1, i.levels[l].vertices,
+                  i.levels[l].faces, static_cast<unsigned long>(i.levels[l].connectivity_bytes),
+                  static_cast<unsigned long>(i.levels[l].geometry_bytes));
+    else
+      std::printf("  %5zu %9u %9u  (clustered)\n", l + 1, i.levels[l].vertices,
+                  i.levels[l].faces);
+  }
   return 0;
 }
 
@@ -226,6 +360,7 @@ int main(int argc, char **argv) {
                "  pomar encode bunny.ply bunny.pomar          # 12-bit grid, all levels\n"
                "  pomar info bunny.pomar                      # levels and bits per vertex\n"
                "  pomar decode bunny.pomar coarse.ply --level 10\n"
+               "  pomar decode bunny.pomar ear.ply --sphere -0.06,0.16,0.0,0.02 --stats\n"
                "  pomar verify bunny.ply bunny.pomar          # lossless check\n"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "pomar 0.1.0 (file format version 1)");
@@ -240,8 +375,15 @@ int main(int argc, char **argv) {
                   "error is at most half a cell")
       ->check(CLI::Range(4, 24))
       ->capture_default_str();
+  enc->add_option("--clusters", ea.clusters,
+                  "Random access: about N clusters (regions decodable on their own)")
+      ->check(CLI::PositiveNumber);
+  enc->add_option("--cluster-ratio", ea.cluster_ratio,
+                  "Random access: clusters as a fraction of the vertices (paper: 1-5%)")
+      ->check(CLI::Range(0.0001, 1.0))
+      ->capture_default_str();
   enc->add_flag("--progressive", ea.progressive,
-                "Pure progressive mode: global levels only (the only mode of format version 1)");
+                "Pure progressive mode: global levels only, no random access (a little smaller)");
   enc->add_flag("-q,--quiet", ea.quiet, "Print nothing on success");
 
   DecodeArgs da;
@@ -250,8 +392,23 @@ int main(int argc, char **argv) {
   dec->add_option("output", da.out, "Output mesh; the format follows the extension (.ply .obj .off .stl)")
       ->required();
   dec->add_option("-l,--level", da.level,
-                  "Stop after L refinement levels (0 = base mesh; default: full resolution)")
+                  "Stop after L refinement levels (0 = base mesh; default: full resolution). With "
+                  "--cluster/--sphere/--box: the level of every other cluster (default: the base "
+                  "clustered mesh)")
       ->check(CLI::NonNegativeNumber);
+  dec->add_option("--cluster", da.clusters,
+                  "Refine cluster ID to LEVEL (default: finest); repeatable. Neighbouring "
+                  "clusters are refined as needed (at most one level apart)")
+      ->type_name("ID[:LEVEL]");
+  dec->add_option("--sphere", da.spheres,
+                  "Refine the clusters with a vertex within R of (X,Y,Z) (of the base clustered "
+                  "mesh) to LEVEL; repeatable")
+      ->type_name("X,Y,Z,R[:LEVEL]");
+  dec->add_option("--box", da.boxes,
+                  "Refine the clusters with a vertex in the box to LEVEL; repeatable")
+      ->type_name("X0,Y0,Z0,X1,Y1,Z1[:LEVEL]");
+  dec->add_flag("--stats", da.stats,
+                "Print clusters decoded, bytes read of the file size, vertices and time");
   dec->add_flag("--ascii", da.ascii, "Write ASCII PLY instead of binary");
   dec->add_flag("-q,--quiet", da.quiet, "Print nothing on success");
 

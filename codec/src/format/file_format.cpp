@@ -58,17 +58,28 @@ void write_header(const FileHeader &h, std::vector<uint8_t> &out) {
   w.u32(checksum(out.data(), out.size()));
 }
 
+struct SizeModels {
+  FrequencyModel length{33};
+  BitModel top[33][2];
+};
+
 /// The cluster index: block sizes (adaptive Elias-gamma) and check bytes, range coded.
 std::vector<uint8_t> pack_cluster_index(const std::vector<std::vector<uint8_t>> &blocks) {
   std::vector<uint8_t> out;
   RangeEncoder rc(&out);
-  FrequencyModel length(33);
+  SizeModels m;
   for (const auto &b : blocks) {
     const uint32_t n = static_cast<uint32_t>(b.size());
     const int nb = bit_length(n);
-    rc.encode(length, nb);
-    if (nb > 1)
-      rc.encode_bypass(n & ((1u << (nb - 1)) - 1), nb - 1);
+    rc.encode(m.length, nb);
+    // The two bits under the leading one are modelled (sizes cluster around a mean).
+    for (int i = nb - 2, k = 0; i >= 0; --i, ++k) {
+      const int bit = (n >> i) & 1;
+      if (k < 2)
+        rc.encode_bit(m.top[nb][k], bit);
+      else
+        rc.encode_bypass(uint32_t(bit), 1);
+    }
     rc.encode_bypass(checksum(b.data(), b.size()) & 0xFF, 8);
   }
   rc.finish();
@@ -296,16 +307,16 @@ ClusterIndex read_cluster_index(const uint8_t *data, const FileLayout &L) {
   check_block(data, h.index_bytes, h.index_checksum, "cluster index");
   ClusterIndex index;
   RangeDecoder rc(data, h.index_bytes);
-  FrequencyModel length(33);
+  SizeModels m;
   uint64_t offset = L.clusters_offset, total = 0;
   index.offset.resize(h.clusters);
   index.size.resize(h.clusters);
   index.check.resize(h.clusters);
   for (uint32_t c = 0; c < h.clusters; ++c) {
-    const int nb = rc.decode(length);
+    const int nb = rc.decode(m.length);
     uint32_t n = nb == 0 ? 0 : 1u;
-    if (nb > 1)
-      n = (n << (nb - 1)) | rc.decode_bypass(nb - 1);
+    for (int i = nb - 2, k = 0; i >= 0; --i, ++k)
+      n = (n << 1) | uint32_t(k < 2 ? rc.decode_bit(m.top[nb][k]) : int(rc.decode_bypass(1)));
     index.offset[c] = offset;
     index.size[c] = n;
     index.check[c] = static_cast<uint8_t>(rc.decode_bypass(8));
