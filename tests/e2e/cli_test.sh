@@ -291,6 +291,56 @@ run verify "$missing" "$WORK/bunny.pomar"
 expect_rc 1
 expect_contains "$ERR" "$missing" "stderr"
 
+# ---- random access ---------------------------------------------------------------------------------
+
+section "encode with --clusters gives a clustered file"
+run encode "$SAMPLES/bunny.ply" "$WORK/ra.pomar" --clusters 500
+expect_rc 0
+run info "$WORK/ra.pomar" --json
+expect_rc 0
+printf '%s' "$OUT" >"$WORK/ra.json"
+clusters=$(json_get "$WORK/ra.json" 'd["clusters"]')
+[ "$clusters" -gt 300 ] && [ "$clusters" -lt 800 ] || fail "expected about 500 clusters, got $clusters"
+pass
+
+section "decode one cluster reads part of the file and is a smaller valid mesh"
+run decode "$WORK/ra.pomar" "$WORK/one.ply" --cluster 0 --stats
+expect_rc 0
+expect_contains "$OUT" "bytes read" "--stats output"
+expect_contains "$OUT" "clusters refined" "--stats output"
+one=$(ply_vertex_count "$WORK/one.ply")
+[ "$one" -lt 34834 ] || fail "one cluster decoded $one vertices (full mesh: 34834)"
+pass
+
+section "sphere and box requests; every cluster at the finest level is lossless"
+run decode "$WORK/ra.pomar" "$WORK/sphere.ply" --sphere -0.06,0.16,0.0,0.02
+expect_rc 0
+run decode "$WORK/ra.pomar" "$WORK/box.ply" --box -1,-1,-1,0,0.1,1:25
+expect_rc 0
+run decode "$WORK/ra.pomar" "$WORK/all.ply" --box -1,-1,-1,1,1,1
+expect_rc 0
+run verify "$SAMPLES/bunny.ply" "$WORK/ra.pomar" "$WORK/all.ply"
+expect_rc 0
+
+section "bad selections are clear errors and write nothing"
+run decode "$WORK/ra.pomar" "$WORK/bad1.ply" --cluster 999999
+expect_rc 1
+expect_contains "$ERR" "cluster 999999" "stderr"
+expect_no_file "$WORK/bad1.ply"
+run decode "$WORK/ra.pomar" "$WORK/bad2.ply" --sphere 1,2,3
+expect_rc 1
+expect_contains "$ERR" "expected 4 numbers" "stderr"
+expect_no_file "$WORK/bad2.ply"
+run decode "$WORK/ra.pomar" "$WORK/bad3.ply" --cluster 3:abc
+expect_rc 1
+expect_no_file "$WORK/bad3.ply"
+run encode "$SAMPLES/bunny.ply" "$WORK/prog.pomar" --progressive
+expect_rc 0
+run decode "$WORK/prog.pomar" "$WORK/bad4.ply" --cluster 0
+expect_rc 1
+expect_contains "$ERR" "progressive" "stderr"
+expect_no_file "$WORK/bad4.ply"
+
 # ---- --help ------------------------------------------------------------------------------------------
 
 section "--help"
@@ -306,8 +356,8 @@ help_mentions() { # help_mentions SUBCOMMAND OPTION...
   local opt
   for opt in "$@"; do expect_contains "$OUT" "$opt" "pomar $sub --help"; done
 }
-help_mentions encode --bits --progressive --quiet input output
-help_mentions decode --level --ascii --quiet input output
+help_mentions encode --bits --progressive --clusters --cluster-ratio --quiet input output
+help_mentions decode --level --cluster --sphere --box --stats --ascii --quiet input output
 help_mentions info --json input
 help_mentions verify original pomar decoded
 
