@@ -100,12 +100,17 @@ struct SelectiveDecoder::State {
   std::vector<Models> level_models;
   ClusterIndex index;
   std::vector<uint32_t> adj_start, adj;
-  struct Cluster {
-    std::vector<uint8_t> block;
-    bool loaded = false;
+  /// A cluster's block, read from the source in chunks as its decoder consumes it.
+  struct Cluster : StreamRefill {
+    State *state = nullptr;
+    uint32_t id = 0;
+    std::vector<uint8_t> block; // sized to the whole block; [0, loaded) read so far
+    size_t loaded = 0;
+    bool checked = false;
     RangeDecoder rc;
     int level = 0;
     uint32_t next_local = 1;
+    size_t more(size_t needed) override { return state->fetch(*this, needed); }
   };
   std::vector<Cluster> clusters;
   std::vector<int> wanted, levels;
@@ -114,24 +119,45 @@ struct SelectiveDecoder::State {
   std::vector<PendingSplit> splits;
 
   bool clustered() const { return layout.header.clustered(); }
-  void load(uint32_t c);
+  static constexpr size_t kChunk = 8; // bytes per on-demand read of a cluster block
+  size_t fetch(Cluster &k, size_t needed);
+  void start(uint32_t c, bool whole);
   void reset_to_snapshot();
   void decode_cluster_level(uint32_t c, int level);
+  std::vector<int> target; // the level map being decoded
+  int target_of(uint32_t c) const { return target.empty() ? finest : target[c]; }
 };
 
-void SelectiveDecoder::State::load(uint32_t c) {
-  Cluster &k = clusters[c];
-  if (!k.loaded) {
-    k.block.resize(index.size[c]);
-    source->read(index.offset[c], index.size[c], k.block.data());
-    bytes_read += index.size[c];
+size_t SelectiveDecoder::State::fetch(Cluster &k, size_t needed) {
+  const size_t size = k.block.size();
+  if (k.loaded >= size)
+    return k.loaded; // past the end: the decoder reads zeros (and notices overruns)
+  const size_t upto = std::min(size, std::max(needed, k.loaded + kChunk));
+  source->read(index.offset[k.id] + k.loaded, upto - k.loaded, k.block.data() + k.loaded);
+  bytes_read += upto - k.loaded;
+  if (k.loaded == 0)
     ++blocks_read;
-    if ((checksum(k.block.data(), k.block.size()) & 0xFF) != index.check[c])
+  k.loaded = upto;
+  if (k.loaded == size && !k.checked) {
+    if ((checksum(k.block.data(), size) & 0xFF) != index.check[k.id])
       throw Error("damaged .pomar file: checksum mismatch in the block of cluster " +
-                  std::to_string(c));
-    k.loaded = true;
+                  std::to_string(k.id));
+    k.checked = true;
   }
-  k.rc.reset(k.block.data(), k.block.size());
+  return k.loaded;
+}
+
+/// (Re)start cluster c's stream; `whole` reads its block at once (it will be decoded to
+/// the end), otherwise bytes are read as the decoder needs them.
+void SelectiveDecoder::State::start(uint32_t c, bool whole) {
+  Cluster &k = clusters[c];
+  if (k.block.empty() && index.size[c] > 0)
+    k.block.resize(index.size[c]);
+  if (whole)
+    fetch(k, k.block.size());
+  else if (k.loaded < std::min<size_t>(k.block.size(), 4))
+    fetch(k, std::min<size_t>(k.block.size(), 4));
+  k.rc.reset(k.block.data(), k.loaded, &k);
 }
 
 void SelectiveDecoder::State::reset_to_snapshot() {
@@ -139,15 +165,13 @@ void SelectiveDecoder::State::reset_to_snapshot() {
   for (Cluster &k : clusters) {
     k.level = global_levels;
     k.next_local = 1;
-    if (k.loaded)
-      k.rc.reset(k.block.data(), k.block.size());
   }
 }
 
 void SelectiveDecoder::State::decode_cluster_level(uint32_t c, int level) {
   Cluster &k = clusters[c];
-  if (k.level == global_levels)
-    load(c); // first clustered level of this cluster: (re)start its stream
+  if (k.level == global_levels) // first clustered level of this cluster: (re)start its stream
+    start(c, target_of(c) == finest);
   DecoderCodec codec(layout.header.grid.bits);
   codec.set(&level_models[size_t(level - global_levels - 1)], &k.rc, &k.rc,
             "cluster " + std::to_string(c) + " level " + std::to_string(level));
@@ -206,8 +230,11 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source)
     s.mesh.cluster[c] = c;
   s.snapshot = s.mesh;
   s.clusters.resize(n);
-  for (auto &k : s.clusters)
-    k.level = s.global_levels;
+  for (uint32_t c = 0; c < n; ++c) {
+    s.clusters[c].state = &s;
+    s.clusters[c].id = c;
+    s.clusters[c].level = s.global_levels;
+  }
   s.wanted.assign(n, s.global_levels);
   s.levels.assign(n, s.global_levels);
   // The cluster graph = the base clustered mesh's edges.
@@ -364,7 +391,8 @@ void SelectiveDecoder::update(const Progress &progress) {
                          s.global_models, progress);
     return;
   }
-  const std::vector<int> target = complete_level_map(s.wanted, s.adj_start, s.adj, s.global_levels);
+  s.target = complete_level_map(s.wanted, s.adj_start, s.adj, s.global_levels);
+  const std::vector<int> &target = s.target;
   bool coarser = false;
   for (size_t c = 0; c < target.size(); ++c)
     coarser = coarser || target[c] < s.clusters[c].level;

@@ -165,9 +165,10 @@ void RangeEncoder::finish() {
 
 // ---------------------------------------------------------------- RangeDecoder
 
-void RangeDecoder::reset(const uint8_t *data, size_t size) {
+void RangeDecoder::reset(const uint8_t *data, size_t size, StreamRefill *refill) {
   data_ = data;
   size_ = size;
+  refill_ = refill;
   pos_ = 0;
   overrun_ = 0;
   range_ = 0xFFFFFFFFu;
@@ -179,6 +180,11 @@ void RangeDecoder::reset(const uint8_t *data, size_t size) {
 uint8_t RangeDecoder::next_byte() {
   if (pos_ < size_)
     return data_[pos_++];
+  if (refill_) {
+    size_ = refill_->more(pos_ + 1);
+    if (pos_ < size_)
+      return data_[pos_++];
+  }
   ++overrun_;
   return 0;
 }

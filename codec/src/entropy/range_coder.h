@@ -84,11 +84,22 @@ private:
   bool first_ = true;    // the very first cached byte is always 0 and is not written
 };
 
+/// Supplies more bytes of a stream on demand (random access reads only what the decoder
+/// consumes). Returns how many bytes are available in total now; the data pointer given
+/// to the decoder must stay valid for all of them.
+class StreamRefill {
+public:
+  virtual ~StreamRefill() = default;
+  virtual size_t more(size_t needed) = 0;
+};
+
 class RangeDecoder {
 public:
   RangeDecoder() = default;
   RangeDecoder(const uint8_t *data, size_t size) { reset(data, size); }
-  void reset(const uint8_t *data, size_t size);
+  /// Decode data[0..size); with `refill`, size may grow as the decoder needs bytes.
+  void reset(const uint8_t *data, size_t size, StreamRefill *refill = nullptr);
+  size_t consumed() const { return pos_; }
   int decode(FrequencyModel &m);
   int decode_bit(BitModel &m);
   uint32_t decode_bypass(int nbits);
@@ -101,6 +112,7 @@ private:
   void normalize();
   const uint8_t *data_ = nullptr;
   size_t size_ = 0, pos_ = 0;
+  StreamRefill *refill_ = nullptr;
   uint32_t range_ = 0xFFFFFFFFu, code_ = 0;
   size_t overrun_ = 0;
 };

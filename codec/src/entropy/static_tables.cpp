@@ -1,8 +1,28 @@
 #include "entropy/static_tables.h"
 
+#include <cstdlib>
+
 #include "pomar/pomar.h"
 
 namespace pomar {
+namespace {
+
+// Frequencies are stored on a logarithmic scale with 3 mantissa bits (at most 6% off):
+// code q in 1..103 stands for ((8 + q%8) << (q/8)) >> 3; 0 is "never seen".
+constexpr int kLogCodes = 104;
+
+uint32_t log_frequency(uint32_t q) { return q == 0 ? 0 : ((8u + (q & 7)) << (q >> 3)) >> 3; }
+
+uint32_t log_code(uint32_t f) { // the code whose frequency is nearest to f (f >= 1)
+  uint32_t best = 1;
+  for (uint32_t q = 1; q < kLogCodes; ++q)
+    if (std::abs(int64_t(log_frequency(q)) - int64_t(f)) <
+        std::abs(int64_t(log_frequency(best)) - int64_t(f)))
+      best = q;
+  return best;
+}
+
+} // namespace
 
 void freeze_on_recordings(std::vector<Models> &models,
                           const std::vector<SymbolRecorder> &recordings) {
@@ -25,6 +45,12 @@ void freeze_on_recordings(std::vector<Models> &models,
           if (it != counts.end())
             c = it->second;
           f.freeze_from_counts(c.data());
+          if (it == counts.end())
+            return; // unused: stays uniform, stored as such
+          uint16_t q[FrequencyModel::kMaxSymbols];
+          for (int i = 0; i < f.symbols(); ++i)
+            q[i] = static_cast<uint16_t>(f.freq(i) ? log_frequency(log_code(f.freq(i))) : 0);
+          f.freeze_with(q);
         },
         [&](BitModel &b) {
           auto it = counts.find(&b);
@@ -73,22 +99,32 @@ namespace {
 struct TableCoder {
   BitModel used[2];
   FrequencyModel index{FrequencyModel::kMaxSymbols};
-  FrequencyModel length{16};
+  FrequencyModel delta{FrequencyModel::kMaxSymbols}; // zigzag step between log codes
 };
 
-void put_gamma(RangeEncoder &rc, FrequencyModel &length, uint32_t v) { // v < 2^15
-  const int n = bit_length(v);
-  rc.encode(length, n);
-  if (n > 1)
-    rc.encode_bypass(v & ((1u << (n - 1)) - 1), n - 1);
+// Log codes of a model's symbols change slowly from one symbol to the next: code the
+// zigzagged step (escape 63 + 7 raw bits for big jumps).
+void put_code(RangeEncoder &rc, TableCoder &t, uint32_t q, uint32_t &prev) {
+  const int32_t d = int32_t(q) - int32_t(prev);
+  const uint32_t z = d >= 0 ? uint32_t(2 * d) : uint32_t(-2 * d - 1);
+  if (z < 63) {
+    rc.encode(t.delta, int(z));
+  } else {
+    rc.encode(t.delta, 63);
+    rc.encode_bypass(q, 7);
+  }
+  prev = q;
 }
 
-uint32_t get_gamma(RangeDecoder &rc, FrequencyModel &length) {
-  const int n = rc.decode(length);
-  uint32_t v = n == 0 ? 0 : 1;
-  if (n > 1)
-    v = (v << (n - 1)) | rc.decode_bypass(n - 1);
-  return v;
+uint32_t get_code(RangeDecoder &rc, TableCoder &t, uint32_t &prev) {
+  const int z = rc.decode(t.delta);
+  uint32_t q;
+  if (z < 63)
+    q = uint32_t(int32_t(prev) + ((z & 1) ? -(z + 1) / 2 : z / 2));
+  else
+    q = rc.decode_bypass(7);
+  prev = q;
+  return q;
 }
 
 } // namespace
@@ -115,8 +151,9 @@ std::vector<uint8_t> write_tables(std::vector<Models> &models) {
             return;
           rc.encode(t.index, first);
           rc.encode(t.index, last);
+          uint32_t prev = 48;
           for (int s = first; s <= last; ++s)
-            put_gamma(rc, t.length, f.freq(s));
+            put_code(rc, t, f.freq(s) ? log_code(f.freq(s)) : 0, prev);
         },
         [&](BitModel &b) {
           const bool used = b.p0 != (1u << (kBitModelBits - 1));
@@ -146,11 +183,12 @@ std::vector<Models> read_tables(const uint8_t *data, size_t size, size_t levels)
               bad();
             for (int s = 0; s < f.symbols(); ++s)
               freq[s] = 0;
+            uint32_t prev = 48;
             for (int s = first; s <= last; ++s) {
-              const uint32_t v = get_gamma(rc, t.length);
-              if (v > 0xFFFF)
+              const uint32_t q = get_code(rc, t, prev);
+              if (q >= kLogCodes)
                 bad();
-              freq[s] = static_cast<uint16_t>(v);
+              freq[s] = static_cast<uint16_t>(log_frequency(q));
             }
           }
           if (!f.freeze_with(freq))
