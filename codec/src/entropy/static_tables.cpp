@@ -1,5 +1,6 @@
 #include "entropy/static_tables.h"
 
+#include <cmath>
 #include <cstdlib>
 
 #include "pomar/pomar.h"
@@ -24,6 +25,26 @@ uint32_t log_code(uint32_t f) { // the code whose frequency is nearest to f (f >
 
 } // namespace
 
+namespace {
+
+/// Bits to code `counts` with frozen frequencies `freq` (infinite if a counted symbol
+/// has frequency 0).
+double data_bits(const std::vector<uint32_t> &counts, const uint16_t *freq, int n) {
+  double total = 0, bits = 0;
+  for (int s = 0; s < n; ++s)
+    total += freq[s];
+  for (int s = 0; s < n; ++s) {
+    if (!counts[size_t(s)])
+      continue;
+    if (!freq[s])
+      return 1e300;
+    bits += counts[size_t(s)] * std::log2(total / freq[s]);
+  }
+  return bits;
+}
+
+} // namespace
+
 void freeze_on_recordings(std::vector<Models> &models,
                           const std::vector<SymbolRecorder> &recordings) {
   std::unordered_map<const void *, std::vector<uint32_t>> counts;
@@ -36,33 +57,71 @@ void freeze_on_recordings(std::vector<Models> &models,
       c.resize(n, 0);
       ++c[e.value];
     }
-  for (Models &m : models)
+  // Level after level; a model whose previous-level table codes this level's symbols
+  // nearly as well as its own would (within what storing its own costs) reuses it.
+  std::vector<std::vector<uint16_t>> previous; // per slot: frozen frequencies (empty: unused)
+  for (Models &m : models) {
+    size_t slot = 0;
+    auto prev_of = [&]() -> std::vector<uint16_t> & {
+      if (previous.size() <= slot)
+        previous.resize(slot + 1);
+      return previous[slot++];
+    };
     for_each_model(
         m,
         [&](FrequencyModel &f) {
-          std::vector<uint32_t> c(size_t(f.symbols()), 0);
+          std::vector<uint16_t> &before = prev_of();
+          const int n = f.symbols();
           auto it = counts.find(&f);
+          std::vector<uint32_t> c(size_t(n), 0);
           if (it != counts.end())
             c = it->second;
           f.freeze_from_counts(c.data());
-          if (it == counts.end())
-            return; // unused: stays uniform, stored as such
+          if (it == counts.end()) {
+            before.clear(); // unused: stays uniform, stored as such
+            return;
+          }
           uint16_t q[FrequencyModel::kMaxSymbols];
-          for (int i = 0; i < f.symbols(); ++i)
+          for (int i = 0; i < n; ++i)
             q[i] = static_cast<uint16_t>(f.freq(i) ? log_frequency(log_code(f.freq(i))) : 0);
+          if (!before.empty()) {
+            int used = 0;
+            for (int i = 0; i < n; ++i)
+              used += q[i] != 0;
+            const double own = data_bits(c, q, n) + 1.5 * used + 2;
+            if (data_bits(c, before.data(), n) <= own) {
+              f.freeze_with(before.data());
+              return;
+            }
+          }
           f.freeze_with(q);
+          before.assign(q, q + n);
         },
         [&](BitModel &b) {
+          std::vector<uint16_t> &before = prev_of();
           auto it = counts.find(&b);
           uint32_t p0 = 1u << (kBitModelBits - 1);
           if (it != counts.end()) {
             const uint64_t zeros = it->second[0], all = zeros + it->second[1];
             p0 = static_cast<uint32_t>((zeros << kBitModelBits) / all);
-            p0 = std::min(std::max(p0, 1u), (1u << kBitModelBits) - 1);
+          }
+          p0 = std::min<uint32_t>(p0 >> 4, 255) * 16 + 8; // the 8-bit code the table keeps
+          if (it != counts.end() && !before.empty()) {
+            auto bits = [&](double p) {
+              return -(it->second[0] * std::log2(p / 4096.0) +
+                       it->second[1] * std::log2(1 - p / 4096.0));
+            };
+            if (bits(before[0]) <= bits(p0) + 6)
+              p0 = before[0];
           }
           b.p0 = static_cast<uint16_t>(p0);
           b.frozen = true;
+          if (it == counts.end())
+            before.clear();
+          else
+            before.assign(1, b.p0);
         });
+  }
 }
 
 std::vector<uint8_t> code_recording(const SymbolRecorder &r, double bits[2]) {
@@ -91,40 +150,53 @@ std::vector<uint8_t> code_recording(const SymbolRecorder &r, double bits[2]) {
   return out;
 }
 
-// Table stream: for each model in for_each_model order, a "used" bit (adaptive); a used
-// frequency model gives its first and last non-zero symbols and the frequencies between
-// (adaptive Elias-gamma); a used binary model gives its 12-bit probability.
+// Table stream, level after level, each model in for_each_model order:
+// - a "used" bit (adaptive; its context says whether the previous level used the model);
+// - a frequency model used by the previous level: per symbol, the zigzagged step from that
+//   level's log code (statistics drift slowly between levels); otherwise the first and last
+//   non-zero symbols and the steps from one symbol's code to the next;
+// - a binary model: its 8-bit probability code, as a step from the previous level's.
+// Unused models are uniform (frequency models) or p0 = 1/2 (binary models).
 namespace {
 
-struct TableCoder {
-  BitModel used[2];
+uint32_t bit_code(uint32_t p0) { return std::min<uint32_t>(p0 >> 4, 255); }
+uint16_t bit_probability(uint32_t code) { return static_cast<uint16_t>(code * 16 + 8); }
+const uint32_t kHalfCode = bit_code(1u << (kBitModelBits - 1));
+
+struct TableModels {
+  BitModel used[4];
+  BitModel same[2]; // "as in the previous level" (frequency / binary models)
   FrequencyModel index{FrequencyModel::kMaxSymbols};
-  FrequencyModel delta{FrequencyModel::kMaxSymbols}; // zigzag step between log codes
+  FrequencyModel along{FrequencyModel::kMaxSymbols};  // steps along an alphabet
+  FrequencyModel across{FrequencyModel::kMaxSymbols}; // steps from the previous level
 };
 
-// Log codes of a model's symbols change slowly from one symbol to the next: code the
-// zigzagged step (escape 63 + 7 raw bits for big jumps).
-void put_code(RangeEncoder &rc, TableCoder &t, uint32_t q, uint32_t &prev) {
-  const int32_t d = int32_t(q) - int32_t(prev);
+/// Per model slot: the previous level's codes (empty: unused there).
+using History = std::vector<std::vector<uint32_t>>;
+
+void put_step(RangeEncoder &rc, FrequencyModel &m, uint32_t q, uint32_t ref) {
+  const int32_t d = int32_t(q) - int32_t(ref);
   const uint32_t z = d >= 0 ? uint32_t(2 * d) : uint32_t(-2 * d - 1);
   if (z < 63) {
-    rc.encode(t.delta, int(z));
+    rc.encode(m, int(z));
   } else {
-    rc.encode(t.delta, 63);
-    rc.encode_bypass(q, 7);
+    rc.encode(m, 63);
+    rc.encode_bypass(q, 8);
   }
-  prev = q;
 }
 
-uint32_t get_code(RangeDecoder &rc, TableCoder &t, uint32_t &prev) {
-  const int z = rc.decode(t.delta);
-  uint32_t q;
-  if (z < 63)
-    q = uint32_t(int32_t(prev) + ((z & 1) ? -(z + 1) / 2 : z / 2));
-  else
-    q = rc.decode_bypass(7);
-  prev = q;
-  return q;
+uint32_t get_step(RangeDecoder &rc, FrequencyModel &m, uint32_t ref) {
+  const int z = rc.decode(m);
+  if (z == 63)
+    return rc.decode_bypass(8);
+  const int64_t q = int64_t(ref) + ((z & 1) ? -(z + 1) / 2 : z / 2);
+  return q < 0 ? 0xFFFFFFFFu : uint32_t(q);
+}
+
+std::vector<uint32_t> &slot_history(History &h, size_t &slot) {
+  if (h.size() <= slot)
+    h.resize(slot + 1);
+  return h[slot++];
 }
 
 } // namespace
@@ -132,35 +204,66 @@ uint32_t get_code(RangeDecoder &rc, TableCoder &t, uint32_t &prev) {
 std::vector<uint8_t> write_tables(std::vector<Models> &models) {
   std::vector<uint8_t> out;
   RangeEncoder rc(&out);
-  TableCoder t;
-  for (Models &m : models)
+  TableModels t;
+  History history;
+  for (Models &m : models) {
+    size_t slot = 0;
     for_each_model(
         m,
         [&](FrequencyModel &f) {
-          int first = 0, last = f.symbols() - 1;
-          while (first < f.symbols() && f.freq(first) == 0)
-            ++first;
-          while (last >= 0 && f.freq(last) == 0)
-            --last;
-          // A model nobody used was frozen uniform: all ones.
+          std::vector<uint32_t> &before = slot_history(history, slot);
+          const size_t n = size_t(f.symbols());
           bool uniform = true;
-          for (int s = 0; s < f.symbols(); ++s)
-            uniform = uniform && f.freq(s) == 1;
-          rc.encode_bit(t.used[0], uniform ? 0 : 1);
-          if (uniform)
+          std::vector<uint32_t> q(n);
+          for (size_t s = 0; s < n; ++s) {
+            uniform = uniform && f.freq(int(s)) == 1;
+            q[s] = f.freq(int(s)) ? log_code(f.freq(int(s))) : 0;
+          }
+          rc.encode_bit(t.used[before.empty() ? 0 : 2], uniform ? 0 : 1);
+          if (uniform) {
+            before.clear();
             return;
-          rc.encode(t.index, first);
-          rc.encode(t.index, last);
-          uint32_t prev = 48;
-          for (int s = first; s <= last; ++s)
-            put_code(rc, t, f.freq(s) ? log_code(f.freq(s)) : 0, prev);
+          }
+          if (!before.empty()) {
+            const bool same = q == before;
+            rc.encode_bit(t.same[0], same ? 1 : 0);
+            if (same)
+              return;
+            for (size_t s = 0; s < n; ++s)
+              put_step(rc, t.across, q[s], before[s]);
+          } else {
+            size_t first = 0, last = n - 1;
+            while (first < last && q[first] == 0)
+              ++first;
+            while (last > first && q[last] == 0)
+              --last;
+            rc.encode(t.index, int(first));
+            rc.encode(t.index, int(last));
+            uint32_t ref = 48;
+            for (size_t s = first; s <= last; ++s) {
+              put_step(rc, t.along, q[s], ref);
+              ref = q[s];
+            }
+          }
+          before = q;
         },
         [&](BitModel &b) {
-          const bool used = b.p0 != (1u << (kBitModelBits - 1));
-          rc.encode_bit(t.used[1], used ? 1 : 0);
-          if (used)
-            rc.encode_bypass(b.p0, kBitModelBits);
+          std::vector<uint32_t> &before = slot_history(history, slot);
+          const uint32_t code = bit_code(b.p0);
+          rc.encode_bit(t.used[before.empty() ? 1 : 3], code != kHalfCode ? 1 : 0);
+          if (code == kHalfCode) {
+            before.clear();
+            return;
+          }
+          if (!before.empty()) {
+            rc.encode_bit(t.same[1], code == before[0] ? 1 : 0);
+            if (code == before[0])
+              return;
+          }
+          put_step(rc, t.across, code, before.empty() ? 128 : before[0]);
+          before.assign(1, code);
         });
+  }
   rc.finish();
   return out;
 }
@@ -168,42 +271,64 @@ std::vector<uint8_t> write_tables(std::vector<Models> &models) {
 std::vector<Models> read_tables(const uint8_t *data, size_t size, size_t levels) {
   std::vector<Models> models(levels);
   RangeDecoder rc(data, size);
-  TableCoder t;
+  TableModels t;
+  History history;
   auto bad = [] { throw Error("damaged .pomar file: invalid static model tables"); };
-  for (Models &m : models)
+  for (Models &m : models) {
+    size_t slot = 0;
     for_each_model(
         m,
         [&](FrequencyModel &f) {
+          std::vector<uint32_t> &before = slot_history(history, slot);
+          const size_t n = size_t(f.symbols());
           uint16_t freq[FrequencyModel::kMaxSymbols];
-          for (int s = 0; s < f.symbols(); ++s)
-            freq[s] = 1;
-          if (rc.decode_bit(t.used[0])) {
-            const int first = rc.decode(t.index), last = rc.decode(t.index);
-            if (first > last || last >= f.symbols())
-              bad();
-            for (int s = 0; s < f.symbols(); ++s)
-              freq[s] = 0;
-            uint32_t prev = 48;
-            for (int s = first; s <= last; ++s) {
-              const uint32_t q = get_code(rc, t, prev);
-              if (q >= kLogCodes)
+          if (!rc.decode_bit(t.used[before.empty() ? 0 : 2])) {
+            for (size_t s = 0; s < n; ++s)
+              freq[s] = 1;
+            before.clear();
+          } else {
+            std::vector<uint32_t> q(n, 0);
+            if (!before.empty() && rc.decode_bit(t.same[0])) {
+              q = before;
+            } else if (!before.empty()) {
+              for (size_t s = 0; s < n; ++s)
+                q[s] = get_step(rc, t.across, before[s]);
+            } else {
+              const size_t first = size_t(rc.decode(t.index)), last = size_t(rc.decode(t.index));
+              if (first > last || last >= n)
                 bad();
-              freq[s] = static_cast<uint16_t>(log_frequency(q));
+              uint32_t ref = 48;
+              for (size_t s = first; s <= last; ++s)
+                ref = q[s] = get_step(rc, t.along, ref);
             }
+            for (size_t s = 0; s < n; ++s) {
+              if (q[s] >= kLogCodes)
+                bad();
+              freq[s] = static_cast<uint16_t>(log_frequency(q[s]));
+            }
+            before = q;
           }
           if (!f.freeze_with(freq))
             bad();
         },
         [&](BitModel &b) {
-          b.p0 = 1u << (kBitModelBits - 1);
-          if (rc.decode_bit(t.used[1])) {
-            const uint32_t p = rc.decode_bypass(kBitModelBits);
-            if (p == 0)
+          std::vector<uint32_t> &before = slot_history(history, slot);
+          uint32_t code = kHalfCode;
+          if (rc.decode_bit(t.used[before.empty() ? 1 : 3])) {
+            if (!before.empty() && rc.decode_bit(t.same[1]))
+              code = before[0];
+            else
+              code = get_step(rc, t.across, before.empty() ? 128 : before[0]);
+            if (code > 255)
               bad();
-            b.p0 = static_cast<uint16_t>(p);
+            before.assign(1, code);
+          } else {
+            before.clear();
           }
+          b.p0 = bit_probability(code);
           b.frozen = true;
         });
+  }
   if (rc.overrun())
     bad();
   return models;
