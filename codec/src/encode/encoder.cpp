@@ -249,6 +249,7 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
     }
   for (uint32_t i : dec.base_triangles)
     base.triangles.push_back(input_to_dec[i]);
+  canonical_faces(base.triangles); // the order the file stores them in
 
   LevelMesh lm;
   lm.q = base.q;

@@ -1,5 +1,7 @@
 #include "format/file_format.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -14,8 +16,6 @@ namespace pomar {
 uint32_t checksum(const uint8_t *data, size_t size) { return XXH32(data, size, 0); }
 
 namespace {
-
-int index_bits(uint32_t vertices) { return std::max(1, bit_length(vertices - 1)); }
 
 void write_header(const FileHeader &h, std::vector<uint8_t> &out) {
   ByteWriter w(out);
@@ -90,15 +90,85 @@ std::vector<uint8_t> pack_cluster_index(const std::vector<std::vector<uint8_t>> 
 
 } // namespace
 
+// The base mesh block is one range-coded stream: positions as differences to the previous
+// vertex (the encoder orders vertices along a Morton curve, so they are small), then the
+// faces, each rotated to start at its smallest index and sorted, as the step from the
+// previous face's first index and the two other indices relative to the first. Every
+// value is a magnitude class (adaptive) followed by sign and mantissa bits.
+namespace {
+
+struct BaseModels {
+  FrequencyModel coord[3] = {FrequencyModel(kMagnitudeSymbols), FrequencyModel(kMagnitudeSymbols),
+                             FrequencyModel(kMagnitudeSymbols)};
+  FrequencyModel first{kMagnitudeSymbols}, other{kMagnitudeSymbols};
+};
+
+void put_value(RangeEncoder &rc, FrequencyModel &m, int64_t v) {
+  const uint64_t a = static_cast<uint64_t>(v < 0 ? -v : v);
+  const int n = bit_length(a);
+  rc.encode(m, n);
+  if (n == 0)
+    return;
+  rc.encode_bypass(v < 0 ? 1 : 0, 1);
+  const int rest = n - 1;
+  if (rest > 24) {
+    rc.encode_bypass(static_cast<uint32_t>(a >> 24) & ((1u << (rest - 24)) - 1), rest - 24);
+    rc.encode_bypass(static_cast<uint32_t>(a & 0xFFFFFF), 24);
+  } else if (rest > 0) {
+    rc.encode_bypass(static_cast<uint32_t>(a) & ((1u << rest) - 1), rest);
+  }
+}
+
+int64_t get_value(RangeDecoder &rc, FrequencyModel &m) {
+  const int n = rc.decode(m);
+  if (n == 0)
+    return 0;
+  const bool negative = rc.decode_bypass(1) != 0;
+  uint64_t a = 1;
+  const int rest = n - 1;
+  if (rest > 24) {
+    a = (a << (rest - 24)) | rc.decode_bypass(rest - 24);
+    a = (a << 24) | rc.decode_bypass(24);
+  } else if (rest > 0) {
+    a = (a << rest) | rc.decode_bypass(rest);
+  }
+  return negative ? -static_cast<int64_t>(a) : static_cast<int64_t>(a);
+}
+
+} // namespace
+
+void canonical_faces(std::vector<uint32_t> &t) {
+  const size_t nf = t.size() / 3;
+  std::vector<std::array<uint32_t, 3>> f(nf);
+  for (size_t i = 0; i < nf; ++i) {
+    std::array<uint32_t, 3> x = {t[3 * i], t[3 * i + 1], t[3 * i + 2]};
+    std::rotate(x.begin(), std::min_element(x.begin(), x.end()), x.end());
+    f[i] = x;
+  }
+  std::sort(f.begin(), f.end());
+  for (size_t i = 0; i < nf; ++i)
+    std::copy(f[i].begin(), f[i].end(), &t[3 * i]);
+}
+
 std::vector<uint8_t> pack_base_mesh(const BaseMesh &base, int bits) {
+  (void)bits;
   std::vector<uint8_t> out;
-  BitWriter w(out);
-  for (int32_t v : base.q)
-    w.put(static_cast<uint32_t>(v), bits);
-  const int ib = index_bits(static_cast<uint32_t>(base.q.size() / 3));
-  for (uint32_t i : base.triangles)
-    w.put(i, ib);
-  w.flush();
+  RangeEncoder rc(&out);
+  BaseModels m;
+  int32_t prev[3] = {0, 0, 0};
+  for (size_t i = 0; i < base.q.size(); ++i) {
+    put_value(rc, m.coord[i % 3], int64_t(base.q[i]) - prev[i % 3]);
+    prev[i % 3] = base.q[i];
+  }
+  uint32_t prev_first = 0;
+  for (size_t f = 0; f < base.triangles.size(); f += 3) {
+    const uint32_t a = base.triangles[f];
+    put_value(rc, m.first, int64_t(a) - prev_first);
+    put_value(rc, m.other, int64_t(base.triangles[f + 1]) - a);
+    put_value(rc, m.other, int64_t(base.triangles[f + 2]) - a);
+    prev_first = a;
+  }
+  rc.finish();
   return out;
 }
 
@@ -239,11 +309,8 @@ FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size) {
   }
   if (nv != h.vertices || nf != h.faces)
     bad("level table does not end at the announced vertex/face counts");
-  const uint64_t base_needed =
-      (uint64_t(h.base_vertices) * 3 * h.grid.bits +
-       uint64_t(h.base_faces) * 3 * index_bits(h.base_vertices) + 7) / 8;
-  if (h.base_bytes != base_needed)
-    bad("base mesh block size does not match its counts");
+  if (h.base_bytes == 0)
+    bad("empty base mesh block");
   uint64_t offset = L.header_bytes;
   L.base_offset = offset;
   offset += h.base_bytes;
@@ -279,18 +346,37 @@ BaseMesh read_base_mesh(const uint8_t *data, const FileLayout &L) {
   const uint8_t *p = data + L.base_offset;
   if (checksum(p, h.base_bytes) != h.base_checksum)
     throw Error("damaged .pomar file: base mesh checksum mismatch");
+  auto bad = [](const char *what) {
+    throw Error(std::string("damaged .pomar file: base mesh ") + what);
+  };
   BaseMesh b;
-  BitReader r(p, h.base_bytes);
+  RangeDecoder rc(p, h.base_bytes);
+  BaseModels m;
+  const int64_t top = (int64_t(1) << h.grid.bits) - 1;
   b.q.resize(size_t(h.base_vertices) * 3);
-  for (auto &v : b.q)
-    v = static_cast<int32_t>(r.get(h.grid.bits));
-  const int ib = index_bits(h.base_vertices);
-  b.triangles.resize(size_t(h.base_faces) * 3);
-  for (auto &i : b.triangles) {
-    i = r.get(ib);
-    if (i >= h.base_vertices)
-      throw Error("damaged .pomar file: base mesh face refers to a missing vertex");
+  int64_t prev[3] = {0, 0, 0};
+  for (size_t i = 0; i < b.q.size(); ++i) {
+    const int64_t v = prev[i % 3] + get_value(rc, m.coord[i % 3]);
+    if (v < 0 || v > top)
+      bad("position outside the quantization grid");
+    b.q[i] = static_cast<int32_t>(v);
+    prev[i % 3] = v;
   }
+  b.triangles.resize(size_t(h.base_faces) * 3);
+  int64_t prev_first = 0;
+  for (size_t f = 0; f < b.triangles.size(); f += 3) {
+    const int64_t a = prev_first + get_value(rc, m.first);
+    const int64_t x = a + get_value(rc, m.other), y = a + get_value(rc, m.other);
+    for (int64_t i : {a, x, y})
+      if (i < 0 || i >= int64_t(h.base_vertices))
+        bad("face refers to a missing vertex");
+    b.triangles[f] = uint32_t(a);
+    b.triangles[f + 1] = uint32_t(x);
+    b.triangles[f + 2] = uint32_t(y);
+    prev_first = a;
+  }
+  if (rc.overrun())
+    bad("data ends too early");
   return b;
 }
 

@@ -53,7 +53,7 @@ struct ClusterIndex {
   std::vector<uint8_t> check;
 };
 
-/// The base mesh: quantized positions and triangles, stored bit-packed, uncompressed.
+/// The base mesh: quantized positions and triangles (range coded, see pack_base_mesh).
 struct BaseMesh {
   std::vector<int32_t> q;
   std::vector<uint32_t> triangles;
@@ -71,6 +71,9 @@ struct FileLayout {
 
 uint32_t checksum(const uint8_t *data, size_t size);
 
+/// Rotate every face to start at its smallest index and sort the faces (the order the
+/// base mesh block stores them in).
+void canonical_faces(std::vector<uint32_t> &triangles);
 std::vector<uint8_t> pack_base_mesh(const BaseMesh &base, int bits);
 /// Assemble a complete file image. `header.levels` must describe `level_blocks` (the
 /// global levels); a clustered file also gets its tables, index and cluster blocks.
