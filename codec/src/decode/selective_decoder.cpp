@@ -119,7 +119,7 @@ struct SelectiveDecoder::State {
   std::vector<PendingSplit> splits;
 
   bool clustered() const { return layout.header.clustered(); }
-  static constexpr size_t kChunk = 8; // bytes per on-demand read of a cluster block
+  static constexpr size_t kChunk = 4; // bytes per on-demand read of a cluster block
   size_t fetch(Cluster &k, size_t needed);
   void start(uint32_t c, bool whole);
   void reset_to_snapshot();
