@@ -51,7 +51,7 @@ struct EncodeArgs {
   std::string in, out;
   int bits = 12;
   uint32_t clusters = 0;
-  double cluster_ratio = 0.02;
+  double cluster_ratio = 0.01;
   bool progressive = false, quiet = false;
 };
 

@@ -47,7 +47,7 @@ void decode_global_levels(const uint8_t *data, const FileLayout &layout, size_t 
     const uint8_t *p = data + layout.level_offset[i];
     conn.reset(p, e.connectivity_bytes);
     geom.reset(p + e.connectivity_bytes, e.geometry_bytes);
-    codec.set(&models, &conn, &geom, "level " + std::to_string(i + 1));
+    codec.set(&models, &conn, &geom, static_cast<uint32_t>(i + 1));
     traverse_level(lm, codec, scratch, static_cast<uint32_t>(i + 1), splits);
     if (conn.overrun() || geom.overrun())
       codec.corrupt("the level's data ends too early");

@@ -15,11 +15,15 @@ class DecoderCodec {
 public:
   explicit DecoderCodec(int bits) : top_((int64_t(1) << bits) - 1) {}
 
-  void set(Models *models, RangeDecoder *conn, RangeDecoder *geom, const std::string &where) {
+  /// Streams and models of what is decoded next: global level `level` (cluster kNone) or
+  /// cluster `cluster`'s data of level `level` (named in error messages).
+  void set(Models *models, RangeDecoder *conn, RangeDecoder *geom, uint32_t level,
+           uint32_t cluster = 0xFFFFFFFFu) {
     m_ = models;
     conn_ = conn;
     geom_ = geom;
-    where_ = where;
+    level_ = level;
+    cluster_ = cluster;
   }
 
   int split_flag(uint32_t, int context) { return conn_->decode_bit(m_->conn.sv[context]); }
@@ -51,14 +55,17 @@ public:
   }
 
   [[noreturn]] void corrupt(const char *what) {
-    throw Error("damaged .pomar file: " + where_ + ": " + what);
+    std::string where = "level " + std::to_string(level_);
+    if (cluster_ != 0xFFFFFFFFu)
+      where = "cluster " + std::to_string(cluster_) + " " + where;
+    throw Error("damaged .pomar file: " + where + ": " + what);
   }
 
 private:
   Models *m_ = nullptr;
   RangeDecoder *conn_ = nullptr, *geom_ = nullptr;
   int64_t top_;
-  std::string where_;
+  uint32_t level_ = 0, cluster_ = 0xFFFFFFFFu;
 };
 
 /// Decode global levels [from, to) of `mesh` (the file image must hold the global part).

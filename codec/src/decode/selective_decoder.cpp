@@ -174,7 +174,7 @@ void SelectiveDecoder::State::decode_cluster_level(uint32_t c, int level) {
     start(c, target_of(c) == finest);
   DecoderCodec codec(layout.header.grid.bits);
   codec.set(&level_models[size_t(level - global_levels - 1)], &k.rc, &k.rc,
-            "cluster " + std::to_string(c) + " level " + std::to_string(level));
+            static_cast<uint32_t>(level), c);
   traverse_cluster(mesh, codec, scratch, c, static_cast<uint32_t>(level), splits);
   apply_splits(mesh, splits, static_cast<uint32_t>(level), c, &k.next_local);
   if (k.rc.overrun())

@@ -250,25 +250,37 @@ inline uint32_t view_of(const LevelMesh &mesh, uint32_t v, uint32_t level) {
   return v;
 }
 
-inline void get_view_ring(const LevelMesh &mesh, uint32_t v, uint32_t level, Ring &actual,
-                          Ring &view) {
-  get_ring(mesh.ct, v, actual);
+/// Like get_ring, mapping neighbours through view_of and skipping the faces that collapse
+/// in the view (one pass for an interior vertex).
+inline void get_view_ring(const LevelMesh &mesh, uint32_t v, uint32_t level, Ring &view) {
+  const CornerTable &ct = mesh.ct;
   view.neighbour.clear();
   view.corner.clear();
-  view.closed = actual.closed;
-  if (actual.neighbour.empty())
+  view.closed = true;
+  const uint32_t start = ct.VC[v];
+  if (start == kNone)
     return;
-  const uint32_t m = actual.size();
-  uint32_t prev = view_of(mesh, actual.neighbour[0], level);
+  uint32_t first = start;
+  for (uint32_t c = ct.swing_ccw(start); c != start; c = ct.swing_ccw(c)) {
+    if (c == kNone) { // open fan: start from its clockwise end
+      view.closed = false;
+      for (uint32_t b = ct.swing_cw(first); b != kNone; b = ct.swing_cw(b))
+        first = b;
+      break;
+    }
+  }
+  uint32_t prev = view_of(mesh, ct.V[CornerTable::next(first)], level);
   view.neighbour.push_back(prev);
-  for (uint32_t i = 0; i < actual.faces(); ++i) {
-    const uint32_t next = view_of(mesh, actual.neighbour[(i + 1) % m], level);
+  uint32_t c = first;
+  do {
+    const uint32_t next = view_of(mesh, ct.V[CornerTable::prev(c)], level);
     if (next != prev) {
-      view.corner.push_back(actual.corner[i]);
+      view.corner.push_back(c);
       view.neighbour.push_back(next);
     }
     prev = next;
-  }
+    c = ct.swing_ccw(c);
+  } while (c != kNone && c != first);
   if (view.closed && view.neighbour.size() > 1)
     view.neighbour.pop_back(); // the wrap-around repeats the first neighbour
 }
@@ -369,8 +381,7 @@ void traverse_cluster(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32
   const uint32_t cluster = mesh.cluster[root];
   const auto key = [&](uint32_t v) { return mesh.key(v); };
   const auto mine = [&](uint32_t v) { return mesh.cluster[v] == cluster; };
-  Ring actual;
-  get_view_ring(mesh, root, level, actual, s.ring);
+  get_view_ring(mesh, root, level, s.ring);
   if (s.ring.neighbour.empty())
     return;
   uint32_t from = s.ring.neighbour[0];
@@ -381,7 +392,7 @@ void traverse_cluster(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32
   s.queue.emplace_back(root, from);
   for (size_t head = 0; head < s.queue.size();) {
     const auto [v, came_from] = s.queue[head++];
-    get_view_ring(mesh, v, level, actual, s.ring);
+    get_view_ring(mesh, v, level, s.ring);
     code_vertex(mesh, codec, s, v, s.ring, level, key, splits);
     queue_neighbours(s, v, came_from, s.ring, mine);
   }
