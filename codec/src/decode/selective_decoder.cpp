@@ -224,10 +224,9 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source)
                        {});
   // The base clustered mesh: each vertex roots its cluster.
   const uint32_t n = h.clusters;
-  s.mesh.cluster.resize(n);
   s.mesh.local.assign(n, 0);
   for (uint32_t c = 0; c < n; ++c)
-    s.mesh.cluster[c] = c;
+    s.mesh.tag[c].cluster = c;
   s.snapshot = s.mesh;
   s.clusters.resize(n);
   for (uint32_t c = 0; c < n; ++c) {
@@ -303,7 +302,7 @@ void SelectiveDecoder::want_vertices(const std::vector<uint32_t> &vertices, int 
   for (uint32_t v : vertices) {
     if (v >= s_->mesh.vertex_count())
       throw Error("vertex " + std::to_string(v) + " is not in the decoded mesh");
-    int &w = s_->wanted[s_->mesh.cluster[v]];
+    int &w = s_->wanted[s_->mesh.cluster_of(v)];
     w = std::max(w, level);
   }
 }
@@ -378,10 +377,10 @@ void SelectiveDecoder::set_wanted(const std::vector<int> &levels) {
 void SelectiveDecoder::update(const Progress &progress) {
   State &s = *s_;
   if (!s.clustered()) {
-    int have = static_cast<int>(s.mesh.level.empty() ? 0 : 0);
     // The progressive mesh's level is the highest level of any vertex.
-    for (uint16_t l : s.mesh.level)
-      have = std::max(have, int(l));
+    int have = 0;
+    for (const LevelMesh::Tag &t : s.mesh.tag)
+      have = std::max(have, int(t.level));
     if (s.uniform_level < have) {
       s.mesh = s.snapshot;
       s.global_models = Models();
@@ -416,13 +415,18 @@ void SelectiveDecoder::update(const Progress &progress) {
 Mesh SelectiveDecoder::mesh() const { return to_mesh(s_->mesh, s_->layout.header.grid); }
 
 std::vector<uint32_t> SelectiveDecoder::vertex_cluster() const {
+  std::vector<uint32_t> out(s_->mesh.vertex_count(), 0);
   if (s_->clustered())
-    return s_->mesh.cluster;
-  return std::vector<uint32_t>(s_->mesh.vertex_count(), 0);
+    for (uint32_t v = 0; v < out.size(); ++v)
+      out[v] = s_->mesh.cluster_of(v);
+  return out;
 }
 
 std::vector<uint32_t> SelectiveDecoder::vertex_level() const {
-  return std::vector<uint32_t>(s_->mesh.level.begin(), s_->mesh.level.end());
+  std::vector<uint32_t> out(s_->mesh.vertex_count());
+  for (uint32_t v = 0; v < out.size(); ++v)
+    out[v] = s_->mesh.level_of(v);
+  return out;
 }
 
 } // namespace pomar

@@ -309,10 +309,9 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
     header.flags |= kFlagClustered;
     header.global_levels = static_cast<uint32_t>(G);
     const uint32_t clusters = lm.vertex_count();
-    lm.cluster.resize(clusters);
     lm.local.assign(clusters, 0);
     for (uint32_t c = 0; c < clusters; ++c)
-      lm.cluster[c] = c;
+      lm.tag[c].cluster = c;
     std::vector<uint32_t> next_local(clusters, 1);
     std::vector<Models> level_models(L - G);
     std::vector<SymbolRecorder> recordings(clusters);

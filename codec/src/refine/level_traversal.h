@@ -32,19 +32,24 @@ struct LevelMesh {
   CornerTable ct;
   std::vector<int32_t> q; // quantized xyz per vertex
   uint32_t seed_faces = 0; // faces of the base mesh (traversal seeds, never removed)
-  // Lineage of every vertex: the level that created it (0 = base mesh) and its parent
-  // (the v_to it was split from; itself for base vertices).
-  std::vector<uint16_t> level;
-  std::vector<uint32_t> parent;
-  // Clustered levels only: the cluster of each vertex (the base clustered mesh vertex it
-  // descends from) and its rank of creation inside the cluster. (cluster, local) names a
-  // vertex the same way whatever clusters were decoded in whatever order.
-  std::vector<uint32_t> cluster, local;
+  // Lineage of every vertex: the level that created it (0 = base mesh), its cluster
+  // (clustered levels: the base clustered mesh vertex it descends from), its parent (the
+  // v_to it was split from; itself for base vertices) and its rank of creation inside its
+  // cluster. (cluster, local) names a vertex the same way whatever clusters were decoded
+  // in whatever order. Level and cluster share a cache line: the walks read both.
+  struct Tag {
+    uint32_t cluster = 0;
+    uint16_t level = 0;
+  };
+  std::vector<Tag> tag;
+  std::vector<uint32_t> parent, local;
   std::vector<uint16_t> face_claim; // per face: last level whose patch held it
   uint32_t vertex_count() const { return ct.vertex_count(); }
-  uint64_t key(uint32_t v) const { return (uint64_t(cluster[v]) << 32) | local[v]; }
+  uint32_t level_of(uint32_t v) const { return tag[v].level; }
+  uint32_t cluster_of(uint32_t v) const { return tag[v].cluster; }
+  uint64_t key(uint32_t v) const { return (uint64_t(tag[v].cluster) << 32) | local[v]; }
   void init_lineage() {
-    level.assign(vertex_count(), 0);
+    tag.assign(vertex_count(), Tag{});
     parent.resize(vertex_count());
     for (uint32_t v = 0; v < vertex_count(); ++v)
       parent[v] = v;
@@ -245,7 +250,7 @@ inline int sv_context(const TraversalScratch &s, const Ring &ring) {
 /// The view is the same whatever clusters were decoded before, which is what makes
 /// selective and incremental decoding equal to a full decode.
 inline uint32_t view_of(const LevelMesh &mesh, uint32_t v, uint32_t level) {
-  while (mesh.level[v] >= level && mesh.parent[v] != v)
+  while (mesh.tag[v].level >= level && mesh.parent[v] != v)
     v = mesh.parent[v];
   return v;
 }
@@ -378,9 +383,9 @@ void traverse_cluster(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32
                       uint32_t level, std::vector<PendingSplit> &splits) {
   s.begin(mesh.vertex_count(), mesh.ct.face_count());
   splits.clear();
-  const uint32_t cluster = mesh.cluster[root];
+  const uint32_t cluster = mesh.cluster_of(root);
   const auto key = [&](uint32_t v) { return mesh.key(v); };
-  const auto mine = [&](uint32_t v) { return mesh.cluster[v] == cluster; };
+  const auto mine = [&](uint32_t v) { return mesh.tag[v].cluster == cluster; };
   get_view_ring(mesh, root, level, s.ring);
   if (s.ring.neighbour.empty())
     return;
@@ -406,12 +411,10 @@ inline void apply_splits(LevelMesh &mesh, const std::vector<PendingSplit> &split
     const uint32_t v_from = mesh.vertex_count();
     apply_split(mesh.ct, ps.op, v_from);
     mesh.q.insert(mesh.q.end(), ps.position, ps.position + 3);
-    mesh.level.push_back(static_cast<uint16_t>(level));
+    mesh.tag.push_back({cluster == kNone ? 0 : cluster, static_cast<uint16_t>(level)});
     mesh.parent.push_back(ps.op.v_to);
-    if (cluster != kNone) {
-      mesh.cluster.push_back(cluster);
+    if (cluster != kNone)
       mesh.local.push_back((*next_local)++);
-    }
   }
   mesh.face_claim.resize(mesh.ct.face_count(), 0);
 }

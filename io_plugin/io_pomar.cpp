@@ -1,0 +1,353 @@
+// MeshLab 2020.09 IO plugin for .pomar files: see io_pomar.h.
+#include "io_pomar.h"
+
+#include <pomar/pomar.h>
+#include <pomar/random_access.h>
+#include <pomar/vcg_adapter.h>
+
+#include <QFile>
+#include <QFileInfo>
+#include <QSaveFile>
+#include <QStringList>
+#include <QtGlobal>
+
+#include <vcg/complex/allocate.h>
+
+#include <cmath>
+#include <exception>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace {
+
+const char *const kFormatName = "POMAR progressive mesh";
+const char *const kExtension = "pomar";
+
+bool isPomar(const QString &format) {
+  return format.compare(QLatin1String(kExtension), Qt::CaseInsensitive) == 0;
+}
+
+/// Forwards the codec's progress to MeshLab's callback, at most every 10%.
+class ProgressRelay {
+public:
+  ProgressRelay(vcg::CallBackPos *cb, const char *label) : cb_(cb), label_(label) {}
+  pomar::Progress function() {
+    if (cb_ == nullptr)
+      return {};
+    return [this](double fraction, const char *) {
+      const int pct = std::isfinite(fraction) ? int(qBound(0.0, fraction, 1.0) * 100) : 0;
+      if (pct / 10 != last_ / 10) {
+        last_ = pct;
+        (*cb_)(pct, label_);
+      }
+    };
+  }
+  void report(int pct) {
+    if (cb_ != nullptr && pct != last_) {
+      last_ = pct;
+      (*cb_)(pct, label_);
+    }
+  }
+
+private:
+  vcg::CallBackPos *cb_;
+  const char *label_;
+  int last_ = -1;
+};
+
+/// Angle-weighted vertex normals as MeshLab computes them after opening a file
+/// (MeshModel::UpdateBoxAndNormals -> UpdateNormal::PerVertexAngleWeighted): true if the
+/// mesh's own per-vertex normals differ materially (more than 10 degrees on more than 1%
+/// of the used vertices), i.e. they came from a file or a tool rather than from the
+/// geometry, so losing them is visible.
+bool hasOwnVertexNormals(const CMeshO &m) {
+  using P = vcg::Point3f;
+  std::vector<P> acc(m.vert.size(), P(0, 0, 0));
+  std::vector<char> used(m.vert.size(), 0);
+  const CVertexO *first = m.vert.empty() ? nullptr : &m.vert[0];
+  for (const CFaceO &f : m.face) {
+    if (f.IsD())
+      continue;
+    const P p0 = P::Construct(f.cP(0)), p1 = P::Construct(f.cP(1)), p2 = P::Construct(f.cP(2));
+    P n = (p1 - p0) ^ (p2 - p0);
+    const float len = n.Norm();
+    if (!(len > 0) || !std::isfinite(len))
+      continue;
+    n /= len;
+    const P e0 = (p1 - p0).Normalize(), e1 = (p2 - p1).Normalize(), e2 = (p0 - p2).Normalize();
+    const float w[3] = {vcg::AngleN(e0, -e2), vcg::AngleN(-e0, e1), vcg::AngleN(-e1, e2)};
+    for (int k = 0; k < 3; ++k) {
+      const size_t v = size_t(f.cV(k) - first);
+      if (v >= acc.size() || !std::isfinite(w[k]))
+        continue;
+      acc[v] += n * w[k];
+      used[v] = 1;
+    }
+  }
+  const float cosLimit = std::cos(10.0f * float(M_PI) / 180.0f);
+  size_t count = 0, differ = 0;
+  for (size_t v = 0; v < m.vert.size(); ++v) {
+    if (m.vert[v].IsD() || !used[v] || !(acc[v].Norm() > 0))
+      continue;
+    ++count;
+    const P stored = P::Construct(m.vert[v].cN());
+    const float sn = stored.Norm();
+    if (!(sn > 0) || (acc[v] / acc[v].Norm()) * (stored / sn) < cosLimit)
+      ++differ;
+  }
+  return count > 0 && differ * 100 > count;
+}
+
+/// What the mesh carries that a .pomar file does not keep (positions and triangles only).
+QStringList notKept(MeshModel &mm) {
+  const CMeshO &m = mm.cm;
+  QStringList out;
+  auto anyVertex = [&](auto pred) {
+    for (const CVertexO &v : m.vert)
+      if (!v.IsD() && pred(v))
+        return true;
+    return false;
+  };
+  auto anyFace = [&](auto pred) {
+    for (const CFaceO &f : m.face)
+      if (!f.IsD() && pred(f))
+        return true;
+    return false;
+  };
+  if (mm.hasDataMask(MeshModel::MM_VERTCOLOR) &&
+      anyVertex([](const CVertexO &v) { return v.cC() != vcg::Color4b(vcg::Color4b::White); }))
+    out << "per-vertex colors";
+  if (mm.hasDataMask(MeshModel::MM_VERTNORMAL) && hasOwnVertexNormals(m))
+    out << "per-vertex normals";
+  if (mm.hasDataMask(MeshModel::MM_VERTQUALITY) &&
+      anyVertex([](const CVertexO &v) { return v.cQ() != 0; }))
+    out << "per-vertex quality";
+  if (mm.hasDataMask(MeshModel::MM_VERTTEXCOORD))
+    out << "per-vertex texture coordinates";
+  if (mm.hasDataMask(MeshModel::MM_VERTRADIUS))
+    out << "per-vertex radius";
+  if (mm.hasDataMask(MeshModel::MM_FACECOLOR) &&
+      anyFace([](const CFaceO &f) { return f.cC() != vcg::Color4b(vcg::Color4b::White); }))
+    out << "per-face colors";
+  if (mm.hasDataMask(MeshModel::MM_FACEQUALITY) &&
+      anyFace([](const CFaceO &f) { return f.cQ() != 0; }))
+    out << "per-face quality";
+  if (mm.hasDataMask(MeshModel::MM_WEDGTEXCOORD))
+    out << "per-wedge texture coordinates";
+  if (mm.hasDataMask(MeshModel::MM_WEDGNORMAL))
+    out << "per-wedge normals";
+  if (mm.hasDataMask(MeshModel::MM_WEDGCOLOR))
+    out << "per-wedge colors";
+  if (mm.hasDataMask(MeshModel::MM_POLYGONAL))
+    out << "polygons (faux edges; saved as triangles)";
+  if (!m.textures.empty())
+    out << QString("%1 texture(s)").arg(m.textures.size());
+  if (m.en > 0)
+    out << QString("%1 edge(s)").arg(m.en);
+  if (m.shot.IsValid())
+    out << "camera";
+  QStringList custom;
+  auto addNames = [&](const auto &attributes) {
+    for (const auto &a : attributes)
+      if (!a._name.empty() && a._name != "pomar_cluster" && a._name != "pomar_level" &&
+          a._name != "pomar_source")
+        custom << QString::fromStdString(a._name);
+  };
+  addNames(m.vert_attr);
+  addNames(m.face_attr);
+  addNames(m.edge_attr);
+  addNames(m.mesh_attr);
+  if (!custom.isEmpty())
+    out << "custom attributes (" + custom.join(", ") + ")";
+  return out;
+}
+
+} // namespace
+
+QString PomarIOPlugin::pluginName() const { return "IOPomar"; }
+
+QList<MeshIOInterface::Format> PomarIOPlugin::importFormats() const {
+  return {Format(kFormatName, kExtension)};
+}
+
+QList<MeshIOInterface::Format> PomarIOPlugin::exportFormats() const {
+  return {Format(kFormatName, kExtension)};
+}
+
+void PomarIOPlugin::GetExportMaskCapability(QString & /*format*/, int &capability,
+                                            int &defaultBits) const {
+  capability = 0; // positions and triangles only: nothing optional to choose
+  defaultBits = 0;
+}
+
+bool PomarIOPlugin::fail(const QString &text) {
+  errorMessage = text;
+  qWarning("pomar: %s", qUtf8Printable(text));
+  return false;
+}
+
+// ---------------------------------------------------------------- open
+
+void PomarIOPlugin::initPreOpenParameter(const QString &format, const QString & /*fileName*/,
+                                         RichParameterList &par) {
+  if (!isPomar(format))
+    return;
+  par.addParam(RichEnum("OpenAt", OPEN_FULL,
+                        QStringList() << "Full resolution" << "Base clustered mesh"
+                                      << "Global level N",
+                        "Open at",
+                        "Full resolution: every level (lossless). Base clustered mesh: the "
+                        "coarse mesh whose vertices are the random-access clusters. Global "
+                        "level N: the whole mesh after N refinement levels (0 = base mesh)."));
+  par.addParam(RichInt("Level", 0, "Level N", "Used by \"Global level N\"."));
+}
+
+bool PomarIOPlugin::open(const QString &format, const QString &fileName, MeshModel &m, int &mask,
+                         const RichParameterList &par, vcg::CallBackPos *cb, QWidget *) {
+  mask = 0; // positions and faces
+  if (!isPomar(format))
+    return fail(QString("unknown format \"%1\"").arg(format));
+  // meshlabserver passes an absolute path, the GUI a bare name with the CWD at its directory.
+  const QString path = QFileInfo(fileName).absoluteFilePath();
+  const std::string native = QFile::encodeName(path).toStdString();
+  const int openAt = par.hasParameter("OpenAt") ? par.getEnum("OpenAt") : OPEN_FULL;
+  const int wantedLevel = par.hasParameter("Level") ? par.getInt("Level") : 0;
+
+  ProgressRelay progress(cb, "Decoding pomar");
+  try {
+    progress.report(0);
+    pomar::SelectiveDecoder decoder(std::make_unique<pomar::FileSource>(native));
+    const pomar::FileInfo &info = decoder.info();
+    int level = decoder.finest_level();
+    if (openAt == OPEN_BASE_CLUSTERED)
+      level = decoder.base_clustered_level();
+    else if (openAt == OPEN_GLOBAL_LEVEL)
+      level = wantedLevel;
+    if (level < 0 || level > decoder.finest_level())
+      throw pomar::Error("level " + std::to_string(level) +
+                         " does not exist: the file has levels 0.." +
+                         std::to_string(decoder.finest_level()));
+
+    pomar::Mesh mesh;
+    std::vector<uint32_t> cluster, vertexLevel;
+    if (info.clustered() && level < decoder.base_clustered_level()) {
+      // Below the base clustered mesh only the plain decoder goes; it knows no vertex levels.
+      QFile file(path);
+      if (!file.open(QIODevice::ReadOnly))
+        throw pomar::Error("cannot read " + native + ": " + file.errorString().toStdString());
+      const QByteArray bytes = file.readAll();
+      if (file.error() != QFileDevice::NoError)
+        throw pomar::Error("cannot read " + native + ": " + file.errorString().toStdString());
+      mesh = pomar::decode(reinterpret_cast<const uint8_t *>(bytes.constData()),
+                           size_t(bytes.size()), level, progress.function());
+    } else {
+      decoder.want_all(level);
+      decoder.update(progress.function());
+      mesh = decoder.mesh();
+      cluster = decoder.vertex_cluster();
+      vertexLevel = decoder.vertex_level();
+    }
+
+    pomar::to_vcg(mesh, m.cm); // also clears m's attributes
+    auto clusterOf =
+        vcg::tri::Allocator<CMeshO>::GetPerVertexAttribute<float>(m.cm, "pomar_cluster");
+    auto levelOf = vcg::tri::Allocator<CMeshO>::GetPerVertexAttribute<float>(m.cm, "pomar_level");
+    const bool haveClusters = info.clustered() && cluster.size() == mesh.vertex_count();
+    const bool haveLevels = vertexLevel.size() == mesh.vertex_count();
+    for (size_t v = 0; v < mesh.vertex_count(); ++v) {
+      clusterOf[v] = haveClusters ? float(cluster[v]) : -1.0f;
+      levelOf[v] = haveLevels ? float(vertexLevel[v]) : -1.0f;
+    }
+    auto source = vcg::tri::Allocator<CMeshO>::GetPerMeshAttribute<std::string>(m.cm, "pomar_source");
+    source() = native;
+
+    progress.report(100);
+    Log("pomar: opened %s at level %d of %d (%s): %zu vertices, %zu faces", qUtf8Printable(path),
+        level, decoder.finest_level(), info.clustered() ? "clustered file" : "progressive file",
+        mesh.vertex_count(), mesh.triangle_count());
+    return true;
+  } catch (const pomar::Error &e) {
+    m.cm.Clear();
+    return fail(QString("cannot open %1: %2").arg(path, QString::fromStdString(e.what())));
+  } catch (const std::exception &e) {
+    m.cm.Clear();
+    return fail(QString("cannot open %1: %2").arg(path, QString::fromStdString(e.what())));
+  }
+}
+
+// ---------------------------------------------------------------- save
+
+void PomarIOPlugin::initSaveParameter(const QString &format, MeshModel & /*m*/,
+                                      RichParameterList &par) {
+  if (!isPomar(format))
+    return;
+  const pomar::EncodeOptions defaults;
+  par.addParam(RichInt("Bits", defaults.bits, "Quantization bits",
+                       "Bits per coordinate (4..24): positions are snapped to a cubic grid of "
+                       "2^bits - 1 steps over the bounding box."));
+  par.addParam(RichFloat("ClusterRatio", float(defaults.cluster_ratio), "Cluster ratio",
+                         "Random access: about ratio x vertices clusters (ignored by a pure "
+                         "progressive file)."));
+  par.addParam(RichBool("Progressive", defaults.progressive, "Pure progressive",
+                        "Global levels only, no clusters: no random access."));
+}
+
+bool PomarIOPlugin::save(const QString &format, const QString &fileName, MeshModel &m,
+                         const int /*mask*/, const RichParameterList &par, vcg::CallBackPos *cb,
+                         QWidget *) {
+  if (!isPomar(format))
+    return fail(QString("unknown format \"%1\"").arg(format));
+  const QString path = QFileInfo(fileName).absoluteFilePath();
+
+  pomar::EncodeOptions options;
+  if (par.hasParameter("Bits"))
+    options.bits = par.getInt("Bits");
+  if (par.hasParameter("ClusterRatio"))
+    options.cluster_ratio = par.getFloat("ClusterRatio");
+  if (par.hasParameter("Progressive"))
+    options.progressive = par.getBool("Progressive");
+
+  ProgressRelay progress(cb, "Encoding pomar");
+  options.progress = progress.function();
+  QStringList dropped = notKept(m);
+  std::vector<uint8_t> bytes;
+  try {
+    progress.report(0);
+    size_t unreferenced = 0;
+    const pomar::Mesh mesh = pomar::from_vcg(m.cm, &unreferenced); // skips deleted elements
+    if (unreferenced > 0)
+      dropped << QString("%1 unreferenced vertices").arg(unreferenced);
+    bytes = pomar::encode(mesh, options);
+  } catch (const pomar::Error &e) {
+    return fail(QString("cannot save %1: %2").arg(path, QString::fromStdString(e.what())));
+  } catch (const std::exception &e) {
+    return fail(QString("cannot save %1: %2").arg(path, QString::fromStdString(e.what())));
+  }
+
+  // Atomic replacement: a temporary file next to the destination, renamed over it on commit.
+  QSaveFile file(path);
+  if (!file.open(QIODevice::WriteOnly))
+    return fail(QString("cannot save %1: %2").arg(path, file.errorString()));
+  if (file.write(reinterpret_cast<const char *>(bytes.data()), qint64(bytes.size())) !=
+          qint64(bytes.size()) ||
+      !file.commit()) {
+    const QString why = file.errorString();
+    file.cancelWriting();
+    return fail(QString("cannot save %1: %2").arg(path, why));
+  }
+  progress.report(100);
+
+  if (!dropped.isEmpty()) {
+    const QString warning =
+        QString("%1: the .pomar format keeps only positions and triangles; not saved: %2")
+            .arg(QFileInfo(path).fileName(), dropped.join("; "));
+    Log(GLLogStream::WARNING, qUtf8Printable(warning));
+    qWarning("pomar: %s", qUtf8Printable(warning)); // Log() is a no-op in meshlabserver
+  }
+  Log("pomar: saved %s: %zu bytes", qUtf8Printable(path), bytes.size());
+  return true;
+}
+
+// One heavy translation unit instead of two (AUTOMOC compiles this in place of mocs_compilation).
+#include "moc_io_pomar.cpp"
