@@ -314,6 +314,14 @@ void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v,
     mesh.face_claim[f] = static_cast<uint16_t>(level);
     s.claimed[f] = s.stamp;
   }
+  // The split walks the patch faces counter-clockwise in the actual mesh: they must be the
+  // ring's faces (true for valid data; a damaged stream could point across a boundary or a
+  // face the view skipped).
+  for (uint32_t t = 0, c = ring.corner[p.first_face]; t < p.faces; ++t) {
+    if (c != ring.corner[(p.first_face + t) % ring.size()])
+      codec.corrupt("a vertex split does not match the mesh");
+    c = mesh.ct.swing_ccw(c);
+  }
   PendingSplit ps;
   ps.op = {v, ring.corner[p.first_face], p.faces, p.il != kNone, p.ir != kNone};
   Prediction prediction;
