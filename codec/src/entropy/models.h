@@ -20,7 +20,7 @@
 
 namespace pomar {
 
-constexpr int kSvContexts = 12;
+constexpr int kSvContexts = 48; // 12 (held faces x split neighbours) x 4 valence classes
 constexpr int kSmallSymbols = 16;         // values 0..15 coded directly, 16 = escape
 constexpr int kValenceContexts = 16;      // ring sizes 0..14, 15+
 constexpr int kSlContexts = 12;

@@ -227,7 +227,8 @@ struct TraversalScratch {
 };
 
 /// s_v context from what the decoder already knows at v: how many of v's faces earlier
-/// patches of this level hold (0..3+) and how many neighbours were split (0..2+).
+/// patches of this level hold (0..3+), how many neighbours were split (0..2+), and v's
+/// valence (<=5, 6, 7, 8+: a v_to gained the valence of the vertex it absorbed).
 /// Returns -1 when every face is held: v cannot be split, s_v is not coded at all.
 inline int sv_context(const TraversalScratch &s, const Ring &ring) {
   uint32_t split_neighbours = 0;
@@ -241,7 +242,9 @@ inline int sv_context(const TraversalScratch &s, const Ring &ring) {
     if (claimed == ring.faces())
       return -1;
   }
-  return static_cast<int>(std::min(claimed, 3u) * 3 + std::min(split_neighbours, 2u));
+  const uint32_t valence = ring.size() <= 5 ? 0 : std::min(ring.size() - 5, 3u);
+  return static_cast<int>((std::min(claimed, 3u) * 3 + std::min(split_neighbours, 2u)) * 4 +
+                          valence);
 }
 
 /// The level-(l-1) view of v's one-ring while level l is being decoded: neighbours created
