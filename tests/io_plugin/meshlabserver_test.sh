@@ -1,0 +1,239 @@
+#!/usr/bin/env bash
+# End-to-end test of the MeshLab IO plugin libio_pomar.so through meshlabserver 2020.09.
+#
+#   bash tests/io_plugin/meshlabserver_test.sh PLUGIN.so POMAR_CLI SAMPLES_DIR WORK_DIR [MESHLAB_LIBDIR]
+#
+# Registered in ctest as "io_plugin_meshlabserver" (tests/io_plugin/CMakeLists.txt).
+# Builds a private MeshLab tree in WORK_DIR (recipe /work/shared/docs/meshlab-plugins.md, 5b:
+# a *copy* of meshlabserver in tree/bin, symlinks to libmeshlab-common.so, the stock plugins
+# libio_base.so + libfilter_select.so and ours), so nothing under /usr is touched and only
+# these plugins load. meshlabserver needs an X display: every call runs under `xvfb-run -a`
+# with HOME in WORK_DIR.
+#
+# meshlabserver exits 0 even when a save fails, so every check looks at the files and the
+# output. Exits 77 (ctest SKIP_RETURN_CODE) when meshlabserver, xvfb-run or MeshLab's library
+# is missing. The first failing check prints what failed and exits 1.
+set -euo pipefail
+
+if [ $# -lt 4 ] || [ $# -gt 5 ]; then
+  echo "usage: $0 PLUGIN.so POMAR_CLI SAMPLES_DIR WORK_DIR [MESHLAB_LIBDIR]" >&2
+  exit 2
+fi
+abspath() { echo "$(cd "$(dirname "$1")" && pwd)/$(basename "$1")"; }
+PLUGIN="$(abspath "$1")"
+POMAR="$(abspath "$2")"
+SAMPLES="$(cd "$3" && pwd)"
+mkdir -p "$4"
+WORK="$(cd "$4" && pwd)"
+MLLIB="${5:-/usr/lib/x86_64-linux-gnu/meshlab}"
+
+skip() { echo "SKIP: $*"; exit 77; }
+command -v meshlabserver >/dev/null 2>&1 || skip "meshlabserver is not installed"
+command -v xvfb-run >/dev/null 2>&1 || skip "xvfb-run is not installed (package xvfb)"
+[ -f "$MLLIB/libmeshlab-common.so" ] || skip "$MLLIB/libmeshlab-common.so not found"
+for p in libio_base.so libfilter_select.so; do
+  [ -f "$MLLIB/plugins/$p" ] || skip "stock plugin $MLLIB/plugins/$p not found"
+done
+[ -f "$PLUGIN" ] || { echo "FAIL: plugin not found: $PLUGIN" >&2; exit 1; }
+[ -x "$POMAR" ] || { echo "FAIL: pomar executable not found: $POMAR" >&2; exit 1; }
+BUNNY="$SAMPLES/bunny.ply"
+NONMANIFOLD="$SAMPLES/tetra_nonmanifold.off"
+[ -f "$BUNNY" ] && [ -f "$NONMANIFOLD" ] || { echo "FAIL: samples missing in $SAMPLES" >&2; exit 1; }
+
+# ---- the private MeshLab tree ----------------------------------------------------------------------
+
+TREE="$WORK/tree"
+PLUGDIR="$TREE/lib/x86_64-linux-gnu/meshlab/plugins"
+rm -rf "$WORK/tree" "$WORK/home" "$WORK/out"
+mkdir -p "$TREE/bin" "$PLUGDIR" "$WORK/home" "$WORK/out"
+chmod 700 "$WORK/home"
+# A copy, not a symlink: MeshLab finds its plugins from the resolved path of its binary.
+cp "$(readlink -f "$(command -v meshlabserver)")" "$TREE/bin/meshlabserver"
+ln -s "$MLLIB/libmeshlab-common.so" "$TREE/lib/x86_64-linux-gnu/meshlab/"
+ln -s "$MLLIB/plugins/libio_base.so" "$MLLIB/plugins/libfilter_select.so" "$PLUGDIR/"
+ln -s "$PLUGIN" "$PLUGDIR/libio_pomar.so"
+ML="$TREE/bin/meshlabserver"
+OUTDIR="$WORK/out"
+
+CHECKS=0
+CUR="(setup)"
+section() { CUR="$*"; printf -- '--- %s\n' "$*"; }
+pass() { CHECKS=$((CHECKS + 1)); }
+fail() {
+  {
+    printf 'FAIL [%s]: %s\n' "$CUR" "$*"
+    if [ -n "${LAST_CMD:-}" ]; then
+      printf '  last command: %s\n  exit status : %s\n  output      :\n' "$LAST_CMD" "$RC"
+      printf '%s\n' "$OUT" | sed 's/^/    /' | head -40
+    fi
+  } >&2
+  exit 1
+}
+
+# ml ARGS...: runs the private meshlabserver under Xvfb; sets RC and OUT (stdout + stderr).
+ml() {
+  LAST_CMD="meshlabserver $*"
+  set +e
+  OUT="$(cd "$OUTDIR" && HOME="$WORK/home" XDG_RUNTIME_DIR="$WORK/home" \
+    xvfb-run -a "$ML" "$@" 2>&1)"
+  RC=$?
+  set -e
+}
+# pomar ARGS...: runs the pomar CLI; sets RC and OUT.
+pomar() {
+  LAST_CMD="pomar $*"
+  set +e
+  OUT="$("$POMAR" "$@" 2>&1)"
+  RC=$?
+  set -e
+}
+expect_rc() { [ "$RC" -eq "$1" ] || fail "expected exit status $1, got $RC"; pass; }
+expect_nonzero() { [ "$RC" -ne 0 ] || fail "expected a non-zero exit status, got 0"; pass; }
+expect_file() { [ -s "$1" ] || fail "expected a non-empty file at $1"; pass; }
+expect_no_file() { [ ! -e "$1" ] || fail "expected no file at $1, but it exists"; pass; }
+expect_output() { # expect_output NEEDLE
+  case "$OUT" in *"$1"*) pass ;; *) fail "the output does not contain '$1'" ;; esac
+}
+expect_no_output() {
+  case "$OUT" in *"$1"*) fail "the output contains '$1'" ;; *) pass ;; esac
+}
+expect_dir_only() { # expect_dir_only NAME...: OUTDIR holds exactly these entries (no stray temp files)
+  local got want
+  got="$(find "$OUTDIR" -mindepth 1 -maxdepth 1 -printf '%f\n' | LC_ALL=C sort | tr '\n' ' ')"
+  want="$(printf '%s\n' "$@" | LC_ALL=C sort | tr '\n' ' ')"
+  [ "$got" = "$want" ] || fail "$OUTDIR holds '$got', expected exactly '$want'"
+  pass
+}
+
+# ---- 1. round trip bunny.ply -> .pomar -> .ply, lossless --------------------------------------------
+
+section "meshlabserver saves bunny.ply as .pomar"
+ml -i "$BUNNY" -o bunny.pomar
+expect_rc 0
+expect_output "Current Plugins Dir is: $PLUGDIR"
+expect_file "$OUTDIR/bunny.pomar"
+expect_no_output "NOT been saved"
+# bunny.ply has 1113 vertices no face uses: the format drops them and the plugin says so.
+expect_output "not saved: 1113 unreferenced vertices"
+expect_dir_only bunny.pomar
+
+section "meshlabserver opens bunny.pomar (full resolution) and saves a PLY"
+ml -i bunny.pomar -o bunny_back.ply
+expect_rc 0
+expect_output "bunny.pomar loaded has 34834 vn 69451 fn"
+expect_file "$OUTDIR/bunny_back.ply"
+
+section "pomar verify: bunny.ply == bunny.pomar == bunny_back.ply"
+pomar verify "$BUNNY" "$OUTDIR/bunny.pomar" "$OUTDIR/bunny_back.ply"
+expect_rc 0
+expect_output "OK"
+
+section "a pure progressive file written by the CLI opens at full resolution"
+pomar encode -q --progressive "$BUNNY" "$OUTDIR/prog.pomar"
+expect_rc 0
+ml -i prog.pomar -o prog_back.ply
+expect_rc 0
+expect_file "$OUTDIR/prog_back.ply"
+pomar verify "$BUNNY" "$OUTDIR/prog.pomar" "$OUTDIR/prog_back.ply"
+expect_rc 0
+rm -f "$OUTDIR"/prog*
+
+section "colors and normals are named in the warning"
+cat >"$OUTDIR/octa.ply" <<'EOF'
+ply
+format ascii 1.0
+element vertex 6
+property float x
+property float y
+property float z
+property float nx
+property float ny
+property float nz
+property uchar red
+property uchar green
+property uchar blue
+property uchar alpha
+element face 8
+property list uchar int vertex_indices
+end_header
+1 0 0 0 0 1 255 0 0 255
+-1 0 0 0 0 1 0 255 0 255
+0 1 0 0 0 1 0 0 255 255
+0 -1 0 0 0 1 255 255 0 255
+0 0 1 0 0 1 0 255 255 255
+0 0 -1 0 0 1 255 0 255 255
+3 0 2 4
+3 2 1 4
+3 1 3 4
+3 3 0 4
+3 2 0 5
+3 1 2 5
+3 3 1 5
+3 0 3 5
+EOF
+ml -i octa.ply -o octa.pomar
+expect_rc 0
+expect_file "$OUTDIR/octa.pomar"
+expect_output "keeps only positions and triangles"
+expect_output "per-vertex colors"
+expect_output "per-vertex normals"
+pomar verify "$OUTDIR/octa.ply" "$OUTDIR/octa.pomar"
+expect_rc 0
+rm -f "$OUTDIR"/octa*
+
+# ---- 2. a non-manifold mesh is refused: no file, an explanation ------------------------------------
+
+section "saving a non-manifold mesh fails and writes nothing"
+ml -i "$NONMANIFOLD" -o tetra.pomar
+expect_rc 0 # meshlabserver's exit status after a failed save
+expect_output "non-manifold"
+expect_output "has NOT been saved"
+expect_no_file "$OUTDIR/tetra.pomar"
+expect_dir_only bunny.pomar bunny_back.ply
+
+section "a failed save leaves an existing destination untouched"
+cp "$OUTDIR/bunny.pomar" "$OUTDIR/keep.pomar"
+ml -i "$NONMANIFOLD" -o keep.pomar
+expect_output "non-manifold"
+cmp -s "$OUTDIR/bunny.pomar" "$OUTDIR/keep.pomar" || fail "keep.pomar was modified by a failed save"
+pass
+expect_dir_only bunny.pomar bunny_back.ply keep.pomar
+rm -f "$OUTDIR/keep.pomar"
+
+# ---- 3. damaged input: a clear message, no output ---------------------------------------------------
+
+size="$(wc -c <"$OUTDIR/bunny.pomar" | tr -d ' ')"
+
+section "a truncated .pomar fails to open"
+head -c "$((size / 2))" "$OUTDIR/bunny.pomar" >"$OUTDIR/trunc.pomar"
+ml -i trunc.pomar -o trunc.ply
+expect_nonzero
+expect_output "Failed loading of $OUTDIR/trunc.pomar"
+expect_output "truncated .pomar file"
+expect_no_file "$OUTDIR/trunc.ply"
+
+section "a .pomar cut inside its header fails to open"
+head -c 100 "$OUTDIR/bunny.pomar" >"$OUTDIR/trunc.pomar"
+ml -i trunc.pomar -o trunc.ply
+expect_nonzero
+expect_output "truncated .pomar file"
+expect_no_file "$OUTDIR/trunc.ply"
+
+section "a corrupted byte in the cluster data fails to open"
+cp "$OUTDIR/bunny.pomar" "$OUTDIR/bad.pomar"
+# Flip one byte 3/4 into the file (cluster blocks, protected by checksums).
+python3 - "$OUTDIR/bad.pomar" <<'EOF'
+import sys
+p = sys.argv[1]
+b = bytearray(open(p, 'rb').read())
+b[len(b) * 3 // 4] ^= 0x5A
+open(p, 'wb').write(b)
+EOF
+ml -i bad.pomar -o bad.ply
+expect_nonzero
+expect_output "damaged .pomar file"
+expect_no_file "$OUTDIR/bad.ply"
+rm -f "$OUTDIR/trunc.pomar" "$OUTDIR/bad.pomar"
+expect_dir_only bunny.pomar bunny_back.ply
+
+echo "PASS: $CHECKS checks"
