@@ -116,29 +116,39 @@ template <class Encoder> double put_small(Encoder &rc, FrequencyModel &m, uint32
   return bits;
 }
 
+/// A signed value as its magnitude class (bit length, model `classes`), a sign bit, the bit
+/// under the leading one (modelled by top[class] if `top` is given) and the rest raw.
 template <class Encoder>
-double put_residual(Encoder &rc, GeometryModels &g, int kind, int ctx, int64_t v) {
+double put_signed(Encoder &rc, FrequencyModel &classes, BitModel *top, int64_t v) {
   const uint64_t a = static_cast<uint64_t>(v < 0 ? -v : v);
   const int n = bit_length(a);
-  double bits = cost_bits(g.magnitude[kind][ctx], n);
-  rc.encode(g.magnitude[kind][ctx], n);
+  double bits = cost_bits(classes, n);
+  rc.encode(classes, n);
   if (n == 0)
     return bits;
   rc.encode_bypass(v < 0 ? 1 : 0, 1);
-  bits += 1 + (n >= 2 ? n - 2 : 0);
-  if (n >= 2) {
-    bits += cost_bits(g.mantissa[kind][n], static_cast<int>((a >> (n - 2)) & 1));
-    rc.encode_bit(g.mantissa[kind][n], static_cast<int>((a >> (n - 2)) & 1));
-    const int rest = n - 2;
-    const uint64_t low = a & ((uint64_t(1) << rest) - 1);
-    if (rest > 24) {
-      rc.encode_bypass(static_cast<uint32_t>(low >> 24), rest - 24);
-      rc.encode_bypass(static_cast<uint32_t>(low & 0xFFFFFF), 24);
-    } else if (rest > 0) {
-      rc.encode_bypass(static_cast<uint32_t>(low), rest);
-    }
+  bits += 1;
+  int rest = n - 1;
+  if (top && n >= 2) {
+    const int bit = static_cast<int>((a >> (n - 2)) & 1);
+    bits += cost_bits(top[n], bit);
+    rc.encode_bit(top[n], bit);
+    --rest;
+  }
+  bits += rest;
+  const uint64_t low = a & ((uint64_t(1) << rest) - 1);
+  if (rest > 24) {
+    rc.encode_bypass(static_cast<uint32_t>(low >> 24), rest - 24);
+    rc.encode_bypass(static_cast<uint32_t>(low & 0xFFFFFF), 24);
+  } else if (rest > 0) {
+    rc.encode_bypass(static_cast<uint32_t>(low), rest);
   }
   return bits;
+}
+
+template <class Encoder>
+double put_residual(Encoder &rc, GeometryModels &g, int kind, int ctx, int64_t v) {
+  return put_signed(rc, g.magnitude[kind][ctx], g.mantissa[kind], v);
 }
 
 // ---------------------------------------------------------------- decoding side
@@ -161,23 +171,28 @@ inline uint32_t get_small(RangeDecoder &rc, FrequencyModel &m) {
   return v > 0xFFFFFFFEu ? 0xFFFFFFFFu : static_cast<uint32_t>(v);
 }
 
-inline int64_t get_residual(RangeDecoder &rc, GeometryModels &g, int kind, int ctx) {
-  const int n = rc.decode(g.magnitude[kind][ctx]);
+inline int64_t get_signed(RangeDecoder &rc, FrequencyModel &classes, BitModel *top) {
+  const int n = rc.decode(classes);
   if (n == 0)
     return 0;
   const bool negative = rc.decode_bypass(1) != 0;
   uint64_t a = 1;
-  if (n >= 2) {
-    a = (a << 1) | static_cast<uint64_t>(rc.decode_bit(g.mantissa[kind][n]));
-    const int rest = n - 2;
-    if (rest > 24) {
-      a = (a << (rest - 24)) | rc.decode_bypass(rest - 24);
-      a = (a << 24) | rc.decode_bypass(24);
-    } else if (rest > 0) {
-      a = (a << rest) | rc.decode_bypass(rest);
-    }
+  int rest = n - 1;
+  if (top && n >= 2) {
+    a = (a << 1) | static_cast<uint64_t>(rc.decode_bit(top[n]));
+    --rest;
+  }
+  if (rest > 24) {
+    a = (a << (rest - 24)) | rc.decode_bypass(rest - 24);
+    a = (a << 24) | rc.decode_bypass(24);
+  } else if (rest > 0) {
+    a = (a << rest) | rc.decode_bypass(rest);
   }
   return negative ? -static_cast<int64_t>(a) : static_cast<int64_t>(a);
+}
+
+inline int64_t get_residual(RangeDecoder &rc, GeometryModels &g, int kind, int ctx) {
+  return get_signed(rc, g.magnitude[kind][ctx], g.mantissa[kind]);
 }
 
 } // namespace pomar

@@ -103,38 +103,6 @@ struct BaseModels {
   FrequencyModel first{kMagnitudeSymbols}, other{kMagnitudeSymbols};
 };
 
-void put_value(RangeEncoder &rc, FrequencyModel &m, int64_t v) {
-  const uint64_t a = static_cast<uint64_t>(v < 0 ? -v : v);
-  const int n = bit_length(a);
-  rc.encode(m, n);
-  if (n == 0)
-    return;
-  rc.encode_bypass(v < 0 ? 1 : 0, 1);
-  const int rest = n - 1;
-  if (rest > 24) {
-    rc.encode_bypass(static_cast<uint32_t>(a >> 24) & ((1u << (rest - 24)) - 1), rest - 24);
-    rc.encode_bypass(static_cast<uint32_t>(a & 0xFFFFFF), 24);
-  } else if (rest > 0) {
-    rc.encode_bypass(static_cast<uint32_t>(a) & ((1u << rest) - 1), rest);
-  }
-}
-
-int64_t get_value(RangeDecoder &rc, FrequencyModel &m) {
-  const int n = rc.decode(m);
-  if (n == 0)
-    return 0;
-  const bool negative = rc.decode_bypass(1) != 0;
-  uint64_t a = 1;
-  const int rest = n - 1;
-  if (rest > 24) {
-    a = (a << (rest - 24)) | rc.decode_bypass(rest - 24);
-    a = (a << 24) | rc.decode_bypass(24);
-  } else if (rest > 0) {
-    a = (a << rest) | rc.decode_bypass(rest);
-  }
-  return negative ? -static_cast<int64_t>(a) : static_cast<int64_t>(a);
-}
-
 } // namespace
 
 void canonical_faces(std::vector<uint32_t> &t) {
@@ -157,15 +125,15 @@ std::vector<uint8_t> pack_base_mesh(const BaseMesh &base, int bits) {
   BaseModels m;
   int32_t prev[3] = {0, 0, 0};
   for (size_t i = 0; i < base.q.size(); ++i) {
-    put_value(rc, m.coord[i % 3], int64_t(base.q[i]) - prev[i % 3]);
+    put_signed(rc, m.coord[i % 3], nullptr, int64_t(base.q[i]) - prev[i % 3]);
     prev[i % 3] = base.q[i];
   }
   uint32_t prev_first = 0;
   for (size_t f = 0; f < base.triangles.size(); f += 3) {
     const uint32_t a = base.triangles[f];
-    put_value(rc, m.first, int64_t(a) - prev_first);
-    put_value(rc, m.other, int64_t(base.triangles[f + 1]) - a);
-    put_value(rc, m.other, int64_t(base.triangles[f + 2]) - a);
+    put_signed(rc, m.first, nullptr, int64_t(a) - prev_first);
+    put_signed(rc, m.other, nullptr, int64_t(base.triangles[f + 1]) - a);
+    put_signed(rc, m.other, nullptr, int64_t(base.triangles[f + 2]) - a);
     prev_first = a;
   }
   rc.finish();
@@ -356,7 +324,7 @@ BaseMesh read_base_mesh(const uint8_t *data, const FileLayout &L) {
   b.q.resize(size_t(h.base_vertices) * 3);
   int64_t prev[3] = {0, 0, 0};
   for (size_t i = 0; i < b.q.size(); ++i) {
-    const int64_t v = prev[i % 3] + get_value(rc, m.coord[i % 3]);
+    const int64_t v = prev[i % 3] + get_signed(rc, m.coord[i % 3], nullptr);
     if (v < 0 || v > top)
       bad("position outside the quantization grid");
     b.q[i] = static_cast<int32_t>(v);
@@ -365,8 +333,8 @@ BaseMesh read_base_mesh(const uint8_t *data, const FileLayout &L) {
   b.triangles.resize(size_t(h.base_faces) * 3);
   int64_t prev_first = 0;
   for (size_t f = 0; f < b.triangles.size(); f += 3) {
-    const int64_t a = prev_first + get_value(rc, m.first);
-    const int64_t x = a + get_value(rc, m.other), y = a + get_value(rc, m.other);
+    const int64_t a = prev_first + get_signed(rc, m.first, nullptr);
+    const int64_t x = a + get_signed(rc, m.other, nullptr), y = a + get_signed(rc, m.other, nullptr);
     for (int64_t i : {a, x, y})
       if (i < 0 || i >= int64_t(h.base_vertices))
         bad("face refers to a missing vertex");
