@@ -24,6 +24,14 @@ namespace {
 const char *const kFormatName = "POMAR progressive mesh";
 const char *const kExtension = "pomar";
 
+/// "<verb> <path>: <what>", or just `what` when the codec's message names the file already.
+QString describe(const char *verb, const QString &path, const char *what) {
+  const QString text = QString::fromStdString(what);
+  if (text.contains(path))
+    return text;
+  return QString("%1 %2: %3").arg(verb, path, text);
+}
+
 bool isPomar(const QString &format) {
   return format.compare(QLatin1String(kExtension), Qt::CaseInsensitive) == 0;
 }
@@ -267,12 +275,9 @@ bool PomarIOPlugin::open(const QString &format, const QString &fileName, MeshMod
         level, decoder.finest_level(), info.clustered() ? "clustered file" : "progressive file",
         mesh.vertex_count(), mesh.triangle_count());
     return true;
-  } catch (const pomar::Error &e) {
+  } catch (const std::exception &e) { // pomar::Error, or std::bad_alloc
     m.cm.Clear();
-    return fail(QString("cannot open %1: %2").arg(path, QString::fromStdString(e.what())));
-  } catch (const std::exception &e) {
-    m.cm.Clear();
-    return fail(QString("cannot open %1: %2").arg(path, QString::fromStdString(e.what())));
+    return fail(describe("cannot open", path, e.what()));
   }
 }
 
@@ -319,10 +324,8 @@ bool PomarIOPlugin::save(const QString &format, const QString &fileName, MeshMod
     if (unreferenced > 0)
       dropped << QString("%1 unreferenced vertices").arg(unreferenced);
     bytes = pomar::encode(mesh, options);
-  } catch (const pomar::Error &e) {
-    return fail(QString("cannot save %1: %2").arg(path, QString::fromStdString(e.what())));
-  } catch (const std::exception &e) {
-    return fail(QString("cannot save %1: %2").arg(path, QString::fromStdString(e.what())));
+  } catch (const std::exception &e) { // pomar::Error (invalid mesh or options), std::bad_alloc
+    return fail(describe("cannot save", path, e.what()));
   }
 
   // Atomic replacement: a temporary file next to the destination, renamed over it on commit.

@@ -1,0 +1,449 @@
+// In-process tests of the MeshLab IO plugin libio_pomar.so: loads it with QPluginLoader as
+// MeshLab's PluginManager does and drives open()/save() with the parameters MeshLab would
+// pass, including the pre-open choices meshlabserver cannot reach ("Base clustered mesh",
+// "Global level N"), the per-vertex/per-mesh attributes and the save parameters.
+// No X display needed: nothing here touches OpenGL or widgets.
+#include <gtest/gtest.h>
+
+#include <QCoreApplication>
+#include <QDir>
+#include <QFile>
+#include <QFileInfo>
+#include <QPluginLoader>
+#include <QStringList>
+#include <QTemporaryDir>
+
+#include <common/interfaces.h>
+#include <common/meshmodel.h>
+
+#include <pomar/pomar.h>
+#include <pomar/random_access.h>
+#include <pomar/vcg_adapter.h>
+
+#include <vcg/complex/algorithms/update/normal.h>
+
+#include "support/mesh_gen.h"
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <fstream>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace {
+
+// ---------------------------------------------------------------- helpers
+
+QStringList g_warnings; // qWarning() lines of the plugin
+
+void captureMessages(QtMsgType type, const QMessageLogContext &, const QString &text) {
+  if (type == QtWarningMsg)
+    g_warnings << text;
+  std::fprintf(stderr, "%s\n", qUtf8Printable(text));
+}
+
+MeshIOInterface *plugin() {
+  static QPluginLoader loader(QStringLiteral(POMAR_IO_PLUGIN));
+  static MeshIOInterface *io = qobject_cast<MeshIOInterface *>(loader.instance());
+  if (io == nullptr)
+    ADD_FAILURE() << "cannot load " << POMAR_IO_PLUGIN << ": "
+                  << loader.errorString().toStdString();
+  return io;
+}
+
+using Tri = std::array<std::array<float, 3>, 3>;
+
+/// The mesh as a sorted list of triangles of positions (smallest rotation first).
+std::vector<Tri> canonical(const pomar::Mesh &m) {
+  std::vector<Tri> out;
+  for (size_t f = 0; f < m.triangle_count(); ++f) {
+    Tri t;
+    for (int k = 0; k < 3; ++k)
+      for (int a = 0; a < 3; ++a)
+        t[k][a] = m.positions[3 * m.triangles[3 * f + k] + a];
+    const Tri r1 = {t[1], t[2], t[0]}, r2 = {t[2], t[0], t[1]};
+    out.push_back(std::min({t, r1, r2}));
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::vector<uint8_t> readBytes(const QString &path) {
+  QFile f(path);
+  if (!f.open(QIODevice::ReadOnly))
+    return {};
+  const QByteArray b = f.readAll();
+  return std::vector<uint8_t>(b.begin(), b.end());
+}
+
+void writeBytes(const QString &path, const std::vector<uint8_t> &bytes) {
+  std::ofstream out(QFile::encodeName(path).toStdString(), std::ios::binary);
+  out.write(reinterpret_cast<const char *>(bytes.data()), std::streamsize(bytes.size()));
+}
+
+std::vector<float> vertexAttribute(CMeshO &m, const char *name) {
+  std::vector<float> out;
+  auto h = vcg::tri::Allocator<CMeshO>::FindPerVertexAttribute<float>(m, name);
+  if (!vcg::tri::Allocator<CMeshO>::IsValidHandle(m, h))
+    return out;
+  for (size_t v = 0; v < m.vert.size(); ++v)
+    out.push_back(h[v]);
+  return out;
+}
+
+std::string sourceAttribute(CMeshO &m) {
+  auto h = vcg::tri::Allocator<CMeshO>::FindPerMeshAttribute<std::string>(m, "pomar_source");
+  return vcg::tri::Allocator<CMeshO>::IsValidHandle(m, h) ? h() : std::string("<none>");
+}
+
+class PomarPluginTest : public ::testing::Test {
+protected:
+  static void SetUpTestSuite() {
+    dir_ = new QTemporaryDir();
+    input_ = new pomar::Mesh(pomar::gen::noisy_sphere(3000, 7));
+    clustered_ = new std::vector<uint8_t>(pomar::encode(*input_));
+    pomar::EncodeOptions progressive;
+    progressive.progressive = true;
+    progressive_ = new std::vector<uint8_t>(pomar::encode(*input_, progressive));
+    writeBytes(path("clustered.pomar"), *clustered_);
+    writeBytes(path("progressive.pomar"), *progressive_);
+  }
+  static void TearDownTestSuite() {
+    delete dir_;
+    delete input_;
+    delete clustered_;
+    delete progressive_;
+  }
+  void SetUp() override {
+    ASSERT_NE(plugin(), nullptr);
+    ASSERT_TRUE(dir_->isValid());
+    g_warnings.clear();
+    plugin()->clearErrorString();
+  }
+
+  void TearDown() override {
+    // vcglib 2020.09's ~TriMesh() does not free named attributes (MeshLab leaks them too).
+    for (MeshModel *mm : doc_.meshList)
+      mm->cm.ClearAttributes();
+  }
+
+  static QString path(const QString &name) { return dir_->filePath(name); }
+
+  /// Open like MeshLab: initPreOpenParameter, then the dialog's choices, then open().
+  bool openAt(const QString &fileName, int choice, int level = 0) {
+    mm_ = doc_.addNewMesh(fileName, "test", true);
+    RichParameterList par;
+    plugin()->initPreOpenParameter("pomar", fileName, par);
+    if (choice >= 0)
+      par.setValue("OpenAt", EnumValue(choice));
+    par.setValue("Level", IntValue(level));
+    int mask = -1;
+    const bool ok = plugin()->open("pomar", fileName, *mm_, mask, par);
+    EXPECT_EQ(mask, 0);
+    return ok;
+  }
+
+  /// A layer holding `mesh`, prepared as MeshLab does after loading it.
+  MeshModel *layer(const pomar::Mesh &mesh) {
+    MeshModel *mm = doc_.addNewMesh("", "input", true);
+    pomar::to_vcg(mesh, mm->cm);
+    mm->UpdateBoxAndNormals();
+    return mm;
+  }
+
+  /// Save with the defaults of initSaveParameter, changed by `edit`.
+  template <class Edit>
+  bool save(MeshModel &mm, const QString &fileName, Edit edit) {
+    RichParameterList par;
+    plugin()->initSaveParameter("pomar", mm, par);
+    edit(par);
+    return plugin()->save("pomar", fileName, mm, 0, par);
+  }
+  bool save(MeshModel &mm, const QString &fileName) {
+    return save(mm, fileName, [](RichParameterList &) {});
+  }
+
+  QStringList dirEntries() const {
+    return QDir(dir_->path()).entryList(QDir::Files | QDir::Hidden | QDir::NoDotAndDotDot);
+  }
+
+  static QTemporaryDir *dir_;
+  static pomar::Mesh *input_;
+  static std::vector<uint8_t> *clustered_, *progressive_;
+  MeshDocument doc_;
+  MeshModel *mm_ = nullptr;
+};
+
+QTemporaryDir *PomarPluginTest::dir_ = nullptr;
+pomar::Mesh *PomarPluginTest::input_ = nullptr;
+std::vector<uint8_t> *PomarPluginTest::clustered_ = nullptr;
+std::vector<uint8_t> *PomarPluginTest::progressive_ = nullptr;
+
+pomar::FileInfo infoOf(const std::vector<uint8_t> &file) {
+  return pomar::inspect(file.data(), file.size());
+}
+
+uint32_t verticesAtLevel(const pomar::FileInfo &info, int level) {
+  return level == 0 ? info.base_vertices : info.levels[size_t(level) - 1].vertices;
+}
+
+// ---------------------------------------------------------------- declarations
+
+TEST_F(PomarPluginTest, FormatsAndCapabilities) {
+  for (const auto &list : {plugin()->importFormats(), plugin()->exportFormats()}) {
+    ASSERT_EQ(list.size(), 1);
+    EXPECT_EQ(list[0].description, "POMAR progressive mesh");
+    EXPECT_EQ(list[0].extensions, QStringList{"pomar"});
+  }
+  QString format = "pomar";
+  int capability = -1, defaultBits = -1;
+  plugin()->GetExportMaskCapability(format, capability, defaultBits);
+  EXPECT_EQ(capability, 0);
+  EXPECT_EQ(defaultBits, 0);
+}
+
+TEST_F(PomarPluginTest, ParameterDefaults) {
+  RichParameterList pre;
+  plugin()->initPreOpenParameter("pomar", "x.pomar", pre);
+  ASSERT_TRUE(pre.hasParameter("OpenAt"));
+  ASSERT_TRUE(pre.hasParameter("Level"));
+  EXPECT_EQ(pre.getEnum("OpenAt"), 0); // full resolution
+  EXPECT_EQ(pre.getInt("Level"), 0);
+
+  MeshModel *mm = doc_.addNewMesh("", "empty", true);
+  RichParameterList save;
+  plugin()->initSaveParameter("pomar", *mm, save);
+  const pomar::EncodeOptions defaults;
+  EXPECT_EQ(save.getInt("Bits"), defaults.bits);
+  EXPECT_FLOAT_EQ(save.getFloat("ClusterRatio"), float(defaults.cluster_ratio));
+  EXPECT_EQ(save.getBool("Progressive"), false);
+
+  RichParameterList other;
+  plugin()->initPreOpenParameter("ply", "x.ply", other);
+  plugin()->initSaveParameter("ply", *mm, other);
+  EXPECT_TRUE(other.isEmpty());
+}
+
+// ---------------------------------------------------------------- open
+
+TEST_F(PomarPluginTest, OpenFullResolutionIsLossless) {
+  ASSERT_TRUE(openAt(path("clustered.pomar"), -1)) << plugin()->errorMsg().toStdString();
+  const pomar::Mesh got = pomar::from_vcg(mm_->cm);
+  EXPECT_EQ(canonical(got), canonical(pomar::decode(clustered_->data(), clustered_->size())));
+
+  const pomar::FileInfo info = infoOf(*clustered_);
+  ASSERT_TRUE(info.clustered());
+  const std::vector<float> cluster = vertexAttribute(mm_->cm, "pomar_cluster");
+  const std::vector<float> level = vertexAttribute(mm_->cm, "pomar_level");
+  ASSERT_EQ(cluster.size(), got.vertex_count());
+  ASSERT_EQ(level.size(), got.vertex_count());
+  std::set<float> clusters(cluster.begin(), cluster.end());
+  EXPECT_EQ(clusters.size(), info.clusters); // every cluster keeps at least its root
+  EXPECT_EQ(*clusters.begin(), 0.0f);
+  EXPECT_EQ(*clusters.rbegin(), float(info.clusters - 1));
+  EXPECT_EQ(*std::min_element(level.begin(), level.end()), 0.0f);
+  EXPECT_EQ(*std::max_element(level.begin(), level.end()), float(info.levels.size()));
+  EXPECT_EQ(sourceAttribute(mm_->cm), QFile::encodeName(path("clustered.pomar")).toStdString());
+}
+
+TEST_F(PomarPluginTest, OpenBaseClusteredMesh) {
+  ASSERT_TRUE(openAt(path("clustered.pomar"), 1)) << plugin()->errorMsg().toStdString();
+  const pomar::FileInfo info = infoOf(*clustered_);
+  EXPECT_EQ(uint32_t(mm_->cm.vn), info.clusters);
+  const std::vector<float> cluster = vertexAttribute(mm_->cm, "pomar_cluster");
+  const std::vector<float> level = vertexAttribute(mm_->cm, "pomar_level");
+  EXPECT_EQ(std::set<float>(cluster.begin(), cluster.end()).size(), info.clusters);
+  EXPECT_LE(*std::max_element(level.begin(), level.end()), float(info.global_levels));
+}
+
+TEST_F(PomarPluginTest, OpenGlobalLevels) {
+  const pomar::FileInfo info = infoOf(*clustered_);
+  const int base = int(info.global_levels), finest = int(info.levels.size());
+  ASSERT_GT(base, 1);
+  ASSERT_GT(finest, base + 1);
+  for (int n : {0, base / 2, base, base + 1, finest}) {
+    SCOPED_TRACE("level " + std::to_string(n));
+    ASSERT_TRUE(openAt(path("clustered.pomar"), 2, n)) << plugin()->errorMsg().toStdString();
+    EXPECT_EQ(uint32_t(mm_->cm.vn), verticesAtLevel(info, n));
+    EXPECT_EQ(canonical(pomar::from_vcg(mm_->cm)),
+              canonical(pomar::decode(clustered_->data(), clustered_->size(), n)));
+    const std::vector<float> cluster = vertexAttribute(mm_->cm, "pomar_cluster");
+    const std::vector<float> level = vertexAttribute(mm_->cm, "pomar_level");
+    ASSERT_EQ(level.size(), size_t(mm_->cm.vn));
+    if (n < base) { // decoded by pomar::decode: no per-vertex levels or clusters
+      EXPECT_EQ(*std::max_element(cluster.begin(), cluster.end()), -1.0f);
+      EXPECT_EQ(*std::max_element(level.begin(), level.end()), -1.0f);
+    } else {
+      EXPECT_GE(*std::min_element(cluster.begin(), cluster.end()), 0.0f);
+      EXPECT_EQ(*std::max_element(level.begin(), level.end()), float(n));
+    }
+    EXPECT_EQ(sourceAttribute(mm_->cm), QFile::encodeName(path("clustered.pomar")).toStdString());
+  }
+}
+
+TEST_F(PomarPluginTest, OpenProgressiveFile) {
+  const pomar::FileInfo info = infoOf(*progressive_);
+  ASSERT_FALSE(info.clustered());
+  const int finest = int(info.levels.size());
+  ASSERT_GT(finest, 3);
+  for (int n : {0, 3, finest}) {
+    SCOPED_TRACE("level " + std::to_string(n));
+    ASSERT_TRUE(openAt(path("progressive.pomar"), 2, n)) << plugin()->errorMsg().toStdString();
+    EXPECT_EQ(uint32_t(mm_->cm.vn), verticesAtLevel(info, n));
+    EXPECT_EQ(canonical(pomar::from_vcg(mm_->cm)),
+              canonical(pomar::decode(progressive_->data(), progressive_->size(), n)));
+    const std::vector<float> cluster = vertexAttribute(mm_->cm, "pomar_cluster");
+    const std::vector<float> level = vertexAttribute(mm_->cm, "pomar_level");
+    EXPECT_EQ(std::set<float>(cluster.begin(), cluster.end()), std::set<float>{-1.0f});
+    EXPECT_EQ(*std::max_element(level.begin(), level.end()), float(n));
+  }
+  // Full resolution (the default) and "base clustered" (= the base mesh: no clusters).
+  ASSERT_TRUE(openAt(path("progressive.pomar"), 0));
+  EXPECT_EQ(uint32_t(mm_->cm.vn), info.vertices);
+  ASSERT_TRUE(openAt(path("progressive.pomar"), 1));
+  EXPECT_EQ(uint32_t(mm_->cm.vn), info.base_vertices);
+}
+
+TEST_F(PomarPluginTest, BareFileNameIsResolvedAgainstTheWorkingDirectory) {
+  const QString old = QDir::currentPath();
+  ASSERT_TRUE(QDir::setCurrent(dir_->path())); // what the GUI does before open()
+  const bool ok = openAt("clustered.pomar", 0);
+  QDir::setCurrent(old);
+  ASSERT_TRUE(ok) << plugin()->errorMsg().toStdString();
+  EXPECT_EQ(sourceAttribute(mm_->cm), QFile::encodeName(path("clustered.pomar")).toStdString());
+}
+
+TEST_F(PomarPluginTest, OpenErrors) {
+  const int finest = int(infoOf(*clustered_).levels.size());
+  EXPECT_FALSE(openAt(path("clustered.pomar"), 2, finest + 1));
+  EXPECT_TRUE(plugin()->errorMsg().contains("does not exist")) << plugin()->errorMsg().toStdString();
+  EXPECT_EQ(mm_->cm.vn, 0);
+  EXPECT_FALSE(openAt(path("clustered.pomar"), 2, -1));
+  EXPECT_TRUE(plugin()->errorMsg().contains("does not exist"));
+
+  EXPECT_FALSE(openAt(path("missing.pomar"), 0));
+  EXPECT_TRUE(plugin()->errorMsg().contains("missing.pomar")) << plugin()->errorMsg().toStdString();
+
+  std::vector<uint8_t> cut(clustered_->begin(), clustered_->begin() + clustered_->size() / 2);
+  writeBytes(path("cut.pomar"), cut);
+  EXPECT_FALSE(openAt(path("cut.pomar"), 0));
+  EXPECT_TRUE(plugin()->errorMsg().contains("truncated")) << plugin()->errorMsg().toStdString();
+  EXPECT_EQ(mm_->cm.vn, 0);
+  EXPECT_FALSE(g_warnings.isEmpty()); // also on stderr: meshlabserver does not print errorMsg()
+  QFile::remove(path("cut.pomar"));
+}
+
+// ---------------------------------------------------------------- save
+
+TEST_F(PomarPluginTest, SaveWithDefaultsEqualsTheLibrary) {
+  MeshModel *mm = layer(*input_);
+  ASSERT_TRUE(save(*mm, path("saved.pomar"))) << plugin()->errorMsg().toStdString();
+  EXPECT_EQ(readBytes(path("saved.pomar")), *clustered_);
+  EXPECT_TRUE(g_warnings.isEmpty()) << g_warnings.join("\n").toStdString();
+  QFile::remove(path("saved.pomar"));
+}
+
+TEST_F(PomarPluginTest, SaveParameters) {
+  MeshModel *mm = layer(*input_);
+  ASSERT_TRUE(save(*mm, path("p.pomar"), [](RichParameterList &par) {
+    par.setValue("Bits", IntValue(10));
+    par.setValue("Progressive", BoolValue(true));
+  })) << plugin()->errorMsg().toStdString();
+  pomar::EncodeOptions o;
+  o.bits = 10;
+  o.progressive = true;
+  EXPECT_EQ(readBytes(path("p.pomar")), pomar::encode(*input_, o));
+  EXPECT_EQ(infoOf(readBytes(path("p.pomar"))).bits, 10);
+  EXPECT_FALSE(infoOf(readBytes(path("p.pomar"))).clustered());
+
+  ASSERT_TRUE(save(*mm, path("p.pomar"), [](RichParameterList &par) {
+    par.setValue("ClusterRatio", FloatValue(0.05f));
+  })); // replaces the existing file
+  pomar::EncodeOptions c;
+  c.cluster_ratio = 0.05f;
+  EXPECT_EQ(readBytes(path("p.pomar")), pomar::encode(*input_, c));
+  EXPECT_GT(infoOf(readBytes(path("p.pomar"))).clusters, infoOf(*clustered_).clusters);
+  QFile::remove(path("p.pomar"));
+}
+
+TEST_F(PomarPluginTest, SaveSkipsDeletedElements) {
+  MeshModel *mm = layer(*input_);
+  vcg::tri::Allocator<CMeshO>::DeleteFace(mm->cm, mm->cm.face[10]);
+  ASSERT_TRUE(save(*mm, path("d.pomar"))) << plugin()->errorMsg().toStdString();
+  const std::vector<uint8_t> file = readBytes(path("d.pomar"));
+  EXPECT_EQ(infoOf(file).faces, input_->triangle_count() - 1);
+  QFile::remove(path("d.pomar"));
+}
+
+TEST_F(PomarPluginTest, SaveWarnsAboutWhatIsNotKept) {
+  MeshModel *mm = layer(*input_);
+  mm->updateDataMask(MeshModel::MM_VERTCOLOR);
+  for (auto &v : mm->cm.vert)
+    v.C() = vcg::Color4b::White;
+  mm->cm.vert[5].C() = vcg::Color4b::Red;
+  vcg::tri::Allocator<CMeshO>::GetPerVertexAttribute<float>(mm->cm, "my_weight");
+  ASSERT_TRUE(save(*mm, path("w.pomar"))) << plugin()->errorMsg().toStdString();
+  const QString all = g_warnings.join("\n");
+  EXPECT_TRUE(all.contains("per-vertex colors")) << all.toStdString();
+  EXPECT_TRUE(all.contains("my_weight")) << all.toStdString();
+  EXPECT_FALSE(all.contains("normals")) << all.toStdString(); // MeshLab's own normals
+  EXPECT_EQ(readBytes(path("w.pomar")), *clustered_);          // and the file is the same
+
+  // Normals that are not MeshLab's angle-weighted ones are named too.
+  g_warnings.clear();
+  for (auto &v : mm->cm.vert)
+    v.N() = vcg::Point3f(0, 0, 1);
+  ASSERT_TRUE(save(*mm, path("w.pomar")));
+  EXPECT_TRUE(g_warnings.join("\n").contains("per-vertex normals"));
+  QFile::remove(path("w.pomar"));
+}
+
+TEST_F(PomarPluginTest, FailedSaveWritesNothing) {
+  const QStringList before = dirEntries();
+  MeshModel *mm = layer(pomar::gen::nonmanifold_edge());
+  EXPECT_FALSE(save(*mm, path("bad.pomar")));
+  EXPECT_TRUE(plugin()->errorMsg().contains("non-manifold")) << plugin()->errorMsg().toStdString();
+  EXPECT_TRUE(g_warnings.join("\n").contains("non-manifold"));
+  EXPECT_EQ(dirEntries(), before);
+
+  // An existing destination is left untouched.
+  EXPECT_FALSE(save(*mm, path("clustered.pomar")));
+  EXPECT_EQ(readBytes(path("clustered.pomar")), *clustered_);
+  EXPECT_EQ(dirEntries(), before);
+
+  // An unwritable destination: the codec succeeds, the write fails.
+  MeshModel *good = layer(*input_);
+  EXPECT_FALSE(save(*good, path("no_such_dir/x.pomar")));
+  EXPECT_TRUE(plugin()->errorMsg().contains("no_such_dir")) << plugin()->errorMsg().toStdString();
+  EXPECT_EQ(dirEntries(), before);
+
+  // Invalid parameters are the codec's errors.
+  EXPECT_FALSE(save(*good, path("bits.pomar"), [](RichParameterList &par) {
+    par.setValue("Bits", IntValue(30));
+  }));
+  EXPECT_FALSE(plugin()->errorMsg().isEmpty());
+  EXPECT_EQ(dirEntries(), before);
+}
+
+TEST_F(PomarPluginTest, OpenThenSaveRoundTrip) {
+  ASSERT_TRUE(openAt(path("clustered.pomar"), 0));
+  mm_->UpdateBoxAndNormals();
+  ASSERT_TRUE(save(*mm_, path("again.pomar"))) << plugin()->errorMsg().toStdString();
+  const std::vector<uint8_t> again = readBytes(path("again.pomar"));
+  EXPECT_EQ(canonical(pomar::decode(again.data(), again.size())),
+            canonical(pomar::decode(clustered_->data(), clustered_->size())));
+  // Our own attributes are not reported as lost data.
+  EXPECT_TRUE(g_warnings.isEmpty()) << g_warnings.join("\n").toStdString();
+  QFile::remove(path("again.pomar"));
+}
+
+} // namespace
+
+int main(int argc, char **argv) {
+  QCoreApplication app(argc, argv);
+  qInstallMessageHandler(captureMessages);
+  ::testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}
