@@ -24,6 +24,7 @@ PACKAGES=(
   libcli11-dev nlohmann-json3-dev libtinyobjloader-dev libxxhash-dev zlib1g-dev
   draco libdraco-dev
   time python3 clang
+  imagemagick x11-utils xdotool        # scripts/gui_screenshot.sh (GUI checks under Xvfb)
 )
 
 log() { printf 'setup: %s\n' "$*"; }
