@@ -21,7 +21,10 @@ public:
     std::memcpy(&v, &f, 4);
     put(v, 4);
   }
-  void bytes(const uint8_t *p, size_t n) { out_.insert(out_.end(), p, p + n); }
+  void bytes(const uint8_t *p, size_t n) {
+    for (size_t i = 0; i < n; ++i) // (vector::insert here trips a GCC 12 false warning)
+      out_.push_back(p[i]);
+  }
 
 private:
   void put(uint32_t v, int n) {
