@@ -401,6 +401,11 @@ void SelectiveDecoder::update(const Progress &progress) {
   for (size_t c = 0; c < target.size(); ++c)
     todo += size_t(target[c] - s.clusters[c].level);
   for (int level = s.global_levels + 1; level <= s.finest; ++level) {
+    // Nothing finer than level-1 exists yet: every current vertex is older than `level`.
+    int finest_now = s.global_levels;
+    for (const auto &k : s.clusters)
+      finest_now = std::max(finest_now, k.level);
+    s.mesh.older_than_level = finest_now < level ? s.mesh.vertex_count() : 0;
     for (uint32_t c = 0; c < target.size(); ++c) {
       if (target[c] < level || s.clusters[c].level >= level)
         continue;
@@ -409,6 +414,7 @@ void SelectiveDecoder::update(const Progress &progress) {
         progress(double(done) / double(todo), "decode");
     }
   }
+  s.mesh.older_than_level = 0;
   s.levels = target;
 }
 

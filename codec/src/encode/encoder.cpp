@@ -319,6 +319,7 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
     for (size_t r = G; r < L; ++r) {
       const uint32_t level = static_cast<uint32_t>(r + 1);
       ccodec.begin_level(dec.levels[L - 1 - r], &level_models[r - G]);
+      lm.older_than_level = lm.vertex_count(); // levels are encoded in order
       for (uint32_t c = 0; c < clusters; ++c) {
         RecorderStream conn{&recordings[c], 0}, geom{&recordings[c], 1};
         ccodec.set_sinks(&conn, &geom);
@@ -327,6 +328,7 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
         ccodec.number_new_vertices();
       }
       ccodec.end_level();
+      lm.older_than_level = 0;
       add_level_entry(0, 0);
       if (options.progress)
         options.progress(double(r + 1) / double(L), "encode");

@@ -44,6 +44,10 @@ struct LevelMesh {
   std::vector<Tag> tag;
   std::vector<uint32_t> parent, local;
   std::vector<uint16_t> face_claim; // per face: last level whose patch held it
+  /// Vertices below this id are known to be older than the level being decoded (0: not
+  /// known). Set when a level starts on a mesh that holds nothing finer, it spares the
+  /// view its lineage lookups (see view_of).
+  uint32_t older_than_level = 0;
   uint32_t vertex_count() const { return ct.vertex_count(); }
   uint32_t level_of(uint32_t v) const { return tag[v].level; }
   uint32_t cluster_of(uint32_t v) const { return tag[v].cluster; }
@@ -253,6 +257,8 @@ inline int sv_context(const TraversalScratch &s, const Ring &ring) {
 /// The view is the same whatever clusters were decoded before, which is what makes
 /// selective and incremental decoding equal to a full decode.
 inline uint32_t view_of(const LevelMesh &mesh, uint32_t v, uint32_t level) {
+  if (v < mesh.older_than_level)
+    return v;
   while (mesh.tag[v].level >= level && mesh.parent[v] != v)
     v = mesh.parent[v];
   return v;
