@@ -7,7 +7,7 @@
 //       against the progressive file and encode time.
 //
 //   pomar_ra_bench one MESH [--bits N] [--clusters N | --ratio R] [--repeat K] [--verbose]
-//       Encodes MESH (default ratio 0.02) to a temporary .pomar file, then decodes K
+//       Encodes MESH (default: the codec's default ratio) to a temporary .pomar file, then decodes K
 //       (default 20) evenly spaced clusters at the finest level, each with a fresh
 //       SelectiveDecoder over a FileSource; prints min/median/max times, bytes and blocks
 //       read, and the same for the constructor alone and for a full decode. --verbose
@@ -81,7 +81,7 @@ struct Args {
   std::string mode, mesh;
   int bits = 12;
   uint32_t clusters = 0;
-  double ratio = 0.02;
+  double ratio = pomar::EncodeOptions{}.cluster_ratio;
   bool ratio_given = false;
   int repeat = 20;
   bool verbose = false;
@@ -174,7 +174,7 @@ int run_curve(const Args &a) {
     if (r.ratio == 0)
       std::snprintf(ratio, sizeof ratio, "progressive");
     else
-      std::snprintf(ratio, sizeof ratio, "%.3f%s", r.ratio, r.ratio == 0.02 ? " (default)" : "");
+      std::snprintf(ratio, sizeof ratio, "%.3f%s", r.ratio, r.ratio == pomar::EncodeOptions{}.cluster_ratio ? " (default)" : "");
     const double overhead = 100.0 * (double(i.total_bytes) / double(prog.total_bytes) - 1.0);
     std::printf("| %s | %s | %u | %.2f | %.2f | %.2f | %s | %s | %+.1f%% | %.3f |\n", ratio,
                 with_commas(i.clusters).c_str(), i.global_levels, bpv(i.total_bytes, i.vertices),
