@@ -10,26 +10,13 @@
 #include "pomar/pomar.h"
 #include "pomar/random_access.h"
 #include "support/mesh_gen.h"
+#include "support/mesh_compare.h"
 
 namespace pomar {
 namespace {
 
-using Tri = std::array<std::array<float, 3>, 3>;
-
-/// The mesh as a sorted list of triangles of positions (smallest rotation first).
-std::vector<Tri> canonical(const Mesh &m) {
-  std::vector<Tri> out;
-  for (size_t f = 0; f < m.triangle_count(); ++f) {
-    Tri t;
-    for (int k = 0; k < 3; ++k)
-      for (int a = 0; a < 3; ++a)
-        t[k][a] = m.positions[3 * m.triangles[3 * f + k] + a];
-    const Tri r1 = {t[1], t[2], t[0]}, r2 = {t[2], t[0], t[1]};
-    out.push_back(std::min({t, r1, r2}));
-  }
-  std::sort(out.begin(), out.end());
-  return out;
-}
+using Tri = test::PositionTriangle;
+using test::canonical;
 
 struct Encoded {
   Mesh input;

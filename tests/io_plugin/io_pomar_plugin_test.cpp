@@ -31,6 +31,7 @@
 #include <set>
 #include <string>
 #include <vector>
+#include "support/mesh_compare.h"
 
 namespace {
 
@@ -53,22 +54,8 @@ MeshIOInterface *plugin() {
   return io;
 }
 
-using Tri = std::array<std::array<float, 3>, 3>;
-
-/// The mesh as a sorted list of triangles of positions (smallest rotation first).
-std::vector<Tri> canonical(const pomar::Mesh &m) {
-  std::vector<Tri> out;
-  for (size_t f = 0; f < m.triangle_count(); ++f) {
-    Tri t;
-    for (int k = 0; k < 3; ++k)
-      for (int a = 0; a < 3; ++a)
-        t[k][a] = m.positions[3 * m.triangles[3 * f + k] + a];
-    const Tri r1 = {t[1], t[2], t[0]}, r2 = {t[2], t[0], t[1]};
-    out.push_back(std::min({t, r1, r2}));
-  }
-  std::sort(out.begin(), out.end());
-  return out;
-}
+using Tri = pomar::test::PositionTriangle;
+using pomar::test::canonical;
 
 std::vector<uint8_t> readBytes(const QString &path) {
   QFile f(path);
