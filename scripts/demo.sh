@@ -2,7 +2,8 @@
 # Demo: set up, build the pomar CLI (Release, Ninja, in build/), then round-trip the Stanford bunny:
 #   samples/bunny.ply -> build/demo/bunny.pomar -> build/demo/bunny_decoded.ply, and verify it is lossless.
 # When the MeshLab plugin target (io_pomar) is configured, it is built too and the project is installed
-# into /usr (pomar -> /usr/bin, libio_pomar.so -> /usr/lib/x86_64-linux-gnu/meshlab/plugins), so that
+# into /usr (pomar -> /usr/bin, libio_pomar.so and libfilter_pomar.so ->
+# /usr/lib/x86_64-linux-gnu/meshlab/plugins), so that
 # meshlab and meshlabserver open .pomar; then meshlabserver converts build/demo/bunny.pomar to
 # build/demo/bunny_meshlab.ply, which is verified the same way.
 # Works from any directory. Installing into /usr needs root (or sudo).
@@ -29,8 +30,8 @@ targets="$(cmake --build "$BUILD" --target help 2>/dev/null || true)" # Ninja: "
 if grep -Eq '^(\.\.\. )?io_pomar(:| |$)' <<<"$targets"; then
   HAVE_PLUGIN=1
   echo
-  echo "demo: building the MeshLab plugin (io_pomar) and installing into /usr"
-  cmake --build "$BUILD" --target io_pomar
+  echo "demo: building the MeshLab plugins (io_pomar, filter_pomar) and installing into /usr"
+  cmake --build "$BUILD" --target io_pomar filter_pomar
   SUDO=()
   if [ "$(id -u)" -ne 0 ] && command -v sudo >/dev/null 2>&1; then SUDO=(sudo); fi
   "${SUDO[@]}" cmake --install "$BUILD" --prefix /usr
