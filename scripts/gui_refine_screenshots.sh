@@ -37,116 +37,23 @@
 # filter_pomar are (re)built here. Works from any directory. Based on scripts/gui_screenshot.sh.
 set -euo pipefail
 
-REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-cd "$REPO"
+# The steps shared with scripts/gui_screenshot.sh: scripts/lib/meshlab_gui.sh.
+# shellcheck source-path=SCRIPTDIR source=lib/meshlab_gui.sh
+. "$(dirname "${BASH_SOURCE[0]}")/lib/meshlab_gui.sh"
+mlgui_init gui_refine_screenshots
+mlgui_parse_args "${BASH_SOURCE[0]}" 37 "$@"   # --help: lines 2-37
 
-USE_INSTALLED=0
-OUTDIR="$REPO/docs/images"
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --installed) USE_INSTALLED=1 ;;
-    -h|--help) sed -n '2,37p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
-    -*) echo "gui_refine_screenshots: unknown option $1" >&2; exit 2 ;;
-    *) OUTDIR="$1" ;;
-  esac
-  shift
-done
-case "$OUTDIR" in /*) ;; *) OUTDIR="$PWD/$OUTDIR" ;; esac
-
-BUILD=build
-POMAR="$BUILD/codec/pomar"
-IO_PLUGIN="$BUILD/io_plugin/libio_pomar.so"
-FILTER_PLUGIN="$BUILD/meshlab_plugin/libfilter_pomar.so"
-SYS_PLUGINS=/usr/lib/x86_64-linux-gnu/meshlab/plugins
-TIMEOUT=90          # seconds to wait for each of: the X server, the dialog, the mesh load, a filter
-RENDER_WAIT=3       # seconds left to the viewer to redraw before a screenshot
-
-log() { printf 'gui_refine_screenshots: %s\n' "$*"; }
-die() { printf 'gui_refine_screenshots: error: %s\n' "$*" >&2; exit 1; }
-
-# ---- prerequisites -------------------------------------------------------------
-missing=()
-for tool in Xvfb:xvfb xdotool:xdotool import:imagemagick xwininfo:x11-utils; do
-  command -v "${tool%%:*}" >/dev/null 2>&1 || missing+=("${tool#*:}")
-done
-[ -x /usr/bin/meshlab ] || missing+=(meshlab)
-[ ${#missing[@]} -eq 0 ] ||
-  die "missing tools; install them with: apt-get install -y --no-install-recommends ${missing[*]}"
-
-[ -f "$BUILD/build.ninja" ] || [ -f "$BUILD/Makefile" ] ||
-  die "$BUILD/ is not configured: run scripts/demo.sh (or cmake -S . -B $BUILD -G Ninja) first"
-targets=(pomar)
-[ $USE_INSTALLED -eq 1 ] || targets+=(io_pomar filter_pomar)
-log "building ${targets[*]}"
-cmake --build "$BUILD" --target "${targets[@]}" >/dev/null ||
-  die "cmake --build $BUILD --target ${targets[*]} failed (are the MeshLab plugins enabled in $BUILD?)"
-[ -x "$POMAR" ] || die "$POMAR was not built"
-
-# ---- temp dir, cleanup ----------------------------------------------------------
-WORK="$(mktemp -d "${TMPDIR:-/tmp}/pomar-gui-refine.XXXXXX")"
-XVFB_PID=""
-ML_PID=""
-cleanup() {
-  if [ -n "$ML_PID" ]; then kill "$ML_PID" 2>/dev/null || true; wait "$ML_PID" 2>/dev/null || true; fi
-  if [ -n "$XVFB_PID" ]; then kill "$XVFB_PID" 2>/dev/null || true; wait "$XVFB_PID" 2>/dev/null || true; fi
-  rm -rf "$WORK"
-}
-trap cleanup EXIT
-trap 'exit 130' INT TERM
-
-# ---- MeshLab to run ------------------------------------------------------------
-if [ $USE_INSTALLED -eq 1 ]; then
-  MESHLAB=/usr/bin/meshlab
-  for so in libio_pomar.so libfilter_pomar.so; do
-    [ -f "$SYS_PLUGINS/$so" ] || die "--installed: $SYS_PLUGINS/$so not found (cmake --install $BUILD --prefix /usr)"
-  done
-else
-  [ -f "$IO_PLUGIN" ] || die "$IO_PLUGIN was not built"
-  [ -f "$FILTER_PLUGIN" ] || die "$FILTER_PLUGIN was not built"
-  # Private tree (meshlab-plugins.md 5b): the binary must be a copy, not a symlink, because
-  # MeshLab finds its plugins from the resolved path of its executable.
-  TREE="$WORK/tree"
-  MLDIR="$TREE/lib/x86_64-linux-gnu/meshlab"
-  mkdir -p "$TREE/bin" "$MLDIR/plugins"
-  cp /usr/bin/meshlab "$TREE/bin/meshlab"
-  ln -s /usr/lib/x86_64-linux-gnu/meshlab/libmeshlab-common.so "$MLDIR/"
-  for so in "$SYS_PLUGINS"/*.so; do
-    case "$(basename "$so")" in libio_pomar.so|libfilter_pomar.so) ;; *) ln -s "$so" "$MLDIR/plugins/" ;; esac
-  done
-  ln -s "$REPO/$IO_PLUGIN" "$MLDIR/plugins/libio_pomar.so"
-  ln -s "$REPO/$FILTER_PLUGIN" "$MLDIR/plugins/libfilter_pomar.so"
-  MESHLAB="$TREE/bin/meshlab"
-fi
-log "meshlab: $MESHLAB"
-
-# ---- input ----------------------------------------------------------------------
-DATA="$WORK/data"
-mkdir -p "$DATA"
-"$POMAR" encode samples/bunny.ply "$DATA/bunny.pomar" --quiet
-log "encoded samples/bunny.ply -> bunny.pomar ($(stat -c %s "$DATA/bunny.pomar") bytes)"
-
-# ---- X server on a free display ----------------------------------------------------
-# -displayfd: Xvfb picks a free display number itself and writes it to that descriptor.
-exec 9>"$WORK/display"
-Xvfb -displayfd 9 -screen 0 1600x1000x24 -nolisten tcp >"$WORK/xvfb.log" 2>&1 &
-XVFB_PID=$!
-exec 9>&-
-for _ in $(seq $((TIMEOUT * 10))); do
-  [ -s "$WORK/display" ] && break
-  kill -0 "$XVFB_PID" 2>/dev/null || { cat "$WORK/xvfb.log" >&2; die "Xvfb exited"; }
-  sleep 0.1
-done
-[ -s "$WORK/display" ] || die "Xvfb did not report a display within ${TIMEOUT}s"
-DISPLAY=":$(head -n1 "$WORK/display" | tr -d '[:space:]')"
-export DISPLAY
-log "Xvfb on $DISPLAY"
+mlgui_require_tools
+mlgui_build io_pomar filter_pomar
+mlgui_make_workdir pomar-gui-refine
+mlgui_pick_meshlab "$BUILD/io_plugin/libio_pomar.so" "$BUILD/meshlab_plugin/libfilter_pomar.so"
+mlgui_encode_bunny
+mlgui_start_xvfb
 
 # ---- GUI helpers ---------------------------------------------------------------------
-ERRLOG="$WORK/meshlab.log"
 MAIN=""            # MeshLab main window id
 MX=0 MY=0 MW=0     # its position and width
 
-fail_log() { tail -n 30 "$ERRLOG" >&2; die "$*"; }
 alive() { kill -0 "$ML_PID" 2>/dev/null || fail_log "meshlab exited ($*)"; }
 
 # log_mark: the current length of MeshLab's log; log_since MARK: what was logged after it.
@@ -242,9 +149,7 @@ apply_filter() {
 
 shot() {   # shot OUT: the main window, after letting the viewer redraw
   sleep "$RENDER_WAIT"
-  mkdir -p "$(dirname "$1")"
-  import -window "$MAIN" "$1"
-  log "  wrote ${1#"$REPO"/} ($(identify -format '%wx%h' "$1" 2>/dev/null || echo '?'))"
+  mlgui_capture "$MAIN" "$1" "  "
 }
 
 # select_rect: Edit -> "Select Faces in a rectangular region", drag over the head. 0 if started.
@@ -273,6 +178,7 @@ select_rect() {
 
 # select_conditional: Filters -> Selection -> Conditional Vertex Selection, (y > 0.15).
 select_conditional() {
+  # shellcheck disable=SC2034  # SCREEN and WINDOW: set by the eval below, unused
   local dlg X Y WIDTH HEIGHT SCREEN WINDOW line
   dlg="$(open_filter 'Conditional Vertex Selection')"
   eval "$(xdotool getwindowgeometry --shell "$dlg")"
@@ -285,31 +191,15 @@ select_conditional() {
 }
 
 # ---- the session ----------------------------------------------------------------------
-mkdir -p "$WORK/home" "$WORK/run"
-chmod 700 "$WORK/run"
-# Fresh HOME: first start, no saved settings (MeshLab writes ~/.config/VCG/*.conf).
-(cd "$DATA" && HOME="$WORK/home" XDG_RUNTIME_DIR="$WORK/run" exec "$MESHLAB" "$DATA/bunny.pomar") \
-  >"$ERRLOG" 2>&1 &
-ML_PID=$!
+mlgui_start_meshlab "$WORK/home" "$WORK/meshlab.log"
 
 log "1. open at the base clustered mesh"
 id="$(find_window 'Pre-Open Options' "$TIMEOUT" || true)"
 alive "before the Pre-Open Options dialog"
 [ -n "$id" ] || fail_log "no Pre-Open Options dialog within ${TIMEOUT}s (is the plugin loaded?)"
-sleep 0.5   # let the dialog finish laying itself out
-xdotool windowfocus --sync "$id"
-# Initially no widget has the focus; the tab order is "Open at" combo -> "Level N" -> Reset.
-# Tab focuses the combo, Down moves it from "Full resolution" to "Base clustered mesh".
-xdotool key Tab; sleep 0.2
-xdotool key Down; sleep 0.2
-xdotool key Return   # OK is the default button
+mlgui_answer_preopen "$id" coarse
 wait_log 0 'All files opened' "$TIMEOUT" >/dev/null || fail_log "the mesh did not load within ${TIMEOUT}s"
-line="$(grep -o 'pomar: opened .*' "$ERRLOG" | head -n1 || true)"
-[ -n "$line" ] || fail_log "no 'pomar: opened' line in MeshLab's log (open failed?)"
-log "  ${line#pomar: }"
-[[ "$line" =~ at\ level\ ([0-9]+)\ of\ ([0-9]+) ]] || die "cannot parse the level from: $line"
-[ "${BASH_REMATCH[1]}" -lt "${BASH_REMATCH[2]}" ] ||
-  die "expected the base clustered mesh (below level ${BASH_REMATCH[2]}), got level ${BASH_REMATCH[1]}"
+mlgui_check_opened coarse "  "
 MAIN="$(find_window 'MeshLab [0-9].*' 10 || true)"
 [ -n "$MAIN" ] || fail_log "MeshLab main window not found"
 eval "$(xdotool getwindowgeometry --shell "$MAIN" | sed 's/^/G_/')"
@@ -370,7 +260,5 @@ dialog_button "$dlg" close
 log "  ${line#LOG: [0-9] }"
 shot "$OUTDIR/meshlab_refine_levels.png"
 
-kill "$ML_PID" 2>/dev/null || true
-wait "$ML_PID" 2>/dev/null || true
-ML_PID=""
+mlgui_stop_meshlab
 log "ok: selection by $SELECTION; refined ${REFINED:-?} clusters in ${REFINE_MS:-?} ms (plugin's log)"

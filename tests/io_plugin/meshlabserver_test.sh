@@ -8,95 +8,41 @@
 # a *copy* of meshlabserver in tree/bin, symlinks to libmeshlab-common.so, the stock plugins
 # libio_base.so + libfilter_select.so and ours), so nothing under /usr is touched and only
 # these plugins load. meshlabserver needs an X display: every call runs under `xvfb-run -a`
-# with HOME in WORK_DIR.
+# with HOME in WORK_DIR. The tree, the meshlabserver runs and the check helpers come from
+# tests/support/meshlab_tree.sh.
 #
 # meshlabserver exits 0 even when a save fails, so every check looks at the files and the
 # output. Exits 77 (ctest SKIP_RETURN_CODE) when meshlabserver, xvfb-run or MeshLab's library
 # is missing. The first failing check prints what failed and exits 1.
 set -euo pipefail
+# shellcheck source-path=SCRIPTDIR source=../support/meshlab_tree.sh
+. "$(dirname "${BASH_SOURCE[0]}")/../support/meshlab_tree.sh"
 
 if [ $# -lt 4 ] || [ $# -gt 5 ]; then
   echo "usage: $0 PLUGIN.so POMAR_CLI SAMPLES_DIR WORK_DIR [MESHLAB_LIBDIR]" >&2
   exit 2
 fi
-abspath() { echo "$(cd "$(dirname "$1")" && pwd)/$(basename "$1")"; }
 PLUGIN="$(abspath "$1")"
-POMAR="$(abspath "$2")"
-SAMPLES="$(cd "$3" && pwd)"
-mkdir -p "$4"
-WORK="$(cd "$4" && pwd)"
-MLLIB="${5:-/usr/lib/x86_64-linux-gnu/meshlab}"
+mlserver_args "${@:2}"   # POMAR SAMPLES WORK MLLIB
+STOCK=(libio_base.so libfilter_select.so)
 
-skip() { echo "SKIP: $*"; exit 77; }
-command -v meshlabserver >/dev/null 2>&1 || skip "meshlabserver is not installed"
-command -v xvfb-run >/dev/null 2>&1 || skip "xvfb-run is not installed (package xvfb)"
-[ -f "$MLLIB/libmeshlab-common.so" ] || skip "$MLLIB/libmeshlab-common.so not found"
-for p in libio_base.so libfilter_select.so; do
-  [ -f "$MLLIB/plugins/$p" ] || skip "stock plugin $MLLIB/plugins/$p not found"
-done
+skip_without_server
+skip_without_meshlab_lib "$MLLIB" "${STOCK[@]}"
 [ -f "$PLUGIN" ] || { echo "FAIL: plugin not found: $PLUGIN" >&2; exit 1; }
 [ -x "$POMAR" ] || { echo "FAIL: pomar executable not found: $POMAR" >&2; exit 1; }
 BUNNY="$SAMPLES/bunny.ply"
 NONMANIFOLD="$SAMPLES/tetra_nonmanifold.off"
-[ -f "$BUNNY" ] && [ -f "$NONMANIFOLD" ] || { echo "FAIL: samples missing in $SAMPLES" >&2; exit 1; }
+for f in "$BUNNY" "$NONMANIFOLD"; do
+  [ -f "$f" ] || { echo "FAIL: samples missing in $SAMPLES" >&2; exit 1; }
+done
 
-# ---- the private MeshLab tree ----------------------------------------------------------------------
+# ---- the private MeshLab tree (tests/support/meshlab_tree.sh), checks ----------------------------------
 
-TREE="$WORK/tree"
-PLUGDIR="$TREE/lib/x86_64-linux-gnu/meshlab/plugins"
-rm -rf "$WORK/tree" "$WORK/home" "$WORK/out"
-mkdir -p "$TREE/bin" "$PLUGDIR" "$WORK/home" "$WORK/out"
-chmod 700 "$WORK/home"
-# A copy, not a symlink: MeshLab finds its plugins from the resolved path of its binary.
-cp "$(readlink -f "$(command -v meshlabserver)")" "$TREE/bin/meshlabserver"
-ln -s "$MLLIB/libmeshlab-common.so" "$TREE/lib/x86_64-linux-gnu/meshlab/"
-ln -s "$MLLIB/plugins/libio_base.so" "$MLLIB/plugins/libfilter_select.so" "$PLUGDIR/"
-ln -s "$PLUGIN" "$PLUGDIR/libio_pomar.so"
-ML="$TREE/bin/meshlabserver"
-OUTDIR="$WORK/out"
+mlserver_prepare "$WORK" "$MLLIB" "${STOCK[@]}"
+mltree_link_as "$TREE" "$PLUGIN" libio_pomar.so
 
-CHECKS=0
-CUR="(setup)"
-section() { CUR="$*"; printf -- '--- %s\n' "$*"; }
-pass() { CHECKS=$((CHECKS + 1)); }
-fail() {
-  {
-    printf 'FAIL [%s]: %s\n' "$CUR" "$*"
-    if [ -n "${LAST_CMD:-}" ]; then
-      printf '  last command: %s\n  exit status : %s\n  output      :\n' "$LAST_CMD" "$RC"
-      printf '%s\n' "$OUT" | sed 's/^/    /' | head -40
-    fi
-  } >&2
-  exit 1
-}
-
-# ml ARGS...: runs the private meshlabserver under Xvfb; sets RC and OUT (stdout + stderr).
-ml() {
-  LAST_CMD="meshlabserver $*"
-  set +e
-  OUT="$(cd "$OUTDIR" && HOME="$WORK/home" XDG_RUNTIME_DIR="$WORK/home" \
-    xvfb-run -a "$ML" "$@" 2>&1)"
-  RC=$?
-  set -e
-}
 # pomar ARGS...: runs the pomar CLI; sets RC and OUT.
-pomar() {
-  LAST_CMD="pomar $*"
-  set +e
-  OUT="$("$POMAR" "$@" 2>&1)"
-  RC=$?
-  set -e
-}
-expect_rc() { [ "$RC" -eq "$1" ] || fail "expected exit status $1, got $RC"; pass; }
-expect_nonzero() { [ "$RC" -ne 0 ] || fail "expected a non-zero exit status, got 0"; pass; }
-expect_file() { [ -s "$1" ] || fail "expected a non-empty file at $1"; pass; }
-expect_no_file() { [ ! -e "$1" ] || fail "expected no file at $1, but it exists"; pass; }
-expect_output() { # expect_output NEEDLE
-  case "$OUT" in *"$1"*) pass ;; *) fail "the output does not contain '$1'" ;; esac
-}
-expect_no_output() {
-  case "$OUT" in *"$1"*) fail "the output contains '$1'" ;; *) pass ;; esac
-}
+pomar() { run_labelled "pomar $*" "$POMAR" "$@"; }
 expect_dir_only() { # expect_dir_only NAME...: OUTDIR holds exactly these entries (no stray temp files)
   local got want
   got="$(find "$OUTDIR" -mindepth 1 -maxdepth 1 -printf '%f\n' | LC_ALL=C sort | tr '\n' ' ')"

@@ -10,7 +10,8 @@
 # *copy* of meshlabserver in tree/bin, symlinks to libmeshlab-common.so, the stock plugins
 # libio_base.so (PLY), libfilter_select.so (Select Faces from Vertices) and libfilter_func.so
 # (Conditional Vertex Selection), and ours). Every call runs under `xvfb-run -a` with HOME in
-# WORK_DIR. meshlabserver exits 0 even when a save fails, so the checks look at the files.
+# WORK_DIR. meshlabserver exits 0 even when a save fails, so the checks look at the files. The
+# tree, the meshlabserver runs and the check helpers come from tests/support/meshlab_tree.sh.
 #
 # The scripts in samples/ hold the levels of samples/bunny.ply encoded with the default options;
 # the test reads the real ones from `pomar info --json` (global_levels, level_count) and runs
@@ -18,30 +19,23 @@
 # Exits 77 (ctest SKIP_RETURN_CODE) when meshlabserver, xvfb-run, python3, MeshLab's library or a
 # stock plugin is missing. The first failing check prints what failed and exits 1.
 set -euo pipefail
+# shellcheck source-path=SCRIPTDIR source=../support/meshlab_tree.sh
+. "$(dirname "${BASH_SOURCE[0]}")/../support/meshlab_tree.sh"
 
 if [ $# -lt 5 ] || [ $# -gt 6 ]; then
   echo "usage: $0 IO_PLUGIN.so FILTER_PLUGIN.so POMAR_CLI SAMPLES_DIR WORK_DIR [MESHLAB_LIBDIR]" >&2
   exit 2
 fi
-abspath() { echo "$(cd "$(dirname "$1")" && pwd)/$(basename "$1")"; }
 IO_PLUGIN="$(abspath "$1")"
 FILTER_PLUGIN="$(abspath "$2")"
-POMAR="$(abspath "$3")"
-SAMPLES="$(cd "$4" && pwd)"
-mkdir -p "$5"
-WORK="$(cd "$5" && pwd)"
-MLLIB="${6:-/usr/lib/x86_64-linux-gnu/meshlab}"
+mlserver_args "${@:3}"   # POMAR SAMPLES WORK MLLIB
 HERE="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 PLYTOOL="$HERE/plytool.py"
+STOCK=(libio_base.so libfilter_select.so libfilter_func.so)
 
-skip() { echo "SKIP: $*"; exit 77; }
-command -v meshlabserver >/dev/null 2>&1 || skip "meshlabserver is not installed"
-command -v xvfb-run >/dev/null 2>&1 || skip "xvfb-run is not installed (package xvfb)"
-command -v python3 >/dev/null 2>&1 || skip "python3 is not installed"
-[ -f "$MLLIB/libmeshlab-common.so" ] || skip "$MLLIB/libmeshlab-common.so not found"
-for p in libio_base.so libfilter_select.so libfilter_func.so; do
-  [ -f "$MLLIB/plugins/$p" ] || skip "stock plugin $MLLIB/plugins/$p not found"
-done
+skip_without_server
+skip_without python3 "python3 is not installed"
+skip_without_meshlab_lib "$MLLIB" "${STOCK[@]}"
 for f in "$IO_PLUGIN" "$FILTER_PLUGIN"; do
   [ -f "$f" ] || { echo "FAIL: plugin not found: $f" >&2; exit 1; }
 done
@@ -49,67 +43,16 @@ done
 BUNNY="$SAMPLES/bunny.ply"
 [ -f "$BUNNY" ] || { echo "FAIL: $BUNNY missing" >&2; exit 1; }
 
-# ---- the private MeshLab tree ----------------------------------------------------------------------
+# ---- the private MeshLab tree (tests/support/meshlab_tree.sh), checks ----------------------------------
 
-TREE="$WORK/tree"
-PLUGDIR="$TREE/lib/x86_64-linux-gnu/meshlab/plugins"
-rm -rf "$WORK/tree" "$WORK/home" "$WORK/out" "$WORK/scripts"
-mkdir -p "$TREE/bin" "$PLUGDIR" "$WORK/home" "$WORK/out" "$WORK/scripts"
-chmod 700 "$WORK/home"
-# A copy, not a symlink: MeshLab finds its plugins from the resolved path of its binary.
-cp "$(readlink -f "$(command -v meshlabserver)")" "$TREE/bin/meshlabserver"
-ln -s "$MLLIB/libmeshlab-common.so" "$TREE/lib/x86_64-linux-gnu/meshlab/"
-for p in libio_base.so libfilter_select.so libfilter_func.so; do
-  ln -s "$MLLIB/plugins/$p" "$PLUGDIR/"
-done
-ln -s "$IO_PLUGIN" "$PLUGDIR/libio_pomar.so"
-ln -s "$FILTER_PLUGIN" "$PLUGDIR/libfilter_pomar.so"
-ML="$TREE/bin/meshlabserver"
-OUTDIR="$WORK/out"
+mlserver_prepare "$WORK" "$MLLIB" "${STOCK[@]}"
+mltree_link_as "$TREE" "$IO_PLUGIN" libio_pomar.so
+mltree_link_as "$TREE" "$FILTER_PLUGIN" libfilter_pomar.so
+rm -rf "$WORK/scripts"
+mkdir -p "$WORK/scripts"
 
-CHECKS=0
-CUR="(setup)"
-LAST_CMD=""
-section() { CUR="$*"; printf -- '--- %s\n' "$*"; }
-pass() { CHECKS=$((CHECKS + 1)); }
-fail() {
-  {
-    printf 'FAIL [%s]: %s\n' "$CUR" "$*"
-    if [ -n "$LAST_CMD" ]; then
-      printf '  last command: %s\n  exit status : %s\n  output      :\n' "$LAST_CMD" "$RC"
-      printf '%s\n' "$OUT" | grep -v '^POMAR: [a-z]*ing' | sed 's/^/    /' | tail -40
-    fi
-  } >&2
-  exit 1
-}
-
-# ml ARGS...: runs the private meshlabserver under Xvfb; sets RC and OUT (stdout + stderr).
-ml() {
-  LAST_CMD="meshlabserver $*"
-  set +e
-  OUT="$(cd "$OUTDIR" && HOME="$WORK/home" XDG_RUNTIME_DIR="$WORK/home" \
-    xvfb-run -a "$ML" "$@" 2>&1)"
-  RC=$?
-  set -e
-}
-# run NAME ARGS...: runs a command; sets RC and OUT.
-run() {
-  LAST_CMD="$*"
-  set +e
-  OUT="$("$@" 2>&1)"
-  RC=$?
-  set -e
-}
-expect_rc() { [ "$RC" -eq "$1" ] || fail "expected exit status $1, got $RC"; pass; }
-expect_nonzero() { [ "$RC" -ne 0 ] || fail "expected a non-zero exit status, got 0"; pass; }
-expect_file() { [ -s "$1" ] || fail "expected a non-empty file at $1"; pass; }
-expect_no_file() { [ ! -e "$1" ] || fail "expected no file at $1, but it exists"; pass; }
-expect_output() { # expect_output NEEDLE
-  case "$OUT" in *"$1"*) pass ;; *) fail "the output does not contain '$1'" ;; esac
-}
-expect_no_output() {
-  case "$OUT" in *"$1"*) fail "the output contains '$1'" ;; *) pass ;; esac
-}
+# fail_excerpt: what fail shows of the output: the last 40 lines, without the filters' progress lines.
+fail_excerpt() { grep -v '^POMAR: [a-z]*ing' | sed 's/^/    /' | tail -40; }
 log_line() { printf '%s\n' "$OUT" | grep -m1 "^LOG: .*$1" | sed 's/^LOG: [0-9]* /    /' || true; }
 # counts FILE.ply: sets VN and FN.
 counts() {
@@ -178,7 +121,7 @@ run "$POMAR" info --json "$OUTDIR/bunny.pomar"
 expect_rc 0
 read -r BASE FINEST CLUSTERS <<<"$(printf '%s' "$OUT" |
   python3 -c 'import json,sys; j=json.load(sys.stdin); print(j["global_levels"], j["level_count"], j["clusters"])')"
-[ "$BASE" -gt 0 ] && [ "$FINEST" -gt "$BASE" ] && [ "$CLUSTERS" -gt 0 ] ||
+{ [ "$BASE" -gt 0 ] && [ "$FINEST" -gt "$BASE" ] && [ "$CLUSTERS" -gt 0 ]; } ||
   fail "unexpected levels from pomar info --json: base $BASE, finest $FINEST, clusters $CLUSTERS"
 pass
 counts "$OUTDIR/full.ply"
@@ -270,9 +213,9 @@ pass
 manifold "$OUTDIR/levels.ply"
 run python3 "$PLYTOOL" colors "$OUTDIR/levels.ply"
 expect_rc 0
-read -r COLOURS BLUE RED <<<"$OUT"
+read -r COLOURS _ RED <<<"$OUT"   # colours, blue (unused), red
 echo "    levels.ply: $COLOURS colours, $RED red (finest level) vertices of $VN"
-[ "$COLOURS" -gt 1 ] && [ "$RED" -gt 0 ] && [ "$RED" -lt "$VN" ] ||
+{ [ "$COLOURS" -gt 1 ] && [ "$RED" -gt 0 ] && [ "$RED" -lt "$VN" ]; } ||
   fail "expected several level colours with some, not all, vertices red: $COLOURS colours, $RED red"
 pass
 
@@ -282,9 +225,9 @@ expect_rc 0
 expect_output "POMAR: coloured $CLUSTERS clusters"
 run python3 "$PLYTOOL" colors "$OUTDIR/clusters.ply"
 expect_rc 0
-read -r COLOURS BLUE RED <<<"$OUT"
+read -r COLOURS _ RED <<<"$OUT"   # colours, blue (unused), red
 echo "    clusters.ply: $COLOURS distinct colours for $CLUSTERS clusters"
-[ "$((COLOURS * 100))" -ge "$((CLUSTERS * 95))" ] && [ "$COLOURS" -le "$CLUSTERS" ] ||
+{ [ "$((COLOURS * 100))" -ge "$((CLUSTERS * 95))" ] && [ "$COLOURS" -le "$CLUSTERS" ]; } ||
   fail "$COLOURS distinct colours for $CLUSTERS clusters"
 pass
 

@@ -1,0 +1,198 @@
+# shellcheck shell=bash
+# Sourced function library (bash) of the scripted MeshLab 2020.09 GUI sessions under Xvfb:
+# scripts/gui_screenshot.sh and scripts/gui_refine_screenshots.sh. It builds the private MeshLab
+# tree with tests/support/meshlab_tree.sh (recipe /work/shared/docs/meshlab-plugins.md section 5b).
+#
+# A script sources it, calls mlgui_init NAME (before any cd: it cd's to the repository) and
+# mlgui_parse_args, then the steps in this order: mlgui_require_tools, mlgui_build,
+# mlgui_make_workdir, mlgui_pick_meshlab, mlgui_encode_bunny, mlgui_start_xvfb; then per session
+# mlgui_start_meshlab, mlgui_answer_preopen, mlgui_check_opened, mlgui_capture, mlgui_stop_meshlab.
+# Globals set here: REPO BUILD POMAR SYS_MLLIB TIMEOUT RENDER_WAIT (mlgui_init), USE_INSTALLED
+# OUTDIR (mlgui_parse_args), WORK XVFB_PID ML_PID (mlgui_make_workdir), MESHLAB
+# (mlgui_pick_meshlab), DATA (mlgui_encode_bunny), DISPLAY (mlgui_start_xvfb), ERRLOG ML_PID
+# (mlgui_start_meshlab). Also log, die and fail_log.
+
+# shellcheck source-path=SCRIPTDIR source=../../tests/support/meshlab_tree.sh
+. "$(dirname "${BASH_SOURCE[0]}")/../../tests/support/meshlab_tree.sh"
+
+# mlgui_init NAME: NAME prefixes log and error lines; sets the globals below and cd's to the repository.
+mlgui_init() {
+  MLGUI_NAME="$1"
+  REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+  cd "$REPO"
+  BUILD=build
+  POMAR="$BUILD/codec/pomar"
+  SYS_MLLIB=/usr/lib/x86_64-linux-gnu/meshlab    # Debian's MeshLab library folder
+  TIMEOUT=90      # seconds to wait for each of: the X server, a dialog, the mesh load, a filter
+  # shellcheck disable=SC2034  # used by the scripts
+  RENDER_WAIT=3   # seconds left to the viewer to (re)draw the mesh before a screenshot
+}
+
+log() { printf '%s: %s\n' "$MLGUI_NAME" "$*"; }
+die() { printf '%s: error: %s\n' "$MLGUI_NAME" "$*" >&2; exit 1; }
+# fail_log MESSAGE: the end of MeshLab's log (ERRLOG) on stderr, then die MESSAGE.
+fail_log() { tail -n 30 "$ERRLOG" >&2; die "$*"; }
+
+# mlgui_parse_args SCRIPT LAST ARGS...: [--installed] [OUTDIR] [-h|--help]; sets USE_INSTALLED and
+# OUTDIR (absolute; default docs/images). --help prints lines 2..LAST of SCRIPT (its header).
+mlgui_parse_args() {
+  local script="$1" last="$2"
+  shift 2
+  USE_INSTALLED=0
+  OUTDIR="$REPO/docs/images"
+  while [ $# -gt 0 ]; do
+    case "$1" in
+      --installed) USE_INSTALLED=1 ;;
+      -h|--help) sed -n "2,${last}p" "$script" | sed 's/^# \{0,1\}//'; exit 0 ;;
+      -*) echo "$MLGUI_NAME: unknown option $1" >&2; exit 2 ;;
+      *) OUTDIR="$1" ;;
+    esac
+    shift
+  done
+  case "$OUTDIR" in /*) ;; *) OUTDIR="$PWD/$OUTDIR" ;; esac
+}
+
+# mlgui_require_tools: dies, naming the Debian packages to install, unless the tools are there.
+mlgui_require_tools() {
+  local missing=() tool
+  for tool in Xvfb:xvfb xdotool:xdotool import:imagemagick xwininfo:x11-utils; do
+    command -v "${tool%%:*}" >/dev/null 2>&1 || missing+=("${tool#*:}")
+  done
+  [ -x /usr/bin/meshlab ] || missing+=(meshlab)
+  [ ${#missing[@]} -eq 0 ] ||
+    die "missing tools; install them with: apt-get install -y --no-install-recommends ${missing[*]}"
+}
+
+# mlgui_build PLUGIN_TARGET...: (re)builds pomar, and the plugin targets unless --installed.
+mlgui_build() {
+  local targets=(pomar) what="is the MeshLab plugin"
+  [ $# -eq 1 ] || what="are the MeshLab plugins"
+  [ -f "$BUILD/build.ninja" ] || [ -f "$BUILD/Makefile" ] ||
+    die "$BUILD/ is not configured: run scripts/demo.sh (or cmake -S . -B $BUILD -G Ninja) first"
+  [ "$USE_INSTALLED" -eq 1 ] || targets+=("$@")
+  log "building ${targets[*]}"
+  cmake --build "$BUILD" --target "${targets[@]}" >/dev/null ||
+    die "cmake --build $BUILD --target ${targets[*]} failed ($what enabled in $BUILD?)"
+  [ -x "$POMAR" ] || die "$POMAR was not built"
+}
+
+# mlgui_cleanup: stops MeshLab and Xvfb if they run, removes WORK (the EXIT trap).
+mlgui_cleanup() {
+  if [ -n "$ML_PID" ]; then kill "$ML_PID" 2>/dev/null || true; wait "$ML_PID" 2>/dev/null || true; fi
+  if [ -n "$XVFB_PID" ]; then kill "$XVFB_PID" 2>/dev/null || true; wait "$XVFB_PID" 2>/dev/null || true; fi
+  rm -rf "$WORK"
+}
+
+# mlgui_make_workdir PREFIX: a temp dir WORK (removed on exit, with MeshLab and Xvfb stopped).
+mlgui_make_workdir() {
+  WORK="$(mktemp -d "${TMPDIR:-/tmp}/$1.XXXXXX")"
+  XVFB_PID=""
+  ML_PID=""
+  trap mlgui_cleanup EXIT
+  trap 'exit 130' INT TERM
+}
+
+# mlgui_pick_meshlab PLUGIN...: sets MESHLAB. With --installed /usr/bin/meshlab, after checking that
+# the plugins (by file name) are installed in /usr; otherwise meshlab in a private tree WORK/tree
+# with the system plugins and the built PLUGIN... (paths relative to the repository) instead of
+# any installed plugin of the same name.
+mlgui_pick_meshlab() {
+  local so names=() tree="$WORK/tree"
+  for so in "$@"; do names+=("$(basename "$so")"); done
+  if [ "$USE_INSTALLED" -eq 1 ]; then
+    MESHLAB=/usr/bin/meshlab
+    for so in "${names[@]}"; do
+      [ -f "$SYS_MLLIB/plugins/$so" ] ||
+        die "--installed: $SYS_MLLIB/plugins/$so not found (cmake --install $BUILD --prefix /usr)"
+    done
+  else
+    for so in "$@"; do [ -f "$so" ] || die "$so was not built"; done
+    mltree_create "$tree" "$SYS_MLLIB" /usr/bin/meshlab meshlab
+    mltree_link_stock_except "$tree" "$SYS_MLLIB" "${names[@]}"
+    for so in "$@"; do mltree_link "$tree" "$REPO/$so"; done
+    MESHLAB="$tree/bin/meshlab"
+  fi
+  log "meshlab: $MESHLAB"
+}
+
+# mlgui_encode_bunny: encodes samples/bunny.ply into DATA/bunny.pomar (DATA=WORK/data).
+mlgui_encode_bunny() {
+  DATA="$WORK/data"
+  mkdir -p "$DATA"
+  "$POMAR" encode samples/bunny.ply "$DATA/bunny.pomar" --quiet
+  log "encoded samples/bunny.ply -> bunny.pomar ($(stat -c %s "$DATA/bunny.pomar") bytes)"
+}
+
+# mlgui_start_xvfb: starts a 1600x1000 Xvfb on a free display (XVFB_PID) and exports DISPLAY.
+mlgui_start_xvfb() {
+  # -displayfd: Xvfb picks a free display number itself and writes it to that descriptor.
+  exec 9>"$WORK/display"
+  Xvfb -displayfd 9 -screen 0 1600x1000x24 -nolisten tcp >"$WORK/xvfb.log" 2>&1 &
+  XVFB_PID=$!
+  exec 9>&-
+  for _ in $(seq $((TIMEOUT * 10))); do
+    [ -s "$WORK/display" ] && break
+    kill -0 "$XVFB_PID" 2>/dev/null || { cat "$WORK/xvfb.log" >&2; die "Xvfb exited"; }
+    sleep 0.1
+  done
+  [ -s "$WORK/display" ] || die "Xvfb did not report a display within ${TIMEOUT}s"
+  DISPLAY=":$(head -n1 "$WORK/display" | tr -d '[:space:]')"
+  export DISPLAY
+  log "Xvfb on $DISPLAY"
+}
+
+# mlgui_start_meshlab HOME LOG: starts MESHLAB on DATA/bunny.pomar in the background (ML_PID) with
+# a fresh HOME, its stdout and stderr in LOG (ERRLOG).
+mlgui_start_meshlab() {
+  local home="$1"
+  ERRLOG="$2"
+  rm -rf "$home"
+  mkdir -p "$home" "$WORK/run"
+  chmod 700 "$WORK/run"
+  # Fresh HOME: first start, no saved settings (MeshLab writes ~/.config/VCG/*.conf).
+  (cd "$DATA" && HOME="$home" XDG_RUNTIME_DIR="$WORK/run" exec "$MESHLAB" "$DATA/bunny.pomar") \
+    >"$ERRLOG" 2>&1 &
+  ML_PID=$!
+}
+
+# mlgui_stop_meshlab: stops the MeshLab started by mlgui_start_meshlab.
+mlgui_stop_meshlab() {
+  kill "$ML_PID" 2>/dev/null || true
+  wait "$ML_PID" 2>/dev/null || true
+  ML_PID=""
+}
+
+# mlgui_answer_preopen WINDOW MODE: answers the plugin's "Pre-Open Options" dialog WINDOW with the
+# keyboard. MODE is "full" (its defaults: "Open at: Full resolution") or "coarse" (Base clustered mesh).
+mlgui_answer_preopen() {
+  sleep 0.5   # let the dialog finish laying itself out
+  xdotool windowfocus --sync "$1"
+  if [ "$2" = coarse ]; then
+    # Initially no widget has the focus; the tab order is "Open at" combo -> "Level N" -> Reset.
+    # Tab focuses the combo, Down moves it from "Full resolution" to "Base clustered mesh".
+    xdotool key Tab; sleep 0.2
+    xdotool key Down; sleep 0.2
+  fi
+  xdotool key Return   # OK is the default button
+}
+
+# mlgui_check_opened MODE PREFIX: logs PREFIX and the plugin's "pomar: opened ... at level L of F"
+# line from ERRLOG, and dies unless L is F (MODE full) or below F (MODE coarse).
+mlgui_check_opened() {
+  local mode="$1" line level finest
+  line="$(grep -o 'pomar: opened .*' "$ERRLOG" | head -n1 || true)"
+  [ -n "$line" ] || fail_log "no 'pomar: opened' line in MeshLab's log (open failed?)"
+  log "$2${line#pomar: }"
+  [[ "$line" =~ at\ level\ ([0-9]+)\ of\ ([0-9]+) ]] || die "cannot parse the level from: $line"
+  level="${BASH_REMATCH[1]}" finest="${BASH_REMATCH[2]}"
+  if [ "$mode" = full ] && [ "$level" -ne "$finest" ]; then die "expected full resolution (level $finest), got level $level"; fi
+  if [ "$mode" = coarse ] && [ "$level" -ge "$finest" ]; then die "expected the base clustered mesh (below level $finest), got level $level"; fi
+  return 0
+}
+
+# mlgui_capture WINDOW OUT PREFIX: saves the X window WINDOW (an id, or root) as OUT; logs it.
+mlgui_capture() {
+  mkdir -p "$(dirname "$2")"
+  import -window "$1" "$2"
+  log "$3wrote ${2#"$REPO"/} ($(identify -format '%wx%h' "$2" 2>/dev/null || echo '?'))"
+}
