@@ -1,0 +1,83 @@
+// libFuzzer target: the mesh file readers (vcglib PLY/OFF/STL, binary STL, tinyobjloader
+// OBJ) via pomar::load_mesh, then pomar::encode on whatever loads.
+// pomar::Error is the expected way to reject input; anything else is a finding.
+#include <pomar/mesh_io.h>
+#include <pomar/pomar.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <fcntl.h>
+#include <unistd.h>
+#include <vector>
+
+namespace {
+std::string temp_base() {
+  const char *dir = std::getenv("TMPDIR");
+  std::string base = std::string(dir && *dir ? dir : "/tmp") + "/pomar_fuzz_readers." +
+                     std::to_string(static_cast<long>(getpid()));
+  return base;
+}
+// The open file descriptors below 256 (a reader that leaks a FILE* adds one).
+std::vector<int> open_fds() {
+  std::vector<int> fds;
+  for (int fd = 0; fd < 256; ++fd)
+    if (fcntl(fd, F_GETFD) != -1) fds.push_back(fd);
+  return fds;
+}
+} // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
+  if (size > 64 * 1024) return 0;
+  static const std::string base = temp_base();
+  for (const char *ext : {".ply", ".obj", ".off", ".stl"}) {
+    const std::string path = base + ext;
+    {
+      std::FILE *f = std::fopen(path.c_str(), "wb");
+      if (!f) {
+        std::perror(path.c_str());
+        std::abort();
+      }
+      if (size && std::fwrite(data, 1, size, f) != size) std::abort();
+      std::fclose(f);
+    }
+    pomar::Mesh mesh;
+    bool loaded = false;
+    const std::vector<int> fds_before = open_fds();
+    try {
+      mesh = pomar::load_mesh(path);
+      loaded = true;
+    } catch (const pomar::Error &) {
+    }
+    std::remove(path.c_str());
+    // A leaked FILE*/fd is a finding too: after `ulimit -n` inputs fopen fails (EMFILE).
+    const std::vector<int> fds_after = open_fds();
+    if (fds_after != fds_before) {
+      // Known finding (regressions/readers-crash-4401b907...): vcglib's
+      // ImporterSTL::OpenAscii returns E_UNESPECTEDEOF without fclose (import_stl.h:287-293).
+      // Tolerated for .stl (the descriptors are closed here) so that it does not end every
+      // run; set POMAR_FUZZ_NO_SKIP=1 to make it fatal again.
+      static const bool strict = std::getenv("POMAR_FUZZ_NO_SKIP") != nullptr;
+      if (strict || std::string(ext) != ".stl") {
+        std::fprintf(stderr, "file descriptor leak: load_mesh(\"%s\") left %zu more open\n",
+                     path.c_str(), fds_after.size() - fds_before.size());
+        std::abort();
+      }
+      for (int fd : fds_after)
+        if (!std::binary_search(fds_before.begin(), fds_before.end(), fd)) close(fd);
+    }
+    if (!loaded) continue;
+    try {
+      pomar::EncodeOptions opt;
+      (void)pomar::encode(mesh, opt);
+      if (mesh.vertex_count() >= 8) {
+        opt.clusters = 2;
+        (void)pomar::encode(mesh, opt);
+      }
+    } catch (const pomar::Error &) {
+    }
+  }
+  return 0;
+}
