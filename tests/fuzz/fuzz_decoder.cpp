@@ -80,11 +80,8 @@ void run(const uint8_t *data, size_t size) {
     } catch (const pomar::Error &) {
     }
   }
-  // Known finding (tests/fuzz/regressions/decoder-crash-da39a3ee...: empty input): SelectiveDecoder
-  // calls MemorySource::read(0, 0, nullptr) and memcpy gets a null destination (UBSan).
-  // Skipped here so that it does not stop every run at its first input; remove the
-  // check once selective_decoder.cpp is fixed (the regression file keeps testing it).
-  if (size == 0 && !std::getenv("POMAR_FUZZ_NO_SKIP")) return;
+  // (regressions/decoder-crash-da39a3ee...: the empty input used to reach memcpy with a
+  // null pointer; fixed in MemorySource::read.)
   try {
     pomar::SelectiveDecoder d(std::make_unique<pomar::MemorySource>(data, size));
     const uint32_t n = d.cluster_count();

@@ -54,19 +54,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     std::remove(path.c_str());
     // A leaked FILE*/fd is a finding too: after `ulimit -n` inputs fopen fails (EMFILE).
     const std::vector<int> fds_after = open_fds();
+    // (regressions/readers-crash-4401b907...: vcglib's ASCII STL reader leaked its FILE on a
+    // malformed vertex; pomar now reads ASCII STL itself.)
     if (fds_after != fds_before) {
-      // Known finding (regressions/readers-crash-4401b907...): vcglib's
-      // ImporterSTL::OpenAscii returns E_UNESPECTEDEOF without fclose (import_stl.h:287-293).
-      // Tolerated for .stl (the descriptors are closed here) so that it does not end every
-      // run; set POMAR_FUZZ_NO_SKIP=1 to make it fatal again.
-      static const bool strict = std::getenv("POMAR_FUZZ_NO_SKIP") != nullptr;
-      if (strict || std::string(ext) != ".stl") {
-        std::fprintf(stderr, "file descriptor leak: load_mesh(\"%s\") left %zu more open\n",
-                     path.c_str(), fds_after.size() - fds_before.size());
-        std::abort();
-      }
-      for (int fd : fds_after)
-        if (!std::binary_search(fds_before.begin(), fds_before.end(), fd)) close(fd);
+      std::fprintf(stderr, "file descriptor leak: load_mesh(\"%s\") left %zu more open\n",
+                   path.c_str(), fds_after.size() - fds_before.size());
+      std::abort();
     }
     if (!loaded) continue;
     try {

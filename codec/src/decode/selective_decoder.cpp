@@ -15,7 +15,8 @@ namespace pomar {
 void MemorySource::read(uint64_t offset, size_t n, uint8_t *out) {
   if (offset > size_ || n > size_ - offset)
     throw Error("read past the end of the .pomar data (truncated file?)");
-  std::memcpy(out, data_ + offset, n);
+  if (n) // an empty source has no data pointer to copy from (found by fuzzing)
+    std::memcpy(out, data_ + offset, n);
 }
 
 FileSource::FileSource(const std::string &path) : path_(path) {
@@ -38,6 +39,8 @@ void FileSource::read(uint64_t offset, size_t n, uint8_t *out) {
   if (offset > size_ || n > size_ - offset)
     throw Error("truncated .pomar file: " + path_ + " ends before byte " +
                 std::to_string(offset + n));
+  if (n == 0)
+    return;
   if (std::fseek(file_, static_cast<long>(offset), SEEK_SET) != 0 ||
       std::fread(out, 1, n, file_) != n)
     throw Error("cannot read " + path_ + ": " + std::strerror(errno));

@@ -1271,12 +1271,41 @@ Mesh read_binary_stl(const std::string &path, uint64_t facets, bool &colored) {
 }
 
 /// ASCII STL through vcglib (3 new vertices per facet, in file order).
+/// ASCII STL, read here rather than by vcglib (whose reader leaks its FILE on a malformed
+/// vertex line, found by fuzzing): every "outer loop" ... "endloop" must hold exactly three
+/// "vertex x y z" lines; everything else (solid names, facet normals) is skipped.
 Mesh read_ascii_stl(const std::string &path) {
-  IoMesh m;
-  const int err = guarded(path, [&] { return StlImporter::OpenAscii(m, path.c_str()); });
-  if (err != StlImporter::E_NOERROR)
-    fail(path, "STL import failed: " + vcg_message<StlImporter>(err, StlImporter::E_LAST));
-  return from_vcg(m);
+  const std::vector<uint8_t> bytes = read_file(path);
+  const std::vector<std::string> tok =
+      split_ws(std::string(reinterpret_cast<const char *>(bytes.data()), bytes.size()));
+  Mesh mesh;
+  size_t in_loop = 0, facet = 0;
+  bool looping = false;
+  for (size_t i = 0; i < tok.size(); ++i) {
+    if (tok[i] == "loop") {
+      looping = true;
+      in_loop = 0;
+    } else if (tok[i] == "vertex") {
+      float v[3];
+      if (!looping || i + 3 >= tok.size() || !parse_float(tok[i + 1], v[0]) ||
+          !parse_float(tok[i + 2], v[1]) || !parse_float(tok[i + 3], v[2]))
+        fail(path, "malformed vertex in ASCII STL facet " + num(facet));
+      mesh.positions.insert(mesh.positions.end(), v, v + 3);
+      ++in_loop;
+      i += 3;
+    } else if (tok[i] == "endloop") {
+      if (!looping || in_loop != 3)
+        fail(path, "ASCII STL facet " + num(facet) + " has " + num(in_loop) +
+                       " vertices (3 expected)");
+      const uint32_t first = static_cast<uint32_t>(mesh.positions.size() / 3 - 3);
+      mesh.triangles.insert(mesh.triangles.end(), {first, first + 1, first + 2});
+      looping = false;
+      ++facet;
+    }
+  }
+  if (looping)
+    fail(path, "ASCII STL ends inside facet " + num(facet));
+  return mesh;
 }
 
 Mesh load_stl(const std::string &path, LoadReport &report) {
