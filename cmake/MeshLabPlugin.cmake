@@ -50,6 +50,8 @@ function(pomar_add_meshlab_plugin target)
   add_library(${target} MODULE ${ARGN})
   set_target_properties(${target} PROPERTIES AUTOMOC ON)
   target_link_libraries(${target} PRIVATE pomar_core pomar_meshlab_common)
+  # io_plugin/pomar_layer.h: what both plugins agree on about a .pomar layer.
+  target_include_directories(${target} PRIVATE "${PROJECT_SOURCE_DIR}/io_plugin")
   target_compile_options(${target} PRIVATE -Wall -Wextra)
   # Fail at link time on a missing symbol; keep pomar_core's symbols out of the dynamic table.
   target_link_options(${target} PRIVATE -Wl,--no-undefined -Wl,--exclude-libs,ALL)

@@ -1,5 +1,6 @@
 // MeshLab 2020.09 IO plugin for .pomar files: see io_pomar.h.
 #include "io_pomar.h"
+#include "pomar_layer.h"
 
 #include <pomar/pomar.h>
 #include <pomar/random_access.h>
@@ -36,33 +37,7 @@ bool isPomar(const QString &format) {
   return format.compare(QLatin1String(kExtension), Qt::CaseInsensitive) == 0;
 }
 
-/// Forwards the codec's progress to MeshLab's callback, at most every 10%.
-class ProgressRelay {
-public:
-  ProgressRelay(vcg::CallBackPos *cb, const char *label) : cb_(cb), label_(label) {}
-  pomar::Progress function() {
-    if (cb_ == nullptr)
-      return {};
-    return [this](double fraction, const char *) {
-      const int pct = std::isfinite(fraction) ? int(qBound(0.0, fraction, 1.0) * 100) : 0;
-      if (pct / 10 != last_ / 10) {
-        last_ = pct;
-        (*cb_)(pct, label_);
-      }
-    };
-  }
-  void report(int pct) {
-    if (cb_ != nullptr && pct != last_) {
-      last_ = pct;
-      (*cb_)(pct, label_);
-    }
-  }
-
-private:
-  vcg::CallBackPos *cb_;
-  const char *label_;
-  int last_ = -1;
-};
+using pomar::meshlab::ProgressRelay;
 
 /// Angle-weighted vertex normals as MeshLab computes them after opening a file
 /// (MeshModel::UpdateBoxAndNormals -> UpdateNormal::PerVertexAngleWeighted): true if the
@@ -158,8 +133,8 @@ QStringList notKept(MeshModel &mm) {
   QStringList custom;
   auto addNames = [&](const auto &attributes) {
     for (const auto &a : attributes)
-      if (!a._name.empty() && a._name != "pomar_cluster" && a._name != "pomar_level" &&
-          a._name != "pomar_source")
+      if (!a._name.empty() && a._name != pomar::meshlab::kClusterAttribute &&
+          a._name != pomar::meshlab::kLevelAttribute && a._name != pomar::meshlab::kSourceAttribute)
         custom << QString::fromStdString(a._name);
   };
   addNames(m.vert_attr);
@@ -259,15 +234,15 @@ bool PomarIOPlugin::open(const QString &format, const QString &fileName, MeshMod
 
     pomar::to_vcg(mesh, m.cm); // also clears m's attributes
     auto clusterOf =
-        vcg::tri::Allocator<CMeshO>::GetPerVertexAttribute<float>(m.cm, "pomar_cluster");
-    auto levelOf = vcg::tri::Allocator<CMeshO>::GetPerVertexAttribute<float>(m.cm, "pomar_level");
+        vcg::tri::Allocator<CMeshO>::GetPerVertexAttribute<float>(m.cm, pomar::meshlab::kClusterAttribute);
+    auto levelOf = vcg::tri::Allocator<CMeshO>::GetPerVertexAttribute<float>(m.cm, pomar::meshlab::kLevelAttribute);
     const bool haveClusters = info.clustered() && cluster.size() == mesh.vertex_count();
     const bool haveLevels = vertexLevel.size() == mesh.vertex_count();
     for (size_t v = 0; v < mesh.vertex_count(); ++v) {
       clusterOf[v] = haveClusters ? float(cluster[v]) : -1.0f;
       levelOf[v] = haveLevels ? float(vertexLevel[v]) : -1.0f;
     }
-    auto source = vcg::tri::Allocator<CMeshO>::GetPerMeshAttribute<std::string>(m.cm, "pomar_source");
+    auto source = vcg::tri::Allocator<CMeshO>::GetPerMeshAttribute<std::string>(m.cm, pomar::meshlab::kSourceAttribute);
     source() = native;
 
     progress.report(100);

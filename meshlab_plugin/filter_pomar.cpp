@@ -1,5 +1,6 @@
 // MeshLab 2020.09 filter plugin for layers opened from .pomar files: see filter_pomar.h.
 #include "filter_pomar.h"
+#include "pomar_layer.h"
 
 #include <pomar/pomar.h>
 #include <pomar/random_access.h>
@@ -30,9 +31,9 @@ double msSince(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
-const char *const kClusterAttr = "pomar_cluster";
-const char *const kLevelAttr = "pomar_level";
-const char *const kSourceAttr = "pomar_source";
+const char *const kClusterAttr = pomar::meshlab::kClusterAttribute;
+const char *const kLevelAttr = pomar::meshlab::kLevelAttribute;
+const char *const kSourceAttr = pomar::meshlab::kSourceAttribute;
 /// TargetLevel default when the file is unknown: "the finest level" after clamping.
 const int kFinestPlaceholder = 99;
 /// Decoders kept at once (each holds its current mesh).
@@ -182,31 +183,7 @@ vcg::Color4b levelColor(double t) {
 
 // ---------------------------------------------------------------- progress
 
-/// Forwards the decoder's progress to MeshLab's callback (mapped into [from, to] percent),
-/// at most every 10%: meshlabserver prints the label for every call.
-class ProgressRelay {
-public:
-  ProgressRelay(vcg::CallBackPos *cb, const char *label) : cb_(cb), label_(label) {}
-  void report(int pct) {
-    if (cb_ != nullptr && pct / 10 != last_ / 10) {
-      last_ = pct;
-      (*cb_)(pct, label_);
-    }
-  }
-  pomar::Progress range(int from, int to) {
-    if (cb_ == nullptr)
-      return {};
-    return [this, from, to](double fraction, const char *) {
-      const double f = std::isfinite(fraction) ? std::min(1.0, std::max(0.0, fraction)) : 0.0;
-      report(from + int(f * (to - from)));
-    };
-  }
-
-private:
-  vcg::CallBackPos *cb_;
-  const char *label_;
-  int last_ = -100;
-};
+using pomar::meshlab::ProgressRelay;
 
 } // namespace
 

@@ -1,0 +1,47 @@
+// What the two MeshLab plugins share about a layer opened from a .pomar file: the names of
+// the attributes the IO plugin writes and the filter plugin reads, and the relay of the
+// codec's progress to MeshLab's callback.
+#pragma once
+
+#include <pomar/pomar.h>
+
+#include <vcg/complex/complex.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace pomar::meshlab {
+
+constexpr const char *kClusterAttribute = "pomar_cluster"; ///< per vertex, float (-1: none)
+constexpr const char *kLevelAttribute = "pomar_level";     ///< per vertex, float (-1: unknown)
+constexpr const char *kSourceAttribute = "pomar_source";   ///< per mesh, absolute path
+
+/// Forwards progress to MeshLab's callback at most every 10% (meshlabserver prints the
+/// label on every call).
+class ProgressRelay {
+public:
+  ProgressRelay(vcg::CallBackPos *cb, const char *label) : cb_(cb), label_(label) {}
+  void report(int pct) {
+    if (cb_ != nullptr && pct / 10 != last_ / 10) {
+      last_ = pct;
+      (*cb_)(pct, label_);
+    }
+  }
+  /// The codec's fraction in [0,1], mapped into [from, to] percent.
+  Progress range(int from, int to) {
+    if (cb_ == nullptr)
+      return {};
+    return [this, from, to](double fraction, const char *) {
+      const double f = std::isfinite(fraction) ? std::min(1.0, std::max(0.0, fraction)) : 0.0;
+      report(from + int(f * (to - from)));
+    };
+  }
+  Progress function() { return range(0, 100); }
+
+private:
+  vcg::CallBackPos *cb_;
+  const char *label_;
+  int last_ = -100;
+};
+
+} // namespace pomar::meshlab
