@@ -32,6 +32,7 @@
 #include <string>
 #include <vector>
 #include "support/mesh_compare.h"
+#include "support/meshlab_layer.h"
 
 namespace {
 
@@ -70,20 +71,8 @@ void writeBytes(const QString &path, const std::vector<uint8_t> &bytes) {
   out.write(reinterpret_cast<const char *>(bytes.data()), std::streamsize(bytes.size()));
 }
 
-std::vector<float> vertexAttribute(CMeshO &m, const char *name) {
-  std::vector<float> out;
-  auto h = vcg::tri::Allocator<CMeshO>::FindPerVertexAttribute<float>(m, name);
-  if (!vcg::tri::Allocator<CMeshO>::IsValidHandle(m, h))
-    return out;
-  for (size_t v = 0; v < m.vert.size(); ++v)
-    out.push_back(h[v]);
-  return out;
-}
-
-std::string sourceAttribute(CMeshO &m) {
-  auto h = vcg::tri::Allocator<CMeshO>::FindPerMeshAttribute<std::string>(m, "pomar_source");
-  return vcg::tri::Allocator<CMeshO>::IsValidHandle(m, h) ? h() : std::string("<none>");
-}
+using pomar::test::sourceAttribute;
+using pomar::test::vertexAttribute;
 
 class PomarPluginTest : public ::testing::Test {
 protected:

@@ -35,6 +35,7 @@
 #include <tuple>
 #include <vector>
 #include "support/mesh_compare.h"
+#include "support/meshlab_layer.h"
 
 namespace {
 
@@ -77,20 +78,8 @@ using Tri = pomar::test::PositionTriangle;
 using pomar::test::canonical;
 std::vector<Tri> canonical(const CMeshO &m) { return canonical(pomar::from_vcg(m)); }
 
-std::vector<float> vertexAttribute(CMeshO &m, const char *name) {
-  std::vector<float> out;
-  auto h = vcg::tri::Allocator<CMeshO>::FindPerVertexAttribute<float>(m, name);
-  if (!vcg::tri::Allocator<CMeshO>::IsValidHandle(m, h))
-    return out;
-  for (size_t v = 0; v < m.vert.size(); ++v)
-    out.push_back(h[v]);
-  return out;
-}
-
-std::string sourceAttribute(CMeshO &m) {
-  auto h = vcg::tri::Allocator<CMeshO>::FindPerMeshAttribute<std::string>(m, "pomar_source");
-  return vcg::tri::Allocator<CMeshO>::IsValidHandle(m, h) ? h() : std::string("<none>");
-}
+using pomar::test::sourceAttribute;
+using pomar::test::vertexAttribute;
 
 void writeBytes(const QString &path, const std::vector<uint8_t> &bytes) {
   std::ofstream out(QFile::encodeName(path).toStdString(), std::ios::binary | std::ios::trunc);
