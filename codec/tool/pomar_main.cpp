@@ -1,7 +1,7 @@
 // pomar: command-line front end of the codec.
 //   pomar encode IN OUT.pomar [--bits N] [--progressive]
-//   pomar decode IN.pomar OUT [--level L]
-//   pomar info IN.pomar [--json]
+//   pomar decode IN.pomar OUT [--level L] [--cluster/--sphere/--box ...] [--skip-damaged]
+//   pomar info IN.pomar [--json | --check]
 //   pomar verify ORIGINAL IN.pomar [DECODED]
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -9,8 +9,8 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
-#include <memory>
 #include <cstdio>
+#include <memory>
 #include <unistd.h>
 
 #include "pomar/mesh_io.h"
@@ -98,8 +98,8 @@ int run_encode(const EncodeArgs &a) {
                 static_cast<unsigned long>(i.cluster_bytes));
   else
     std::printf("pure progressive (no random access)\n");
-  std::printf("time: read %.3f s, encode %.3f s (decimate %.3f s, code %.3f s)\n", t_load,
-              t_encode, r.decimate_seconds, r.encode_seconds);
+  std::printf("time: read %.3f s, encode %.3f s (decimate %.3f s, code %.3f s)\n", t_load, t_encode,
+              r.decimate_seconds, r.encode_seconds);
   return 0;
 }
 
@@ -109,7 +109,7 @@ struct DecodeArgs {
   std::string in, out;
   int level = -1;
   std::vector<std::string> clusters, spheres, boxes;
-  bool ascii = false, quiet = false, stats = false;
+  bool ascii = false, quiet = false, stats = false, skip_damaged = false;
   bool selective() const { return !clusters.empty() || !spheres.empty() || !boxes.empty(); }
 };
 
@@ -127,21 +127,24 @@ std::vector<double> parse_spec(const std::string &spec, size_t count, int finest
       if (used != spec.size() - colon - 1)
         throw std::invalid_argument("level");
     } catch (const std::exception &) {
-      throw pomar::Error(std::string("bad ") + what + " '" + spec + "': the level after ':' must be an integer");
+      throw pomar::Error(std::string("bad ") + what + " '" + spec +
+                         "': the level after ':' must be an integer");
     }
   }
   std::vector<double> v;
   size_t pos = 0;
   while (pos <= body.size()) {
     const size_t comma = body.find(',', pos);
-    const std::string item = body.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
+    const std::string item =
+        body.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
     try {
       size_t used = 0;
       v.push_back(std::stod(item, &used));
       if (used != item.size())
         throw std::invalid_argument("number");
     } catch (const std::exception &) {
-      throw pomar::Error(std::string("bad ") + what + " '" + spec + "': '" + item + "' is not a number");
+      throw pomar::Error(std::string("bad ") + what + " '" + spec + "': '" + item +
+                         "' is not a number");
     }
     if (comma == std::string::npos)
       break;
@@ -153,12 +156,44 @@ std::vector<double> parse_spec(const std::string &spec, size_t count, int finest
   return v;
 }
 
+/// Exit status of a decode that skipped damaged blocks (the output is written).
+constexpr int kExitDamaged = 3;
+
+/// List skipped blocks on stderr; returns the exit status (0 or kExitDamaged).
+int report_damage(const std::vector<pomar::DamagedBlock> &damaged, const std::string &out) {
+  if (damaged.empty())
+    return 0;
+  std::fprintf(stderr,
+               "pomar: warning: %zu damaged block%s skipped; %s is a valid mesh, coarser where "
+               "they were:\n",
+               damaged.size(), damaged.size() == 1 ? "" : "s", out.c_str());
+  const size_t shown = std::min<size_t>(damaged.size(), 20);
+  for (size_t i = 0; i < shown; ++i)
+    std::fprintf(stderr, "  %s (kept at level %d): %s\n", damaged[i].block.c_str(),
+                 damaged[i].level_kept, damaged[i].problem.c_str());
+  if (shown < damaged.size())
+    std::fprintf(stderr, "  ... and %zu more\n", damaged.size() - shown);
+  return kExitDamaged;
+}
+
+/// A damaged or missing level or cluster block can be skipped; say so in the error.
+[[noreturn]] void rethrow_with_hint(const pomar::Error &e) {
+  const std::string m = e.what();
+  const bool block = m.find("level ") != std::string::npos ||
+                     m.find("cluster ") != std::string::npos ||
+                     m.rfind("truncated .pomar file", 0) == 0;
+  if (block && (m.rfind("damaged", 0) == 0 || m.rfind("truncated", 0) == 0))
+    throw pomar::Error(m + " (pomar info --check lists damaged blocks; pomar decode "
+                           "--skip-damaged decodes the rest)");
+  throw e;
+}
+
 int run_selective_decode(const DecodeArgs &a) {
   const auto t0 = Clock::now();
-  pomar::SelectiveDecoder d(std::make_unique<pomar::FileSource>(a.in));
+  pomar::SelectiveDecoder d(std::make_unique<pomar::FileSource>(a.in), a.skip_damaged);
   if (!d.info().clustered())
     throw pomar::Error(a.in + " is a pure progressive file (encoded with --progressive): it has "
-                       "no clusters to select; use --level");
+                              "no clusters to select; use --level");
   const int finest = d.finest_level();
   if (a.level >= 0)
     d.want_all(std::max(a.level, d.base_clustered_level()));
@@ -166,7 +201,8 @@ int run_selective_decode(const DecodeArgs &a) {
     int level;
     const std::vector<double> id = parse_spec(spec, 1, finest, level, "--cluster");
     if (id[0] < 0 || id[0] != double(uint32_t(id[0])))
-      throw pomar::Error("bad --cluster '" + spec + "': the cluster id must be a non-negative integer");
+      throw pomar::Error("bad --cluster '" + spec +
+                         "': the cluster id must be a non-negative integer");
     d.want_cluster(static_cast<uint32_t>(id[0]), level);
   }
   for (const std::string &spec : a.spheres) {
@@ -182,7 +218,11 @@ int run_selective_decode(const DecodeArgs &a) {
     const float hi[3] = {float(v[3]), float(v[4]), float(v[5])};
     d.want_box(lo, hi, level);
   }
-  d.update(terminal_progress(a.quiet));
+  try {
+    d.update(terminal_progress(a.quiet));
+  } catch (const pomar::Error &e) {
+    rethrow_with_hint(e);
+  }
   const pomar::Mesh mesh = d.mesh();
   const double t_decode = since(t0);
   pomar::save_mesh(a.out, mesh, !a.ascii);
@@ -195,7 +235,7 @@ int run_selective_decode(const DecodeArgs &a) {
                 static_cast<unsigned long>(d.bytes_read()), static_cast<unsigned long>(file_size),
                 100.0 * double(d.bytes_read()) / double(file_size), t_decode);
   }
-  return 0;
+  return report_damage(d.damaged(), a.out);
 }
 
 int run_decode(const DecodeArgs &a) {
@@ -203,14 +243,26 @@ int run_decode(const DecodeArgs &a) {
     return run_selective_decode(a);
   const auto t0 = Clock::now();
   const std::vector<uint8_t> data = pomar::read_file(a.in);
-  const pomar::Mesh mesh =
-      pomar::decode(data.data(), data.size(), a.level, terminal_progress(a.quiet));
+  pomar::DecodeOptions options;
+  options.level = a.level;
+  options.skip_damaged = a.skip_damaged;
+  options.progress = terminal_progress(a.quiet);
+  pomar::DecodeReport report;
+  pomar::Mesh mesh;
+  try {
+    mesh = pomar::decode(data.data(), data.size(), options, &report);
+  } catch (const pomar::Error &e) {
+    rethrow_with_hint(e);
+  }
   const double t_decode = since(t0);
   pomar::save_mesh(a.out, mesh, !a.ascii);
   if (!a.quiet || a.stats)
     std::printf("%s: %zu vertices, %zu faces (decoded in %.3f s, %zu bytes read)\n", a.out.c_str(),
                 mesh.vertex_count(), mesh.triangle_count(), t_decode, data.size());
-  return 0;
+  if (!report.damaged.empty() && report.clusters_below_request)
+    std::fprintf(stderr, "pomar: warning: %u clusters below the requested level\n",
+                 report.clusters_below_request);
+  return report_damage(report.damaged, a.out);
 }
 
 // ---------------------------------------------------------------- info
@@ -226,7 +278,9 @@ nlohmann::json info_json(const pomar::FileInfo &i) {
   j["base_vertices"] = i.base_vertices;
   j["base_faces"] = i.base_faces;
   nlohmann::json levels = nlohmann::json::array();
-  levels.push_back({{"level", 0}, {"vertices", i.base_vertices}, {"faces", i.base_faces},
+  levels.push_back({{"level", 0},
+                    {"vertices", i.base_vertices},
+                    {"faces", i.base_faces},
                     {"bytes", i.base_bytes}});
   for (size_t l = 0; l < i.levels.size(); ++l)
     levels.push_back({{"level", l + 1},
@@ -252,6 +306,21 @@ nlohmann::json info_json(const pomar::FileInfo &i) {
   j["connectivity_bpv"] = bpv(i.connectivity_bytes, i.vertices);
   j["geometry_bpv"] = bpv(i.geometry_bytes, i.vertices);
   return j;
+}
+
+/// info --check: every block's checksum; exit kExitDamaged if one fails.
+int run_check(const std::string &in) {
+  const std::vector<uint8_t> data = pomar::read_file(in);
+  const std::vector<pomar::DamagedBlock> damaged = pomar::check_blocks(data.data(), data.size());
+  if (damaged.empty()) {
+    std::printf("%s: every block passes its check\n", in.c_str());
+    return 0;
+  }
+  std::printf("%s: %zu damaged block%s (pomar decode --skip-damaged decodes the rest):\n",
+              in.c_str(), damaged.size(), damaged.size() == 1 ? "" : "s");
+  for (const pomar::DamagedBlock &b : damaged)
+    std::printf("  %s: %s\n", b.block.c_str(), b.problem.c_str());
+  return kExitDamaged;
 }
 
 int run_info(const std::string &in, bool json) {
@@ -294,12 +363,11 @@ int run_info(const std::string &in, bool json) {
               static_cast<unsigned long>(i.base_bytes));
   for (size_t l = 0; l < i.levels.size(); ++l) {
     if (l < i.global_levels)
-      std::printf("  %5zu %9u %9u  %10lu  %10lu\n", l + 1, i.levels[l].vertices,
-                  i.levels[l].faces, static_cast<unsigned long>(i.levels[l].connectivity_bytes),
+      std::printf("  %5zu %9u %9u  %10lu  %10lu\n", l + 1, i.levels[l].vertices, i.levels[l].faces,
+                  static_cast<unsigned long>(i.levels[l].connectivity_bytes),
                   static_cast<unsigned long>(i.levels[l].geometry_bytes));
     else
-      std::printf("  %5zu %9u %9u  (clustered)\n", l + 1, i.levels[l].vertices,
-                  i.levels[l].faces);
+      std::printf("  %5zu %9u %9u  (clustered)\n", l + 1, i.levels[l].vertices, i.levels[l].faces);
   }
   return 0;
 }
@@ -366,7 +434,8 @@ int main(int argc, char **argv) {
   app.set_version_flag("--version", "pomar 0.1.0 (file format version 1)");
 
   EncodeArgs ea;
-  auto *enc = app.add_subcommand("encode", "Compress a mesh (PLY, OBJ, OFF, STL) into a .pomar file");
+  auto *enc =
+      app.add_subcommand("encode", "Compress a mesh (PLY, OBJ, OFF, STL) into a .pomar file");
   enc->add_option("input", ea.in, "Input mesh: manifold, consistently oriented triangles")
       ->required();
   enc->add_option("output", ea.out, "Output .pomar file (written atomically)")->required();
@@ -389,7 +458,8 @@ int main(int argc, char **argv) {
   DecodeArgs da;
   auto *dec = app.add_subcommand("decode", "Decompress a .pomar file into a mesh file");
   dec->add_option("input", da.in, "Input .pomar file")->required();
-  dec->add_option("output", da.out, "Output mesh; the format follows the extension (.ply .obj .off .stl)")
+  dec->add_option("output", da.out,
+                  "Output mesh; the format follows the extension (.ply .obj .off .stl)")
       ->required();
   dec->add_option("-l,--level", da.level,
                   "Stop after L refinement levels (0 = base mesh; default: full resolution). With "
@@ -410,14 +480,25 @@ int main(int argc, char **argv) {
   dec->add_flag("--stats", da.stats,
                 "Print clusters decoded, bytes read of the file size, vertices and time");
   dec->add_flag("--ascii", da.ascii, "Write ASCII PLY instead of binary");
+  dec->add_flag("--skip-damaged", da.skip_damaged,
+                "Decode around damaged or missing blocks (bit rot, truncated download) instead "
+                "of failing: a damaged cluster stays at the base clustered level and its "
+                "neighbours at most one level finer per step, a damaged global level stops the "
+                "decoding before it. Skipped blocks are listed on stderr and the exit status is "
+                "3 (the output is written). The header, base mesh, tables and index must be "
+                "intact");
   dec->add_flag("-q,--quiet", da.quiet, "Print nothing on success");
 
   std::string info_in;
-  bool info_jsonf = false;
+  bool info_jsonf = false, info_check = false;
   auto *inf = app.add_subcommand("info", "Describe a .pomar file: counts, levels, bits per vertex");
   inf->add_option("input", info_in, "Input .pomar file")->required();
-  inf->add_flag("--json", info_jsonf, "One JSON object (keys: vertices, faces, bits, levels, "
-                                      "connectivity_bits, geometry_bits, total_bytes, ...)");
+  inf->add_flag("--json", info_jsonf,
+                "One JSON object (keys: vertices, faces, bits, levels, "
+                "connectivity_bits, geometry_bits, total_bytes, ...)");
+  inf->add_flag("--check", info_check,
+                "Check every block's checksum instead (no decoding); exit status 3 lists the "
+                "damaged or missing blocks");
 
   std::string v_orig, v_file, v_decoded;
   auto *ver = app.add_subcommand(
@@ -437,7 +518,7 @@ int main(int argc, char **argv) {
     if (*dec)
       return run_decode(da);
     if (*inf)
-      return run_info(info_in, info_jsonf);
+      return info_check ? run_check(info_in) : run_info(info_in, info_jsonf);
     if (*ver)
       return run_verify(v_orig, v_file, v_decoded);
   } catch (const pomar::Error &e) {

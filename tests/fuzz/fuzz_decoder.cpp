@@ -80,6 +80,15 @@ void run(const uint8_t *data, size_t size) {
     } catch (const pomar::Error &) {
     }
   }
+  // Decoding around damage: must end with a valid mesh or pomar::Error, never loop.
+  try {
+    pomar::DecodeOptions o;
+    o.skip_damaged = true;
+    pomar::DecodeReport r;
+    (void)pomar::decode(data, size, o, &r);
+    (void)pomar::check_blocks(data, size);
+  } catch (const pomar::Error &) {
+  }
   // (regressions/decoder-crash-da39a3ee...: the empty input used to reach memcpy with a
   // null pointer; fixed in MemorySource::read.)
   try {

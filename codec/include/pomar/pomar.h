@@ -46,8 +46,8 @@ struct EncodeOptions {
 
 /// One refinement level of a file: the mesh it produces and what it costs.
 struct LevelInfo {
-  uint32_t vertices = 0;          ///< vertex count after decoding this level
-  uint32_t faces = 0;             ///< face count after decoding this level
+  uint32_t vertices = 0; ///< vertex count after decoding this level
+  uint32_t faces = 0;    ///< face count after decoding this level
   uint64_t connectivity_bytes = 0;
   uint64_t geometry_bytes = 0;
 };
@@ -67,23 +67,24 @@ struct Quantizer {
 struct FileInfo {
   uint32_t version = 0;
   int bits = 0;
-  Quantizer grid;                  ///< the exact grid of the file
-  float bbox_min[3] = {0, 0, 0};   ///< grid origin
-  float bbox_max[3] = {0, 0, 0};   ///< grid origin + extent (the grid is a cube)
-  uint32_t vertices = 0; ///< at full resolution
+  Quantizer grid;                ///< the exact grid of the file
+  float bbox_min[3] = {0, 0, 0}; ///< grid origin
+  float bbox_max[3] = {0, 0, 0}; ///< grid origin + extent (the grid is a cube)
+  uint32_t vertices = 0;         ///< at full resolution
   uint32_t faces = 0;
   uint32_t base_vertices = 0;
   uint32_t base_faces = 0;
   std::vector<LevelInfo> levels; ///< levels[i] = refinement level i+1
   uint64_t total_bytes = 0;
-  uint64_t header_bytes = 0; ///< header + level table
-  uint64_t base_bytes = 0;   ///< the stored base mesh
+  uint64_t header_bytes = 0;       ///< header + level table
+  uint64_t base_bytes = 0;         ///< the stored base mesh
   uint64_t connectivity_bytes = 0; ///< sum over levels (clustered part: encoder's estimate)
   uint64_t geometry_bytes = 0;     ///< sum over levels (clustered part: encoder's estimate)
   // Random access (clustered files; zero/absent in pure progressive files).
-  uint32_t global_levels = 0; ///< levels decoded for the whole mesh (= levels.size() if progressive)
-  uint32_t clusters = 0;      ///< vertices of the base clustered mesh = clusters
-  uint64_t global_bytes = 0;  ///< header, base mesh, global levels, tables, index
+  /// levels decoded for the whole mesh (= levels.size() if progressive)
+  uint32_t global_levels = 0;
+  uint32_t clusters = 0;     ///< vertices of the base clustered mesh = clusters
+  uint64_t global_bytes = 0; ///< header, base mesh, global levels, tables, index
   uint64_t tables_bytes = 0, index_bytes = 0, cluster_bytes = 0;
   std::vector<uint32_t> cluster_block_bytes; ///< filled by inspect()
   bool clustered() const { return clusters != 0; }
@@ -113,5 +114,42 @@ FileInfo inspect(const uint8_t *data, size_t size);
 /// Decode the mesh after `level` refinement levels (0 = base mesh, -1 = full resolution).
 /// Throws pomar::Error if the image is damaged or truncated (checked per block).
 Mesh decode(const uint8_t *data, size_t size, int level = -1, const Progress &progress = {});
+
+/// A block of a .pomar file that failed its checks (checksum, structure, or missing from a
+/// truncated file) and was skipped by a decode with `skip_damaged`.
+struct DamagedBlock {
+  std::string block;   ///< "cluster 17" or "level 9"
+  std::string problem; ///< what is wrong with it (the error the strict decoder reports)
+  int level_kept = 0;  ///< the region it codes stays at this level
+};
+
+struct DecodeOptions {
+  int level = -1; ///< 0 = base mesh, -1 = full resolution
+  /// Decode around damage instead of failing: a damaged global level stops the decoding
+  /// at the level before it; a damaged cluster block leaves that cluster at the base
+  /// clustered level and its neighbours at most one level finer per step of distance
+  /// (the level map rule), everything else is decoded as asked. Every skipped block is
+  /// listed in DecodeReport::damaged. Damage in the header, base mesh, model tables or
+  /// cluster index still fails: nothing can be decoded without them.
+  bool skip_damaged = false;
+  Progress progress; ///< optional
+};
+
+struct DecodeReport {
+  std::vector<DamagedBlock> damaged; ///< empty when the file is intact
+  int level = 0;                     ///< the finest level decoded anywhere
+  /// Clustered files with damage: clusters decoded below the requested level.
+  uint32_t clusters_below_request = 0;
+};
+
+/// decode() with options; `*report` (optional) says what was skipped.
+Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options,
+            DecodeReport *report = nullptr);
+
+/// Check every block's checksum without decoding (the header, base mesh, model tables and
+/// cluster index must be intact: that throws). Returns the damaged or missing blocks,
+/// empty for an intact file. Cluster blocks carry an 8-bit check: a damaged block passes
+/// it with probability 1/256, which a decode (with its structural checks) may still catch.
+std::vector<DamagedBlock> check_blocks(const uint8_t *data, size_t size);
 
 } // namespace pomar

@@ -62,7 +62,11 @@ private:
 /// clusters: it decodes to one uniform level (want_level).
 class SelectiveDecoder {
 public:
-  explicit SelectiveDecoder(std::unique_ptr<ByteSource> source);
+  /// Reads the header and the global part (they must be intact). With `skip_damaged`,
+  /// update() decodes around damaged or missing cluster blocks instead of failing (see
+  /// damaged()), the file may be truncated after its global part, and every block is read
+  /// whole so that its check is verified before it is decoded.
+  explicit SelectiveDecoder(std::unique_ptr<ByteSource> source, bool skip_damaged = false);
   ~SelectiveDecoder();
   SelectiveDecoder(const SelectiveDecoder &) = delete;
   SelectiveDecoder &operator=(const SelectiveDecoder &) = delete;
@@ -95,6 +99,12 @@ public:
   /// The level map after update(): the level of every cluster.
   const std::vector<int> &levels() const;
 
+  /// Blocks skipped because they failed their checks or were missing (skip_damaged only;
+  /// otherwise update() throws). A damaged cluster stays at base_clustered_level() and
+  /// limits its neighbours to one level more per step of distance, as the level map rule
+  /// demands; the mesh stays valid and every other cluster is decoded as wanted.
+  const std::vector<DamagedBlock> &damaged() const;
+
   // ----- the current mesh -----
   Mesh mesh() const;
   /// Per vertex of mesh(): its cluster and the level that created it.
@@ -102,8 +112,8 @@ public:
   std::vector<uint32_t> vertex_level() const;
 
   // ----- statistics -----
-  uint64_t bytes_read() const;     ///< everything read from the source so far
-  uint32_t blocks_read() const;    ///< cluster blocks read so far
+  uint64_t bytes_read() const;       ///< everything read from the source so far
+  uint32_t blocks_read() const;      ///< cluster blocks read so far
   uint32_t clusters_decoded() const; ///< clusters above the base clustered level
 
 private:

@@ -2,9 +2,9 @@
 #include <memory>
 #include <string>
 
+#include "decode/decoder_codec.h"
 #include "entropy/models.h"
 #include "format/file_format.h"
-#include "decode/decoder_codec.h"
 #include "pomar/random_access.h"
 #include "refine/level_traversal.h"
 
@@ -34,31 +34,48 @@ LevelMesh base_level_mesh(const uint8_t *data, const FileLayout &layout) {
   return lm;
 }
 
-void decode_global_levels(const uint8_t *data, const FileLayout &layout, size_t from, size_t to,
-                          LevelMesh &lm, Models &models, const Progress &progress) {
+size_t decode_global_levels(const uint8_t *data, const FileLayout &layout, size_t from, size_t to,
+                            LevelMesh &lm, Models &models, const Progress &progress,
+                            std::vector<DamagedBlock> *damaged) {
   const FileHeader &h = layout.header;
   DecoderCodec codec(h.grid.bits);
   TraversalScratch scratch;
   std::vector<PendingSplit> splits;
   RangeDecoder conn, geom;
   for (size_t i = from; i < to; ++i) {
-    check_level(data, layout, i);
     const LevelEntry &e = h.levels[i];
-    const uint8_t *p = data + layout.level_offset[i];
-    conn.reset(p, e.connectivity_bytes);
-    geom.reset(p + e.connectivity_bytes, e.geometry_bytes);
-    codec.set(&models, &conn, &geom, static_cast<uint32_t>(i + 1));
-    traverse_level(lm, codec, scratch, static_cast<uint32_t>(i + 1), splits);
-    if (conn.overrun() || geom.overrun())
-      codec.corrupt("the level's data ends too early");
-    if (lm.vertex_count() + splits.size() != e.vertices)
-      codec.corrupt("the number of vertex splits differs from the level table");
+    bool traversing = false;
+    try {
+      check_level(data, layout, i);
+      const uint8_t *p = data + layout.level_offset[i];
+      conn.reset(p, e.connectivity_bytes);
+      geom.reset(p + e.connectivity_bytes, e.geometry_bytes);
+      codec.set(&models, &conn, &geom, static_cast<uint32_t>(i + 1));
+      traversing = true;
+      traverse_level(lm, codec, scratch, static_cast<uint32_t>(i + 1), splits);
+      if (conn.overrun() || geom.overrun())
+        codec.corrupt("the level's data ends too early");
+      if (lm.vertex_count() + splits.size() != e.vertices)
+        codec.corrupt("the number of vertex splits differs from the level table");
+      size_t faces = lm.ct.face_count();
+      for (const PendingSplit &ps : splits)
+        faces += size_t(ps.op.has_l) + size_t(ps.op.has_r);
+      if (faces != e.faces)
+        codec.corrupt("the face count differs from the level table");
+    } catch (const Error &err) {
+      if (!damaged)
+        throw;
+      // Every check comes before the splits are applied: the mesh is still level i.
+      if (traversing)
+        release_claims(lm, scratch, static_cast<uint32_t>(i + 1));
+      damaged->push_back({"level " + std::to_string(i + 1), err.what(), static_cast<int>(i)});
+      return i;
+    }
     apply_splits(lm, splits, static_cast<uint32_t>(i + 1));
-    if (lm.ct.face_count() != e.faces)
-      codec.corrupt("the face count differs from the level table");
     if (progress)
       progress(double(i + 1) / double(to), "decode");
   }
+  return to;
 }
 
 FileInfo inspect(const uint8_t *data, size_t size) {
@@ -74,24 +91,85 @@ FileInfo inspect(const uint8_t *data, size_t size) {
   return info;
 }
 
+std::vector<DamagedBlock> check_blocks(const uint8_t *data, size_t size) {
+  const FileLayout layout = read_layout(data, size, size, true);
+  const FileHeader &h = layout.header;
+  read_base_mesh(data, layout);
+  std::vector<DamagedBlock> damaged;
+  const size_t global = h.clustered() ? h.global_levels : h.levels.size();
+  for (size_t i = 0; i < global; ++i) {
+    try {
+      check_level(data, layout, i);
+    } catch (const Error &e) {
+      damaged.push_back({"level " + std::to_string(i + 1), e.what(), static_cast<int>(i)});
+    }
+  }
+  if (!h.clustered())
+    return damaged;
+  check_block(data + layout.tables_offset, h.tables_bytes, h.tables_checksum,
+              "static model tables");
+  const ClusterIndex index = read_cluster_index(data + layout.index_offset, layout);
+  for (uint32_t c = 0; c < h.clusters; ++c) {
+    const char *problem = nullptr;
+    if (index.offset[c] + index.size[c] > size)
+      problem = "missing: the file ends before this block (truncated file)";
+    else if ((checksum(data + index.offset[c], index.size[c]) & 0xFF) != index.check[c])
+      problem = "checksum mismatch";
+    if (problem)
+      damaged.push_back({"cluster " + std::to_string(c),
+                         std::string("damaged .pomar file: block of cluster ") + std::to_string(c) +
+                             ": " + problem,
+                         static_cast<int>(h.global_levels)});
+  }
+  return damaged;
+}
+
 Mesh decode(const uint8_t *data, size_t size, int level, const Progress &progress) {
-  const FileLayout layout = read_layout(data, size);
+  DecodeOptions options;
+  options.level = level;
+  options.progress = progress;
+  return decode(data, size, options);
+}
+
+Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, DecodeReport *report) {
+  DecodeReport scratch_report;
+  DecodeReport &r = report ? *report : scratch_report;
+  r = DecodeReport();
+  const FileLayout layout = read_layout(data, size, size, options.skip_damaged);
   const FileHeader &h = layout.header;
   const size_t levels = h.levels.size();
-  if (level < -1 || level > static_cast<int>(levels))
-    throw Error("level " + std::to_string(level) + " does not exist: the file has levels 0.." +
-                std::to_string(levels));
-  const size_t target = level < 0 ? levels : static_cast<size_t>(level);
+  if (options.level < -1 || options.level > static_cast<int>(levels))
+    throw Error("level " + std::to_string(options.level) +
+                " does not exist: the file has levels 0.." + std::to_string(levels));
+  const size_t target = options.level < 0 ? levels : static_cast<size_t>(options.level);
   const size_t global = h.clustered() ? h.global_levels : levels;
-  if (target > global) { // clustered levels: every cluster at `target`
-    SelectiveDecoder d(std::make_unique<MemorySource>(data, size));
+  // Clustered levels go through the selective decoder, unless a global level they build
+  // on is damaged (then the decoding stops there, below).
+  bool global_intact = true;
+  if (target > global && options.skip_damaged)
+    for (size_t i = 0; i < global && global_intact; ++i) {
+      try {
+        check_level(data, layout, i);
+      } catch (const Error &) {
+        global_intact = false;
+      }
+    }
+  if (target > global && global_intact) { // clustered levels: every cluster at `target`
+    SelectiveDecoder d(std::make_unique<MemorySource>(data, size), options.skip_damaged);
     d.want_all(static_cast<int>(target));
-    d.update(progress);
+    d.update(options.progress);
+    r.damaged = d.damaged();
+    for (int l : d.levels()) {
+      r.level = std::max(r.level, l);
+      r.clusters_below_request += l < static_cast<int>(target);
+    }
     return d.mesh();
   }
   LevelMesh lm = base_level_mesh(data, layout);
   Models models;
-  decode_global_levels(data, layout, 0, target, lm, models, progress);
+  r.level = static_cast<int>(decode_global_levels(data, layout, 0, std::min(target, global), lm,
+                                                  models, options.progress,
+                                                  options.skip_damaged ? &r.damaged : nullptr));
   return to_mesh(lm, h.grid);
 }
 

@@ -82,6 +82,37 @@ std::vector<int> complete_level_map(const std::vector<int> &wanted,
   return m;
 }
 
+/// limit[x] = min over clusters c of cap[c] + d(c, x) (d = edge distance in the cluster
+/// graph), at most `top`: the finest level map that respects every cap and the level map
+/// rule. Buckets by value, lowest first (a multi-source breadth-first search).
+static std::vector<int> cap_distance_map(const std::vector<int> &cap,
+                                         const std::vector<uint32_t> &start,
+                                         const std::vector<uint32_t> &adj, int top) {
+  std::vector<int> limit(cap.size(), top);
+  int low = top;
+  for (size_t c = 0; c < cap.size(); ++c) {
+    limit[c] = std::min(cap[c], top);
+    low = std::min(low, limit[c]);
+  }
+  std::vector<std::vector<uint32_t>> bucket(size_t(top - low + 1));
+  for (size_t c = 0; c < cap.size(); ++c)
+    if (limit[c] < top)
+      bucket[size_t(limit[c] - low)].push_back(static_cast<uint32_t>(c));
+  for (int lvl = low; lvl < top; ++lvl) {
+    for (size_t i = 0; i < bucket[size_t(lvl - low)].size(); ++i) {
+      const uint32_t c = bucket[size_t(lvl - low)][i];
+      if (limit[c] != lvl)
+        continue;
+      for (uint32_t k = start[c]; k < start[c + 1]; ++k)
+        if (limit[adj[k]] > lvl + 1) {
+          limit[adj[k]] = lvl + 1;
+          bucket[size_t(lvl + 1 - low)].push_back(adj[k]);
+        }
+    }
+  }
+  return limit;
+}
+
 // ---------------------------------------------------------------- decoder state
 
 struct SelectiveDecoder::State {
@@ -95,8 +126,8 @@ struct SelectiveDecoder::State {
 
   // Progressive part.
   Models global_models;
-  LevelMesh mesh;     // current state
-  LevelMesh snapshot; // the base clustered mesh (clustered) or base mesh (progressive)
+  LevelMesh mesh;        // current state
+  LevelMesh snapshot;    // the base clustered mesh (clustered) or base mesh (progressive)
   int uniform_level = 0; // progressive files: the level of the whole mesh
 
   // Clustered part.
@@ -118,6 +149,14 @@ struct SelectiveDecoder::State {
   std::vector<Cluster> clusters;
   std::vector<int> wanted, levels;
 
+  // Damaged blocks (skip_damaged): cap[c] = the finest level cluster c may reach.
+  bool skip_damaged = false;
+  std::vector<int> cap;
+  std::vector<DamagedBlock> damaged;
+  uint32_t decoding = kNone; // the cluster being decoded, for error reports
+  bool traversing = false;   // its traversal has started (it may have claimed faces)
+  int uniform_cap = 1 << 30; // progressive files: the level before a damaged one
+
   TraversalScratch scratch;
   std::vector<PendingSplit> splits;
 
@@ -127,6 +166,8 @@ struct SelectiveDecoder::State {
   void start(uint32_t c, bool whole);
   void reset_to_snapshot();
   void decode_cluster_level(uint32_t c, int level);
+  void decode_target(const Progress &progress);
+  bool skip_cluster(uint32_t c, const Error &e);
   std::vector<int> target; // the level map being decoded
   int target_of(uint32_t c) const { return target.empty() ? finest : target[c]; }
 };
@@ -173,24 +214,64 @@ void SelectiveDecoder::State::reset_to_snapshot() {
 
 void SelectiveDecoder::State::decode_cluster_level(uint32_t c, int level) {
   Cluster &k = clusters[c];
+  decoding = c;
   if (k.level == global_levels) // first clustered level of this cluster: (re)start its stream
-    start(c, target_of(c) == finest);
+    start(c, skip_damaged || target_of(c) == finest);
   DecoderCodec codec(layout.header.grid.bits);
   codec.set(&level_models[size_t(level - global_levels - 1)], &k.rc, &k.rc,
             static_cast<uint32_t>(level), c);
+  traversing = true;
   traverse_cluster(mesh, codec, scratch, c, static_cast<uint32_t>(level), splits);
-  apply_splits(mesh, splits, static_cast<uint32_t>(level), c, &k.next_local);
   if (k.rc.overrun())
     codec.corrupt("the block ends too early");
+  traversing = false;
+  // Every check is done: a damaged block leaves the mesh as it was.
+  apply_splits(mesh, splits, static_cast<uint32_t>(level), c, &k.next_local);
   k.level = level;
+  decoding = kNone;
+}
+
+/// After `e` while decoding cluster `c` (kNone: not in a cluster): with skip_damaged,
+/// record the damage, cap the cluster at the base clustered level and return true (the
+/// caller decodes again); otherwise false (the caller rethrows).
+bool SelectiveDecoder::State::skip_cluster(uint32_t c, const Error &e) {
+  if (c == kNone)
+    return false;
+  // The failed traversal applied nothing; only its face claims need undoing.
+  if (traversing)
+    release_claims(mesh, scratch, static_cast<uint32_t>(clusters[c].level + 1));
+  traversing = false;
+  decoding = kNone;
+  if (!skip_damaged)
+    return false;
+  damaged.push_back({"cluster " + std::to_string(c), e.what(), global_levels});
+  // Levels of this cluster decoded earlier from the same block cannot be trusted either:
+  // the cap coarsens it (decode_target re-decodes from the base clustered mesh then).
+  cap[c] = global_levels;
+  // A block that passed its 8-bit check and still fails may be intact and fail because a
+  // neighbour's damaged block slipped through its own check (1 in 256) and decoded to a
+  // wrong but valid state. The neighbours' blocks are suspects: keep them coarse too.
+  if (clusters[c].checked)
+    for (uint32_t k = adj_start[c]; k < adj_start[c + 1]; ++k) {
+      const uint32_t nb = adj[k];
+      if (cap[nb] == global_levels)
+        continue;
+      cap[nb] = global_levels;
+      damaged.push_back({"cluster " + std::to_string(nb),
+                         "suspect: its block passes its 8-bit check, but cluster " +
+                             std::to_string(c) + " next to it failed to decode",
+                         global_levels});
+    }
+  return true;
 }
 
 // ---------------------------------------------------------------- construction
 
-SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source)
+SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source, bool skip_damaged)
     : s_(std::make_unique<State>()) {
   State &s = *s_;
   s.source = std::move(source);
+  s.skip_damaged = skip_damaged;
   const uint64_t file_size = s.source->size();
   // Header: fixed part, then its full size.
   s.global.resize(std::min<uint64_t>(file_size, kFixedHeaderBytes));
@@ -201,11 +282,11 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source)
                 " bytes");
   s.global.resize(hsize);
   s.source->read(0, hsize, s.global.data());
-  s.layout = read_layout(s.global.data(), hsize, file_size);
-  // The global part.
-  s.global.resize(s.layout.global_bytes);
-  s.source->read(hsize, s.layout.global_bytes - hsize, s.global.data() + hsize);
-  s.bytes_read = s.layout.global_bytes;
+  s.layout = read_layout(s.global.data(), hsize, file_size, skip_damaged);
+  // The global part (a truncated progressive file: what is there of it).
+  s.global.resize(std::min<uint64_t>(s.layout.global_bytes, file_size));
+  s.source->read(hsize, s.global.size() - hsize, s.global.data() + hsize);
+  s.bytes_read = s.global.size();
   s.info = file_info(s.layout, file_size);
   const FileHeader &h = s.layout.header;
   s.finest = static_cast<int>(h.levels.size());
@@ -223,8 +304,7 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source)
                                h.levels.size() - h.global_levels);
   s.index = read_cluster_index(s.global.data() + s.layout.index_offset, s.layout);
   s.info.cluster_block_bytes = s.index.size;
-  decode_global_levels(s.global.data(), s.layout, 0, h.global_levels, s.mesh, s.global_models,
-                       {});
+  decode_global_levels(s.global.data(), s.layout, 0, h.global_levels, s.mesh, s.global_models, {});
   // The base clustered mesh: each vertex roots its cluster.
   const uint32_t n = h.clusters;
   s.mesh.local.assign(n, 0);
@@ -239,6 +319,7 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source)
   }
   s.wanted.assign(n, s.global_levels);
   s.levels.assign(n, s.global_levels);
+  s.cap.assign(n, s.finest);
   // The cluster graph = the base clustered mesh's edges.
   Ring ring;
   s.adj_start.assign(n + 1, 0);
@@ -259,6 +340,7 @@ int SelectiveDecoder::base_clustered_level() const { return s_->global_levels; }
 int SelectiveDecoder::finest_level() const { return s_->finest; }
 const std::vector<int> &SelectiveDecoder::wanted() const { return s_->wanted; }
 const std::vector<int> &SelectiveDecoder::levels() const { return s_->levels; }
+const std::vector<DamagedBlock> &SelectiveDecoder::damaged() const { return s_->damaged; }
 uint64_t SelectiveDecoder::bytes_read() const { return s_->bytes_read; }
 uint32_t SelectiveDecoder::blocks_read() const { return s_->blocks_read; }
 
@@ -389,36 +471,62 @@ void SelectiveDecoder::update(const Progress &progress) {
       s.global_models = Models();
       have = 0;
     }
-    decode_global_levels(s.global.data(), s.layout, size_t(have), size_t(s.uniform_level), s.mesh,
-                         s.global_models, progress);
+    const size_t want = size_t(std::min(s.uniform_level, s.uniform_cap));
+    const size_t reached =
+        decode_global_levels(s.global.data(), s.layout, size_t(have), want, s.mesh, s.global_models,
+                             progress, s.skip_damaged ? &s.damaged : nullptr);
+    if (reached < want)
+      s.uniform_cap = int(reached);
     return;
   }
-  s.target = complete_level_map(s.wanted, s.adj_start, s.adj, s.global_levels);
-  const std::vector<int> &target = s.target;
+  // Decode the completed level map; a damaged block caps its cluster and the map is
+  // completed and decoded again (each round skips one more block, so this ends).
+  for (;;) {
+    try {
+      s.decode_target(progress);
+      return;
+    } catch (const Error &e) {
+      if (!s.skip_cluster(s.decoding, e))
+        throw;
+    }
+  }
+}
+
+/// Bring the mesh to the level map completed from `wanted` and limited by the caps.
+void SelectiveDecoder::State::decode_target(const Progress &progress) {
+  decoding = kNone;
+  target = complete_level_map(wanted, adj_start, adj, global_levels);
+  if (!damaged.empty()) {
+    // Each damaged cluster limits the others to its cap + their distance to it, the
+    // largest map below both the request and the caps that keeps the level map rule.
+    const std::vector<int> limit = cap_distance_map(cap, adj_start, adj, finest);
+    for (size_t c = 0; c < target.size(); ++c)
+      target[c] = std::min(target[c], limit[c]);
+  }
   bool coarser = false;
   for (size_t c = 0; c < target.size(); ++c)
-    coarser = coarser || target[c] < s.clusters[c].level;
+    coarser = coarser || target[c] < clusters[c].level;
   if (coarser)
-    s.reset_to_snapshot();
+    reset_to_snapshot();
   size_t todo = 0, done = 0;
   for (size_t c = 0; c < target.size(); ++c)
-    todo += size_t(target[c] - s.clusters[c].level);
-  for (int level = s.global_levels + 1; level <= s.finest; ++level) {
+    todo += size_t(target[c] - clusters[c].level);
+  for (int level = global_levels + 1; level <= finest; ++level) {
     // Nothing finer than level-1 exists yet: every current vertex is older than `level`.
-    int finest_now = s.global_levels;
-    for (const auto &k : s.clusters)
+    int finest_now = global_levels;
+    for (const auto &k : clusters)
       finest_now = std::max(finest_now, k.level);
-    s.mesh.older_than_level = finest_now < level ? s.mesh.vertex_count() : 0;
+    mesh.older_than_level = finest_now < level ? mesh.vertex_count() : 0;
     for (uint32_t c = 0; c < target.size(); ++c) {
-      if (target[c] < level || s.clusters[c].level >= level)
+      if (target[c] < level || clusters[c].level >= level)
         continue;
-      s.decode_cluster_level(c, level);
+      decode_cluster_level(c, level);
       if (progress && (++done % 64 == 0 || done == todo))
         progress(double(done) / double(todo), "decode");
     }
   }
-  s.mesh.older_than_level = 0;
-  s.levels = target;
+  mesh.older_than_level = 0;
+  levels = target;
 }
 
 Mesh SelectiveDecoder::mesh() const { return to_mesh(s_->mesh, s_->layout.header.grid); }

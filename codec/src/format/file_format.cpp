@@ -188,7 +188,7 @@ size_t header_size(const uint8_t *data, size_t size) {
          ((flags & kFlagClustered) ? kClusterHeaderBytes : 0) + 4;
 }
 
-FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size) {
+FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size, bool allow_truncated) {
   if (file_size == 0)
     file_size = size;
   if (size < 8 || std::memcmp(data, kMagic, 8) != 0)
@@ -221,8 +221,8 @@ FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size) {
   h.base_checksum = r.u32();
   if (levels > kMaxLevels)
     bad("level count " + std::to_string(levels) + " exceeds " + std::to_string(kMaxLevels));
-  L.header_bytes = kFixedHeaderBytes + kLevelEntryBytes * levels +
-                   (h.clustered() ? kClusterHeaderBytes : 0) + 4;
+  L.header_bytes =
+      kFixedHeaderBytes + kLevelEntryBytes * levels + (h.clustered() ? kClusterHeaderBytes : 0) + 4;
   if (size < L.header_bytes)
     bad("header is truncated");
   const uint32_t stored = [&] {
@@ -301,7 +301,12 @@ FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size) {
   } else {
     L.global_bytes = offset;
   }
-  if (offset > file_size)
+  L.file_size = file_size;
+  // With allow_truncated, only what every decode needs must be present.
+  const uint64_t needed = !allow_truncated ? offset
+                          : h.clustered()  ? L.global_bytes
+                                           : L.base_offset + h.base_bytes;
+  if (needed > file_size)
     throw Error("truncated .pomar file: " + std::to_string(file_size) +
                 " bytes, the header announces " + std::to_string(offset));
   if (h.vertices > 512 * uint64_t(file_size) + 64)
@@ -334,7 +339,8 @@ BaseMesh read_base_mesh(const uint8_t *data, const FileLayout &L) {
   int64_t prev_first = 0;
   for (size_t f = 0; f < b.triangles.size(); f += 3) {
     const int64_t a = prev_first + get_signed(rc, m.first, nullptr);
-    const int64_t x = a + get_signed(rc, m.other, nullptr), y = a + get_signed(rc, m.other, nullptr);
+    const int64_t x = a + get_signed(rc, m.other, nullptr),
+                  y = a + get_signed(rc, m.other, nullptr);
     for (int64_t i : {a, x, y})
       if (i < 0 || i >= int64_t(h.base_vertices))
         bad("face refers to a missing vertex");
@@ -351,6 +357,10 @@ BaseMesh read_base_mesh(const uint8_t *data, const FileLayout &L) {
 void check_level(const uint8_t *data, const FileLayout &L, size_t i) {
   const LevelEntry &e = L.header.levels[i];
   const size_t n = size_t(e.connectivity_bytes) + e.geometry_bytes;
+  if (L.level_offset[i] + n > L.file_size)
+    throw Error("truncated .pomar file: level " + std::to_string(i + 1) + " ends at byte " +
+                std::to_string(L.level_offset[i] + n) + ", the file has " +
+                std::to_string(L.file_size));
   if (checksum(data + L.level_offset[i], n) != e.checksum)
     throw Error("damaged .pomar file: checksum mismatch in level " + std::to_string(i + 1) +
                 " block");

@@ -67,6 +67,7 @@ struct FileLayout {
   std::vector<size_t> level_offset; // start of each global level's connectivity bytes
   size_t tables_offset = 0, index_offset = 0, clusters_offset = 0;
   size_t global_bytes = 0; // everything before the first cluster block
+  uint64_t file_size = 0;  // bytes actually present (less than announced if truncated)
 };
 
 uint32_t checksum(const uint8_t *data, size_t size);
@@ -88,12 +89,16 @@ size_t header_size(const uint8_t *data, size_t size);
 
 /// Parse and check the header (magic, version, checksum, sizes against `file_size`).
 /// `data` must hold at least the header; `file_size` is the size of the whole file.
-FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size = 0);
+/// `allow_truncated` accepts a file that ends early as long as the part nothing can be
+/// decoded without is there (header and base mesh; clustered files: the whole global
+/// part); the blocks past the end are then reported missing when they are needed.
+FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size = 0,
+                       bool allow_truncated = false);
 /// Decode the cluster index block (`data` = the whole index block).
 ClusterIndex read_cluster_index(const uint8_t *data, const FileLayout &layout);
 /// Check the base block's checksum and unpack it.
 BaseMesh read_base_mesh(const uint8_t *data, const FileLayout &layout);
-/// Throw if level `i`'s checksum does not match.
+/// Throw if level `i` is missing (truncated file) or its checksum does not match.
 void check_level(const uint8_t *data, const FileLayout &layout, size_t i);
 /// Check a global block's checksum (tables or index); `what` names it in the error.
 void check_block(const uint8_t *data, size_t size, uint32_t expected, const char *what);

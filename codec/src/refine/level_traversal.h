@@ -30,7 +30,7 @@ namespace pomar {
 /// The mesh being refined: what the decoder holds, and what the encoder replicates.
 struct LevelMesh {
   CornerTable ct;
-  std::vector<int32_t> q; // quantized xyz per vertex
+  std::vector<int32_t> q;  // quantized xyz per vertex
   uint32_t seed_faces = 0; // faces of the base mesh (traversal seeds, never removed)
   // Lineage of every vertex: the level that created it (0 = base mesh), its cluster
   // (clustered levels: the base clustered mesh vertex it descends from), its parent (the
@@ -422,6 +422,14 @@ void traverse_cluster(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32
 
 /// Apply the collected splits in traversal order; new vertices get consecutive ids.
 /// For a cluster's splits, `cluster`/`next_local` number them inside the cluster.
+/// Undo the face claims of a traversal of `level` that stopped on damaged data, so that
+/// the other clusters of the level can still claim those faces.
+inline void release_claims(LevelMesh &mesh, const TraversalScratch &s, uint32_t level) {
+  for (uint32_t f = 0; f < mesh.face_claim.size(); ++f)
+    if (s.claimed[f] == s.stamp && mesh.face_claim[f] == level)
+      mesh.face_claim[f] = static_cast<uint16_t>(level - 1);
+}
+
 inline void apply_splits(LevelMesh &mesh, const std::vector<PendingSplit> &splits, uint32_t level,
                          uint32_t cluster = kNone, uint32_t *next_local = nullptr) {
   for (const PendingSplit &ps : splits) {

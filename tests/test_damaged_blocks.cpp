@@ -1,0 +1,336 @@
+// Damaged and missing blocks: strict decoding names them, check_blocks lists them, and
+// decoding with skip_damaged returns exactly what an intact file gives for the level map
+// the damage leaves (damaged cluster at the base clustered level, the others limited by
+// their distance to it).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <deque>
+#include <string>
+
+#include "format/file_format.h"
+#include "mesh/corner_table.h"
+#include "pomar/pomar.h"
+#include "pomar/random_access.h"
+#include "support/mesh_compare.h"
+#include "support/mesh_gen.h"
+
+namespace pomar {
+namespace {
+
+using test::canonical;
+
+struct Encoded {
+  std::vector<uint8_t> file;
+  FileInfo info;
+};
+
+Encoded encode_with(const Mesh &m, double ratio, bool progressive = false) {
+  EncodeOptions o;
+  o.cluster_ratio = ratio;
+  o.progressive = progressive;
+  Encoded e;
+  e.file = encode(m, o);
+  e.info = inspect(e.file.data(), e.file.size());
+  return e;
+}
+
+const Encoded &sphere() {
+  static const Encoded e = encode_with(gen::icosphere(5), 0.02);
+  return e;
+}
+
+const Encoded &pieces() { // several connected components: several cluster graphs
+  static const Encoded e = encode_with(gen::components(4), 0.05);
+  return e;
+}
+
+uint64_t block_offset(const Encoded &e, uint32_t cluster) {
+  uint64_t at = e.info.global_bytes;
+  for (uint32_t c = 0; c < cluster; ++c)
+    at += e.info.cluster_block_bytes[c];
+  return at;
+}
+
+/// Clusters with a block long enough to damage, spread over the file.
+std::vector<uint32_t> damageable(const Encoded &e, size_t count) {
+  std::vector<uint32_t> out;
+  const uint32_t n = e.info.clusters;
+  for (uint32_t i = 0; i < n && out.size() < count; ++i) {
+    const uint32_t c = (i * 7919u + n / 3) % n;
+    if (e.info.cluster_block_bytes[c] >= 8 && std::find(out.begin(), out.end(), c) == out.end())
+      out.push_back(c);
+  }
+  return out;
+}
+
+std::vector<uint8_t> with_flipped_byte(std::vector<uint8_t> file, uint64_t at, uint8_t mask) {
+  file.at(at) ^= mask;
+  return file;
+}
+
+std::vector<uint8_t> damage_clusters(const Encoded &e, const std::vector<uint32_t> &clusters) {
+  std::vector<uint8_t> file = e.file;
+  for (uint32_t c : clusters)
+    file = with_flipped_byte(file, block_offset(e, c) + e.info.cluster_block_bytes[c] / 2, 0x24);
+  return file;
+}
+
+/// Edge distances in the cluster graph (the base clustered mesh) from `sources`.
+std::vector<int> distances(const Encoded &e, const std::vector<uint32_t> &sources) {
+  const Mesh base = decode(e.file.data(), e.file.size(), int(e.info.global_levels));
+  std::vector<std::vector<uint32_t>> adj(base.vertex_count());
+  for (size_t f = 0; f < base.triangle_count(); ++f)
+    for (int k = 0; k < 3; ++k)
+      adj[base.triangles[3 * f + k]].push_back(base.triangles[3 * f + (k + 1) % 3]);
+  std::vector<int> d(base.vertex_count(), 1 << 20);
+  std::deque<uint32_t> queue;
+  for (uint32_t s : sources) {
+    d[s] = 0;
+    queue.push_back(s);
+  }
+  while (!queue.empty()) {
+    const uint32_t v = queue.front();
+    queue.pop_front();
+    for (uint32_t w : adj[v])
+      if (d[w] > d[v] + 1) {
+        d[w] = d[v] + 1;
+        queue.push_back(w);
+      }
+  }
+  return d;
+}
+
+std::unique_ptr<SelectiveDecoder> open(const std::vector<uint8_t> &file, bool skip) {
+  return std::make_unique<SelectiveDecoder>(
+      std::make_unique<MemorySource>(file.data(), file.size()), skip);
+}
+
+/// The damaged decode `d` must be: valid, with the damaged clusters at the base clustered
+/// level and every other one at min(finest, base + distance to the damage), and equal to
+/// an intact decode of that level map.
+void expect_decoded_around(const Encoded &e, const SelectiveDecoder &d,
+                           const std::vector<uint32_t> &damaged) {
+  const int base = int(e.info.global_levels), finest = int(e.info.levels.size());
+  ASSERT_EQ(d.damaged().size(), damaged.size());
+  for (size_t i = 0; i < damaged.size(); ++i) {
+    const auto it =
+        std::find_if(d.damaged().begin(), d.damaged().end(), [&](const DamagedBlock &b) {
+          return b.block == "cluster " + std::to_string(damaged[i]);
+        });
+    ASSERT_NE(it, d.damaged().end()) << "cluster " << damaged[i] << " not reported";
+    EXPECT_EQ(it->level_kept, base);
+    EXPECT_FALSE(it->problem.empty());
+  }
+  const std::vector<int> dist = distances(e, damaged);
+  const std::vector<int> &levels = d.levels();
+  for (size_t c = 0; c < levels.size(); ++c)
+    EXPECT_EQ(levels[c], std::min(finest, base + dist[c])) << "cluster " << c;
+  const Mesh m = d.mesh();
+  CornerTable ct;
+  EXPECT_NO_THROW(build_corner_table(m.triangles.data(), m.triangle_count(), m.vertex_count(), ct));
+  auto intact = open(e.file, false);
+  intact->set_wanted(levels);
+  intact->update();
+  EXPECT_EQ(intact->levels(), levels);
+  EXPECT_EQ(canonical(m), canonical(intact->mesh()));
+}
+
+TEST(DamagedBlocks, StrictDecodingNamesTheCluster) {
+  const Encoded &e = sphere();
+  const uint32_t c = damageable(e, 1).at(0);
+  const std::vector<uint8_t> file = damage_clusters(e, {c});
+  try {
+    decode(file.data(), file.size());
+    FAIL() << "a damaged block decoded without error";
+  } catch (const Error &err) {
+    EXPECT_NE(std::string(err.what()).find("cluster " + std::to_string(c)), std::string::npos)
+        << err.what();
+  }
+}
+
+TEST(DamagedBlocks, OneDamagedClusterLeavesTheRestDecodable) {
+  for (const Encoded *e : {&sphere(), &pieces()}) {
+    const uint32_t c = damageable(*e, 1).at(0);
+    const std::vector<uint8_t> file = damage_clusters(*e, {c});
+    auto d = open(file, true);
+    d->want_all(d->finest_level());
+    d->update();
+    expect_decoded_around(*e, *d, {c});
+    // The same through decode(): same mesh, and the report agrees.
+    DecodeOptions o;
+    o.skip_damaged = true;
+    DecodeReport r;
+    const Mesh m = decode(file.data(), file.size(), o, &r);
+    EXPECT_EQ(canonical(m), canonical(d->mesh()));
+    ASSERT_EQ(r.damaged.size(), 1u);
+    EXPECT_EQ(r.damaged[0].block, "cluster " + std::to_string(c));
+    uint32_t below = 0;
+    for (int l : d->levels())
+      below += l < d->finest_level();
+    EXPECT_EQ(r.clusters_below_request, below);
+    EXPECT_GT(below, 0u);
+  }
+}
+
+TEST(DamagedBlocks, SeveralDamagedClusters) {
+  const Encoded &e = sphere();
+  const std::vector<uint32_t> bad = damageable(e, 3);
+  ASSERT_EQ(bad.size(), 3u);
+  const std::vector<uint8_t> file = damage_clusters(e, bad);
+  auto d = open(file, true);
+  d->want_all(d->finest_level());
+  d->update();
+  expect_decoded_around(e, *d, bad);
+  const std::vector<DamagedBlock> listed = check_blocks(file.data(), file.size());
+  ASSERT_EQ(listed.size(), 3u);
+  for (const DamagedBlock &b : listed)
+    EXPECT_NE(b.problem.find("checksum mismatch"), std::string::npos);
+}
+
+TEST(DamagedBlocks, DamageFoundByARegionRequestStaysReportedOnce) {
+  const Encoded &e = sphere();
+  const uint32_t c = damageable(e, 1).at(0);
+  const std::vector<uint8_t> file = damage_clusters(e, {c});
+  auto d = open(file, true);
+  d->want_cluster(c, d->finest_level());
+  d->update();
+  ASSERT_EQ(d->damaged().size(), 1u);
+  EXPECT_EQ(d->levels()[c], d->base_clustered_level());
+  d->want_all(d->finest_level()); // refine everything afterwards: the damage is known
+  d->update();
+  expect_decoded_around(e, *d, {c});
+}
+
+TEST(DamagedBlocks, TruncatedFileDecodesTheBlocksThatArrived) {
+  const Encoded &e = sphere();
+  const size_t keep = size_t(e.info.global_bytes + e.info.cluster_bytes / 2);
+  const std::vector<uint8_t> file(e.file.begin(), e.file.begin() + long(keep));
+  std::vector<uint32_t> missing;
+  for (uint32_t c = 0; c < e.info.clusters; ++c)
+    if (block_offset(e, c) + e.info.cluster_block_bytes[c] > keep)
+      missing.push_back(c);
+  ASSERT_FALSE(missing.empty());
+  EXPECT_THROW(decode(file.data(), file.size()), Error);
+  EXPECT_THROW(open(file, false), Error);
+  auto d = open(file, true);
+  d->want_all(d->finest_level());
+  d->update();
+  expect_decoded_around(e, *d, missing);
+  const std::vector<DamagedBlock> listed = check_blocks(file.data(), file.size());
+  ASSERT_EQ(listed.size(), missing.size());
+  EXPECT_NE(listed[0].problem.find("truncated"), std::string::npos);
+}
+
+TEST(DamagedBlocks, StructuralDamagePastTheEightBitCheck) {
+  // Corruptions that keep a block's 8-bit check: the decoder's structural checks must
+  // catch most of them, and what they catch is skipped like any other damage.
+  const Encoded &e = sphere();
+  const ClusterIndex index = [&] {
+    const FileLayout L = read_layout(e.file.data(), e.file.size());
+    return read_cluster_index(e.file.data() + L.index_offset, L);
+  }();
+  int caught = 0, tried = 0;
+  for (uint32_t c : damageable(e, 40)) {
+    const uint64_t at = index.offset[c], n = index.size[c];
+    for (uint32_t k = 0; k < 4096 && tried < 12; ++k) {
+      std::vector<uint8_t> file = with_flipped_byte(e.file, at + k % n, uint8_t(1 + k / n));
+      if ((checksum(file.data() + at, n) & 0xFF) != index.check[c])
+        continue;
+      ++tried;
+      auto d = open(file, true);
+      d->want_all(d->finest_level());
+      d->update();
+      if (d->damaged().empty())
+        continue; // undetectable: a valid stream that decodes to other positions
+      ++caught;
+      // The failing cluster and its neighbours are reported (the damage may be in any of
+      // them); the damaged one must be among them.
+      std::vector<uint32_t> reported;
+      for (const DamagedBlock &b : d->damaged())
+        reported.push_back(uint32_t(std::stoul(b.block.substr(8))));
+      EXPECT_NE(std::find(reported.begin(), reported.end(), c), reported.end());
+      expect_decoded_around(e, *d, reported);
+      break;
+    }
+  }
+  EXPECT_GT(tried, 0);
+  EXPECT_GT(caught, 0);
+}
+
+TEST(DamagedBlocks, ProgressiveFileStopsBeforeADamagedLevel) {
+  const Encoded e = encode_with(gen::icosphere(4), 0, true);
+  const FileLayout L = read_layout(e.file.data(), e.file.size());
+  const size_t level = 4; // 1-based number of the damaged level
+  const std::vector<uint8_t> file = with_flipped_byte(e.file, L.level_offset[level - 1] + 1, 0x81);
+  EXPECT_THROW(decode(file.data(), file.size()), Error);
+  DecodeOptions o;
+  o.skip_damaged = true;
+  DecodeReport r;
+  const Mesh m = decode(file.data(), file.size(), o, &r);
+  EXPECT_EQ(canonical(m), canonical(decode(e.file.data(), e.file.size(), int(level - 1))));
+  ASSERT_EQ(r.damaged.size(), 1u);
+  EXPECT_EQ(r.damaged[0].block, "level " + std::to_string(level));
+  EXPECT_EQ(r.damaged[0].level_kept, int(level - 1));
+  EXPECT_EQ(r.level, int(level - 1));
+  ASSERT_EQ(check_blocks(file.data(), file.size()).size(), 1u);
+  // The selective decoder of a progressive file stops there too.
+  auto d = open(file, true);
+  d->want_all(d->finest_level());
+  d->update();
+  EXPECT_EQ(canonical(d->mesh()), canonical(m));
+  EXPECT_EQ(d->damaged().size(), 1u);
+  // Truncated in the middle of a level: the levels before it.
+  const size_t cut = L.level_offset[level - 1] + 2;
+  const std::vector<uint8_t> head(e.file.begin(), e.file.begin() + long(cut));
+  const Mesh t = decode(head.data(), head.size(), o, &r);
+  EXPECT_EQ(canonical(t), canonical(decode(e.file.data(), e.file.size(), int(level - 1))));
+  ASSERT_FALSE(r.damaged.empty());
+  EXPECT_NE(r.damaged[0].problem.find("truncated"), std::string::npos);
+}
+
+TEST(DamagedBlocks, DamagedGlobalLevelOfAClusteredFile) {
+  const Encoded &e = sphere();
+  const FileLayout L = read_layout(e.file.data(), e.file.size());
+  ASSERT_GE(e.info.global_levels, 2u);
+  const std::vector<uint8_t> file = with_flipped_byte(e.file, L.level_offset[1] + 1, 0x40);
+  DecodeOptions o;
+  o.skip_damaged = true;
+  DecodeReport r;
+  const Mesh m = decode(file.data(), file.size(), o, &r);
+  EXPECT_EQ(canonical(m), canonical(decode(e.file.data(), e.file.size(), 1)));
+  ASSERT_EQ(r.damaged.size(), 1u);
+  EXPECT_EQ(r.damaged[0].block, "level 2");
+}
+
+TEST(DamagedBlocks, HeaderBaseTablesAndIndexMustBeIntact) {
+  const Encoded &e = sphere();
+  const FileLayout L = read_layout(e.file.data(), e.file.size());
+  DecodeOptions o;
+  o.skip_damaged = true;
+  for (uint64_t at : {uint64_t(20), uint64_t(L.base_offset + 2), uint64_t(L.tables_offset + 1),
+                      uint64_t(L.index_offset + 1)}) {
+    const std::vector<uint8_t> file = with_flipped_byte(e.file, at, 0x10);
+    EXPECT_THROW(decode(file.data(), file.size(), o), Error) << "byte " << at;
+    EXPECT_THROW(check_blocks(file.data(), file.size()), Error) << "byte " << at;
+  }
+  // Truncated inside the global part: nothing to decode.
+  const std::vector<uint8_t> head(e.file.begin(), e.file.begin() + long(L.index_offset));
+  EXPECT_THROW(decode(head.data(), head.size(), o), Error);
+}
+
+TEST(DamagedBlocks, IntactFilesReportNothing) {
+  for (const Encoded *e : {&sphere(), &pieces()}) {
+    EXPECT_TRUE(check_blocks(e->file.data(), e->file.size()).empty());
+    DecodeOptions o;
+    o.skip_damaged = true;
+    DecodeReport r;
+    const Mesh m = decode(e->file.data(), e->file.size(), o, &r);
+    EXPECT_TRUE(r.damaged.empty());
+    EXPECT_EQ(r.clusters_below_request, 0u);
+    EXPECT_EQ(canonical(m), canonical(decode(e->file.data(), e->file.size())));
+  }
+}
+
+} // namespace
+} // namespace pomar
