@@ -341,6 +341,60 @@ expect_rc 1
 expect_contains "$ERR" "progressive" "stderr"
 expect_no_file "$WORK/bad4.ply"
 
+# ---- damaged and truncated files -------------------------------------------------------------------
+
+section "damaged cluster block: strict decode fails, --skip-damaged decodes the rest"
+run encode "$SAMPLES/bunny.ply" "$WORK/ok.pomar" -q
+expect_rc 0
+run info "$WORK/ok.pomar" --check
+expect_rc 0
+expect_contains "$OUT" "every block passes" "stdout of info --check"
+# Flip one byte in the middle of the cluster data (after the global part).
+"$POMAR" info "$WORK/ok.pomar" --json >"$WORK/ok.json"
+python3 - "$WORK/ok.pomar" "$WORK/damaged.pomar" "$WORK/truncated.pomar" "$(json_get "$WORK/ok.json" "d['global_bytes']")" <<'PY'
+import sys
+src, dmg, trunc, global_bytes = sys.argv[1], sys.argv[2], sys.argv[3], int(sys.argv[4])
+data = bytearray(open(src, "rb").read())
+at = global_bytes + (len(data) - global_bytes) // 3
+data[at] ^= 0x5A
+open(dmg, "wb").write(data)
+open(trunc, "wb").write(open(src, "rb").read()[: global_bytes + (len(data) - global_bytes) * 3 // 4])
+PY
+run decode "$WORK/damaged.pomar" "$WORK/strict.ply"
+expect_rc 1
+expect_one_line_error
+expect_contains "$ERR" "cluster" "stderr"
+expect_contains "$ERR" "--skip-damaged" "stderr (hint)"
+expect_no_file "$WORK/strict.ply"
+run info "$WORK/damaged.pomar" --check
+expect_rc 3
+expect_contains "$OUT" "1 damaged block" "stdout of info --check"
+run decode "$WORK/damaged.pomar" "$WORK/skipped.ply" --skip-damaged
+expect_rc 3
+expect_file "$WORK/skipped.ply"
+expect_contains "$ERR" "damaged block skipped" "stderr"
+expect_contains "$ERR" "kept at level" "stderr"
+[ "$(ply_vertex_count "$WORK/skipped.ply")" -gt 0 ] || fail "no vertices in the mesh decoded around the damage"; pass
+# The result is a valid manifold mesh: it re-encodes.
+run encode "$WORK/skipped.ply" "$WORK/skipped.pomar" -q
+expect_rc 0
+run decode "$WORK/damaged.pomar" "$WORK/region.ply" --sphere -0.06,0.16,0.0,0.03 --skip-damaged
+[ "$RC" -eq 0 ] || [ "$RC" -eq 3 ] || fail "region decode with --skip-damaged: exit $RC"; pass
+expect_file "$WORK/region.ply"
+
+section "truncated file: --skip-damaged decodes the blocks that arrived"
+run decode "$WORK/truncated.pomar" "$WORK/t_strict.ply"
+expect_rc 1
+expect_contains "$ERR" "truncated" "stderr"
+expect_no_file "$WORK/t_strict.ply"
+run decode "$WORK/truncated.pomar" "$WORK/t_skip.ply" --skip-damaged
+expect_rc 3
+expect_file "$WORK/t_skip.ply"
+expect_contains "$ERR" "read past the end" "stderr"
+run info "$WORK/truncated.pomar" --check
+expect_rc 3
+expect_contains "$OUT" "truncated file" "stdout of info --check"
+
 # ---- --help ------------------------------------------------------------------------------------------
 
 section "--help"
@@ -357,8 +411,8 @@ help_mentions() { # help_mentions SUBCOMMAND OPTION...
   for opt in "$@"; do expect_contains "$OUT" "$opt" "pomar $sub --help"; done
 }
 help_mentions encode --bits --progressive --clusters --cluster-ratio --quiet input output
-help_mentions decode --level --cluster --sphere --box --stats --ascii --quiet input output
-help_mentions info --json input
+help_mentions decode --level --cluster --sphere --box --stats --ascii --quiet --skip-damaged input output
+help_mentions info --json --check input
 help_mentions verify original pomar decoded
 
 LAST_CMD=""
