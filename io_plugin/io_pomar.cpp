@@ -177,13 +177,18 @@ void PomarIOPlugin::initPreOpenParameter(const QString &format, const QString & 
   if (!isPomar(format))
     return;
   par.addParam(RichEnum("OpenAt", OPEN_FULL,
-                        QStringList() << "Full resolution" << "Base clustered mesh"
+                        QStringList() << "Full resolution"
+                                      << "Base clustered mesh"
                                       << "Global level N",
                         "Open at",
                         "Full resolution: every level (lossless). Base clustered mesh: the "
                         "coarse mesh whose vertices are the random-access clusters. Global "
                         "level N: the whole mesh after N refinement levels (0 = base mesh)."));
   par.addParam(RichInt("Level", 0, "Level N", "Used by \"Global level N\"."));
+  par.addParam(RichBool("SkipDamaged", false, "Skip damaged blocks",
+                        "Open a damaged or truncated file anyway: regions whose blocks fail "
+                        "their checks stay coarse (listed as warnings). Off: such a file is "
+                        "refused with a message naming the damaged block."));
 }
 
 bool PomarIOPlugin::open(const QString &format, const QString &fileName, MeshModel &m, int &mask,
@@ -196,11 +201,12 @@ bool PomarIOPlugin::open(const QString &format, const QString &fileName, MeshMod
   const std::string native = QFile::encodeName(path).toStdString();
   const int openAt = par.hasParameter("OpenAt") ? par.getEnum("OpenAt") : OPEN_FULL;
   const int wantedLevel = par.hasParameter("Level") ? par.getInt("Level") : 0;
+  const bool skipDamaged = par.hasParameter("SkipDamaged") && par.getBool("SkipDamaged");
 
   ProgressRelay progress(cb, "Decoding pomar");
   try {
     progress.report(0);
-    pomar::SelectiveDecoder decoder(std::make_unique<pomar::FileSource>(native));
+    pomar::SelectiveDecoder decoder(std::make_unique<pomar::FileSource>(native), skipDamaged);
     const pomar::FileInfo &info = decoder.info();
     int level = decoder.finest_level();
     if (openAt == OPEN_BASE_CLUSTERED)
@@ -214,6 +220,7 @@ bool PomarIOPlugin::open(const QString &format, const QString &fileName, MeshMod
 
     pomar::Mesh mesh;
     std::vector<uint32_t> cluster, vertexLevel;
+    std::vector<pomar::DamagedBlock> damaged;
     if (info.clustered() && level < decoder.base_clustered_level()) {
       // Below the base clustered mesh only the plain decoder goes; it knows no vertex levels.
       QFile file(path);
@@ -222,27 +229,50 @@ bool PomarIOPlugin::open(const QString &format, const QString &fileName, MeshMod
       const QByteArray bytes = file.readAll();
       if (file.error() != QFileDevice::NoError)
         throw pomar::Error("cannot read " + native + ": " + file.errorString().toStdString());
+      pomar::DecodeOptions options;
+      options.level = level;
+      options.skip_damaged = skipDamaged;
+      options.progress = progress.function();
+      pomar::DecodeReport report;
       mesh = pomar::decode(reinterpret_cast<const uint8_t *>(bytes.constData()),
-                           size_t(bytes.size()), level, progress.function());
+                           size_t(bytes.size()), options, &report);
+      damaged = report.damaged;
     } else {
       decoder.want_all(level);
       decoder.update(progress.function());
       mesh = decoder.mesh();
       cluster = decoder.vertex_cluster();
       vertexLevel = decoder.vertex_level();
+      damaged = decoder.damaged();
+    }
+    if (!damaged.empty()) {
+      QString warning = QString("%1: %2 damaged block(s) skipped, the mesh is coarser there:")
+                            .arg(path)
+                            .arg(damaged.size());
+      for (size_t i = 0; i < damaged.size() && i < 10; ++i)
+        warning += QString("\n  %1 (kept at level %2): %3")
+                       .arg(QString::fromStdString(damaged[i].block))
+                       .arg(damaged[i].level_kept)
+                       .arg(QString::fromStdString(damaged[i].problem));
+      if (damaged.size() > 10)
+        warning += QString("\n  ... and %1 more").arg(damaged.size() - 10);
+      Log(GLLogStream::WARNING, qUtf8Printable(warning));
+      qWarning("pomar: %s", qUtf8Printable(warning)); // Log() is a no-op in meshlabserver
     }
 
     pomar::to_vcg(mesh, m.cm); // also clears m's attributes
-    auto clusterOf =
-        vcg::tri::Allocator<CMeshO>::GetPerVertexAttribute<float>(m.cm, pomar::meshlab::kClusterAttribute);
-    auto levelOf = vcg::tri::Allocator<CMeshO>::GetPerVertexAttribute<float>(m.cm, pomar::meshlab::kLevelAttribute);
+    auto clusterOf = vcg::tri::Allocator<CMeshO>::GetPerVertexAttribute<float>(
+        m.cm, pomar::meshlab::kClusterAttribute);
+    auto levelOf = vcg::tri::Allocator<CMeshO>::GetPerVertexAttribute<float>(
+        m.cm, pomar::meshlab::kLevelAttribute);
     const bool haveClusters = info.clustered() && cluster.size() == mesh.vertex_count();
     const bool haveLevels = vertexLevel.size() == mesh.vertex_count();
     for (size_t v = 0; v < mesh.vertex_count(); ++v) {
       clusterOf[v] = haveClusters ? float(cluster[v]) : -1.0f;
       levelOf[v] = haveLevels ? float(vertexLevel[v]) : -1.0f;
     }
-    auto source = vcg::tri::Allocator<CMeshO>::GetPerMeshAttribute<std::string>(m.cm, pomar::meshlab::kSourceAttribute);
+    auto source = vcg::tri::Allocator<CMeshO>::GetPerMeshAttribute<std::string>(
+        m.cm, pomar::meshlab::kSourceAttribute);
     source() = native;
 
     progress.report(100);

@@ -24,6 +24,8 @@
 
 #include "support/mesh_gen.h"
 
+#include "support/mesh_compare.h"
+#include "support/meshlab_layer.h"
 #include <algorithm>
 #include <array>
 #include <cstdio>
@@ -31,8 +33,6 @@
 #include <set>
 #include <string>
 #include <vector>
-#include "support/mesh_compare.h"
-#include "support/meshlab_layer.h"
 
 namespace {
 
@@ -108,13 +108,14 @@ protected:
   static QString path(const QString &name) { return dir_->filePath(name); }
 
   /// Open like MeshLab: initPreOpenParameter, then the dialog's choices, then open().
-  bool openAt(const QString &fileName, int choice, int level = 0) {
+  bool openAt(const QString &fileName, int choice, int level = 0, bool skipDamaged = false) {
     mm_ = doc_.addNewMesh(fileName, "test", true);
     RichParameterList par;
     plugin()->initPreOpenParameter("pomar", fileName, par);
     if (choice >= 0)
       par.setValue("OpenAt", EnumValue(choice));
     par.setValue("Level", IntValue(level));
+    par.setValue("SkipDamaged", BoolValue(skipDamaged));
     int mask = -1;
     const bool ok = plugin()->open("pomar", fileName, *mm_, mask, par);
     EXPECT_EQ(mask, 0);
@@ -130,8 +131,7 @@ protected:
   }
 
   /// Save with the defaults of initSaveParameter, changed by `edit`.
-  template <class Edit>
-  bool save(MeshModel &mm, const QString &fileName, Edit edit) {
+  template <class Edit> bool save(MeshModel &mm, const QString &fileName, Edit edit) {
     RichParameterList par;
     plugin()->initSaveParameter("pomar", mm, par);
     edit(par);
@@ -187,6 +187,7 @@ TEST_F(PomarPluginTest, ParameterDefaults) {
   ASSERT_TRUE(pre.hasParameter("Level"));
   EXPECT_EQ(pre.getEnum("OpenAt"), 0); // full resolution
   EXPECT_EQ(pre.getInt("Level"), 0);
+  EXPECT_FALSE(pre.getBool("SkipDamaged"));
 
   MeshModel *mm = doc_.addNewMesh("", "empty", true);
   RichParameterList save;
@@ -294,7 +295,8 @@ TEST_F(PomarPluginTest, BareFileNameIsResolvedAgainstTheWorkingDirectory) {
 TEST_F(PomarPluginTest, OpenErrors) {
   const int finest = int(infoOf(*clustered_).levels.size());
   EXPECT_FALSE(openAt(path("clustered.pomar"), 2, finest + 1));
-  EXPECT_TRUE(plugin()->errorMsg().contains("does not exist")) << plugin()->errorMsg().toStdString();
+  EXPECT_TRUE(plugin()->errorMsg().contains("does not exist"))
+      << plugin()->errorMsg().toStdString();
   EXPECT_EQ(mm_->cm.vn, 0);
   EXPECT_FALSE(openAt(path("clustered.pomar"), 2, -1));
   EXPECT_TRUE(plugin()->errorMsg().contains("does not exist"));
@@ -308,6 +310,19 @@ TEST_F(PomarPluginTest, OpenErrors) {
   EXPECT_TRUE(plugin()->errorMsg().contains("truncated")) << plugin()->errorMsg().toStdString();
   EXPECT_EQ(mm_->cm.vn, 0);
   EXPECT_FALSE(g_warnings.isEmpty()); // also on stderr: meshlabserver does not print errorMsg()
+
+  // With "Skip damaged blocks" the half that arrived opens, coarser where blocks are missing.
+  g_warnings.clear();
+  ASSERT_TRUE(openAt(path("cut.pomar"), 0, 0, true)) << plugin()->errorMsg().toStdString();
+  EXPECT_GT(mm_->cm.vn, 0);
+  EXPECT_LT(size_t(mm_->cm.vn), size_t(infoOf(*clustered_).vertices));
+  EXPECT_TRUE(g_warnings.join("\n").contains("damaged block"))
+      << g_warnings.join("\n").toStdString();
+  pomar::DecodeOptions o;
+  o.skip_damaged = true;
+  const pomar::Mesh expected = pomar::decode(cut.data(), cut.size(), o);
+  EXPECT_EQ(size_t(mm_->cm.vn), expected.vertex_count());
+  EXPECT_EQ(size_t(mm_->cm.fn), expected.triangle_count());
   QFile::remove(path("cut.pomar"));
 }
 
@@ -365,7 +380,7 @@ TEST_F(PomarPluginTest, SaveWarnsAboutWhatIsNotKept) {
   EXPECT_TRUE(all.contains("per-vertex colors")) << all.toStdString();
   EXPECT_TRUE(all.contains("my_weight")) << all.toStdString();
   EXPECT_FALSE(all.contains("normals")) << all.toStdString(); // MeshLab's own normals
-  EXPECT_EQ(readBytes(path("w.pomar")), *clustered_);          // and the file is the same
+  EXPECT_EQ(readBytes(path("w.pomar")), *clustered_);         // and the file is the same
 
   // Normals that are not MeshLab's angle-weighted ones are named too.
   g_warnings.clear();
@@ -396,9 +411,8 @@ TEST_F(PomarPluginTest, FailedSaveWritesNothing) {
   EXPECT_EQ(dirEntries(), before);
 
   // Invalid parameters are the codec's errors.
-  EXPECT_FALSE(save(*good, path("bits.pomar"), [](RichParameterList &par) {
-    par.setValue("Bits", IntValue(30));
-  }));
+  EXPECT_FALSE(save(*good, path("bits.pomar"),
+                    [](RichParameterList &par) { par.setValue("Bits", IntValue(30)); }));
   EXPECT_FALSE(plugin()->errorMsg().isEmpty());
   EXPECT_EQ(dirEntries(), before);
 }
