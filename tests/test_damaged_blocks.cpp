@@ -319,6 +319,31 @@ TEST(DamagedBlocks, HeaderBaseTablesAndIndexMustBeIntact) {
   EXPECT_THROW(decode(head.data(), head.size(), o), Error);
 }
 
+TEST(DamagedBlocks, EveryTruncationAndFlipGivesAValidMeshOrAnError) {
+  const Encoded &e = sphere();
+  DecodeOptions o;
+  o.skip_damaged = true;
+  auto expect_valid = [&](const std::vector<uint8_t> &file, bool must_decode, const char *what,
+                          size_t where) {
+    try {
+      DecodeReport r;
+      const Mesh m = decode(file.data(), file.size(), o, &r);
+      CornerTable ct;
+      EXPECT_NO_THROW(
+          build_corner_table(m.triangles.data(), m.triangle_count(), m.vertex_count(), ct))
+          << what << " " << where;
+    } catch (const Error &err) {
+      EXPECT_FALSE(must_decode) << what << " " << where << ": " << err.what();
+    }
+  };
+  for (size_t n = 0; n < e.file.size(); n += 1 + e.file.size() / 61) {
+    const std::vector<uint8_t> cut(e.file.begin(), e.file.begin() + long(n));
+    expect_valid(cut, n >= e.info.global_bytes, "truncated to", n);
+  }
+  for (size_t i = 0; i < e.file.size(); i += 1 + e.file.size() / 157)
+    expect_valid(with_flipped_byte(e.file, i, 0x08), i >= e.info.global_bytes, "flip at", i);
+}
+
 TEST(DamagedBlocks, IntactFilesReportNothing) {
   for (const Encoded *e : {&sphere(), &pieces()}) {
     EXPECT_TRUE(check_blocks(e->file.data(), e->file.size()).empty());
