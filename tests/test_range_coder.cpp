@@ -22,11 +22,22 @@ std::vector<Op> random_ops(uint32_t seed, size_t n, bool skewed) {
   for (size_t i = 0; i < n; ++i) {
     Op op{int(rng() % 5), 0, 0};
     switch (op.kind) {
-    case 0: op.value = skewed ? std::min(geo(rng), 11) : int(rng() % 12); break;
-    case 1: op.value = skewed ? (rng() % 50 == 0) : int(rng() & 1); break;
-    case 2: op.nbits = 1 + int(rng() % 24); op.value = rng() & ((1u << op.nbits) - 1); break;
-    case 3: op.value = skewed ? geo(rng) : int64_t(rng() % 100000); break;
-    case 4: op.value = (skewed ? geo(rng) : int64_t(rng() % (1u << 26))) * (rng() & 1 ? -1 : 1); break;
+    case 0:
+      op.value = skewed ? std::min(geo(rng), 11) : int(rng() % 12);
+      break;
+    case 1:
+      op.value = skewed ? (rng() % 50 == 0) : int(rng() & 1);
+      break;
+    case 2:
+      op.nbits = 1 + int(rng() % 24);
+      op.value = rng() & ((1u << op.nbits) - 1);
+      break;
+    case 3:
+      op.value = skewed ? geo(rng) : int64_t(rng() % 100000);
+      break;
+    case 4:
+      op.value = (skewed ? geo(rng) : int64_t(rng() % (1u << 26))) * (rng() & 1 ? -1 : 1);
+      break;
     }
     ops.push_back(op);
   }
@@ -43,11 +54,21 @@ void roundtrip(const std::vector<Op> &ops) {
     GeometryModels g;
     for (const Op &op : ops) {
       switch (op.kind) {
-      case 0: enc.encode(fm, int(op.value)); break;
-      case 1: enc.encode_bit(bm, int(op.value)); break;
-      case 2: enc.encode_bypass(uint32_t(op.value), op.nbits); break;
-      case 3: put_small(enc, small, uint32_t(op.value)); break;
-      case 4: put_residual(enc, g, 1, 7, op.value); break;
+      case 0:
+        enc.encode(fm, int(op.value));
+        break;
+      case 1:
+        enc.encode_bit(bm, int(op.value));
+        break;
+      case 2:
+        enc.encode_bypass(uint32_t(op.value), op.nbits);
+        break;
+      case 3:
+        put_small(enc, small, uint32_t(op.value));
+        break;
+      case 4:
+        put_residual(enc, g, 1, 7, op.value);
+        break;
       }
     }
     enc.finish();
@@ -61,11 +82,21 @@ void roundtrip(const std::vector<Op> &ops) {
     const Op &op = ops[i];
     int64_t got = 0;
     switch (op.kind) {
-    case 0: got = dec.decode(fm); break;
-    case 1: got = dec.decode_bit(bm); break;
-    case 2: got = dec.decode_bypass(op.nbits); break;
-    case 3: got = get_small(dec, small); break;
-    case 4: got = get_residual(dec, g, 1, 7); break;
+    case 0:
+      got = dec.decode(fm);
+      break;
+    case 1:
+      got = dec.decode_bit(bm);
+      break;
+    case 2:
+      got = dec.decode_bypass(op.nbits);
+      break;
+    case 3:
+      got = get_small(dec, small);
+      break;
+    case 4:
+      got = get_residual(dec, g, 1, 7);
+      break;
     }
     ASSERT_EQ(got, op.value) << "operation " << i << " kind " << op.kind;
   }
@@ -110,6 +141,45 @@ TEST(RangeCoder, TruncatedStreamIsDetected) {
   for (int i = 0; i < 1000; ++i)
     dec.decode_bypass(24);
   EXPECT_TRUE(dec.overrun());
+}
+
+TEST(RangeCoder, DominantSymbolNeverReachesFrequencyZero) {
+  // A symbol coded over and over climbs towards the 2^16 total; its count used to wrap in
+  // 16 bits (to 0 at 65,512 + 24), after which coding it never terminated.
+  // Where the dominant count lands when the total passes 2^16 depends on the history:
+  // warm-ups of 0..59 updates of another symbol cover cases that used to reach 0 (e.g. 6).
+  for (int symbols : {2, 3, 17, 40, 64}) {
+    for (int warmup = 0; warmup < 60; ++warmup) {
+      FrequencyModel model(symbols);
+      for (int i = 0; i < warmup; ++i)
+        model.update(0);
+      for (int i = 0; i < 20000; ++i) {
+        model.update(symbols - 1);
+        ASSERT_GT(model.freq(symbols - 1), 0u) << symbols << " symbols, warm-up " << warmup;
+      }
+      uint32_t total = 0;
+      for (int k = 0; k < symbols; ++k) {
+        EXPECT_GT(model.freq(k), 0u);
+        total += model.freq(k);
+      }
+      EXPECT_EQ(total, model.total());
+    }
+    // And a long skewed stream round-trips.
+    std::vector<uint8_t> bytes;
+    RangeEncoder enc(&bytes);
+    FrequencyModel em(symbols), dm(symbols);
+    for (int i = 0; i < 6; ++i)
+      enc.encode(em, 0);
+    for (int i = 0; i < 300000; ++i)
+      enc.encode(em, i % 5000 == 0 ? 0 : symbols - 1);
+    enc.finish();
+    RangeDecoder dec(bytes.data(), bytes.size());
+    for (int i = 0; i < 6; ++i)
+      ASSERT_EQ(dec.decode(dm), 0);
+    for (int i = 0; i < 300000; ++i)
+      ASSERT_EQ(dec.decode(dm), i % 5000 == 0 ? 0 : symbols - 1) << i;
+    EXPECT_FALSE(dec.overrun());
+  }
 }
 
 } // namespace

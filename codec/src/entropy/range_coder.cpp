@@ -66,14 +66,20 @@ bool FrequencyModel::freeze_with(const uint16_t *freq) {
 void FrequencyModel::update(int s) {
   if (frozen_)
     return;
-  freq_[s] = static_cast<uint16_t>(freq_[s] + kIncrement);
+  // In 32 bits: a dominant symbol can be at 65,512 or more, and 16-bit arithmetic used to
+  // wrap it to 0..23 (0 halved stays 0: a symbol of frequency 0 empties the coder's range
+  // and the encoder never stopped writing; found on a 100k-vertex mesh).
+  const uint32_t f = uint32_t(freq_[s]) + kIncrement;
   total_ += kIncrement;
-  if (total_ > kMaxTotal) {
-    total_ = 0;
-    for (int i = 0; i < n_; ++i) {
-      freq_[i] = static_cast<uint16_t>((freq_[i] + 1) >> 1);
-      total_ += freq_[i];
-    }
+  if (total_ <= kMaxTotal) {
+    freq_[s] = static_cast<uint16_t>(f); // f < total_ <= 2^16: fits
+    return;
+  }
+  total_ = 0;
+  for (int i = 0; i < n_; ++i) {
+    const uint32_t fi = i == s ? f : freq_[i];
+    freq_[i] = static_cast<uint16_t>((fi + 1) >> 1);
+    total_ += freq_[i];
   }
 }
 
