@@ -3,10 +3,11 @@
 // Everything works on corners (corner c = 3 * face + k, as in mesh/corner_table.h) and
 // flat 32-bit arrays. The steps, each a small function below:
 //   remove_bad_faces  faces repeating a vertex, then exact duplicates (same cyclic order);
-//   find_mates        edge -> corners by counting sort; a two-face edge is "gluable";
+//   find_mates        edge -> corners by counting sort; a two-face edge is "gluable",
+//                     an edge of more than two faces is cut;
 //   orient            BFS over gluable edges choosing a flip per face, fewest flips per piece;
-//   glue              after flipping, an edge is glued iff two faces use it in opposite
-//                     directions (the others are cut: > 2 faces, or not orientable);
+//   cut_nonorientable after flipping, a gluable edge stays glued iff its two faces use it
+//                     in opposite directions (the others are cut);
 //   split_fans        union-find of the corners of each vertex across glued edges: one
 //                     output vertex per class (= per fan of faces).
 // The result is checked with the codec's own build_corner_table().
@@ -67,32 +68,31 @@ struct DisjointSets {
 
 /// Calls visit(corners, count) once per undirected edge of the triangles `t` (over
 /// `nv` vertices), with the corners facing that edge in increasing order. Corners are
-/// bucketed by the lower vertex of their edge (counting sort), each short bucket is
-/// then sorted by the upper vertex: O(n) plus small sorts.
+/// bucketed by the lower vertex of their edge (counting sort) as 64-bit keys (upper
+/// vertex, corner), and each short bucket is sorted: O(n) plus small sorts.
 template <class Visit> void for_each_edge(const std::vector<uint32_t> &t, size_t nv, Visit visit) {
   const uint32_t nc = static_cast<uint32_t>(t.size());
-  auto lo = [&](uint32_t c) { return std::min(t[CornerTable::next(c)], t[CornerTable::prev(c)]); };
-  auto hi = [&](uint32_t c) { return std::max(t[CornerTable::next(c)], t[CornerTable::prev(c)]); };
-  std::vector<uint32_t> start(nv + 1, 0), order(nc);
+  std::vector<uint32_t> start(nv + 1, 0);
   for (uint32_t c = 0; c < nc; ++c)
-    ++start[lo(c) + 1];
+    ++start[std::min(t[CornerTable::next(c)], t[CornerTable::prev(c)]) + 1];
   for (size_t v = 0; v < nv; ++v)
     start[v + 1] += start[v];
   std::vector<uint32_t> fill(start.begin(), start.end() - 1);
-  for (uint32_t c = 0; c < nc; ++c)
-    order[fill[lo(c)]++] = c;
+  std::vector<uint64_t> keys(nc);
+  for (uint32_t c = 0; c < nc; ++c) {
+    const uint32_t a = t[CornerTable::next(c)], b = t[CornerTable::prev(c)];
+    keys[fill[std::min(a, b)]++] = uint64_t(std::max(a, b)) << 32 | c;
+  }
+  std::vector<uint32_t> corners;
   for (size_t v = 0; v < nv; ++v) {
-    uint32_t *first = order.data() + start[v], *last = order.data() + start[v + 1];
-    std::sort(first, last, [&](uint32_t x, uint32_t y) {
-      const uint32_t hx = hi(x), hy = hi(y);
-      return hx != hy ? hx < hy : x < y;
-    });
-    for (uint32_t *run = first; run != last;) {
-      uint32_t *end = run + 1;
-      while (end != last && hi(*end) == hi(*run))
-        ++end;
-      visit(run, static_cast<size_t>(end - run));
-      run = end;
+    uint64_t *first = keys.data() + start[v], *last = keys.data() + start[v + 1];
+    std::sort(first, last);
+    for (uint64_t *run = first; run != last;) {
+      corners.clear();
+      const uint64_t edge = *run >> 32;
+      for (; run != last && *run >> 32 == edge; ++run)
+        corners.push_back(static_cast<uint32_t>(*run));
+      visit(corners.data(), corners.size());
     }
   }
 }
@@ -176,13 +176,18 @@ void remove_bad_faces(std::vector<uint32_t> &t, size_t nv, std::vector<uint32_t>
 
 // ------------------------------------------------------------------ step 2: orientation
 
-/// mate[c] = the other corner facing c's edge if exactly two faces use it, else kNone.
-std::vector<uint32_t> find_mates(const std::vector<uint32_t> &t, size_t nv) {
+/// mate[c] = the other corner facing c's edge if exactly two faces use it (a "gluable"
+/// edge), else kNone. Edges of more than two faces are cut: counted here.
+std::vector<uint32_t> find_mates(const std::vector<uint32_t> &t, size_t nv, RepairReport &r) {
   std::vector<uint32_t> mate(t.size(), kNone);
   for_each_edge(t, nv, [&](const uint32_t *c, size_t n) {
     if (n == 2) {
       mate[c[0]] = c[1];
       mate[c[1]] = c[0];
+    } else if (n > 2 && r.edges_cut++ == 0) {
+      r.cut_edge_example[0] = t[CornerTable::next(c[0])];
+      r.cut_edge_example[1] = t[CornerTable::prev(c[0])];
+      r.cut_edge_faces = n;
     }
   });
   return mate;
@@ -190,9 +195,10 @@ std::vector<uint32_t> find_mates(const std::vector<uint32_t> &t, size_t nv) {
 
 /// Chooses a flip per face so that faces on gluable edges use them in opposite
 /// directions, by BFS over each connected piece (the first face reached decides; a cycle
-/// that disagrees, as in a Moebius strip, is cut later by glue()). A piece where more than
-/// half the faces would flip is flipped back: the fewest changes. Applies the flips to `t`.
-void orient(std::vector<uint32_t> &t, const std::vector<uint32_t> &mate,
+/// that disagrees, as in a Moebius strip, is cut later by cut_nonorientable()). A piece where more
+/// than half the faces would flip is flipped back: the fewest changes. Applies the flips to `t`
+/// (and renumbers `mate` to follow the corners).
+void orient(std::vector<uint32_t> &t, std::vector<uint32_t> &mate,
             const std::vector<uint32_t> &origin, RepairReport &r) {
   const uint32_t nf = static_cast<uint32_t>(t.size() / 3);
   std::vector<uint8_t> flip(nf, 0), seen(nf, 0);
@@ -220,6 +226,15 @@ void orient(std::vector<uint32_t> &t, const std::vector<uint32_t> &mate,
       for (uint32_t f : piece)
         flip[f] ^= 1;
   }
+  // Flipping face f swaps its corners 1 and 2: renumber the mates the same way.
+  std::vector<uint32_t> renamed(mate.size());
+  for (uint32_t c = 0; c < mate.size(); ++c)
+    renamed[c] = flip[c / 3] && c % 3 != 0 ? (c % 3 == 1 ? c + 1 : c - 1) : c;
+  std::vector<uint32_t> flipped_mate(mate.size(), kNone);
+  for (uint32_t c = 0; c < mate.size(); ++c)
+    if (mate[c] != kNone)
+      flipped_mate[renamed[c]] = renamed[mate[c]];
+  mate.swap(flipped_mate);
   for (uint32_t f = 0; f < nf; ++f) {
     if (!flip[f])
       continue;
@@ -229,32 +244,23 @@ void orient(std::vector<uint32_t> &t, const std::vector<uint32_t> &mate,
   }
 }
 
-/// After orient(): an edge is glued iff exactly two faces use it in opposite directions.
-/// Returns the glue (mate per corner, kNone if not glued) and counts the cut edges.
-std::vector<uint32_t> glue(const std::vector<uint32_t> &t, size_t nv, RepairReport &r) {
-  std::vector<uint32_t> mate(t.size(), kNone);
-  bool example_is_nonmanifold = false;
-  auto note_cut = [&](const uint32_t *c, size_t n) {
-    // Prefer an edge shared by more than two faces as the example: the commoner case.
-    if (r.edges_cut++ == 0 || (n > 2 && !example_is_nonmanifold)) {
-      r.cut_edge_example[0] = t[CornerTable::next(c[0])];
-      r.cut_edge_example[1] = t[CornerTable::prev(c[0])];
-      r.cut_edge_faces = n;
-      example_is_nonmanifold = n > 2;
+/// After orient(): a gluable edge stays glued iff its two faces now use it in opposite
+/// directions; the others cannot be oriented and are cut (counted), leaving `mate` as the
+/// glue.
+void cut_nonorientable(const std::vector<uint32_t> &t, std::vector<uint32_t> &mate,
+                       RepairReport &r) {
+  for (uint32_t c = 0; c < mate.size(); ++c) {
+    const uint32_t m = mate[c];
+    if (m == kNone || m < c || !same_direction(t, c, m))
+      continue;
+    mate[c] = mate[m] = kNone;
+    ++r.edges_cut_nonorientable;
+    if (r.edges_cut++ == 0) { // an edge of more than two faces is the better example
+      r.cut_edge_example[0] = t[CornerTable::next(c)];
+      r.cut_edge_example[1] = t[CornerTable::prev(c)];
+      r.cut_edge_faces = 2;
     }
-  };
-  for_each_edge(t, nv, [&](const uint32_t *c, size_t n) {
-    if (n == 2 && !same_direction(t, c[0], c[1])) {
-      mate[c[0]] = c[1];
-      mate[c[1]] = c[0];
-    } else if (n == 2) {
-      ++r.edges_cut_nonorientable;
-      note_cut(c, n);
-    } else if (n > 2) {
-      note_cut(c, n);
-    }
-  });
-  return mate;
+  }
 }
 
 // ------------------------------------------------------------------ step 3: fans
@@ -359,8 +365,9 @@ RepairReport make_manifold(Mesh &mesh) {
 
   std::vector<uint32_t> t = mesh.triangles, origin;
   remove_bad_faces(t, nv, origin, r);
-  orient(t, find_mates(t, nv), origin, r);
-  std::vector<uint32_t> mate = glue(t, nv, r);
+  std::vector<uint32_t> mate = find_mates(t, nv, r);
+  orient(t, mate, origin, r);
+  cut_nonorientable(t, mate, r);
 
   std::vector<uint32_t> copy_of;
   std::vector<uint32_t> split = split_fans(t, nv, mate, copy_of);
