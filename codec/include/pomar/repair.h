@@ -29,7 +29,7 @@ struct RepairReport {
   /// Edges no longer glued: shared by more than two faces, plus two-face edges that
   /// cannot be oriented consistently (e.g. the seam of a Moebius strip).
   size_t edges_cut = 0;
-  size_t edges_cut_nonorientable = 0; ///< the second kind above (included in edges_cut)
+  size_t edges_cut_nonorientable = 0; ///< the second kind (included in edges_cut)
   /// Input vertices whose faces fell apart into several fans, each fan getting its own
   /// vertex (same position). vertices_added copies were appended to the vertex array.
   size_t vertices_split = 0;
@@ -38,11 +38,12 @@ struct RepairReport {
   // One example of each kind (valid when its count is non-zero).
   size_t degenerate_example = 0; ///< input face index
   uint32_t degenerate_vertices[3] = {0, 0, 0};
-  size_t duplicate_example = 0; ///< input face index
-  size_t duplicate_of = 0;      ///< the earlier input face it repeats
-  size_t flipped_example = 0;   ///< input face index
-  uint32_t cut_edge_example[2] = {0, 0};
-  size_t cut_edge_faces = 0;     ///< faces on that edge
+  size_t duplicate_example = 0;                  ///< input face index
+  size_t duplicate_of = 0;                       ///< the earlier input face it repeats
+  size_t flipped_example = 0;                    ///< input face index
+  uint32_t nonmanifold_edge_example[2] = {0, 0}; ///< input vertices of a cut edge
+  size_t nonmanifold_edge_faces = 0;             ///< faces on that edge (> 2)
+  uint32_t nonorientable_edge_example[2] = {0, 0};
   uint32_t split_example = 0;    ///< input vertex index
   size_t split_example_fans = 0; ///< fans it was split into
 

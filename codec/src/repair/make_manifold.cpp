@@ -185,9 +185,9 @@ std::vector<uint32_t> find_mates(const std::vector<uint32_t> &t, size_t nv, Repa
       mate[c[0]] = c[1];
       mate[c[1]] = c[0];
     } else if (n > 2 && r.edges_cut++ == 0) {
-      r.cut_edge_example[0] = t[CornerTable::next(c[0])];
-      r.cut_edge_example[1] = t[CornerTable::prev(c[0])];
-      r.cut_edge_faces = n;
+      r.nonmanifold_edge_example[0] = t[CornerTable::next(c[0])];
+      r.nonmanifold_edge_example[1] = t[CornerTable::prev(c[0])];
+      r.nonmanifold_edge_faces = n;
     }
   });
   return mate;
@@ -254,11 +254,10 @@ void cut_nonorientable(const std::vector<uint32_t> &t, std::vector<uint32_t> &ma
     if (m == kNone || m < c || !same_direction(t, c, m))
       continue;
     mate[c] = mate[m] = kNone;
-    ++r.edges_cut_nonorientable;
-    if (r.edges_cut++ == 0) { // an edge of more than two faces is the better example
-      r.cut_edge_example[0] = t[CornerTable::next(c)];
-      r.cut_edge_example[1] = t[CornerTable::prev(c)];
-      r.cut_edge_faces = 2;
+    ++r.edges_cut;
+    if (r.edges_cut_nonorientable++ == 0) {
+      r.nonorientable_edge_example[0] = t[CornerTable::next(c)];
+      r.nonorientable_edge_example[1] = t[CornerTable::prev(c)];
     }
   }
 }
@@ -328,12 +327,15 @@ std::string RepairReport::summary() const {
   if (faces_flipped)
     lines.push_back("flipped " + plural(faces_flipped, "face") +
                     " to orient the mesh consistently (e.g. face " + num(flipped_example) + ")");
-  if (edges_cut)
-    lines.push_back("cut " + plural(edges_cut, "edge") + " (" +
-                    num(edges_cut - edges_cut_nonorientable) + " shared by more than two faces, " +
-                    num(edges_cut_nonorientable) + " not orientable; e.g. edge (" +
-                    num(cut_edge_example[0]) + ", " + num(cut_edge_example[1]) + "), " +
-                    plural(cut_edge_faces, "face") + ")");
+  auto edge = [&](const uint32_t *e) { return "edge (" + num(e[0]) + ", " + num(e[1]) + ")"; };
+  if (edges_cut > edges_cut_nonorientable)
+    lines.push_back("cut " + plural(edges_cut - edges_cut_nonorientable, "edge") +
+                    " shared by more than two faces (e.g. " + edge(nonmanifold_edge_example) +
+                    ", " + plural(nonmanifold_edge_faces, "face") + ")");
+  if (edges_cut_nonorientable)
+    lines.push_back("cut " + plural(edges_cut_nonorientable, "edge") +
+                    " whose two faces cannot be oriented consistently (e.g. " +
+                    edge(nonorientable_edge_example) + ")");
   if (vertices_split)
     lines.push_back("split " +
                     plural(vertices_split, "non-manifold vertex", "non-manifold vertices") +
