@@ -391,9 +391,10 @@ int run_verify(const std::string &original, const std::string &file, const std::
   if (!same) {
     std::fprintf(stderr, "pomar: MISMATCH: %s differs from %s on the %d-bit grid%s\n", what.c_str(),
                  original.c_str(), info.bits,
-                 could_repair ? " (the original is not manifold: if it was encoded with "
-                                "--repair, verify with --repair)"
-                              : "");
+                 could_repair
+                     ? " (the original needs a repair to be encoded: if it was encoded with "
+                       "--repair, verify with --repair)"
+                     : "");
     return 3;
   }
   std::printf("OK: %s matches %s%s: the same %zu oriented triangles, every vertex on its %d-bit "
