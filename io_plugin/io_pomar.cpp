@@ -4,6 +4,7 @@
 
 #include <pomar/pomar.h>
 #include <pomar/random_access.h>
+#include <pomar/repair.h>
 #include <pomar/vcg_adapter.h>
 
 #include <QFile>
@@ -301,6 +302,11 @@ void PomarIOPlugin::initSaveParameter(const QString &format, MeshModel & /*m*/,
                          "progressive file)."));
   par.addParam(RichBool("Progressive", defaults.progressive, "Pure progressive",
                         "Global levels only, no clusters: no random access."));
+  par.addParam(RichBool("Repair", false, "Repair (cut into a manifold mesh)",
+                        "Opt-in: save a non-manifold or inconsistently oriented mesh by cutting it "
+                        "(faces repeating a vertex and exact duplicates removed, faces flipped, "
+                        "non-manifold vertices split into copies at the same position). Every "
+                        "change is reported as a warning; the layer itself is not modified."));
 }
 
 bool PomarIOPlugin::save(const QString &format, const QString &fileName, MeshModel &m,
@@ -317,18 +323,33 @@ bool PomarIOPlugin::save(const QString &format, const QString &fileName, MeshMod
     options.cluster_ratio = par.getFloat("ClusterRatio");
   if (par.hasParameter("Progressive"))
     options.progressive = par.getBool("Progressive");
+  const bool repair = par.hasParameter("Repair") && par.getBool("Repair");
 
   ProgressRelay progress(cb, "Encoding pomar");
   options.progress = progress.function();
   QStringList dropped = notKept(m);
   std::vector<uint8_t> bytes;
+  QString repaired; // what the Repair option changed, "" if off or nothing
   try {
     progress.report(0);
     size_t unreferenced = 0;
-    const pomar::Mesh mesh = pomar::from_vcg(m.cm, &unreferenced); // skips deleted elements
+    pomar::Mesh mesh = pomar::from_vcg(m.cm, &unreferenced); // skips deleted elements
     if (unreferenced > 0)
       dropped << QString("%1 unreferenced vertices").arg(unreferenced);
-    bytes = pomar::encode(mesh, options);
+    if (repair) {
+      const pomar::RepairReport report = pomar::make_manifold(mesh);
+      if (report.changed())
+        repaired = QString::fromStdString(report.summary()).replace('\n', "; ");
+    }
+    try {
+      bytes = pomar::encode(mesh, options);
+    } catch (const pomar::Error &e) {
+      pomar::Mesh copy = mesh;
+      if (repair || !pomar::make_manifold(copy).changed())
+        throw;
+      throw pomar::Error(std::string(e.what()) +
+                         " (the Repair save option cuts it into a manifold mesh)");
+    }
   } catch (const std::exception &e) { // pomar::Error (invalid mesh or options), std::bad_alloc
     return fail(describe("cannot save", path, e.what()));
   }
@@ -346,6 +367,12 @@ bool PomarIOPlugin::save(const QString &format, const QString &fileName, MeshMod
   }
   progress.report(100);
 
+  if (!repaired.isEmpty()) {
+    const QString warning =
+        QString("%1: repaired before saving: %2").arg(QFileInfo(path).fileName(), repaired);
+    Log(GLLogStream::WARNING, qUtf8Printable(warning));
+    qWarning("pomar: %s", qUtf8Printable(warning)); // Log() is a no-op in meshlabserver
+  }
   if (!dropped.isEmpty()) {
     const QString warning =
         QString("%1: the .pomar format keeps only positions and triangles; not saved: %2")

@@ -1,8 +1,8 @@
 // pomar: command-line front end of the codec.
-//   pomar encode IN OUT.pomar [--bits N] [--progressive]
+//   pomar encode IN OUT.pomar [--bits N] [--progressive] [--repair]
 //   pomar decode IN.pomar OUT [--level L] [--cluster/--sphere/--box ...] [--skip-damaged]
 //   pomar info IN.pomar [--json | --check]
-//   pomar verify ORIGINAL IN.pomar [DECODED]
+//   pomar verify ORIGINAL IN.pomar [DECODED] [--repair]
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
@@ -16,6 +16,7 @@
 #include "pomar/mesh_io.h"
 #include "pomar/pomar.h"
 #include "pomar/random_access.h"
+#include "pomar/repair.h"
 
 namespace {
 
@@ -41,6 +42,36 @@ pomar::Progress terminal_progress(bool quiet) {
   };
 }
 
+/// True if make_manifold() would change `mesh` (a copy): then `--repair` is worth a hint.
+bool repair_would_help(const pomar::Mesh &mesh) {
+  pomar::Mesh copy = mesh;
+  try {
+    return pomar::make_manifold(copy).changed();
+  } catch (const pomar::Error &) {
+    return false;
+  }
+}
+
+constexpr const char *kRepairHint = " (pomar encode --repair cuts it into a manifold mesh)";
+
+/// Runs make_manifold() on `mesh` and prints what it changed on stderr, one line per kind
+/// of change; "nothing to repair" only when not quiet. Returns the seconds it took.
+double repair_and_report(pomar::Mesh &mesh, bool quiet) {
+  const auto t0 = Clock::now();
+  const pomar::RepairReport r = pomar::make_manifold(mesh);
+  const double seconds = since(t0);
+  if (!r.changed() && quiet)
+    return seconds;
+  const std::string summary = r.summary();
+  size_t begin = 0;
+  while (begin <= summary.size()) {
+    const size_t end = std::min(summary.find('\n', begin), summary.size());
+    std::fprintf(stderr, "pomar: repair: %s\n", summary.substr(begin, end - begin).c_str());
+    begin = end + 1;
+  }
+  return seconds;
+}
+
 double bpv(uint64_t bytes, uint32_t vertices) {
   return vertices ? 8.0 * double(bytes) / double(vertices) : 0.0;
 }
@@ -52,13 +83,13 @@ struct EncodeArgs {
   int bits = 12;
   uint32_t clusters = 0;
   double cluster_ratio = 0.01;
-  bool progressive = false, quiet = false;
+  bool progressive = false, quiet = false, repair = false;
 };
 
 int run_encode(const EncodeArgs &a) {
   const auto t0 = Clock::now();
   pomar::LoadReport load;
-  const pomar::Mesh mesh = pomar::load_mesh(a.in, &load);
+  pomar::Mesh mesh = pomar::load_mesh(a.in, &load);
   if (!load.ignored_attributes.empty() && !a.quiet) {
     std::string list;
     for (const auto &s : load.ignored_attributes)
@@ -67,6 +98,7 @@ int run_encode(const EncodeArgs &a) {
                  a.in.c_str(), list.c_str());
   }
   const double t_load = since(t0);
+  const double t_repair = a.repair ? repair_and_report(mesh, a.quiet) : 0.0;
   pomar::EncodeOptions opt;
   opt.bits = a.bits;
   opt.clusters = a.clusters;
@@ -75,7 +107,14 @@ int run_encode(const EncodeArgs &a) {
   opt.progress = terminal_progress(a.quiet);
   pomar::EncodeReport r;
   const auto t1 = Clock::now();
-  const std::vector<uint8_t> file = pomar::encode(mesh, opt, &r);
+  std::vector<uint8_t> file;
+  try {
+    file = pomar::encode(mesh, opt, &r);
+  } catch (const pomar::Error &e) {
+    if (!a.repair && repair_would_help(mesh))
+      throw pomar::Error(e.what() + std::string(kRepairHint));
+    throw;
+  }
   const double t_encode = since(t1);
   pomar::write_file_atomic(a.out, file.data(), file.size());
   if (a.quiet)
@@ -98,8 +137,11 @@ int run_encode(const EncodeArgs &a) {
                 static_cast<unsigned long>(i.cluster_bytes));
   else
     std::printf("pure progressive (no random access)\n");
-  std::printf("time: read %.3f s, encode %.3f s (decimate %.3f s, code %.3f s)\n", t_load, t_encode,
-              r.decimate_seconds, r.encode_seconds);
+  std::printf("time: read %.3f s, ", t_load);
+  if (a.repair)
+    std::printf("repair %.3f s, ", t_repair);
+  std::printf("encode %.3f s (decimate %.3f s, code %.3f s)\n", t_encode, r.decimate_seconds,
+              r.encode_seconds);
   return 0;
 }
 
@@ -396,8 +438,13 @@ std::vector<Triangle> triangle_multiset(const pomar::Mesh &m) {
   return out;
 }
 
-int run_verify(const std::string &original, const std::string &file, const std::string &decoded) {
+int run_verify(const std::string &original, const std::string &file, const std::string &decoded,
+               bool repair) {
   pomar::Mesh ref = pomar::load_mesh(original);
+  // With --repair the reference is the repaired original: what `encode --repair` encoded.
+  if (repair)
+    repair_and_report(ref, true);
+  const bool could_repair = !repair && repair_would_help(ref);
   const std::vector<uint8_t> data = pomar::read_file(file);
   const pomar::FileInfo info = pomar::inspect(data.data(), data.size());
   const pomar::Mesh out =
@@ -410,33 +457,42 @@ int run_verify(const std::string &original, const std::string &file, const std::
   const bool same = triangle_multiset(ref) == triangle_multiset(out);
   const std::string what = decoded.empty() ? file : decoded;
   if (!same) {
-    std::fprintf(stderr, "pomar: MISMATCH: %s differs from %s on the %d-bit grid\n", what.c_str(),
-                 original.c_str(), info.bits);
+    std::fprintf(stderr, "pomar: MISMATCH: %s differs from %s on the %d-bit grid%s\n", what.c_str(),
+                 original.c_str(), info.bits,
+                 could_repair
+                     ? " (the original needs a repair to be encoded: if it was encoded with "
+                       "--repair, verify with --repair)"
+                     : "");
     return 3;
   }
-  std::printf("OK: %s matches %s: the same %zu oriented triangles, every vertex on its %d-bit "
+  std::printf("OK: %s matches %s%s: the same %zu oriented triangles, every vertex on its %d-bit "
               "grid position\n",
-              what.c_str(), original.c_str(), out.triangle_count(), info.bits);
+              what.c_str(), original.c_str(), repair ? " after repair" : "", out.triangle_count(),
+              info.bits);
   return 0;
 }
 
 } // namespace
 
 int main(int argc, char **argv) {
-  CLI::App app{"pomar: progressive, randomly accessible compression of manifold triangle meshes "
-               "(POMAR, Maglo et al. 2013).\n\nExamples:\n"
-               "  pomar encode bunny.ply bunny.pomar          # 12-bit grid, all levels\n"
-               "  pomar info bunny.pomar                      # levels and bits per vertex\n"
-               "  pomar decode bunny.pomar coarse.ply --level 10\n"
-               "  pomar decode bunny.pomar ear.ply --sphere -0.06,0.16,0.0,0.02 --stats\n"
-               "  pomar verify bunny.ply bunny.pomar          # lossless check\n"};
+  CLI::App app{
+      "pomar: progressive, randomly accessible compression of manifold triangle meshes "
+      "(POMAR, Maglo et al. 2013).\n\nExamples:\n"
+      "  pomar encode bunny.ply bunny.pomar          # 12-bit grid, all levels\n"
+      "  pomar info bunny.pomar                      # levels and bits per vertex\n"
+      "  pomar decode bunny.pomar coarse.ply --level 10\n"
+      "  pomar decode bunny.pomar ear.ply --sphere -0.06,0.16,0.0,0.02 --stats\n"
+      "  pomar verify bunny.ply bunny.pomar          # lossless check\n"
+      "  pomar encode messy.stl messy.pomar --repair # cut a non-manifold mesh first\n"
+      "  pomar verify messy.stl messy.pomar --repair # lossless w.r.t. the repaired mesh\n"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "pomar 0.1.0 (file format version 1)");
 
   EncodeArgs ea;
   auto *enc =
       app.add_subcommand("encode", "Compress a mesh (PLY, OBJ, OFF, STL) into a .pomar file");
-  enc->add_option("input", ea.in, "Input mesh: manifold, consistently oriented triangles")
+  enc->add_option("input", ea.in,
+                  "Input mesh: manifold, consistently oriented triangles (or use --repair)")
       ->required();
   enc->add_option("output", ea.out, "Output .pomar file (written atomically)")->required();
   enc->add_option("-b,--bits", ea.bits,
@@ -453,7 +509,14 @@ int main(int argc, char **argv) {
       ->capture_default_str();
   enc->add_flag("--progressive", ea.progressive,
                 "Pure progressive mode: global levels only, no random access (a little smaller)");
-  enc->add_flag("-q,--quiet", ea.quiet, "Print nothing on success");
+  enc->add_flag("--repair", ea.repair,
+                "Opt-in: first cut a non-manifold, inconsistently oriented or degenerate mesh into "
+                "a manifold one (remove faces repeating a vertex and exact duplicate faces, "
+                "reorient faces, cut edges of more than two faces or that cannot be oriented, "
+                "split vertices joining several fans into copies at the same position) and print "
+                "every change on stderr. Positions are never moved; verify with --repair");
+  enc->add_flag("-q,--quiet", ea.quiet,
+                "Print nothing on success (what --repair changed is still printed)");
 
   DecodeArgs da;
   auto *dec = app.add_subcommand("decode", "Decompress a .pomar file into a mesh file");
@@ -501,11 +564,15 @@ int main(int argc, char **argv) {
                 "damaged or missing blocks");
 
   std::string v_orig, v_file, v_decoded;
+  bool v_repair = false;
   auto *ver = app.add_subcommand(
       "verify", "Check that a .pomar file (or a mesh decoded from it) is the original, losslessly");
   ver->add_option("original", v_orig, "The mesh that was encoded")->required();
   ver->add_option("pomar", v_file, "The .pomar file")->required();
   ver->add_option("decoded", v_decoded, "A mesh decoded from it (default: decode in memory)");
+  ver->add_flag("--repair", v_repair,
+                "The file was encoded with encode --repair: compare with the original as repaired "
+                "(the same cut as encode --repair; lossless means equal to that mesh)");
 
   try {
     app.parse(argc, argv);
@@ -520,7 +587,7 @@ int main(int argc, char **argv) {
     if (*inf)
       return info_check ? run_check(info_in) : run_info(info_in, info_jsonf);
     if (*ver)
-      return run_verify(v_orig, v_file, v_decoded);
+      return run_verify(v_orig, v_file, v_decoded, v_repair);
   } catch (const pomar::Error &e) {
     std::fprintf(stderr, "pomar: error: %s\n", e.what());
     return 1;

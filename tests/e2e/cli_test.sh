@@ -240,6 +240,61 @@ sum_after="$(sha256sum <"$WORK/nm/existing.pomar")"
 pass
 expect_dir_only "$WORK/nm" existing.pomar
 
+section "the refusal of a non-manifold input hints at --repair"
+run encode "$NONMANIFOLD" "$WORK/nm/hint.pomar"
+expect_rc 1
+expect_one_line_error
+expect_contains "$ERR" "(pomar encode --repair cuts it into a manifold mesh)" "stderr"
+expect_no_file "$WORK/nm/hint.pomar"
+
+section "encode --repair cuts the non-manifold input and reports every change"
+mkdir "$WORK/repair"
+run encode "$NONMANIFOLD" "$WORK/repair/out.pomar" --repair
+expect_rc 0
+expect_file "$WORK/repair/out.pomar"
+expect_contains "$ERR" "pomar: repair: cut 1 edge shared by more than two faces (e.g. edge (1, 0), 4 faces)" "stderr"
+expect_contains "$ERR" "pomar: repair: split 2 non-manifold vertices into 4 (e.g. vertex 0 into 2)" "stderr"
+[ "$(printf '%s\n' "$ERR" | grep -c '^pomar: repair: ')" -eq 2 ] || fail "expected exactly two repair lines on stderr"
+pass
+expect_contains "$OUT" "8 vertices, 8 faces" "stdout"
+expect_dir_only "$WORK/repair" out.pomar
+
+section "verify --repair accepts the repaired file"
+run verify "$NONMANIFOLD" "$WORK/repair/out.pomar" --repair
+expect_rc 0
+expect_contains "$OUT" "after repair: the same 8 oriented triangles" "stdout"
+
+section "encode --repair on a manifold mesh changes nothing and says so"
+run encode "$BUNNY" "$WORK/repair/bunny.pomar" --repair
+expect_rc 0
+expect_contains "$ERR" "pomar: repair: nothing to repair" "stderr"
+cmp -s "$WORK/repair/bunny.pomar" "$WORK/bunny.pomar" || fail "encode --repair of a manifold mesh differs from a plain encode"
+pass
+
+section "a flipped face: refused with the hint, repaired, and plain verify points to --repair"
+python3 - "$NONMANIFOLD" "$WORK/repair/flipped.off" <<'PY'
+import sys
+# The first tetrahedron of the sample (vertices 0-3, faces 0-3) with face 1 reversed.
+lines = [l for l in open(sys.argv[1]) if l.strip() and not l.startswith("#")]
+verts = lines[2:6]
+faces = [l.split() for l in lines[8:12]]
+faces[1] = [faces[1][0], faces[1][1], faces[1][3], faces[1][2]]
+with open(sys.argv[2], "w") as f:
+    f.write("OFF\n4 4 0\n" + "".join(verts) + "".join(" ".join(t) + "\n" for t in faces))
+PY
+run encode "$WORK/repair/flipped.off" "$WORK/repair/flipped.pomar"
+expect_rc 1
+expect_contains "$ERR" "inconsistently oriented" "stderr"
+expect_contains "$ERR" "(pomar encode --repair cuts it into a manifold mesh)" "stderr"
+run encode "$WORK/repair/flipped.off" "$WORK/repair/flipped.pomar" --repair --quiet
+expect_rc 0
+expect_contains "$ERR" "pomar: repair: flipped 1 face to orient the mesh consistently (e.g. face 1)" "stderr"
+run verify "$WORK/repair/flipped.off" "$WORK/repair/flipped.pomar"
+expect_rc 3
+expect_contains "$ERR" "verify with --repair" "stderr"
+run verify "$WORK/repair/flipped.off" "$WORK/repair/flipped.pomar" --repair
+expect_rc 0
+
 # ---- corrupt .pomar input ---------------------------------------------------------------------------
 
 section "truncated .pomar fails to decode"
@@ -410,10 +465,10 @@ help_mentions() { # help_mentions SUBCOMMAND OPTION...
   local opt
   for opt in "$@"; do expect_contains "$OUT" "$opt" "pomar $sub --help"; done
 }
-help_mentions encode --bits --progressive --clusters --cluster-ratio --quiet input output
+help_mentions encode --bits --progressive --clusters --cluster-ratio --repair --quiet input output
 help_mentions decode --level --cluster --sphere --box --stats --ascii --quiet --skip-damaged input output
 help_mentions info --json --check input
-help_mentions verify original pomar decoded
+help_mentions verify original pomar decoded --repair
 
 LAST_CMD=""
 printf 'cli_end_to_end: all %d checks passed\n' "$CHECKS"

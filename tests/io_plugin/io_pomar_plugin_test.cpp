@@ -196,6 +196,7 @@ TEST_F(PomarPluginTest, ParameterDefaults) {
   EXPECT_EQ(save.getInt("Bits"), defaults.bits);
   EXPECT_FLOAT_EQ(save.getFloat("ClusterRatio"), float(defaults.cluster_ratio));
   EXPECT_EQ(save.getBool("Progressive"), false);
+  EXPECT_EQ(save.getBool("Repair"), false); // repairing is opt-in
 
   RichParameterList other;
   plugin()->initPreOpenParameter("ply", "x.ply", other);
@@ -415,6 +416,41 @@ TEST_F(PomarPluginTest, FailedSaveWritesNothing) {
                     [](RichParameterList &par) { par.setValue("Bits", IntValue(30)); }));
   EXPECT_FALSE(plugin()->errorMsg().isEmpty());
   EXPECT_EQ(dirEntries(), before);
+}
+
+TEST_F(PomarPluginTest, RepairOptionSavesANonManifoldMeshAndSaysWhatChanged) {
+  // Without the option: refused, and the message points at the option.
+  MeshModel *mm = layer(pomar::gen::nonmanifold_edge()); // three faces on edge (0, 1)
+  EXPECT_FALSE(save(*mm, path("book.pomar")));
+  EXPECT_TRUE(
+      plugin()->errorMsg().contains("(the Repair save option cuts it into a manifold mesh)"))
+      << plugin()->errorMsg().toStdString();
+
+  // With it: saved, one warning naming every change, the layer left as it was.
+  g_warnings.clear();
+  ASSERT_TRUE(save(*mm, path("book.pomar"), [](RichParameterList &par) {
+    par.setValue("Repair", BoolValue(true));
+  })) << plugin()->errorMsg().toStdString();
+  const QString all = g_warnings.join("\n");
+  EXPECT_TRUE(all.contains("book.pomar: repaired before saving: cut 1 edge shared by more than two "
+                           "faces (e.g. edge (0, 1), 3 faces); split 2 non-manifold vertices "
+                           "into 6 (e.g. vertex 0 into 3)"))
+      << all.toStdString();
+  EXPECT_EQ(mm->cm.vn, 5);
+  const std::vector<uint8_t> bytes = readBytes(path("book.pomar"));
+  const pomar::Mesh out = pomar::decode(bytes.data(), bytes.size());
+  EXPECT_EQ(out.vertex_count(), 9u); // three separate triangles
+  EXPECT_EQ(out.triangle_count(), 3u);
+  QFile::remove(path("book.pomar"));
+
+  // A manifold mesh saved with the option: no warning and the same bytes.
+  g_warnings.clear();
+  MeshModel *good = layer(*input_);
+  ASSERT_TRUE(save(*good, path("r.pomar"),
+                   [](RichParameterList &par) { par.setValue("Repair", BoolValue(true)); }));
+  EXPECT_TRUE(g_warnings.isEmpty()) << g_warnings.join("\n").toStdString();
+  EXPECT_EQ(readBytes(path("r.pomar")), *clustered_);
+  QFile::remove(path("r.pomar"));
 }
 
 TEST_F(PomarPluginTest, OpenThenSaveRoundTrip) {
