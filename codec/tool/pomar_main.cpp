@@ -1,6 +1,6 @@
 // pomar: command-line front end of the codec.
-//   pomar encode IN OUT.pomar [--bits N] [--progressive]
-//   pomar decode IN.pomar OUT [--level L]
+//   pomar encode IN OUT.pomar [--bits N] [--progressive] [--max-memory SIZE]
+//   pomar decode IN.pomar OUT [--level L] [--max-memory SIZE]
 //   pomar info IN.pomar [--json]
 //   pomar verify ORIGINAL IN.pomar [DECODED]
 #include <CLI/CLI.hpp>
@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <unistd.h>
 
+#include "pomar/limits.h"
 #include "pomar/mesh_io.h"
 #include "pomar/pomar.h"
 #include "pomar/random_access.h"
@@ -53,12 +54,16 @@ struct EncodeArgs {
   uint32_t clusters = 0;
   double cluster_ratio = 0.01;
   bool progressive = false, quiet = false;
+  std::string max_memory = "auto";
 };
 
 int run_encode(const EncodeArgs &a) {
   const auto t0 = Clock::now();
+  const uint64_t memory_limit = pomar::parse_memory_size(a.max_memory);
   pomar::LoadReport load;
-  const pomar::Mesh mesh = pomar::load_mesh(a.in, &load);
+  // Refused as soon as the file's header tells the mesh size, before it is read.
+  const pomar::Mesh mesh = pomar::load_mesh(
+      a.in, &load, [&](uint64_t v, uint64_t f) { pomar::check_encode_memory(v, f, memory_limit); });
   if (!load.ignored_attributes.empty() && !a.quiet) {
     std::string list;
     for (const auto &s : load.ignored_attributes)
@@ -73,6 +78,7 @@ int run_encode(const EncodeArgs &a) {
   opt.cluster_ratio = a.cluster_ratio;
   opt.progressive = a.progressive;
   opt.progress = terminal_progress(a.quiet);
+  opt.memory_limit = memory_limit;
   pomar::EncodeReport r;
   const auto t1 = Clock::now();
   const std::vector<uint8_t> file = pomar::encode(mesh, opt, &r);
@@ -110,6 +116,7 @@ struct DecodeArgs {
   int level = -1;
   std::vector<std::string> clusters, spheres, boxes;
   bool ascii = false, quiet = false, stats = false;
+  std::string max_memory = "auto";
   bool selective() const { return !clusters.empty() || !spheres.empty() || !boxes.empty(); }
 };
 
@@ -155,7 +162,8 @@ std::vector<double> parse_spec(const std::string &spec, size_t count, int finest
 
 int run_selective_decode(const DecodeArgs &a) {
   const auto t0 = Clock::now();
-  pomar::SelectiveDecoder d(std::make_unique<pomar::FileSource>(a.in));
+  pomar::SelectiveDecoder d(std::make_unique<pomar::FileSource>(a.in),
+                            pomar::parse_memory_size(a.max_memory));
   if (!d.info().clustered())
     throw pomar::Error(a.in + " is a pure progressive file (encoded with --progressive): it has "
                        "no clusters to select; use --level");
@@ -201,10 +209,11 @@ int run_selective_decode(const DecodeArgs &a) {
 int run_decode(const DecodeArgs &a) {
   if (a.selective())
     return run_selective_decode(a);
+  const uint64_t memory_limit = pomar::parse_memory_size(a.max_memory);
   const auto t0 = Clock::now();
   const std::vector<uint8_t> data = pomar::read_file(a.in);
   const pomar::Mesh mesh =
-      pomar::decode(data.data(), data.size(), a.level, terminal_progress(a.quiet));
+      pomar::decode(data.data(), data.size(), a.level, terminal_progress(a.quiet), memory_limit);
   const double t_decode = since(t0);
   pomar::save_mesh(a.out, mesh, !a.ascii);
   if (!a.quiet || a.stats)
@@ -385,6 +394,14 @@ int main(int argc, char **argv) {
   enc->add_flag("--progressive", ea.progressive,
                 "Pure progressive mode: global levels only, no random access (a little smaller)");
   enc->add_flag("-q,--quiet", ea.quiet, "Print nothing on success");
+  enc->add_option("--max-memory", ea.max_memory,
+                  "Refuse (exit 1, no output file) a mesh whose loading and encoding would need "
+                  "more than SIZE of memory, checked from the file's header before reading it: "
+                  "bytes or a number with K, M, G, T (powers of 1024), e.g. 512M, 2G, 1.5GiB; "
+                  "'none' = no check. Default 'auto': the memory available (the smallest of "
+                  "MemAvailable, the cgroup's limit and ulimit -v/-d; no check if unknown)")
+      ->type_name("SIZE")
+      ->capture_default_str();
 
   DecodeArgs da;
   auto *dec = app.add_subcommand("decode", "Decompress a .pomar file into a mesh file");
@@ -411,6 +428,13 @@ int main(int argc, char **argv) {
                 "Print clusters decoded, bytes read of the file size, vertices and time");
   dec->add_flag("--ascii", da.ascii, "Write ASCII PLY instead of binary");
   dec->add_flag("-q,--quiet", da.quiet, "Print nothing on success");
+  dec->add_option("--max-memory", da.max_memory,
+                  "Refuse (exit 1, no output file) a file whose decoding would need more than "
+                  "SIZE of memory, checked from its header (with --cluster/--sphere/--box: for "
+                  "the base clustered mesh): as for encode, e.g. 512M, 2G, 'none'; default "
+                  "'auto' = the memory available")
+      ->type_name("SIZE")
+      ->capture_default_str();
 
   std::string info_in;
   bool info_jsonf = false;

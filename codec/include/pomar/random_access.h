@@ -62,7 +62,11 @@ private:
 /// clusters: it decodes to one uniform level (want_level).
 class SelectiveDecoder {
 public:
-  explicit SelectiveDecoder(std::unique_ptr<ByteSource> source);
+  /// Reads the header and global part and decodes the base clustered mesh. Throws
+  /// pomar::Error on a damaged file, or right after the header if that mesh would need more
+  /// memory than `memory_limit` (bytes; 0 = automatic, UINT64_MAX = do not check; see
+  /// pomar/limits.h). Later refinement is not checked: it decodes what is asked for.
+  explicit SelectiveDecoder(std::unique_ptr<ByteSource> source, uint64_t memory_limit = 0);
   ~SelectiveDecoder();
   SelectiveDecoder(const SelectiveDecoder &) = delete;
   SelectiveDecoder &operator=(const SelectiveDecoder &) = delete;

@@ -2,9 +2,10 @@
 #include <memory>
 #include <string>
 
+#include "decode/decoder_codec.h"
 #include "entropy/models.h"
 #include "format/file_format.h"
-#include "decode/decoder_codec.h"
+#include "pomar/limits.h"
 #include "pomar/random_access.h"
 #include "refine/level_traversal.h"
 
@@ -74,17 +75,20 @@ FileInfo inspect(const uint8_t *data, size_t size) {
   return info;
 }
 
-Mesh decode(const uint8_t *data, size_t size, int level, const Progress &progress) {
+Mesh decode(const uint8_t *data, size_t size, int level, const Progress &progress,
+            uint64_t memory_limit) {
   const FileLayout layout = read_layout(data, size);
   const FileHeader &h = layout.header;
   const size_t levels = h.levels.size();
   if (level < -1 || level > static_cast<int>(levels))
     throw Error("level " + std::to_string(level) + " does not exist: the file has levels 0.." +
                 std::to_string(levels));
+  check_decode_memory(file_info(layout, size), level, memory_limit);
   const size_t target = level < 0 ? levels : static_cast<size_t>(level);
   const size_t global = h.clustered() ? h.global_levels : levels;
   if (target > global) { // clustered levels: every cluster at `target`
-    SelectiveDecoder d(std::make_unique<MemorySource>(data, size));
+    // Checked above for the whole target level; the constructor's check is smaller.
+    SelectiveDecoder d(std::make_unique<MemorySource>(data, size), kNoMemoryLimit);
     d.want_all(static_cast<int>(target));
     d.update(progress);
     return d.mesh();

@@ -6,6 +6,7 @@
 #include "decode/decoder_codec.h"
 #include "entropy/static_tables.h"
 #include "format/file_format.h"
+#include "pomar/limits.h"
 #include "pomar/random_access.h"
 
 namespace pomar {
@@ -187,7 +188,7 @@ void SelectiveDecoder::State::decode_cluster_level(uint32_t c, int level) {
 
 // ---------------------------------------------------------------- construction
 
-SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source)
+SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source, uint64_t memory_limit)
     : s_(std::make_unique<State>()) {
   State &s = *s_;
   s.source = std::move(source);
@@ -202,6 +203,11 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source)
   s.global.resize(hsize);
   s.source->read(0, hsize, s.global.data());
   s.layout = read_layout(s.global.data(), hsize, file_size);
+  // What the constructor decodes: the base clustered mesh (progressive files: the base
+  // mesh). Further refinement is what the caller asks for, region by region.
+  check_decode_memory(file_info(s.layout, file_size),
+                      s.layout.header.clustered() ? int(s.layout.header.global_levels) : 0,
+                      memory_limit);
   // The global part.
   s.global.resize(s.layout.global_bytes);
   s.source->read(hsize, s.layout.global_bytes - hsize, s.global.data() + hsize);
