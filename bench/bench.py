@@ -251,6 +251,8 @@ def bench_mesh(label, path, args, tools, workdir, source):
         row["enc_ratio"] = enc_s / d_enc_s if d_enc_s else None
         if d_dec_s is not None and dec_s is not None and d_dec_s > 0:
             row["dec_ratio"] = dec_s / d_dec_s
+        row["enc_mb_ratio"] = ratio(enc_mb, d_enc_mb)
+        row["dec_mb_ratio"] = ratio(dec_mb, d_dec_mb)
         if d_dec_s is None:
             row["draco_note"] = "draco_decoder failed: " + first_error_line(r.stderr)
         else:
@@ -259,6 +261,11 @@ def bench_mesh(label, path, args, tools, workdir, source):
                 row["draco_note"] = ("Draco's decoded mesh has %s vertices (pomar: %s)"
                                      % (format(dv, ","), format(nv, ",")))
     return row
+
+
+def ratio(a, b):
+    """a / b, or None when either is unknown (a failed run, no GNU time figure) or b is 0."""
+    return a / b if a is not None and b else None
 
 
 def ply_vertex_count(path):
@@ -344,13 +351,16 @@ COLUMNS = [  # (header, key, format)
     ("enc peak MB", "enc_mb", ".1f"), ("dec peak MB", "dec_mb", ".1f"),
     ("lossless", "lossless", "s"), ("draco bpv", "draco_bpv", ".2f"),
     ("draco enc s", "draco_enc_s", ".3f"), ("draco dec s", "draco_dec_s", ".3f"),
+    ("draco enc MB", "draco_enc_mb", ".1f"), ("draco dec MB", "draco_dec_mb", ".1f"),
     ("size pomar/draco", "size_ratio", ".2f"), ("enc pomar/draco", "enc_ratio", ".2f"),
-    ("dec pomar/draco", "dec_ratio", ".2f"),
+    ("dec pomar/draco", "dec_ratio", ".2f"), ("enc MB pomar/draco", "enc_mb_ratio", ".2f"),
+    ("dec MB pomar/draco", "dec_mb_ratio", ".2f"),
 ]
 CSV_KEYS = ["mesh", "source", "vertices", "faces", "levels", "runs", "conn_bpv", "geom_bpv", "bpv",
             "pomar_bytes", "enc_s", "dec_s", "enc_mb", "dec_mb", "lossless", "draco_bytes",
             "draco_bpv", "draco_enc_s", "draco_dec_s", "draco_enc_mb", "draco_dec_mb",
-            "size_ratio", "enc_ratio", "dec_ratio", "note", "draco_note"]
+            "size_ratio", "enc_ratio", "dec_ratio", "enc_mb_ratio", "dec_mb_ratio", "note",
+            "draco_note"]
 
 
 def fmt(value, spec):

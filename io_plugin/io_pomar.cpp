@@ -207,7 +207,9 @@ bool PomarIOPlugin::open(const QString &format, const QString &fileName, MeshMod
   ProgressRelay progress(cb, "Decoding pomar");
   try {
     progress.report(0);
-    pomar::SelectiveDecoder decoder(std::make_unique<pomar::FileSource>(native), skipDamaged);
+    pomar::SelectiveOptions options;
+    options.skip_damaged = skipDamaged;
+    pomar::SelectiveDecoder decoder(std::make_unique<pomar::FileSource>(native), options);
     const pomar::FileInfo &info = decoder.info();
     int level = decoder.finest_level();
     if (openAt == OPEN_BASE_CLUSTERED)

@@ -14,7 +14,7 @@ CC=clang CXX=clang++ cmake -G Ninja -S "$ROOT" -B "$BUILD_DIR" \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPOMAR_BUILD_FUZZERS=ON -DPOMAR_SANITIZE=ON \
   -DPOMAR_BUILD_TESTS=OFF -DPOMAR_BUILD_BENCH=OFF -DPOMAR_BUILD_MESHLAB_PLUGINS=OFF >/dev/null || exit 2
 echo "== build"
-cmake --build "$BUILD_DIR" --target $TARGETS || exit 2
+cmake --build "$BUILD_DIR" -j "${JOBS:-2}" --target $TARGETS || exit 2
 
 status=0
 for t in $TARGETS; do

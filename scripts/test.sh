@@ -3,8 +3,9 @@
 # This is the project's test command (also run by .ci/run). Works from any directory.
 #
 # Release optimisation but with assertions enabled (no -DNDEBUG), so assert()s in the codec and in
-# vcglib are checked while the tests run; then the same suite again under ASan + UBSan (build-asan/,
-# see the end of this script). Takes a few minutes from scratch on 2 cores.
+# vcglib are checked while the tests run; then the same suite again under ASan + UBSan (build-asan/),
+# then a timed libFuzzer run of each fuzz target (build-fuzz/; POMAR_TEST_FUZZ_SECONDS, default 20,
+# 0 skips). Takes about 6 minutes from scratch on 2 cores (tests/fuzz/README.md has the breakdown).
 set -euo pipefail
 
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -50,6 +51,31 @@ if [ "${POMAR_TEST_SANITIZE:-1}" != 0 ]; then
   UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   LSAN_OPTIONS="suppressions=$REPO/tests/sanitizers/lsan.supp" \
     ctest --test-dir "$ASAN_BUILD" --output-on-failure -j "$JOBS"
+fi
+
+# ---- timed fuzz run ---------------------------------------------------------------------------------
+# Each libFuzzer target (tests/fuzz/) runs for POMAR_TEST_FUZZ_SECONDS (default 20; 0 skips) from its
+# seed corpus plus what earlier runs found (build-fuzz/fuzz-run/, kept between runs), built by
+# scripts/fuzz.sh with clang + ASan/UBSan in build-fuzz/. A crash, sanitizer report, leak, timeout
+# (> 10 s) or out-of-memory (> 2 GB) fails the test command; the reproducer path is printed. Skipped
+# with a note when clang++ cannot link a libFuzzer program.
+FUZZ_SECONDS="${POMAR_TEST_FUZZ_SECONDS:-20}"
+if [ "$FUZZ_SECONDS" != 0 ]; then
+  probe="$(mktemp -d)"
+  echo 'extern "C" int LLVMFuzzerTestOneInput(const unsigned char *, unsigned long) { return 0; }' \
+    >"$probe/probe.cc"
+  if command -v clang++ >/dev/null 2>&1 &&
+    clang++ -fsanitize=fuzzer "$probe/probe.cc" -o "$probe/probe" >/dev/null 2>&1; then
+    echo "test: fuzzing each target for ${FUZZ_SECONDS} s (scripts/fuzz.sh, build-fuzz/)"
+    if ! JOBS="$JOBS" bash scripts/fuzz.sh "$FUZZ_SECONDS"; then
+      rm -rf "$probe"
+      echo "test: FAILED: the timed fuzz run found a problem or did not build (see above)" >&2
+      exit 1
+    fi
+  else
+    echo "test: clang++ with libFuzzer not available: timed fuzz run skipped"
+  fi
+  rm -rf "$probe"
 fi
 
 echo "test: all tests passed"

@@ -102,8 +102,10 @@ std::vector<int> distances(const Encoded &e, const std::vector<uint32_t> &source
 }
 
 std::unique_ptr<SelectiveDecoder> open(const std::vector<uint8_t> &file, bool skip) {
+  SelectiveOptions options;
+  options.skip_damaged = skip;
   return std::make_unique<SelectiveDecoder>(
-      std::make_unique<MemorySource>(file.data(), file.size()), skip);
+      std::make_unique<MemorySource>(file.data(), file.size()), options);
 }
 
 /// The damaged decode `d` must be: valid, with the damaged clusters at the base clustered

@@ -1,6 +1,7 @@
 // pomar: command-line front end of the codec.
-//   pomar encode IN OUT.pomar [--bits N] [--progressive] [--repair]
+//   pomar encode IN OUT.pomar [--bits N] [--progressive] [--repair] [--max-memory SIZE]
 //   pomar decode IN.pomar OUT [--level L] [--cluster/--sphere/--box ...] [--skip-damaged]
+//                [--max-memory SIZE]
 //   pomar info IN.pomar [--json | --check]
 //   pomar verify ORIGINAL IN.pomar [DECODED] [--repair]
 #include <CLI/CLI.hpp>
@@ -13,6 +14,7 @@
 #include <memory>
 #include <unistd.h>
 
+#include "pomar/limits.h"
 #include "pomar/mesh_io.h"
 #include "pomar/pomar.h"
 #include "pomar/random_access.h"
@@ -84,12 +86,16 @@ struct EncodeArgs {
   uint32_t clusters = 0;
   double cluster_ratio = 0.01;
   bool progressive = false, quiet = false, repair = false;
+  std::string max_memory = "auto";
 };
 
 int run_encode(const EncodeArgs &a) {
   const auto t0 = Clock::now();
+  const uint64_t memory_limit = pomar::parse_memory_size(a.max_memory);
   pomar::LoadReport load;
-  pomar::Mesh mesh = pomar::load_mesh(a.in, &load);
+  // Refused as soon as the file's header tells the mesh size, before it is read.
+  pomar::Mesh mesh = pomar::load_mesh(
+      a.in, &load, [&](uint64_t v, uint64_t f) { pomar::check_encode_memory(v, f, memory_limit); });
   if (!load.ignored_attributes.empty() && !a.quiet) {
     std::string list;
     for (const auto &s : load.ignored_attributes)
@@ -105,6 +111,7 @@ int run_encode(const EncodeArgs &a) {
   opt.cluster_ratio = a.cluster_ratio;
   opt.progressive = a.progressive;
   opt.progress = terminal_progress(a.quiet);
+  opt.memory_limit = memory_limit;
   pomar::EncodeReport r;
   const auto t1 = Clock::now();
   std::vector<uint8_t> file;
@@ -152,6 +159,7 @@ struct DecodeArgs {
   int level = -1;
   std::vector<std::string> clusters, spheres, boxes;
   bool ascii = false, quiet = false, stats = false, skip_damaged = false;
+  std::string max_memory = "auto";
   bool selective() const { return !clusters.empty() || !spheres.empty() || !boxes.empty(); }
 };
 
@@ -232,7 +240,10 @@ int report_damage(const std::vector<pomar::DamagedBlock> &damaged, const std::st
 
 int run_selective_decode(const DecodeArgs &a) {
   const auto t0 = Clock::now();
-  pomar::SelectiveDecoder d(std::make_unique<pomar::FileSource>(a.in), a.skip_damaged);
+  pomar::SelectiveOptions options;
+  options.skip_damaged = a.skip_damaged;
+  options.memory_limit = pomar::parse_memory_size(a.max_memory);
+  pomar::SelectiveDecoder d(std::make_unique<pomar::FileSource>(a.in), options);
   if (!d.info().clustered())
     throw pomar::Error(a.in + " is a pure progressive file (encoded with --progressive): it has "
                               "no clusters to select; use --level");
@@ -283,11 +294,13 @@ int run_selective_decode(const DecodeArgs &a) {
 int run_decode(const DecodeArgs &a) {
   if (a.selective())
     return run_selective_decode(a);
+  const uint64_t memory_limit = pomar::parse_memory_size(a.max_memory);
   const auto t0 = Clock::now();
   const std::vector<uint8_t> data = pomar::read_file(a.in);
   pomar::DecodeOptions options;
   options.level = a.level;
   options.skip_damaged = a.skip_damaged;
+  options.memory_limit = memory_limit;
   options.progress = terminal_progress(a.quiet);
   pomar::DecodeReport report;
   pomar::Mesh mesh;
@@ -517,6 +530,14 @@ int main(int argc, char **argv) {
                 "every change on stderr. Positions are never moved; verify with --repair");
   enc->add_flag("-q,--quiet", ea.quiet,
                 "Print nothing on success (what --repair changed is still printed)");
+  enc->add_option("--max-memory", ea.max_memory,
+                  "Refuse (exit 1, no output file) a mesh whose loading and encoding would need "
+                  "more than SIZE of memory, checked from the file's header before reading it: "
+                  "bytes or a number with K, M, G, T (powers of 1024), e.g. 512M, 2G, 1.5GiB; "
+                  "'none' = no check. Default 'auto': the memory available (the smallest of "
+                  "MemAvailable, the cgroup's limit and ulimit -v/-d; no check if unknown)")
+      ->type_name("SIZE")
+      ->capture_default_str();
 
   DecodeArgs da;
   auto *dec = app.add_subcommand("decode", "Decompress a .pomar file into a mesh file");
@@ -551,6 +572,13 @@ int main(int argc, char **argv) {
                 "3 (the output is written). The header, base mesh, tables and index must be "
                 "intact");
   dec->add_flag("-q,--quiet", da.quiet, "Print nothing on success");
+  dec->add_option("--max-memory", da.max_memory,
+                  "Refuse (exit 1, no output file) a file whose decoding would need more than "
+                  "SIZE of memory, checked from its header (with --cluster/--sphere/--box: for "
+                  "the base clustered mesh): as for encode, e.g. 512M, 2G, 'none'; default "
+                  "'auto' = the memory available")
+      ->type_name("SIZE")
+      ->capture_default_str();
 
   std::string info_in;
   bool info_jsonf = false, info_check = false;

@@ -450,6 +450,65 @@ run info "$WORK/truncated.pomar" --check
 expect_rc 3
 expect_contains "$OUT" "truncated file" "stdout of info --check"
 
+# ---- memory limits (--max-memory) -----------------------------------------------------------------------
+
+section "encode --max-memory 1M: refused from the header, no output"
+mkdir -p "$WORK/mem"
+run encode "$SAMPLES/bunny.ply" "$WORK/mem/out.pomar" --max-memory 1M
+expect_rc 1
+expect_one_line_error
+expect_contains "$ERR" "not enough memory to encode 35,947 vertices and 69,451 faces" "stderr"
+expect_contains "$ERR" "the limit is 1.0 MiB; use --max-memory" "stderr"
+expect_dir_only "$WORK/mem"
+
+section "encode --max-memory: sizes that fit, 'none', bad sizes"
+for size in 1.5GiB 2G 512M none 4294967296; do
+  run encode "$SAMPLES/bunny.ply" "$WORK/mem/ok.pomar" --max-memory "$size" -q
+  expect_rc 0
+  expect_file "$WORK/mem/ok.pomar"
+  rm -f "$WORK/mem/ok.pomar"
+done
+for size in 12x "" 1.5.2G 5Q; do
+  run encode "$SAMPLES/bunny.ply" "$WORK/mem/bad.pomar" --max-memory "$size"
+  expect_rc 1
+  expect_contains "$ERR" "bad memory size" "stderr"
+  expect_no_file "$WORK/mem/bad.pomar"
+done
+
+section "decode --max-memory 1M: refused from the header, no output"
+run encode "$SAMPLES/bunny.ply" "$WORK/mem/bunny.pomar" -q
+expect_rc 0
+for mode in full selective; do
+  extra=(); [ "$mode" = selective ] && extra=(--cluster 0)
+  run decode "$WORK/mem/bunny.pomar" "$WORK/mem/out.ply" --max-memory 1M "${extra[@]}"
+  expect_rc 1
+  expect_one_line_error
+  expect_contains "$ERR" "not enough memory to decode" "stderr"
+  expect_no_file "$WORK/mem/out.ply"
+done
+run decode "$WORK/mem/bunny.pomar" "$WORK/mem/out.ply" --max-memory 64M -q
+expect_rc 0
+expect_file "$WORK/mem/out.ply"
+
+section "a PLY header claiming 2^31 (or 2^31 - 1) vertices with a tiny body"
+for count in 2147483648 2147483647; do
+  printf 'ply\nformat binary_little_endian 1.0\nelement vertex %s\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n' "$count" >"$WORK/mem/huge.ply"
+  printf '\0\0\0\0\0\0\0\0\0\0\0\0' >>"$WORK/mem/huge.ply"
+  for limit in none 1G; do
+    run encode "$WORK/mem/huge.ply" "$WORK/mem/huge.pomar" --max-memory "$limit"
+    expect_rc 1
+    expect_one_line_error
+    if [ "$count" = 2147483648 ]; then
+      expect_contains "$ERR" "invalid PLY header: bad element line" "stderr"
+    elif [ "$limit" = none ]; then
+      expect_contains "$ERR" "truncated PLY file (vertex 0 of 2147483647)" "stderr"
+    else
+      expect_contains "$ERR" "not enough memory to encode 2,147,483,647 vertices and 1 faces" "stderr"
+    fi
+    expect_no_file "$WORK/mem/huge.pomar"
+  done
+done
+
 # ---- --help ------------------------------------------------------------------------------------------
 
 section "--help"
@@ -465,8 +524,8 @@ help_mentions() { # help_mentions SUBCOMMAND OPTION...
   local opt
   for opt in "$@"; do expect_contains "$OUT" "$opt" "pomar $sub --help"; done
 }
-help_mentions encode --bits --progressive --clusters --cluster-ratio --repair --quiet input output
-help_mentions decode --level --cluster --sphere --box --stats --ascii --quiet --skip-damaged input output
+help_mentions encode --bits --progressive --clusters --cluster-ratio --repair --quiet --max-memory 512M input output
+help_mentions decode --level --cluster --sphere --box --stats --ascii --quiet --skip-damaged --max-memory input output
 help_mentions info --json --check input
 help_mentions verify original pomar decoded --repair
 

@@ -1,6 +1,7 @@
 // libFuzzer target: the .pomar decoders on arbitrary bytes.
 // pomar::Error is the expected way to reject input; anything else (crash, sanitizer
 // report, other exception, hang, OOM) is a finding.
+#include <pomar/limits.h>
 #include <pomar/pomar.h>
 #include <pomar/random_access.h>
 
@@ -69,6 +70,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
 }
 
 namespace {
+// An explicit memory limit (below libFuzzer's -rss_limit_mb=2048) rather than the automatic
+// one: the same input is refused or decoded whatever memory the machine has free.
+constexpr uint64_t kMemoryLimit = 1ull << 30;
+
 void run(const uint8_t *data, size_t size) {
   try {
     pomar::inspect(data, size);
@@ -76,7 +81,7 @@ void run(const uint8_t *data, size_t size) {
   }
   for (int level : {-1, 0, 1}) {
     try {
-      pomar::decode(data, size, level);
+      pomar::decode(data, size, level, {}, kMemoryLimit);
     } catch (const pomar::Error &) {
     }
   }
@@ -84,6 +89,7 @@ void run(const uint8_t *data, size_t size) {
   try {
     pomar::DecodeOptions o;
     o.skip_damaged = true;
+    o.memory_limit = kMemoryLimit;
     pomar::DecodeReport r;
     (void)pomar::decode(data, size, o, &r);
     (void)pomar::check_blocks(data, size);
@@ -92,12 +98,15 @@ void run(const uint8_t *data, size_t size) {
   // (regressions/decoder-crash-da39a3ee...: the empty input used to reach memcpy with a
   // null pointer; fixed in MemorySource::read.)
   try {
-    pomar::SelectiveDecoder d(std::make_unique<pomar::MemorySource>(data, size));
+    pomar::SelectiveOptions so;
+    so.memory_limit = kMemoryLimit;
+    pomar::SelectiveDecoder d(std::make_unique<pomar::MemorySource>(data, size), so);
     const uint32_t n = d.cluster_count();
     const int finest = d.finest_level();
     if (n > 0) {
       d.want_cluster(0, finest);
-      if (n > 1) d.want_cluster(n / 2, d.base_clustered_level() + 1);
+      if (n > 1)
+        d.want_cluster(n / 2, d.base_clustered_level() + 1);
     }
     d.update();
     (void)d.mesh();

@@ -1,6 +1,7 @@
 // libFuzzer target: the mesh file readers (vcglib PLY/OFF/STL, binary STL, tinyobjloader
 // OBJ) via pomar::load_mesh, then pomar::encode on whatever loads.
 // pomar::Error is the expected way to reject input; anything else is a finding.
+#include <pomar/limits.h>
 #include <pomar/mesh_io.h>
 #include <pomar/pomar.h>
 
@@ -14,6 +15,10 @@
 #include <vector>
 
 namespace {
+
+/// Memory limit for loading and encoding (see LLVMFuzzerTestOneInput).
+constexpr uint64_t kMemoryLimit = 1ull << 30;
+
 std::string temp_base() {
   const char *dir = std::getenv("TMPDIR");
   std::string base = std::string(dir && *dir ? dir : "/tmp") + "/pomar_fuzz_readers." +
@@ -47,7 +52,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     bool loaded = false;
     const std::vector<int> fds_before = open_fds();
     try {
-      mesh = pomar::load_mesh(path);
+      // An explicit memory limit (below -rss_limit_mb=2048), checked from the headers:
+      // refusals do not depend on the machine's free memory.
+      mesh = pomar::load_mesh(path, nullptr, [](uint64_t v, uint64_t f) {
+        pomar::check_encode_memory(v, f, kMemoryLimit);
+      });
       loaded = true;
     } catch (const pomar::Error &) {
     }
@@ -64,6 +73,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     if (!loaded) continue;
     try {
       pomar::EncodeOptions opt;
+      opt.memory_limit = kMemoryLimit;
       (void)pomar::encode(mesh, opt);
       if (mesh.vertex_count() >= 8) {
         opt.clusters = 2;

@@ -16,6 +16,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -23,24 +24,37 @@ namespace pomar {
 
 /// What load_mesh found in a file besides the mesh it returns.
 struct LoadReport {
-  std::string format;             ///< "ply", "obj", "off" or "stl"
-  size_t file_vertices = 0;       ///< vertices stored in the file (STL: 3 per facet)
-  size_t file_faces = 0;          ///< faces/polygons in the file (PLY tristrips: triangles)
+  std::string format;               ///< "ply", "obj", "off" or "stl"
+  size_t file_vertices = 0;         ///< vertices stored in the file (STL: 3 per facet)
+  size_t file_faces = 0;            ///< faces/polygons in the file (PLY tristrips: triangles)
   size_t unreferenced_vertices = 0; ///< dropped because no face uses them
-  size_t welded_vertices = 0;     ///< STL only: corners merged with an identical position
+  size_t welded_vertices = 0;       ///< STL only: corners merged with an identical position
   size_t polygons_triangulated = 0; ///< faces with more than 3 vertices, split into triangles
   /// Data present in the file that is not kept, e.g. "normals", "colors",
   /// "texture coordinates", "quality", "materials", "flags", "radius", "edges", "camera".
   std::vector<std::string> ignored_attributes;
 };
 
+/// Called by load_mesh as soon as the file tells how large the mesh is, before the large
+/// allocations: PLY and OFF header counts (PLY again after its structure walk if polygons
+/// or strips make more triangles), binary STL facet count, OBJ 'v' lines and triangles
+/// (after a line scan, before the parser), ASCII STL facets (counted in the text before it
+/// is parsed). Binary STL passes half a vertex per facet (what a closed mesh keeps once
+/// identical corners are welded), ASCII STL one (its text is held while it is parsed). It
+/// may throw pomar::Error to
+/// refuse the file (load_mesh prefixes the path), e.g. for a memory limit:
+///   [&](uint64_t v, uint64_t f) { pomar::check_encode_memory(v, f, limit); }
+using SizeCheck = std::function<void(uint64_t vertices, uint64_t faces)>;
+
 /// Read a triangle mesh. Polygons are split into triangles (PLY/OBJ: fan from the first
 /// vertex; OFF: vcglib's rule, which picks the better diagonal of a quad), STL corners with
 /// exactly equal positions are welded, unreferenced vertices are dropped. Vertex and face
 /// order of the file is kept otherwise. `*report` is reset first. Throws pomar::Error if
 /// the file is missing, unreadable, malformed, has a NaN/Inf coordinate or contains no
-/// triangles, and for files vcglib would misread (see mesh_io.cpp).
-Mesh load_mesh(const std::string &path, LoadReport *report = nullptr);
+/// triangles, and for files vcglib would misread (see mesh_io.cpp), and when `size_check`
+/// throws.
+Mesh load_mesh(const std::string &path, LoadReport *report = nullptr,
+               const SizeCheck &size_check = {});
 
 /// Write a triangle mesh, replacing `path` atomically (see write_file_atomic). `binary`
 /// selects binary little-endian PLY / binary STL (default) or ASCII PLY / ASCII STL; OBJ and

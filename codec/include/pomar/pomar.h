@@ -42,6 +42,10 @@ struct EncodeOptions {
   double cluster_ratio = 0.01;
   bool progressive = false; ///< pure progressive mode: global levels only, no clusters
   Progress progress;        ///< optional
+  /// Peak memory allowed, in bytes: encode() throws pomar::Error before its large
+  /// allocations if it would need more (pomar/limits.h). 0 = automatic (the memory
+  /// available to the process), UINT64_MAX (kNoMemoryLimit) = do not check.
+  uint64_t memory_limit = 0;
 };
 
 /// One refinement level of a file: the mesh it produces and what it costs.
@@ -112,8 +116,11 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options = {},
 FileInfo inspect(const uint8_t *data, size_t size);
 
 /// Decode the mesh after `level` refinement levels (0 = base mesh, -1 = full resolution).
-/// Throws pomar::Error if the image is damaged or truncated (checked per block).
-Mesh decode(const uint8_t *data, size_t size, int level = -1, const Progress &progress = {});
+/// Throws pomar::Error if the image is damaged or truncated (checked per block), or, right
+/// after reading the header, if the mesh would need more memory than `memory_limit` (bytes;
+/// 0 = automatic, UINT64_MAX = do not check; see pomar/limits.h).
+Mesh decode(const uint8_t *data, size_t size, int level = -1, const Progress &progress = {},
+            uint64_t memory_limit = 0);
 
 /// A block of a .pomar file that failed its checks (checksum, structure, or missing from a
 /// truncated file) and was skipped by a decode with `skip_damaged`.
@@ -133,6 +140,9 @@ struct DecodeOptions {
   /// cluster index still fails: nothing can be decoded without them.
   bool skip_damaged = false;
   Progress progress; ///< optional
+  /// Peak memory allowed, in bytes, checked right after the header (0 = automatic,
+  /// UINT64_MAX = do not check; see pomar/limits.h).
+  uint64_t memory_limit = 0;
 };
 
 struct DecodeReport {

@@ -56,17 +56,27 @@ private:
   uint64_t size_ = 0;
 };
 
+struct SelectiveOptions {
+  /// update() decodes around damaged or missing cluster blocks instead of failing (see
+  /// SelectiveDecoder::damaged()); the file may be truncated after its global part; every
+  /// block is read whole so that its check is verified before it is decoded.
+  bool skip_damaged = false;
+  /// Bytes the base clustered mesh may need (0 = automatic, UINT64_MAX = do not check; see
+  /// pomar/limits.h). Later refinement is not checked: it decodes what is asked for.
+  uint64_t memory_limit = 0;
+};
+
 /// Selective, incremental decoder of a .pomar file. Levels are numbered as everywhere
 /// else (0 = base mesh, info().levels.size() = full resolution); clusters can be refined
 /// from base_clustered_level() to finest_level(). A pure progressive file has no
 /// clusters: it decodes to one uniform level (want_level).
 class SelectiveDecoder {
 public:
-  /// Reads the header and the global part (they must be intact). With `skip_damaged`,
-  /// update() decodes around damaged or missing cluster blocks instead of failing (see
-  /// damaged()), the file may be truncated after its global part, and every block is read
-  /// whole so that its check is verified before it is decoded.
-  explicit SelectiveDecoder(std::unique_ptr<ByteSource> source, bool skip_damaged = false);
+  /// Reads the header and global part and decodes the base clustered mesh. Throws
+  /// pomar::Error on a damaged global part, or right after the header if that mesh would
+  /// need more memory than `options.memory_limit` (see SelectiveOptions).
+  explicit SelectiveDecoder(std::unique_ptr<ByteSource> source,
+                            const SelectiveOptions &options = {});
   ~SelectiveDecoder();
   SelectiveDecoder(const SelectiveDecoder &) = delete;
   SelectiveDecoder &operator=(const SelectiveDecoder &) = delete;

@@ -31,7 +31,8 @@ size_t vertex_index(const MeshType &m, const typename MeshType::VertexType *v, s
   const VertexType *first = m.vert.empty() ? nullptr : &m.vert[0];
   const std::less<const VertexType *> less;
   if (v == nullptr || first == nullptr || less(v, first) || !less(v, first + m.vert.size()))
-    throw Error("vcg mesh: face " + std::to_string(face) + " has a vertex pointer outside the vertex array");
+    throw Error("vcg mesh: face " + std::to_string(face) +
+                " has a vertex pointer outside the vertex array");
   return static_cast<size_t>(v - first);
 }
 
@@ -44,8 +45,7 @@ size_t vertex_index(const MeshType &m, const typename MeshType::VertexType *v, s
 /// their relative order and are renumbered compactly; faces keep their order.
 /// Throws pomar::Error if a live face references a deleted vertex or a vertex outside
 /// m.vert, or if a face is not a triangle.
-template <class MeshType>
-Mesh from_vcg(const MeshType &m, size_t *unreferenced = nullptr) {
+template <class MeshType> Mesh from_vcg(const MeshType &m, size_t *unreferenced = nullptr) {
   constexpr uint32_t kUnused = UINT32_MAX;
   std::vector<uint32_t> remap(m.vert.size(), kUnused);
   size_t live_faces = 0;
@@ -114,8 +114,7 @@ Mesh from_vcg(const MeshType &m, size_t *unreferenced = nullptr) {
 /// normals and adjacency are not computed (call vcg::tri::UpdateNormal/UpdateTopology).
 /// Throws pomar::Error (leaving m untouched) if `src` is malformed: array sizes not a
 /// multiple of 3, an index out of range, or more elements than vcglib's int counters hold.
-template <class MeshType>
-void to_vcg(const Mesh &src, MeshType &m) {
+template <class MeshType> void to_vcg(const Mesh &src, MeshType &m) {
   using CoordType = typename MeshType::CoordType;
   using ScalarType = typename MeshType::ScalarType;
 

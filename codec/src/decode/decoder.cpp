@@ -5,6 +5,7 @@
 #include "decode/decoder_codec.h"
 #include "entropy/models.h"
 #include "format/file_format.h"
+#include "pomar/limits.h"
 #include "pomar/random_access.h"
 #include "refine/level_traversal.h"
 
@@ -124,10 +125,12 @@ std::vector<DamagedBlock> check_blocks(const uint8_t *data, size_t size) {
   return damaged;
 }
 
-Mesh decode(const uint8_t *data, size_t size, int level, const Progress &progress) {
+Mesh decode(const uint8_t *data, size_t size, int level, const Progress &progress,
+            uint64_t memory_limit) {
   DecodeOptions options;
   options.level = level;
   options.progress = progress;
+  options.memory_limit = memory_limit;
   return decode(data, size, options);
 }
 
@@ -141,6 +144,7 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
   if (options.level < -1 || options.level > static_cast<int>(levels))
     throw Error("level " + std::to_string(options.level) +
                 " does not exist: the file has levels 0.." + std::to_string(levels));
+  check_decode_memory(file_info(layout, size), options.level, options.memory_limit);
   const size_t target = options.level < 0 ? levels : static_cast<size_t>(options.level);
   const size_t global = h.clustered() ? h.global_levels : levels;
   // Clustered levels go through the selective decoder, unless a global level they build
@@ -155,7 +159,11 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
       }
     }
   if (target > global && global_intact) { // clustered levels: every cluster at `target`
-    SelectiveDecoder d(std::make_unique<MemorySource>(data, size), options.skip_damaged);
+    // Checked above for the whole target level; the constructor's check is smaller.
+    SelectiveOptions so;
+    so.skip_damaged = options.skip_damaged;
+    so.memory_limit = kNoMemoryLimit;
+    SelectiveDecoder d(std::make_unique<MemorySource>(data, size), so);
     d.want_all(static_cast<int>(target));
     d.update(options.progress);
     r.damaged = d.damaged();

@@ -6,6 +6,7 @@
 #include "decode/decoder_codec.h"
 #include "entropy/static_tables.h"
 #include "format/file_format.h"
+#include "pomar/limits.h"
 #include "pomar/random_access.h"
 
 namespace pomar {
@@ -267,11 +268,12 @@ bool SelectiveDecoder::State::skip_cluster(uint32_t c, const Error &e) {
 
 // ---------------------------------------------------------------- construction
 
-SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source, bool skip_damaged)
+SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
+                                   const SelectiveOptions &options)
     : s_(std::make_unique<State>()) {
   State &s = *s_;
   s.source = std::move(source);
-  s.skip_damaged = skip_damaged;
+  s.skip_damaged = options.skip_damaged;
   const uint64_t file_size = s.source->size();
   // Header: fixed part, then its full size.
   s.global.resize(std::min<uint64_t>(file_size, kFixedHeaderBytes));
@@ -282,7 +284,12 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source, bool skip
                 " bytes");
   s.global.resize(hsize);
   s.source->read(0, hsize, s.global.data());
-  s.layout = read_layout(s.global.data(), hsize, file_size, skip_damaged);
+  s.layout = read_layout(s.global.data(), hsize, file_size, options.skip_damaged);
+  // What the constructor decodes: the base clustered mesh (progressive files: the base
+  // mesh). Further refinement is what the caller asks for, region by region.
+  check_decode_memory(file_info(s.layout, file_size),
+                      s.layout.header.clustered() ? int(s.layout.header.global_levels) : 0,
+                      options.memory_limit);
   // The global part (a truncated progressive file: what is there of it).
   s.global.resize(std::min<uint64_t>(s.layout.global_bytes, file_size));
   s.source->read(hsize, s.global.size() - hsize, s.global.data() + hsize);

@@ -14,6 +14,7 @@
 #include "format/file_format.h"
 #include "geometry/quantize.h"
 #include "mesh/reorder.h"
+#include "pomar/limits.h"
 #include "refine/level_traversal.h"
 
 namespace pomar {
@@ -206,6 +207,10 @@ void check_input(const Mesh &mesh, const EncodeOptions &options) {
 std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, EncodeReport *report) {
   auto t0 = std::chrono::steady_clock::now();
   check_input(mesh, options);
+  // The caller already holds the input mesh: an automatic check counts only the rest.
+  const uint64_t held =
+      mesh.positions.size() * sizeof(float) + mesh.triangles.size() * sizeof(uint32_t);
+  check_encode_memory(mesh.vertex_count(), mesh.triangle_count(), options.memory_limit, held);
   std::vector<uint32_t> triangles, compact_to_input;
   const std::vector<float> positions = compact_vertices(mesh, triangles, compact_to_input);
   const uint32_t nv = static_cast<uint32_t>(compact_to_input.size());

@@ -27,8 +27,8 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cerrno>
 #include <cctype>
+#include <cerrno>
 #include <charconv>
 #include <climits>
 #include <cmath>
@@ -37,6 +37,7 @@
 #include <fstream>
 #include <istream>
 #include <streambuf>
+#include <string_view>
 #include <system_error>
 #include <unordered_map>
 
@@ -54,6 +55,18 @@ namespace {
 /// Every error message starts with the path of the file concerned.
 [[noreturn]] void fail(const std::string &path, const std::string &what) {
   throw Error(path + ": " + what);
+}
+
+/// Runs the caller's size check (if any), prefixing its error with the path.
+void run_size_check(const SizeCheck &check, const std::string &path, uint64_t vertices,
+                    uint64_t faces) {
+  if (!check)
+    return;
+  try {
+    check(vertices, faces);
+  } catch (const Error &e) {
+    fail(path, e.what());
+  }
 }
 
 std::string errno_text(int e) { return std::generic_category().message(e); }
@@ -946,12 +959,24 @@ private:
 
 using PlyImporter = vcg::tri::io::ImporterPLY<IoMesh>;
 
-Mesh load_ply(const std::string &path, LoadReport &report) {
+/// The count of the first element with that name (0 if none).
+uint64_t element_count(const PlyHeader &h, const char *name) {
+  for (const PlyElement &e : h.elements)
+    if (e.name == name)
+      return e.count;
+  return 0;
+}
+
+Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &check) {
   PlyLayout layout;
   {
     FileReader in(path);
     const PlyHeader header = read_ply_header(in, path);
+    const uint64_t faces = element_count(header, "face");
+    run_size_check(check, path, element_count(header, "vertex"), faces);
     layout = PlyWalker(in, header, path).run();
+    if (layout.triangles > faces) // polygons or triangle strips
+      run_size_check(check, path, layout.vertices, layout.triangles);
   }
   int file_mask = 0; // what the file has, whatever our mesh type can store
   PlyImporter::LoadMask(path.c_str(), file_mask);
@@ -1031,10 +1056,12 @@ struct OffLayout {
 /// bounds (missing faces, bad indices) or silently misread (garbage numbers).
 class OffWalker {
 public:
-  explicit OffWalker(const std::string &path) : path_(path), lines_(path) {}
+  OffWalker(const std::string &path, const SizeCheck &check)
+      : path_(path), check_(check), lines_(path) {}
 
   OffLayout run() {
     const OffHeader h = header();
+    run_size_check(check_, path_, h.vertices, h.faces);
     tokens_ = lines_.next();
     k_ = 0;
     for (uint64_t i = 0; i < h.vertices; ++i)
@@ -1132,6 +1159,7 @@ private:
   }
 
   std::string path_;
+  const SizeCheck &check_;
   OffLines lines_;
   std::vector<std::string> tokens_;
   size_t k_ = 0;
@@ -1139,9 +1167,9 @@ private:
 
 using OffImporter = vcg::tri::io::ImporterOFF<IoMesh>;
 
-Mesh load_off(const std::string &path, LoadReport &report) {
+Mesh load_off(const std::string &path, LoadReport &report, const SizeCheck &check) {
   check_regular_file(path);
-  const OffLayout layout = OffWalker(path).run();
+  const OffLayout layout = OffWalker(path, check).run();
   IoMesh m;
   int mask = 0;
   const int err = guarded(path, [&] { return OffImporter::Open(m, path.c_str(), mask); });
@@ -1270,30 +1298,66 @@ Mesh read_binary_stl(const std::string &path, uint64_t facets, bool &colored) {
   return mesh;
 }
 
-/// ASCII STL through vcglib (3 new vertices per facet, in file order).
+/// The tokens of a text separated by spaces, tabs, CR and LF (as split_ws), one at a time,
+/// as views into the text: no copy of a file that may be hundreds of megabytes.
+class TokenCursor {
+public:
+  explicit TokenCursor(std::string_view text) : text_(text) {}
+  /// The next token; false at the end of the text.
+  bool next(std::string_view &out) {
+    const size_t begin = text_.find_first_not_of(" \t\r\n", pos_);
+    if (begin == std::string_view::npos)
+      return false;
+    pos_ = std::min(text_.find_first_of(" \t\r\n", begin), text_.size());
+    out = text_.substr(begin, pos_ - begin);
+    return true;
+  }
+
+private:
+  std::string_view text_;
+  size_t pos_ = 0;
+};
+
+/// Counts the occurrences of `word` in `text` (for ASCII STL: "endloop" = facets).
+uint64_t count_occurrences(std::string_view text, std::string_view word) {
+  uint64_t n = 0;
+  for (size_t at = text.find(word); at != text.npos; at = text.find(word, at + word.size()))
+    ++n;
+  return n;
+}
+
 /// ASCII STL, read here rather than by vcglib (whose reader leaks its FILE on a malformed
 /// vertex line, found by fuzzing): every "outer loop" ... "endloop" must hold exactly three
-/// "vertex x y z" lines; everything else (solid names, facet normals) is skipped.
-Mesh read_ascii_stl(const std::string &path) {
+/// "vertex x y z" lines; everything else (solid names, facet normals) is skipped. 3 new
+/// vertices per facet, in file order. The size check sees the facet count ("endloop"
+/// keywords) before the mesh is allocated.
+Mesh read_ascii_stl(const std::string &path, const SizeCheck &check) {
   const std::vector<uint8_t> bytes = read_file(path);
-  const std::vector<std::string> tok =
-      split_ws(std::string(reinterpret_cast<const char *>(bytes.data()), bytes.size()));
+  const std::string_view text(reinterpret_cast<const char *>(bytes.data()), bytes.size());
+  const uint64_t facets = count_occurrences(text, "endloop");
+  // The text (about 250 bytes a facet) stays in memory while the facets are read: counted
+  // as one vertex per facet, twice what the welded mesh keeps (binary STL: see load_stl).
+  run_size_check(check, path, facets, facets);
   Mesh mesh;
+  mesh.positions.reserve(static_cast<size_t>(9 * facets));
+  mesh.triangles.reserve(static_cast<size_t>(3 * facets));
   size_t in_loop = 0, facet = 0;
   bool looping = false;
-  for (size_t i = 0; i < tok.size(); ++i) {
-    if (tok[i] == "loop") {
+  TokenCursor tokens(text);
+  std::string_view tok;
+  while (tokens.next(tok)) {
+    if (tok == "loop") {
       looping = true;
       in_loop = 0;
-    } else if (tok[i] == "vertex") {
+    } else if (tok == "vertex") {
       float v[3];
-      if (!looping || i + 3 >= tok.size() || !parse_float(tok[i + 1], v[0]) ||
-          !parse_float(tok[i + 2], v[1]) || !parse_float(tok[i + 3], v[2]))
-        fail(path, "malformed vertex in ASCII STL facet " + num(facet));
+      std::string_view c;
+      for (float &x : v)
+        if (!looping || !tokens.next(c) || !parse_float(std::string(c), x))
+          fail(path, "malformed vertex in ASCII STL facet " + num(facet));
       mesh.positions.insert(mesh.positions.end(), v, v + 3);
       ++in_loop;
-      i += 3;
-    } else if (tok[i] == "endloop") {
+    } else if (tok == "endloop") {
       if (!looping || in_loop != 3)
         fail(path, "ASCII STL facet " + num(facet) + " has " + num(in_loop) +
                        " vertices (3 expected)");
@@ -1308,10 +1372,16 @@ Mesh read_ascii_stl(const std::string &path) {
   return mesh;
 }
 
-Mesh load_stl(const std::string &path, LoadReport &report) {
+Mesh load_stl(const std::string &path, LoadReport &report, const SizeCheck &check) {
   const StlKind kind = classify_stl(path);
+  // Identical corners are welded below: a closed mesh keeps about one vertex per two
+  // facets, which is what the encoder will hold (the 3 corners per facet read first cost
+  // less than its per-vertex structures).
+  if (kind.binary)
+    run_size_check(check, path, kind.facets / 2, kind.facets);
   bool colored = false;
-  Mesh mesh = kind.binary ? read_binary_stl(path, kind.facets, colored) : read_ascii_stl(path);
+  Mesh mesh =
+      kind.binary ? read_binary_stl(path, kind.facets, colored) : read_ascii_stl(path, check);
   if (colored)
     add_unique(report.ignored_attributes, "colors");
   for (size_t v = 0; v < mesh.vertex_count(); ++v)
@@ -1469,9 +1539,10 @@ size_t drop_unreferenced(Mesh &mesh) {
   return dropped;
 }
 
-Mesh load_obj(const std::string &path, LoadReport &report) {
+Mesh load_obj(const std::string &path, LoadReport &report, const SizeCheck &check) {
   const std::vector<uint8_t> bytes = read_file(path);
   const ObjScan scan = scan_obj(bytes, path);
+  run_size_check(check, path, scan.vertices, scan.triangles);
 
   MemoryBuffer buffer(bytes.data(), bytes.size());
   std::istream stream(&buffer);
@@ -1684,12 +1755,17 @@ std::vector<uint8_t> read_file(const std::string &path) {
     fail(path, "cannot open: " + errno_text(errno));
   FdGuard guard(fd);
   struct stat st;
-  if (::fstat(fd, &st) == 0 && S_ISDIR(st.st_mode))
+  const bool have_stat = ::fstat(fd, &st) == 0;
+  if (have_stat && S_ISDIR(st.st_mode))
     fail(path, "is a directory");
+  // A regular file is read into a buffer of its size (+1 to see the end): growing by
+  // doubling would briefly hold 1.5 times a large file.
   std::vector<uint8_t> data;
+  if (have_stat && S_ISREG(st.st_mode))
+    data.resize(static_cast<size_t>(st.st_size) + 1);
   size_t used = 0;
   for (;;) {
-    if (data.size() - used < 65536)
+    if (used == data.size())
       data.resize(std::max<size_t>(data.size() * 2, used + 65536));
     const ssize_t r = ::read(fd, data.data() + used, data.size() - used);
     if (r < 0 && errno == EINTR)
@@ -1701,7 +1777,8 @@ std::vector<uint8_t> read_file(const std::string &path) {
     used += static_cast<size_t>(r);
   }
   data.resize(used);
-  data.shrink_to_fit();
+  if (data.capacity() - used > used / 8) // grown by doubling (not a regular file)
+    data.shrink_to_fit();
   return data;
 }
 
@@ -1721,7 +1798,7 @@ void write_file_atomic(const std::string &path, const void *data, size_t size) {
   tmp.commit(false);
 }
 
-Mesh load_mesh(const std::string &path, LoadReport *report) {
+Mesh load_mesh(const std::string &path, LoadReport *report, const SizeCheck &size_check) {
   const Format format = format_of(path);
   LoadReport local;
   LoadReport &r = report ? *report : local;
@@ -1729,10 +1806,18 @@ Mesh load_mesh(const std::string &path, LoadReport *report) {
   r.format = format_name(format);
   Mesh mesh;
   switch (format) {
-  case Format::Ply: mesh = load_ply(path, r); break;
-  case Format::Off: mesh = load_off(path, r); break;
-  case Format::Stl: mesh = load_stl(path, r); break;
-  case Format::Obj: mesh = load_obj(path, r); break;
+  case Format::Ply:
+    mesh = load_ply(path, r, size_check);
+    break;
+  case Format::Off:
+    mesh = load_off(path, r, size_check);
+    break;
+  case Format::Stl:
+    mesh = load_stl(path, r, size_check);
+    break;
+  case Format::Obj:
+    mesh = load_obj(path, r, size_check);
+    break;
   }
   if (mesh.triangles.empty())
     fail(path, "contains no triangles");

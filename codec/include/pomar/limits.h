@@ -1,0 +1,70 @@
+// Memory limits: refuse a mesh that will not fit in memory before allocating for it, with
+// a clear pomar::Error, rather than let the machine swap or the kernel kill the process.
+//
+//   estimate     what encoding (loading included) or decoding (writing included) a mesh of
+//                V vertices and F faces needs at its peak, from measured peaks
+//                (bench/README.md, "Memory"), rounded up;
+//   available    what the process may still use: the smallest of MemAvailable, the
+//                cgroup's limit minus its usage and RLIMIT_AS/RLIMIT_DATA minus the
+//                process's use, "unknown" when none can be read;
+//   check        throws when the estimate is above the limit: an explicit byte count, or
+//                0 = automatic (available memory; no check when it is unknown), or
+//                kNoMemoryLimit = no check.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "pomar/pomar.h"
+
+namespace pomar {
+
+/// The memory limit meaning "do not check".
+constexpr uint64_t kNoMemoryLimit = UINT64_MAX;
+
+/// Peak resident memory of loading a mesh file and encoding it (`pomar encode`), for a mesh
+/// of this many vertices and faces. Conservative: a little above the measured peaks.
+uint64_t encode_memory_estimate(uint64_t vertices, uint64_t faces);
+
+/// Peak resident memory of decoding a mesh of this size and writing it out (`pomar
+/// decode`); `clustered` files (random access) need a little more than progressive ones.
+uint64_t decode_memory_estimate(uint64_t vertices, uint64_t faces, bool clustered);
+
+/// Memory this process may still use, and which bound gave it.
+struct AvailableMemory {
+  bool known = false; ///< false: nothing could be read (then nothing is refused)
+  uint64_t bytes = 0; ///< the smallest bound
+  std::string source; ///< "MemAvailable", "cgroup memory.max", "RLIMIT_AS", ...
+};
+
+/// Reads /proc/meminfo, the process's cgroup (v2 memory.max/memory.current or v1
+/// memory.limit_in_bytes/memory.usage_in_bytes, each ancestor too, page cache that can be
+/// dropped counted as free) and RLIMIT_AS/RLIMIT_DATA against /proc/self/status. `root`
+/// is prepended to the /proc and /sys paths (for tests; the rlimits are the process's own).
+AvailableMemory available_memory(const std::string &root = "");
+
+/// Parses a memory size: a plain byte count ("1048576"), or a number (decimals allowed)
+/// with a unit K, M, G or T, optionally followed by "B" or "iB", any case ("512M", "2G",
+/// "1.5GiB", "64kb"); units are powers of 1024. "none" (or "unlimited") gives
+/// kNoMemoryLimit and "auto" gives 0. Throws pomar::Error naming the text otherwise.
+uint64_t parse_memory_size(const std::string &text);
+
+/// "18.2 GiB", "512.0 MiB", "900 bytes".
+std::string format_memory_size(uint64_t bytes);
+
+/// Throws pomar::Error if `needed` bytes do not fit in `limit` (0 = automatic, see above):
+/// "not enough memory to <action> <V> vertices and <F> faces: needs about 18.2 GiB, 7.1 GiB
+/// available (MemAvailable); use --max-memory to change the limit". `held` is what the
+/// caller already holds of `needed` (the input mesh): an automatic check compares the rest
+/// with what is available; an explicit limit bounds the whole peak.
+void check_memory(const char *action, uint64_t vertices, uint64_t faces, uint64_t needed,
+                  uint64_t held, uint64_t limit);
+
+/// check_memory with encode_memory_estimate (action "encode").
+void check_encode_memory(uint64_t vertices, uint64_t faces, uint64_t limit, uint64_t held = 0);
+
+/// check_memory with decode_memory_estimate for the mesh of `level` (-1 = full resolution)
+/// of the file `info` describes (action "decode").
+void check_decode_memory(const FileInfo &info, int level, uint64_t limit);
+
+} // namespace pomar

@@ -1,0 +1,304 @@
+// Memory limits (pomar/limits.h): estimates from measured peaks, the memory available to
+// the process, and the check that refuses a mesh before the large allocations.
+#include "pomar/limits.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+#include <sys/resource.h>
+
+namespace pomar {
+namespace {
+
+// ------------------------------------------------------------------ estimates
+//
+// Linear fits (fixed + per vertex + per face) of the peak resident set size of `pomar
+// encode` / `pomar decode` (random access and --progressive files), measured with
+// /usr/bin/time on closed meshes (F = 2V) and open strips (F = V, F = 4V/3) of 30k to 2M
+// vertices, rounded up so that every measured peak is at least 15% below the estimate
+// (bench/README.md, "Memory"). Least-squares fits: encode 13.7 MiB + 258 B/vertex +
+// 127 B/face; decode 4.8 MiB + 56 B/vertex + 52 B/face (random access), 4.2 MiB + 75
+// B/vertex + 34 B/face (progressive). Small meshes peak above the fit (allocator, vcglib
+// buffers): hence the larger fixed parts.
+
+constexpr uint64_t kEncodeFixed = 24ull << 20;
+constexpr uint64_t kEncodePerVertex = 300;
+constexpr uint64_t kEncodePerFace = 150;
+
+constexpr uint64_t kDecodeFixed = 8ull << 20;
+constexpr uint64_t kClusteredDecodePerVertex = 64;
+constexpr uint64_t kClusteredDecodePerFace = 60;
+constexpr uint64_t kProgressiveDecodePerVertex = 86;
+constexpr uint64_t kProgressiveDecodePerFace = 40;
+
+/// a + b * c, saturating at UINT64_MAX (counts come from untrusted headers).
+uint64_t add_mul(uint64_t a, uint64_t b, uint64_t c) {
+  if (c != 0 && b > (UINT64_MAX - a) / c)
+    return UINT64_MAX;
+  return a + b * c;
+}
+
+// ------------------------------------------------------------------ reading /proc and /sys
+
+/// The whole (small) file, or "" if it cannot be read.
+std::string slurp(const std::string &path) {
+  std::ifstream in(path);
+  if (!in)
+    return "";
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// The number after "key" at the start of a line ("MemAvailable:   123 kB"), times
+/// `unit`; false if there is no such line.
+bool find_field(const std::string &text, const std::string &key, uint64_t unit, uint64_t &out) {
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.compare(0, key.size(), key) != 0)
+      continue;
+    const char *p = line.c_str() + key.size();
+    while (*p == ' ' || *p == '\t' || *p == ':')
+      ++p;
+    char *end = nullptr;
+    errno = 0;
+    const unsigned long long v = std::strtoull(p, &end, 10);
+    if (end == p || errno != 0)
+      return false;
+    out = v > UINT64_MAX / unit ? UINT64_MAX : v * unit;
+    return true;
+  }
+  return false;
+}
+
+/// A cgroup limit file: a byte count, or "max" / a huge value for "no limit" (false).
+bool read_limit(const std::string &path, uint64_t &out) {
+  const std::string text = slurp(path);
+  if (text.empty() || text.compare(0, 3, "max") == 0)
+    return false;
+  char *end = nullptr;
+  errno = 0;
+  const unsigned long long v = std::strtoull(text.c_str(), &end, 10);
+  if (end == text.c_str() || errno != 0 || v >= (1ull << 60)) // v1 "unlimited" is ~2^63
+    return false;
+  out = v;
+  return true;
+}
+
+/// Keeps the smaller bound.
+void offer(AvailableMemory &best, uint64_t bytes, const std::string &source) {
+  if (!best.known || bytes < best.bytes) {
+    best.known = true;
+    best.bytes = bytes;
+    best.source = source;
+  }
+}
+
+/// The cgroup paths of this process: "0::/a/b" (v2) and the v1 memory controller's.
+void cgroup_paths(const std::string &root, std::string &v2, std::string &v1) {
+  std::istringstream in(slurp(root + "/proc/self/cgroup"));
+  std::string line;
+  while (std::getline(in, line)) {
+    const size_t a = line.find(':'), b = a == std::string::npos ? a : line.find(':', a + 1);
+    if (b == std::string::npos)
+      continue;
+    const std::string controllers = "," + line.substr(a + 1, b - a - 1) + ",";
+    if (line.compare(0, a, "0") == 0 && b == a + 1)
+      v2 = line.substr(b + 1);
+    else if (controllers.find(",memory,") != std::string::npos)
+      v1 = line.substr(b + 1);
+  }
+}
+
+/// `dir` and its ancestors up to `top` (both absolute, dir inside top).
+std::vector<std::string> up_to(const std::string &top, std::string rel) {
+  std::vector<std::string> dirs;
+  while (!rel.empty() && rel != "/") {
+    dirs.push_back(top + rel);
+    rel = rel.substr(0, rel.find_last_of('/'));
+  }
+  dirs.push_back(top);
+  return dirs;
+}
+
+/// limit - usage + the page cache the kernel can drop, for every cgroup from this
+/// process's up to the root of the hierarchy (a parent's limit binds too).
+void offer_cgroups(const std::string &root, AvailableMemory &best) {
+  std::string v2, v1;
+  cgroup_paths(root, v2, v1);
+  struct Kind {
+    std::string top, rel, limit, usage, cache, name;
+  };
+  const Kind kinds[] = {
+      {root + "/sys/fs/cgroup", v2, "memory.max", "memory.current", "inactive_file",
+       "cgroup memory.max"},
+      {root + "/sys/fs/cgroup/memory", v1, "memory.limit_in_bytes", "memory.usage_in_bytes",
+       "total_inactive_file", "cgroup memory.limit_in_bytes"},
+  };
+  for (const Kind &k : kinds)
+    for (const std::string &dir : up_to(k.top, k.rel)) {
+      uint64_t limit = 0, usage = 0, cache = 0;
+      if (!read_limit(dir + "/" + k.limit, limit) || !read_limit(dir + "/" + k.usage, usage))
+        continue;
+      find_field(slurp(dir + "/memory.stat"), k.cache + " ", 1, cache);
+      const uint64_t used = usage - std::min(usage, cache);
+      offer(best, limit - std::min(limit, used), k.name);
+    }
+}
+
+/// RLIMIT_AS against the process's virtual size, RLIMIT_DATA against its data segment.
+void offer_rlimits(const std::string &root, AvailableMemory &best) {
+  const std::string status = slurp(root + "/proc/self/status");
+  const struct {
+    int resource;
+    const char *field, *name;
+  } limits[] = {{RLIMIT_AS, "VmSize", "RLIMIT_AS"}, {RLIMIT_DATA, "VmData", "RLIMIT_DATA"}};
+  for (const auto &l : limits) {
+    struct rlimit r;
+    if (::getrlimit(l.resource, &r) != 0 || r.rlim_cur == RLIM_INFINITY)
+      continue;
+    uint64_t used = 0;
+    find_field(status, l.field, 1024, used);
+    const uint64_t cap = static_cast<uint64_t>(r.rlim_cur);
+    offer(best, cap - std::min(cap, used), l.name);
+  }
+}
+
+/// 1,234,567
+std::string grouped(uint64_t v) {
+  std::string digits = std::to_string(v), out;
+  for (size_t i = 0; i < digits.size(); ++i) {
+    if (i > 0 && (digits.size() - i) % 3 == 0)
+      out += ',';
+    out += digits[i];
+  }
+  return out;
+}
+
+std::string lower(std::string s) {
+  for (char &c : s)
+    c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+} // namespace
+
+uint64_t encode_memory_estimate(uint64_t vertices, uint64_t faces) {
+  return add_mul(add_mul(kEncodeFixed, vertices, kEncodePerVertex), faces, kEncodePerFace);
+}
+
+uint64_t decode_memory_estimate(uint64_t vertices, uint64_t faces, bool clustered) {
+  const uint64_t per_vertex = clustered ? kClusteredDecodePerVertex : kProgressiveDecodePerVertex;
+  const uint64_t per_face = clustered ? kClusteredDecodePerFace : kProgressiveDecodePerFace;
+  return add_mul(add_mul(kDecodeFixed, vertices, per_vertex), faces, per_face);
+}
+
+AvailableMemory available_memory(const std::string &root) {
+  AvailableMemory best;
+  uint64_t bytes = 0;
+  if (find_field(slurp(root + "/proc/meminfo"), "MemAvailable", 1024, bytes))
+    offer(best, bytes, "MemAvailable");
+  offer_cgroups(root, best);
+  offer_rlimits(root, best);
+  return best;
+}
+
+uint64_t parse_memory_size(const std::string &text) {
+  const std::string t = lower(text);
+  if (t == "none" || t == "unlimited")
+    return kNoMemoryLimit;
+  if (t == "auto")
+    return 0;
+  auto bad = [&] {
+    return Error("bad memory size '" + text +
+                 "': expected bytes or a number with K, M, G or T (e.g. 512M, 1.5GiB), "
+                 "'auto' or 'none'");
+  };
+  size_t digits = 0;
+  while (digits < t.size() &&
+         (std::isdigit(static_cast<unsigned char>(t[digits])) || t[digits] == '.'))
+    ++digits;
+  if (digits == 0)
+    throw bad();
+  const std::string number = t.substr(0, digits), unit = t.substr(digits);
+  static const struct {
+    const char *name;
+    int shift;
+  } units[] = {{"", 0},     {"b", 0},   {"k", 10},   {"kb", 10}, {"kib", 10},
+               {"m", 20},   {"mb", 20}, {"mib", 20}, {"g", 30},  {"gb", 30},
+               {"gib", 30}, {"t", 40},  {"tb", 40},  {"tib", 40}};
+  int shift = -1;
+  for (const auto &u : units)
+    if (unit == u.name)
+      shift = u.shift;
+  char *end = nullptr;
+  const double value = std::strtod(number.c_str(), &end);
+  if (shift < 0 || end != number.c_str() + number.size() || !std::isfinite(value))
+    throw bad();
+  const double bytes = std::ceil(std::ldexp(value, shift));
+  if (bytes >= 18446744073709551615.0)
+    throw Error("memory size '" + text + "' is too large (use 'none' for no limit)");
+  return static_cast<uint64_t>(bytes);
+}
+
+std::string format_memory_size(uint64_t bytes) {
+  if (bytes < 1024)
+    return std::to_string(bytes) + " bytes";
+  static const char *const units[] = {"KiB", "MiB", "GiB", "TiB", "PiB", "EiB"};
+  double v = double(bytes) / 1024;
+  int u = 0;
+  while (v >= 1024 && u < 5)
+    v /= 1024, ++u;
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f %s", v, units[u]);
+  return buf;
+}
+
+void check_memory(const char *action, uint64_t vertices, uint64_t faces, uint64_t needed,
+                  uint64_t held, uint64_t limit) {
+  if (limit == kNoMemoryLimit)
+    return;
+  std::string have;
+  uint64_t need = needed;
+  if (limit == 0) { // automatic: the part not yet held against what is available
+    const AvailableMemory a = available_memory();
+    if (!a.known)
+      return;
+    need = needed - std::min(needed, held);
+    if (need <= a.bytes)
+      return;
+    have = format_memory_size(a.bytes) + " available (" + a.source + ")";
+  } else {
+    if (needed <= limit)
+      return;
+    have = "the limit is " + format_memory_size(limit);
+  }
+  throw Error(std::string("not enough memory to ") + action + " " + grouped(vertices) +
+              " vertices and " + grouped(faces) + " faces: needs about " +
+              format_memory_size(need) + (need != needed ? " more" : "") + ", " + have +
+              "; use --max-memory to change the limit");
+}
+
+void check_encode_memory(uint64_t vertices, uint64_t faces, uint64_t limit, uint64_t held) {
+  check_memory("encode", vertices, faces, encode_memory_estimate(vertices, faces), held, limit);
+}
+
+void check_decode_memory(const FileInfo &info, int level, uint64_t limit) {
+  uint64_t v = info.vertices, f = info.faces;
+  if (level == 0) {
+    v = info.base_vertices, f = info.base_faces;
+  } else if (level > 0 && static_cast<size_t>(level) <= info.levels.size()) {
+    v = info.levels[size_t(level) - 1].vertices, f = info.levels[size_t(level) - 1].faces;
+  }
+  check_memory("decode", v, f, decode_memory_estimate(v, f, info.clustered()), 0, limit);
+}
+
+} // namespace pomar

@@ -1,0 +1,280 @@
+// Memory limits (pomar/limits.h): the size parser, the estimates, the check with explicit
+// limits, available memory read from a fake /proc and /sys tree, and the checks in
+// encode(), decode() and SelectiveDecoder. Nothing here depends on this machine's memory.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <vector>
+
+#include "pomar/limits.h"
+#include "pomar/pomar.h"
+#include "pomar/random_access.h"
+#include "support/mesh_gen.h"
+
+namespace pomar {
+namespace {
+
+/// The message of the pomar::Error that `f` throws ("" and a test failure if none).
+template <class F> std::string error_of(F f) {
+  try {
+    f();
+  } catch (const Error &e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no pomar::Error thrown";
+  return "";
+}
+
+// ------------------------------------------------------------------ parse / format
+
+TEST(MemorySize, ParsesBytesUnitsAndKeywords) {
+  EXPECT_EQ(parse_memory_size("0"), 0u);
+  EXPECT_EQ(parse_memory_size("1048576"), 1048576u);
+  EXPECT_EQ(parse_memory_size("512M"), 512ull << 20);
+  EXPECT_EQ(parse_memory_size("2G"), 2ull << 30);
+  EXPECT_EQ(parse_memory_size("1.5GiB"), 3ull << 29);
+  EXPECT_EQ(parse_memory_size("64kb"), 64ull << 10);
+  EXPECT_EQ(parse_memory_size("3T"), 3ull << 40);
+  EXPECT_EQ(parse_memory_size("100B"), 100u);
+  EXPECT_EQ(parse_memory_size("0.5k"), 512u);
+  EXPECT_EQ(parse_memory_size("1.0001K"), 1025u); // rounded up to whole bytes
+  EXPECT_EQ(parse_memory_size("none"), kNoMemoryLimit);
+  EXPECT_EQ(parse_memory_size("NONE"), kNoMemoryLimit);
+  EXPECT_EQ(parse_memory_size("unlimited"), kNoMemoryLimit);
+  EXPECT_EQ(parse_memory_size("auto"), 0u);
+}
+
+TEST(MemorySize, RefusesWhatIsNotASize) {
+  for (const char *bad : {"", "M", "12x", "1.5.2G", "-1", "1 G", "1e9", "GiB", "2Gi", "0x10"}) {
+    const std::string msg = error_of([&] { parse_memory_size(bad); });
+    EXPECT_NE(msg.find("bad memory size '" + std::string(bad) + "'"), std::string::npos) << msg;
+  }
+  EXPECT_NE(error_of([] { parse_memory_size("99999999T"); }).find("too large"), std::string::npos);
+}
+
+TEST(MemorySize, FormatsWithBinaryUnits) {
+  EXPECT_EQ(format_memory_size(900), "900 bytes");
+  EXPECT_EQ(format_memory_size(1024), "1.0 KiB");
+  EXPECT_EQ(format_memory_size(512ull << 20), "512.0 MiB");
+  EXPECT_EQ(format_memory_size(uint64_t(18.2 * double(1ull << 30))), "18.2 GiB");
+}
+
+// ------------------------------------------------------------------ estimates
+
+TEST(MemoryEstimate, IsAboveTheMeasuredPeaks) {
+  // Peak RSS (KiB) of `pomar encode` / `pomar decode` measured with /usr/bin/time
+  // (bench/README.md, "Memory"): vertices, faces, encode, decode random access, decode
+  // progressive. The estimates must stay above them with some margin.
+  struct Peak {
+    uint64_t v, f, enc, dec_ra, dec_prog;
+  } peaks[] = {{34834, 69451, 25760, 10392, 9344},          // bunny
+               {299292, 598580, 175148, 52496, 46100},      // noisy sphere 300k
+               {998562, 1997120, 521644, 161328, 140748},   // noisy sphere 1M
+               {1998092, 3996180, 1007336, 314904, 282200}, // noisy sphere 2M
+               {437645, 871414, 236376, 71864, 64924},      // dragon
+               {1000000, 999998, 393032, 111436, 109152},   // 2-row strip
+               {900000, 1199996, 385832, 111452, 111672}};  // 3-row strip
+  for (const Peak &p : peaks) {
+    EXPECT_GT(encode_memory_estimate(p.v, p.f), p.enc * 1024 * 11 / 10) << p.v;
+    EXPECT_GT(decode_memory_estimate(p.v, p.f, true), p.dec_ra * 1024 * 11 / 10) << p.v;
+    EXPECT_GT(decode_memory_estimate(p.v, p.f, false), p.dec_prog * 1024 * 11 / 10) << p.v;
+  }
+}
+
+TEST(MemoryEstimate, GrowsWithTheMeshAndSaturates) {
+  EXPECT_LT(encode_memory_estimate(1000, 2000), encode_memory_estimate(2000, 2000));
+  EXPECT_LT(encode_memory_estimate(1000, 2000), encode_memory_estimate(1000, 4000));
+  EXPECT_LT(decode_memory_estimate(1000, 2000, true), decode_memory_estimate(1000, 4000, true));
+  // 50M vertices and 100M faces: tens of GiB, not a wrapped-around small number.
+  EXPECT_GT(encode_memory_estimate(50000000, 100000000), 16ull << 30);
+  EXPECT_EQ(encode_memory_estimate(UINT64_MAX / 2, UINT64_MAX / 2), UINT64_MAX);
+  EXPECT_EQ(decode_memory_estimate(UINT64_MAX, 1, false), UINT64_MAX);
+}
+
+// ------------------------------------------------------------------ the check
+
+TEST(MemoryCheck, ExplicitLimitRefusesWithCountsAndSizes) {
+  const uint64_t need = encode_memory_estimate(50000000, 100000000);
+  const std::string msg = error_of([&] { check_encode_memory(50000000, 100000000, 1ull << 30); });
+  EXPECT_EQ(msg, "not enough memory to encode 50,000,000 vertices and 100,000,000 faces: needs "
+                 "about " +
+                     format_memory_size(need) +
+                     ", the limit is 1.0 GiB; use --max-memory to change the limit");
+  EXPECT_NO_THROW(check_encode_memory(50000000, 100000000, need));
+  EXPECT_THROW(check_encode_memory(50000000, 100000000, need - 1), Error);
+  // An explicit limit bounds the whole peak: what the caller holds does not count.
+  EXPECT_THROW(check_encode_memory(50000000, 100000000, need - 1, need), Error);
+  EXPECT_NO_THROW(check_encode_memory(50000000, 100000000, kNoMemoryLimit));
+  EXPECT_NO_THROW(check_memory("decode", 1, 1, UINT64_MAX, 0, kNoMemoryLimit));
+}
+
+TEST(MemoryCheck, DecodeCheckUsesTheCountsOfTheRequestedLevel) {
+  FileInfo info;
+  info.vertices = 1000000, info.faces = 2000000;
+  info.base_vertices = 10, info.base_faces = 16;
+  info.levels = {{1000, 2000, 0, 0}, {1000000, 2000000, 0, 0}};
+  const uint64_t full = decode_memory_estimate(1000000, 2000000, false);
+  EXPECT_THROW(check_decode_memory(info, -1, full - 1), Error);
+  EXPECT_THROW(check_decode_memory(info, 2, full - 1), Error);
+  EXPECT_NO_THROW(check_decode_memory(info, 1, decode_memory_estimate(1000, 2000, false)));
+  EXPECT_NO_THROW(check_decode_memory(info, 0, decode_memory_estimate(10, 16, false)));
+  const std::string msg = error_of([&] { check_decode_memory(info, 1, 1024); });
+  EXPECT_NE(msg.find("not enough memory to decode 1,000 vertices and 2,000 faces"),
+            std::string::npos)
+      << msg;
+}
+
+// ------------------------------------------------------------------ available memory
+
+/// A fake root with /proc and /sys files, removed afterwards.
+class FakeRoot : public ::testing::Test {
+protected:
+  void SetUp() override {
+    std::string pattern = ::testing::TempDir() + "/pomar_limits_XXXXXX";
+    ASSERT_NE(mkdtemp(&pattern[0]), nullptr);
+    root_ = pattern;
+  }
+  void TearDown() override { std::system(("rm -rf '" + root_ + "'").c_str()); }
+
+  void put(const std::string &rel, const std::string &text) {
+    const std::string full = root_ + rel;
+    std::system(("mkdir -p '" + full.substr(0, full.find_last_of('/')) + "'").c_str());
+    std::ofstream(full) << text;
+  }
+  /// The rlimits are the process's own: tests that expect none to bind skip if one is set.
+  static bool rlimits_set() {
+    struct rlimit r;
+    for (int res : {RLIMIT_AS, RLIMIT_DATA})
+      if (getrlimit(res, &r) == 0 && r.rlim_cur != RLIM_INFINITY)
+        return true;
+    return false;
+  }
+  std::string root_;
+};
+
+TEST_F(FakeRoot, NothingReadableMeansUnknownAndNoRefusal) {
+  if (rlimits_set())
+    GTEST_SKIP() << "an address-space or data rlimit is set for this process";
+  const AvailableMemory a = available_memory(root_);
+  EXPECT_FALSE(a.known);
+}
+
+TEST_F(FakeRoot, MemAvailableAlone) {
+  if (rlimits_set())
+    GTEST_SKIP() << "an address-space or data rlimit is set for this process";
+  put("/proc/meminfo", "MemTotal:       16000000 kB\nMemFree:  100 kB\n"
+                       "MemAvailable:    7444889 kB\nBuffers: 1 kB\n");
+  const AvailableMemory a = available_memory(root_);
+  ASSERT_TRUE(a.known);
+  EXPECT_EQ(a.bytes, 7444889ull * 1024);
+  EXPECT_EQ(a.source, "MemAvailable");
+}
+
+TEST_F(FakeRoot, CgroupV2LimitBindsWhenSmaller) {
+  if (rlimits_set())
+    GTEST_SKIP() << "an address-space or data rlimit is set for this process";
+  put("/proc/meminfo", "MemAvailable: 8000000 kB\n");
+  put("/proc/self/cgroup", "0::/job/step\n");
+  // The process's own cgroup has no limit; its parent allows 1 GiB with 300 MiB used, of
+  // which 100 MiB is page cache that can be dropped.
+  put("/sys/fs/cgroup/job/step/memory.max", "max\n");
+  put("/sys/fs/cgroup/job/step/memory.current", "104857600\n");
+  put("/sys/fs/cgroup/job/memory.max", "1073741824\n");
+  put("/sys/fs/cgroup/job/memory.current", "314572800\n");
+  put("/sys/fs/cgroup/job/memory.stat", "anon 1\ninactive_file 104857600\nactive_file 5\n");
+  const AvailableMemory a = available_memory(root_);
+  ASSERT_TRUE(a.known);
+  EXPECT_EQ(a.bytes, (1024ull - 200) << 20);
+  EXPECT_EQ(a.source, "cgroup memory.max");
+}
+
+TEST_F(FakeRoot, CgroupV1LimitAndUnlimitedMarker) {
+  if (rlimits_set())
+    GTEST_SKIP() << "an address-space or data rlimit is set for this process";
+  put("/proc/meminfo", "MemAvailable: 4000000 kB\n");
+  put("/proc/self/cgroup", "5:cpu,cpuacct:/\n4:memory:/box\n0::/\n");
+  put("/sys/fs/cgroup/memory/memory.limit_in_bytes", "9223372036854771712\n"); // unlimited
+  put("/sys/fs/cgroup/memory/memory.usage_in_bytes", "5000000000\n");
+  put("/sys/fs/cgroup/memory/box/memory.limit_in_bytes", "2147483648\n");
+  put("/sys/fs/cgroup/memory/box/memory.usage_in_bytes", "1073741824\n");
+  put("/sys/fs/cgroup/memory/box/memory.stat", "cache 9\ntotal_inactive_file 0\n");
+  AvailableMemory a = available_memory(root_);
+  ASSERT_TRUE(a.known);
+  EXPECT_EQ(a.bytes, 1ull << 30);
+  EXPECT_EQ(a.source, "cgroup memory.limit_in_bytes");
+  // Over the limit (usage can exceed it briefly): nothing available, not a wrap-around.
+  put("/sys/fs/cgroup/memory/box/memory.usage_in_bytes", "3000000000\n");
+  a = available_memory(root_);
+  EXPECT_EQ(a.bytes, 0u);
+}
+
+TEST_F(FakeRoot, MemAvailableBindsWhenSmallerThanTheCgroup) {
+  if (rlimits_set())
+    GTEST_SKIP() << "an address-space or data rlimit is set for this process";
+  put("/proc/meminfo", "MemAvailable: 1024 kB\n");
+  put("/proc/self/cgroup", "0::/\n");
+  put("/sys/fs/cgroup/memory.max", "1073741824\n");
+  put("/sys/fs/cgroup/memory.current", "0\n");
+  const AvailableMemory a = available_memory(root_);
+  EXPECT_EQ(a.bytes, 1u << 20);
+  EXPECT_EQ(a.source, "MemAvailable");
+}
+
+TEST(AvailableMemory, ThisMachineGivesSomethingPlausibleOrUnknown) {
+  const AvailableMemory a = available_memory();
+  if (!a.known)
+    GTEST_SKIP() << "no /proc/meminfo, cgroup or rlimit readable here";
+  EXPECT_GT(a.bytes, 0u);
+  EXPECT_FALSE(a.source.empty());
+}
+
+// ------------------------------------------------------------------ in the codec
+
+TEST(MemoryCheck, EncodeRefusesBeforeWorkingAndHonoursNone) {
+  const Mesh mesh = gen::icosphere(3);
+  EncodeOptions opt;
+  opt.memory_limit = 1 << 20; // 1 MiB: below the fixed part of any estimate
+  const std::string msg = error_of([&] { encode(mesh, opt); });
+  EXPECT_NE(msg.find("not enough memory to encode 642 vertices and 1,280 faces"), std::string::npos)
+      << msg;
+  opt.memory_limit = kNoMemoryLimit;
+  EXPECT_FALSE(encode(mesh, opt).empty());
+  opt.memory_limit = encode_memory_estimate(mesh.vertex_count(), mesh.triangle_count());
+  EXPECT_FALSE(encode(mesh, opt).empty());
+}
+
+TEST(MemoryCheck, DecodeAndSelectiveDecoderRefuseAfterTheHeader) {
+  const Mesh mesh = gen::icosphere(4);
+  EncodeOptions eo;
+  eo.clusters = 8;
+  const std::vector<uint8_t> file = encode(mesh, eo);
+  const FileInfo info = inspect(file.data(), file.size());
+  ASSERT_TRUE(info.clustered());
+  // Full resolution needs the full estimate; level 0 only the base mesh's.
+  const uint64_t full = decode_memory_estimate(info.vertices, info.faces, true);
+  EXPECT_THROW(decode(file.data(), file.size(), -1, {}, full - 1), Error);
+  EXPECT_EQ(decode(file.data(), file.size(), -1, {}, full).vertex_count(), info.vertices);
+  EXPECT_EQ(decode(file.data(), file.size(), 0, {}, full - 1).vertex_count(), info.base_vertices);
+  // A level above the global ones goes through the selective decoder: still the full check.
+  EXPECT_THROW(decode(file.data(), file.size(), int(info.levels.size()), {}, full - 1), Error);
+  const std::string msg = error_of([&] {
+    SelectiveDecoder d(std::make_unique<MemorySource>(file.data(), file.size()), {false, 1024});
+  });
+  const LevelInfo &base_clustered = info.levels[info.global_levels - 1];
+  EXPECT_NE(msg.find("not enough memory to decode " + std::to_string(base_clustered.vertices) +
+                     " vertices"),
+            std::string::npos)
+      << msg;
+  SelectiveDecoder d(std::make_unique<MemorySource>(file.data(), file.size()),
+                     {false, kNoMemoryLimit});
+  EXPECT_EQ(d.cluster_count(), info.clusters);
+}
+
+} // namespace
+} // namespace pomar

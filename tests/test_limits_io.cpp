@@ -1,0 +1,123 @@
+// load_mesh's size check (pomar/mesh_io.h SizeCheck): it sees the counts each format's
+// header gives before the mesh is read, and its error is reported with the file's path.
+#include <pomar/limits.h>
+#include <pomar/mesh_io.h>
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "support/mesh_gen.h"
+
+namespace pomar {
+namespace {
+
+class SizeCheckTest : public ::testing::Test {
+protected:
+  void SetUp() override {
+    std::string pattern = ::testing::TempDir() + "/pomar_size_check_XXXXXX";
+    ASSERT_NE(mkdtemp(&pattern[0]), nullptr);
+    dir_ = pattern;
+  }
+  void TearDown() override { std::system(("rm -rf '" + dir_ + "'").c_str()); }
+  std::string path(const std::string &name) const { return dir_ + "/" + name; }
+  std::string write(const std::string &name, const std::string &bytes) const {
+    std::ofstream(path(name), std::ios::binary) << bytes;
+    return path(name);
+  }
+  std::string dir_;
+};
+
+/// The counts the check was called with, in order.
+struct Calls {
+  std::vector<std::pair<uint64_t, uint64_t>> seen;
+  SizeCheck record() {
+    return [this](uint64_t v, uint64_t f) { seen.emplace_back(v, f); };
+  }
+};
+
+TEST_F(SizeCheckTest, SeesTheCountsOfEveryFormat) {
+  const Mesh cube = gen::icosphere(1); // 42 vertices, 80 triangles
+  struct Case {
+    const char *name;
+    bool binary;
+    std::vector<std::pair<uint64_t, uint64_t>> expected;
+  } cases[] = {
+      {"m.ply", true, {{42, 80}}},  {"m.off", false, {{42, 80}}}, {"m.obj", false, {{42, 80}}},
+      {"m.stl", true, {{40, 80}}},  // binary STL: half a vertex per facet
+      {"a.stl", false, {{80, 80}}}, // ASCII STL: one per facet (its text is held)
+  };
+  for (const Case &c : cases) {
+    save_mesh(path(c.name), cube, c.binary);
+    Calls calls;
+    const Mesh m = load_mesh(path(c.name), nullptr, calls.record());
+    EXPECT_EQ(m.triangle_count(), 80u) << c.name;
+    EXPECT_EQ(calls.seen, c.expected) << c.name;
+  }
+}
+
+TEST_F(SizeCheckTest, PolygonsAreCheckedAgainWithTheirTriangles) {
+  const std::string ply =
+      write("quads.ply", "ply\nformat ascii 1.0\nelement vertex 5\n"
+                         "property float x\nproperty float y\nproperty float z\n"
+                         "element face 1\nproperty list uchar int vertex_indices\n"
+                         "end_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 2 0\n"
+                         "5 0 1 2 3 4\n");
+  Calls calls;
+  load_mesh(ply, nullptr, calls.record());
+  const std::vector<std::pair<uint64_t, uint64_t>> expected = {{5, 1}, {5, 3}};
+  EXPECT_EQ(calls.seen, expected);
+}
+
+TEST_F(SizeCheckTest, RefusalNamesThePathAndComesBeforeTheBody) {
+  // A header promising 2^31 - 1 vertices over a 12-byte body: the check refuses from the
+  // header; without a check the structure walk reports the truncation. Neither allocates
+  // for the promised vertices.
+  const std::string ply = write("huge.ply", std::string("ply\nformat binary_little_endian 1.0\n"
+                                                        "element vertex 2147483647\n"
+                                                        "property float x\nproperty float y\n"
+                                                        "property float z\nelement face 1\n"
+                                                        "property list uchar int vertex_indices\n"
+                                                        "end_header\n") +
+                                                std::string(12, '\0'));
+  try {
+    load_mesh(ply, nullptr, [](uint64_t v, uint64_t f) { check_encode_memory(v, f, 1ull << 30); });
+    ADD_FAILURE() << "no error";
+  } catch (const Error &e) {
+    EXPECT_EQ(std::string(e.what()).rfind(ply + ": not enough memory to encode 2,147,483,647 "
+                                                "vertices and 1 faces: needs about ",
+                                          0),
+              0u)
+        << e.what();
+  }
+  try {
+    load_mesh(ply);
+    ADD_FAILURE() << "no error";
+  } catch (const Error &e) {
+    EXPECT_EQ(std::string(e.what()), ply + ": truncated PLY file (vertex 0 of 2147483647)");
+  }
+}
+
+TEST_F(SizeCheckTest, OffAndStlHeadersAreCheckedBeforeTheBody) {
+  const std::string off = write("huge.off", "OFF\n1000000000 2000000000 0\n0 0 0\n");
+  Calls calls;
+  auto refuse = [&](uint64_t v, uint64_t f) {
+    calls.seen.emplace_back(v, f);
+    throw Error("refused");
+  };
+  EXPECT_THROW(load_mesh(off, nullptr, refuse), Error);
+  std::string stl(84, '\0'); // binary STL header promising 3 facets, with all 3
+  stl[80] = 3;
+  stl += std::string(150, '\0');
+  const std::string stl_path = write("three.stl", stl);
+  EXPECT_THROW(load_mesh(stl_path, nullptr, refuse), Error);
+  const std::vector<std::pair<uint64_t, uint64_t>> expected = {{1000000000, 2000000000}, {1, 3}};
+  EXPECT_EQ(calls.seen, expected);
+}
+
+} // namespace
+} // namespace pomar
