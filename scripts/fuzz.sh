@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
 # Build the libFuzzer targets (tests/fuzz/) with clang + ASan/UBSan and run each one.
 #   scripts/fuzz.sh [SECONDS]     # seconds per target, default 60
-# Environment: BUILD_DIR (default build-fuzz), FUZZ_TARGETS (default: both), JOBS.
+# Environment: BUILD_DIR (default build-fuzz), FUZZ_TARGETS (default: all three), JOBS.
 # Exits non-zero if a fuzzer found a crash / timeout / OOM; the reproducer paths are printed.
 set -u
 SECONDS_PER_TARGET="${1:-60}"
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD_DIR="${BUILD_DIR:-$ROOT/build-fuzz}"
-TARGETS="${FUZZ_TARGETS:-fuzz_decoder fuzz_mesh_readers}"
+TARGETS="${FUZZ_TARGETS:-fuzz_decoder fuzz_mesh_readers fuzz_repair}"
 
 echo "== configure $BUILD_DIR (clang, ASan+UBSan+libFuzzer)"
 CC=clang CXX=clang++ cmake -G Ninja -S "$ROOT" -B "$BUILD_DIR" \
@@ -21,6 +21,7 @@ for t in $TARGETS; do
   case "$t" in
     fuzz_decoder) seeds="$ROOT/tests/fuzz/corpus_decoder" ;;
     fuzz_mesh_readers) seeds="$ROOT/tests/fuzz/corpus_readers" ;;
+    fuzz_repair) seeds="$ROOT/tests/fuzz/corpus_repair" ;;
     *) seeds="" ;;
   esac
   run="$BUILD_DIR/fuzz-run/$t"
