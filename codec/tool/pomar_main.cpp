@@ -213,16 +213,25 @@ constexpr int kExitDamaged = 3;
 int report_damage(const std::vector<pomar::DamagedBlock> &damaged, const std::string &out) {
   if (damaged.empty())
     return 0;
+  std::vector<const pomar::DamagedBlock *> skipped;
+  for (const pomar::DamagedBlock &b : damaged) {
+    if (b.level_kept >= 0)
+      skipped.push_back(&b);
+    else // damage no block check located: nothing could be skipped
+      std::fprintf(stderr, "pomar: warning: %s: %s\n", out.c_str(), b.problem.c_str());
+  }
+  if (skipped.empty())
+    return kExitDamaged;
   std::fprintf(stderr,
                "pomar: warning: %zu damaged block%s skipped; %s is a valid mesh, coarser where "
                "they were:\n",
-               damaged.size(), damaged.size() == 1 ? "" : "s", out.c_str());
-  const size_t shown = std::min<size_t>(damaged.size(), 20);
+               skipped.size(), skipped.size() == 1 ? "" : "s", out.c_str());
+  const size_t shown = std::min<size_t>(skipped.size(), 20);
   for (size_t i = 0; i < shown; ++i)
-    std::fprintf(stderr, "  %s (kept at level %d): %s\n", damaged[i].block.c_str(),
-                 damaged[i].level_kept, damaged[i].problem.c_str());
-  if (shown < damaged.size())
-    std::fprintf(stderr, "  ... and %zu more\n", damaged.size() - shown);
+    std::fprintf(stderr, "  %s (kept at level %d): %s\n", skipped[i]->block.c_str(),
+                 skipped[i]->level_kept, skipped[i]->problem.c_str());
+  if (shown < skipped.size())
+    std::fprintf(stderr, "  ... and %zu more\n", skipped.size() - shown);
   return kExitDamaged;
 }
 
@@ -499,7 +508,8 @@ int main(int argc, char **argv) {
       "  pomar encode messy.stl messy.pomar --repair # cut a non-manifold mesh first\n"
       "  pomar verify messy.stl messy.pomar --repair # lossless w.r.t. the repaired mesh\n"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "pomar 0.1.0 (file format version 1)");
+  app.set_version_flag("--version",
+                       "pomar 0.1.0 (writes .pomar format versions 1 and 3, reads 1 to 3)");
 
   EncodeArgs ea;
   auto *enc =

@@ -46,6 +46,8 @@ bool repair_checksums(std::vector<uint8_t> &b) {
       const size_t c = pomar::kFixedHeaderBytes + pomar::kLevelEntryBytes * h.levels.size();
       fix(c + 12, L.tables_offset, h.tables_bytes);
       fix(c + 20, L.index_offset, h.index_bytes);
+      if (h.has_cluster_checksum) // version 3: all cluster data
+        fix(c + 36, L.clusters_offset, h.cluster_bytes);
     }
     put_u32(b, hsize - 4, pomar::checksum(b.data(), hsize - 4));
     return true;

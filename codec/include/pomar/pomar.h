@@ -125,9 +125,12 @@ Mesh decode(const uint8_t *data, size_t size, int level = -1, const Progress &pr
 /// A block of a .pomar file that failed its checks (checksum, structure, or missing from a
 /// truncated file) and was skipped by a decode with `skip_damaged`.
 struct DamagedBlock {
-  std::string block;   ///< "cluster 17" or "level 9"
+  std::string block;   ///< "cluster 17", "level 9", or "cluster data" (see below)
   std::string problem; ///< what is wrong with it (the error the strict decoder reports)
-  int level_kept = 0;  ///< the region it codes stays at this level
+  /// The region it codes stays at this level. -1 for "cluster data": all blocks together
+  /// fail their checksum (format version 3) though each passes its own 8-bit check, so the
+  /// damaged one cannot be located and skipped; the mesh may be wrong in places.
+  int level_kept = 0;
 };
 
 struct DecodeOptions {

@@ -11,6 +11,15 @@
 
 namespace pomar {
 
+const char *const kUnplacedDamage =
+    "damaged .pomar file: a block that passes its 8-bit check failed to decode; it and its "
+    "neighbours were skipped, but the damage may lie in another block whose wrong data "
+    "decoded: the mesh may be wrong in places";
+
+const char *const kUnlocatedDamage =
+    "damaged .pomar file: the cluster data fails its checksum although every block passes "
+    "its 8-bit check: a damaged block cannot be located, the mesh may be wrong in places";
+
 Mesh to_mesh(const LevelMesh &lm, const Quantizer &grid) {
   Mesh out;
   out.positions.resize(lm.q.size());
@@ -122,6 +131,11 @@ std::vector<DamagedBlock> check_blocks(const uint8_t *data, size_t size) {
                              ": " + problem,
                          static_cast<int>(h.global_levels)});
   }
+  // Version 3: the cluster data as a whole (catches what the 8-bit checks let through).
+  const uint64_t end = layout.clusters_offset + h.cluster_bytes;
+  if (damaged.empty() && h.has_cluster_checksum && end <= size &&
+      checksum(data + layout.clusters_offset, h.cluster_bytes) != h.cluster_checksum)
+    damaged.push_back({"cluster data", kUnlocatedDamage, -1});
   return damaged;
 }
 

@@ -68,6 +68,11 @@ private:
   uint32_t level_ = 0, cluster_ = 0xFFFFFFFFu;
 };
 
+/// The message for damage in the cluster data that no block's own check found.
+extern const char *const kUnlocatedDamage;
+/// The caution added when a block that passed its 8-bit check fails to decode.
+extern const char *const kUnplacedDamage;
+
 /// Decode global levels [from, to) of `mesh` (the file image must hold the global part)
 /// and return `to`. A damaged level throws pomar::Error, or, if `damaged` is given, is
 /// recorded there and ends the decoding: the mesh stays at the level before it, whose

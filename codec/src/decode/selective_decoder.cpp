@@ -156,6 +156,7 @@ struct SelectiveDecoder::State {
   std::vector<DamagedBlock> damaged;
   uint32_t decoding = kNone; // the cluster being decoded, for error reports
   bool traversing = false;   // its traversal has started (it may have claimed faces)
+  bool data_checked = false; // the version 3 checksum of all cluster data was verified
   int uniform_cap = 1 << 30; // progressive files: the level before a damaged one
 
   TraversalScratch scratch;
@@ -168,6 +169,7 @@ struct SelectiveDecoder::State {
   void reset_to_snapshot();
   void decode_cluster_level(uint32_t c, int level);
   void decode_target(const Progress &progress);
+  void check_cluster_data();
   bool skip_cluster(uint32_t c, const Error &e);
   std::vector<int> target; // the level map being decoded
   int target_of(uint32_t c) const { return target.empty() ? finest : target[c]; }
@@ -252,7 +254,12 @@ bool SelectiveDecoder::State::skip_cluster(uint32_t c, const Error &e) {
   // A block that passed its 8-bit check and still fails may be intact and fail because a
   // neighbour's damaged block slipped through its own check (1 in 256) and decoded to a
   // wrong but valid state. The neighbours' blocks are suspects: keep them coarse too.
-  if (clusters[c].checked)
+  if (clusters[c].checked) {
+    // The damage may also lie further away, in a block whose wrong data happened to decode:
+    // say so once (nothing can locate it).
+    if (std::none_of(damaged.begin(), damaged.end(),
+                     [](const DamagedBlock &b) { return b.level_kept < 0; }))
+      damaged.push_back({"cluster data", kUnplacedDamage, -1});
     for (uint32_t k = adj_start[c]; k < adj_start[c + 1]; ++k) {
       const uint32_t nb = adj[k];
       if (cap[nb] == global_levels)
@@ -263,6 +270,7 @@ bool SelectiveDecoder::State::skip_cluster(uint32_t c, const Error &e) {
                              std::to_string(c) + " next to it failed to decode",
                          global_levels});
     }
+  }
   return true;
 }
 
@@ -534,6 +542,28 @@ void SelectiveDecoder::State::decode_target(const Progress &progress) {
   }
   mesh.older_than_level = 0;
   levels = target;
+  check_cluster_data();
+}
+
+/// Once every block has been read whole (a full decode), check them together against the
+/// version 3 checksum of the cluster data: a damaged block that passed its 8-bit check
+/// (1 in 256) and decoded to a wrong but valid state is caught here.
+void SelectiveDecoder::State::check_cluster_data() {
+  const FileHeader &h = layout.header;
+  if (data_checked || !h.has_cluster_checksum || !damaged.empty())
+    return; // (damage found already: the cluster data cannot match)
+  std::vector<const std::vector<uint8_t> *> blocks;
+  for (const Cluster &k : clusters) {
+    if (k.loaded != index.size[k.id])
+      return; // not everything was read
+    blocks.push_back(&k.block);
+  }
+  data_checked = true;
+  if (checksum(blocks) == h.cluster_checksum)
+    return;
+  if (!skip_damaged)
+    throw Error(kUnlocatedDamage);
+  damaged.push_back({"cluster data", kUnlocatedDamage, -1});
 }
 
 Mesh SelectiveDecoder::mesh() const { return to_mesh(s_->mesh, s_->layout.header.grid); }

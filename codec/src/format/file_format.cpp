@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <new>
 #include <string>
 #include <xxhash.h>
 
@@ -14,6 +15,19 @@
 namespace pomar {
 
 uint32_t checksum(const uint8_t *data, size_t size) { return XXH32(data, size, 0); }
+
+uint32_t checksum(const std::vector<const std::vector<uint8_t> *> &blocks) {
+  XXH32_state_t *state = XXH32_createState();
+  if (!state)
+    throw std::bad_alloc();
+  XXH32_reset(state, 0);
+  for (const std::vector<uint8_t> *b : blocks)
+    if (!b->empty())
+      XXH32_update(state, b->data(), b->size());
+  const uint32_t h = XXH32_digest(state);
+  XXH32_freeState(state);
+  return h;
+}
 
 namespace {
 
@@ -52,8 +66,10 @@ void write_header(const FileHeader &h, std::vector<uint8_t> &out) {
     w.u32(h.index_checksum);
     w.u32(static_cast<uint32_t>(h.cluster_bytes));
     w.u32(static_cast<uint32_t>(h.cluster_bytes >> 32));
-    w.u32(static_cast<uint32_t>(h.cluster_connectivity_bytes));
-    w.u32(static_cast<uint32_t>(h.cluster_connectivity_bytes >> 32));
+    // Version 3: the informative connectivity share in 32 bits (saturated), then the
+    // checksum of the cluster data.
+    w.u32(static_cast<uint32_t>(std::min<uint64_t>(h.cluster_connectivity_bytes, 0xFFFFFFFFu)));
+    w.u32(h.cluster_checksum);
   }
   w.u32(checksum(out.data(), out.size()));
 }
@@ -158,8 +174,13 @@ std::vector<uint8_t> write_file(FileHeader header, const std::vector<uint8_t> &b
     header.index_bytes = static_cast<uint32_t>(index.size());
     header.index_checksum = checksum(index.data(), index.size());
     header.cluster_bytes = 0;
-    for (const auto &b : cluster_blocks)
+    std::vector<const std::vector<uint8_t> *> blocks;
+    for (const auto &b : cluster_blocks) {
       header.cluster_bytes += b.size();
+      blocks.push_back(&b);
+    }
+    header.has_cluster_checksum = true;
+    header.cluster_checksum = checksum(blocks);
   }
   std::vector<uint8_t> out;
   write_header(header, out);
@@ -199,11 +220,12 @@ FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size, boo
   FileLayout L;
   FileHeader &h = L.header;
   h.version = r.u16();
-  if (h.version != kFormatVersion && h.version != kClusteredFormatVersion)
+  if (h.version != kFormatVersion && h.version != kClusteredFormatVersion &&
+      h.version != kClusteredFormatVersion2)
     throw Error("unsupported .pomar version " + std::to_string(h.version) +
-                " (this build reads versions 1 and 2)");
+                " (this build reads versions 1 to 3)");
   h.flags = r.u16();
-  if ((h.version == kClusteredFormatVersion) != h.clustered() || (h.flags & ~kFlagClustered))
+  if ((h.version != kFormatVersion) != h.clustered() || (h.flags & ~kFlagClustered))
     bad("unknown flags " + std::to_string(h.flags) + " for version " + std::to_string(h.version));
   h.grid.bits = r.u8();
   r.u8();
@@ -249,7 +271,12 @@ FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size, boo
     h.cluster_bytes = r.u32();
     h.cluster_bytes |= uint64_t(r.u32()) << 32;
     h.cluster_connectivity_bytes = r.u32();
-    h.cluster_connectivity_bytes |= uint64_t(r.u32()) << 32;
+    if (h.version == kClusteredFormatVersion2) {
+      h.cluster_connectivity_bytes |= uint64_t(r.u32()) << 32;
+    } else {
+      h.has_cluster_checksum = true;
+      h.cluster_checksum = r.u32();
+    }
     if (h.cluster_connectivity_bytes > h.cluster_bytes)
       bad("cluster connectivity share exceeds the cluster data");
     if (h.global_levels >= levels)

@@ -11,8 +11,9 @@
 namespace pomar {
 
 constexpr uint8_t kMagic[8] = {'P', 'O', 'M', 'A', 'R', '\r', '\n', 0x1A};
-constexpr uint16_t kFormatVersion = 1;          // pure progressive files
-constexpr uint16_t kClusteredFormatVersion = 2; // files with clustered levels
+constexpr uint16_t kFormatVersion = 1;           // pure progressive files
+constexpr uint16_t kClusteredFormatVersion = 3;  // files with clustered levels
+constexpr uint16_t kClusteredFormatVersion2 = 2; // read only: no cluster data checksum
 constexpr uint16_t kFlagClustered = 1;
 constexpr size_t kClusterHeaderBytes = 40;
 constexpr size_t kFixedHeaderBytes = 60;
@@ -43,6 +44,10 @@ struct FileHeader {
   // The encoder's split of cluster_bytes into connectivity and geometry (from the ideal
   // code lengths; the blocks interleave both). Informative only.
   uint64_t cluster_connectivity_bytes = 0;
+  // Version 3: XXH32 of all cluster blocks in order (a full decode checks it; the blocks'
+  // own 8-bit checks let 1 damaged block in 256 through).
+  bool has_cluster_checksum = false;
+  uint32_t cluster_checksum = 0;
   bool clustered() const { return (flags & kFlagClustered) != 0; }
 };
 
@@ -71,6 +76,8 @@ struct FileLayout {
 };
 
 uint32_t checksum(const uint8_t *data, size_t size);
+/// XXH32 (seed 0) of the concatenation of `blocks`, as checksum() of the whole would give.
+uint32_t checksum(const std::vector<const std::vector<uint8_t> *> &blocks);
 
 /// Rotate every face to start at its smallest index and sort the faces (the order the
 /// base mesh block stores them in).
