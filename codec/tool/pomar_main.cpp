@@ -508,6 +508,8 @@ int main(int argc, char **argv) {
       "  pomar encode messy.stl messy.pomar --repair # cut a non-manifold mesh first\n"
       "  pomar verify messy.stl messy.pomar --repair # lossless w.r.t. the repaired mesh\n"};
   app.require_subcommand(1);
+  // Ctrl-C or kill during a write: no temporary file left, the old output untouched.
+  pomar::remove_temporary_files_on_signals();
   app.set_version_flag("--version",
                        "pomar 0.1.0 (writes .pomar format versions 1 and 3, reads 1 to 3)");
 

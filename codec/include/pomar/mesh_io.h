@@ -71,6 +71,13 @@ void save_mesh(const std::string &path, const Mesh &mesh, bool binary = true);
 /// the system error.
 void write_file_atomic(const std::string &path, const void *data, size_t size);
 
+/// Install handlers for SIGINT, SIGTERM and SIGHUP that remove the temporary files of
+/// writes in progress (write_file_atomic, save_mesh) and then let the signal end the
+/// process as it would have: an interrupted program leaves the previous output untouched
+/// and no temporary file behind. For programs, like the pomar tool, that own their
+/// signal handling; a library user with its own handlers can leave this alone.
+void remove_temporary_files_on_signals();
+
 /// Read a whole file. Throws pomar::Error naming the path and the system error text.
 std::vector<uint8_t> read_file(const std::string &path);
 

@@ -17,6 +17,8 @@
 #include <pomar/mesh_io.h>
 #include <pomar/vcg_adapter.h>
 
+#include "io/temp_registry.h"
+
 #include <wrap/io_trimesh/export_ply.h>
 #include <wrap/io_trimesh/export_stl.h>
 #include <wrap/io_trimesh/import_off.h>
@@ -368,10 +370,12 @@ public:
     const std::string prefix = slash == std::string::npos ? "" : dir_;
     path_ = prefix + "." + base + ".tmp." + num(static_cast<uint64_t>(::getpid())) + "." +
             num(counter++);
+    slot_ = register_temporary(path_); // removed by a signal handler, if installed
   }
   ~TempFile() {
     if (!committed_)
       ::unlink(path_.c_str());
+    unregister_temporary(slot_);
   }
   TempFile(const TempFile &) = delete;
   TempFile &operator=(const TempFile &) = delete;
@@ -386,6 +390,8 @@ public:
     if (::rename(path_.c_str(), target_.c_str()) != 0)
       fail(target_, "cannot rename temporary file into place: " + errno_text(errno));
     committed_ = true;
+    unregister_temporary(slot_);
+    slot_ = -1;
     const int dfd = ::open(dir_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
     if (dfd >= 0) { // best effort: the data itself is already on disk
       ::fsync(dfd);
@@ -405,6 +411,7 @@ private:
 
   std::string target_, dir_, path_;
   bool committed_ = false;
+  int slot_ = -1;
 };
 
 /// Writes all of data to fd, retrying after signals and short writes.
