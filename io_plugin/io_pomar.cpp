@@ -277,6 +277,9 @@ bool PomarIOPlugin::open(const QString &format, const QString &fileName, MeshMod
     auto source = vcg::tri::Allocator<CMeshO>::GetPerMeshAttribute<std::string>(
         m.cm, pomar::meshlab::kSourceAttribute);
     source() = native;
+    auto skip = vcg::tri::Allocator<CMeshO>::GetPerMeshAttribute<int>(
+        m.cm, pomar::meshlab::kSkipDamagedAttribute);
+    skip() = skipDamaged ? 1 : 0;
 
     progress.report(100);
     Log("pomar: opened %s at level %d of %d (%s): %zu vertices, %zu faces", qUtf8Printable(path),

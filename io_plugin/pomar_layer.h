@@ -15,6 +15,9 @@ namespace pomar::meshlab {
 constexpr const char *kClusterAttribute = "pomar_cluster"; ///< per vertex, float (-1: none)
 constexpr const char *kLevelAttribute = "pomar_level";     ///< per vertex, float (-1: unknown)
 constexpr const char *kSourceAttribute = "pomar_source";   ///< per mesh, absolute path
+/// per mesh, int: 1 if the layer was opened with "Skip damaged blocks" (the filters then
+/// decode around damaged blocks too)
+constexpr const char *kSkipDamagedAttribute = "pomar_skip_damaged";
 
 /// Forwards progress to MeshLab's callback at most every 10% (meshlabserver prints the
 /// label on every call).

@@ -114,6 +114,13 @@ bool sourceOf(CMeshO &m, std::string &path) {
   return true;
 }
 
+/// Whether the layer was opened with "Skip damaged blocks".
+bool skipsDamage(CMeshO &m) {
+  auto h = vcg::tri::Allocator<CMeshO>::FindPerMeshAttribute<int>(
+      m, pomar::meshlab::kSkipDamagedAttribute);
+  return vcg::tri::Allocator<CMeshO>::IsValidHandle(m, h) && h() != 0;
+}
+
 /// The per-vertex cluster and level attributes of a layer as integers; false (with `why`)
 /// if they are missing or hold values that are not cluster ids / levels of this file.
 /// `clusters` = 0 for a pure progressive file (no cluster ids needed).
@@ -193,9 +200,11 @@ struct PomarFilterPlugin::Session {
   std::string path;
   qint64 fileSize = -1, fileTime = 0; ///< to notice a file replaced on disk
   std::unique_ptr<pomar::SelectiveDecoder> decoder;
-  bool pristine = true;   ///< the decoder was never updated (fresh state)
+  bool skipDamaged = false;  ///< decode around damaged blocks (the layer was opened so)
+  size_t damageReported = 0; ///< decoder->damaged() entries already logged
+  bool pristine = true;      ///< the decoder was never updated (fresh state)
   bool haveSignature = false;
-  Signature signature;    ///< of the mesh the decoder's current state produced
+  Signature signature; ///< of the mesh the decoder's current state produced
   uint64_t lastUse = 0;
   // Facts about the file.
   bool clustered = false;
@@ -203,7 +212,11 @@ struct PomarFilterPlugin::Session {
   uint32_t clusters = 0;
 
   void open() {
-    decoder = std::make_unique<pomar::SelectiveDecoder>(std::make_unique<pomar::FileSource>(path));
+    pomar::SelectiveOptions options;
+    options.skip_damaged = skipDamaged;
+    decoder = std::make_unique<pomar::SelectiveDecoder>(std::make_unique<pomar::FileSource>(path),
+                                                        options);
+    damageReported = 0;
     pristine = true;
     haveSignature = false;
     clustered = decoder->info().clustered();
@@ -218,7 +231,8 @@ struct PomarFilterPlugin::Session {
   int clamp(int level) const { return std::min(finest, std::max(base, level)); }
 };
 
-PomarFilterPlugin::Session *PomarFilterPlugin::session(const std::string &path, QString &error) {
+PomarFilterPlugin::Session *PomarFilterPlugin::session(const std::string &path, bool skipDamaged,
+                                                       QString &error) {
   const QFileInfo fi(QFile::decodeName(path.c_str()));
   if (!fi.exists() || !fi.isFile()) {
     sessions_.erase(path);
@@ -227,8 +241,9 @@ PomarFilterPlugin::Session *PomarFilterPlugin::session(const std::string &path, 
   }
   const qint64 size = fi.size(), time = fi.lastModified().toMSecsSinceEpoch();
   auto it = sessions_.find(path);
-  if (it != sessions_.end() && (it->second->fileSize != size || it->second->fileTime != time)) {
-    sessions_.erase(it); // replaced on disk: start over
+  if (it != sessions_.end() && (it->second->fileSize != size || it->second->fileTime != time ||
+                                it->second->skipDamaged != skipDamaged)) {
+    sessions_.erase(it); // replaced on disk, or opened with the other damage policy: start over
     it = sessions_.end();
   }
   if (it == sessions_.end()) {
@@ -236,6 +251,7 @@ PomarFilterPlugin::Session *PomarFilterPlugin::session(const std::string &path, 
     s->path = path;
     s->fileSize = size;
     s->fileTime = time;
+    s->skipDamaged = skipDamaged;
     try {
       s->open();
     } catch (const std::exception &e) { // pomar::Error, std::bad_alloc
@@ -294,8 +310,8 @@ bool syncToLayer(PomarFilterPlugin::Session &s, CMeshO &m, ProgressRelay &progre
   s.decoder->update(progress.range(0, 50));
   s.signature = signatureOf(s.decoder->mesh());
   s.haveSignature = true;
-  how = QString("decoder state rebuilt from the layer's attributes in %1 ms").arg(msSince(t0), 0,
-                                                                                    'f', 1);
+  how = QString("decoder state rebuilt from the layer's attributes in %1 ms")
+            .arg(msSince(t0), 0, 'f', 1);
   if (s.signature != current)
     how += QString("; note: the layer (%1 vertices, %2 faces) differs from what the file decodes "
                    "to at its levels (%3 vertices, %4 faces), edits are replaced")
@@ -465,7 +481,7 @@ void PomarFilterPlugin::initParameterSet(QAction *a, MeshModel &m, RichParameter
   const int id = ID(a);
   if ((id == FP_REFINE_SELECTED || id == FP_COARSEN_SELECTED || id == FP_SET_LEVEL) &&
       sourceOf(m.cm, path))
-    s = session(path, ignored); // cheap: header and global part; kept for applyFilter
+    s = session(path, skipsDamage(m.cm), ignored); // cheap: header and global part
   const QString range =
       s != nullptr ? QString(" This file: levels %1 (base clustered mesh) to %2 (full resolution).")
                          .arg(s->base)
@@ -523,22 +539,28 @@ bool PomarFilterPlugin::applyFilter(QAction *a, MeshDocument &md, const RichPara
     return showClusters(*mm);
 
   QString error;
-  Session *s = session(path, error);
+  Session *s = session(path, skipsDamage(mm->cm), error);
   if (s == nullptr)
     return fail(error);
   try {
+    bool ok = false;
     switch (id) {
     case FP_REFINE_SELECTED:
-      return refineOrCoarsen(true, *mm, *s, par.getInt("TargetLevel"), cb);
+      ok = refineOrCoarsen(true, *mm, *s, par.getInt("TargetLevel"), cb);
+      break;
     case FP_COARSEN_SELECTED:
-      return refineOrCoarsen(false, *mm, *s, par.getInt("TargetLevel"), cb);
+      ok = refineOrCoarsen(false, *mm, *s, par.getInt("TargetLevel"), cb);
+      break;
     case FP_SET_LEVEL:
-      return setLevel(*mm, *s, par.getInt("Level"), cb);
+      ok = setLevel(*mm, *s, par.getInt("Level"), cb);
+      break;
     case FP_SHOW_LEVELS:
       return showLevels(*mm, s);
     default:
       return fail("unknown filter");
     }
+    warnAboutNewDamage(*s);
+    return ok;
   } catch (const std::exception &e) { // pomar::Error (damaged file), std::bad_alloc
     // The decoder may be half way through an update: forget it. The layer is unchanged
     // (it is replaced only after a successful update).
@@ -547,6 +569,24 @@ bool PomarFilterPlugin::applyFilter(QAction *a, MeshDocument &md, const RichPara
     const QString file = QFile::decodeName(path.c_str());
     return fail(what.contains(file) ? what : QString("%1: %2").arg(file, what));
   }
+}
+
+/// Blocks the decoder skipped since the last report (layers opened with "Skip damaged
+/// blocks"): one warning listing them.
+void PomarFilterPlugin::warnAboutNewDamage(Session &s) {
+  const std::vector<pomar::DamagedBlock> &damaged = s.decoder->damaged();
+  if (damaged.size() <= s.damageReported)
+    return;
+  QString text = QString("%1: %2 damaged block(s) skipped, the mesh stays coarser there:")
+                     .arg(QFile::decodeName(s.path.c_str()))
+                     .arg(damaged.size() - s.damageReported);
+  for (size_t i = s.damageReported; i < damaged.size() && i < s.damageReported + 10; ++i)
+    text += QString("\n  %1: %2")
+                .arg(QString::fromStdString(damaged[i].block),
+                     QString::fromStdString(damaged[i].problem));
+  s.damageReported = damaged.size();
+  Log(GLLogStream::WARNING, qUtf8Printable("POMAR: " + text));
+  qWarning("pomar: %s", qUtf8Printable(text)); // Log() is a no-op in meshlabserver
 }
 
 bool PomarFilterPlugin::refineOrCoarsen(bool refine, MeshModel &mm, Session &s, int requested,
@@ -667,7 +707,10 @@ bool PomarFilterPlugin::setLevel(MeshModel &mm, Session &s, int requested, vcg::
   progress.report(100);
   Log("POMAR: set level of detail %d%s in %.1f ms (decode %.1f ms): %d vertices, %d faces; read "
       "%.1f KB more of the file",
-      level, level == s.finest ? " (full resolution)" : level == s.base ? " (base clustered)" : "",
+      level,
+      level == s.finest ? " (full resolution)"
+      : level == s.base ? " (base clustered)"
+                        : "",
       msSince(t0), decodeMs, mm.cm.vn, mm.cm.fn, double(d.bytes_read() - bytes0) / 1024.0);
   return true;
 }

@@ -69,7 +69,8 @@ public:
 private:
   /// The session of `path`, created (or re-created when the file changed on disk) if
   /// needed; nullptr with `error` set when the file cannot be read.
-  Session *session(const std::string &path, QString &error);
+  Session *session(const std::string &path, bool skipDamaged, QString &error);
+  void warnAboutNewDamage(Session &s);
   bool refineOrCoarsen(bool refine, MeshModel &mm, Session &s, int level, vcg::CallBackPos *cb);
   bool setLevel(MeshModel &mm, Session &s, int level, vcg::CallBackPos *cb);
   bool showClusters(MeshModel &mm);

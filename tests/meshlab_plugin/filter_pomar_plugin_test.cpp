@@ -23,6 +23,8 @@
 
 #include "support/mesh_gen.h"
 
+#include "support/mesh_compare.h"
+#include "support/meshlab_layer.h"
 #include <algorithm>
 #include <array>
 #include <cstdio>
@@ -34,8 +36,6 @@
 #include <string>
 #include <tuple>
 #include <vector>
-#include "support/mesh_compare.h"
-#include "support/meshlab_layer.h"
 
 namespace {
 
@@ -47,8 +47,7 @@ const char *const kShowLevels = "POMAR: Show Levels";
 
 // ---------------------------------------------------------------- plugins
 
-template <class Interface>
-Interface *instance(QPluginLoader &loader) {
+template <class Interface> Interface *instance(QPluginLoader &loader) {
   Interface *p = qobject_cast<Interface *>(loader.instance());
   if (p == nullptr)
     ADD_FAILURE() << "cannot load " << loader.fileName().toStdString() << ": "
@@ -133,11 +132,12 @@ protected:
   static QString path(const QString &name) { return dir_->filePath(name); }
 
   /// Opens `name` with the IO plugin like meshlabserver (full resolution by default).
-  MeshModel *open(const QString &name, int openAt = 0) {
+  MeshModel *open(const QString &name, int openAt = 0, bool skipDamaged = false) {
     MeshModel *mm = doc_.addNewMesh(path(name), name, true);
     RichParameterList par;
     io()->initPreOpenParameter("pomar", path(name), par);
     par.setValue("OpenAt", EnumValue(openAt));
+    par.setValue("SkipDamaged", BoolValue(skipDamaged));
     int mask = 0;
     EXPECT_TRUE(io()->open("pomar", path(name), *mm, mask, par)) << io()->errorMsg().toStdString();
     mm->UpdateBoxAndNormals();
@@ -160,7 +160,8 @@ protected:
     return apply(kSetLevel, [&](RichParameterList &p) { p.setValue("Level", IntValue(level)); });
   }
   bool refine(int level) {
-    return apply(kRefine, [&](RichParameterList &p) { p.setValue("TargetLevel", IntValue(level)); });
+    return apply(kRefine,
+                 [&](RichParameterList &p) { p.setValue("TargetLevel", IntValue(level)); });
   }
   bool coarsen(int level) {
     return apply(kCoarsen,
@@ -300,7 +301,8 @@ TEST_F(FilterPomarTest, SetLevelOfDetail) {
   EXPECT_EQ(mm->cm.vn, int(info_->clusters));
   EXPECT_EQ(canonical(mm->cm), canonical(d->mesh()));
   expectAttributes(*mm, *d);
-  EXPECT_TRUE(logText().contains(QString("POMAR: set level of detail %1 (base clustered)").arg(base_)));
+  EXPECT_TRUE(
+      logText().contains(QString("POMAR: set level of detail %1 (base clustered)").arg(base_)));
 
   const int mid = (base_ + finest_) / 2;
   ASSERT_TRUE(setLevel(mid));
@@ -541,15 +543,18 @@ TEST_F(FilterPomarTest, PureProgressiveFile) {
   EXPECT_EQ(par.getInt("Level"), 0);
 
   ASSERT_TRUE(setLevel(5)) << filter()->errorMsg().toStdString();
-  EXPECT_EQ(canonical(mm->cm), canonical(pomar::decode(progressive_->data(), progressive_->size(), 5)));
+  EXPECT_EQ(canonical(mm->cm),
+            canonical(pomar::decode(progressive_->data(), progressive_->size(), 5)));
   auto d = decoderOf(*progressive_);
   d->want_all(5);
   d->update();
   expectAttributes(*mm, *d, "progressive.pomar");
   ASSERT_TRUE(setLevel(2)); // coarser
-  EXPECT_EQ(canonical(mm->cm), canonical(pomar::decode(progressive_->data(), progressive_->size(), 2)));
+  EXPECT_EQ(canonical(mm->cm),
+            canonical(pomar::decode(progressive_->data(), progressive_->size(), 2)));
   ASSERT_TRUE(setLevel(-1));
-  EXPECT_EQ(canonical(mm->cm), canonical(pomar::decode(progressive_->data(), progressive_->size())));
+  EXPECT_EQ(canonical(mm->cm),
+            canonical(pomar::decode(progressive_->data(), progressive_->size())));
 
   ASSERT_TRUE(apply(kShowLevels)) << filter()->errorMsg().toStdString();
   EXPECT_TRUE(mm->cm.vert[0].cC() == vcg::Color4b(255, 0, 0, 255));
@@ -609,7 +614,8 @@ TEST_F(FilterPomarTest, LayerOpenedBelowTheBaseClusteredLevel) {
   ASSERT_TRUE(io()->open("pomar", path("clustered.pomar"), *mm, mask, par));
   vcg::tri::UpdateSelection<CMeshO>::FaceAll(mm->cm);
   EXPECT_FALSE(refine(finest_));
-  EXPECT_TRUE(filter()->errorMsg().contains("Set Level of Detail")) << filter()->errorMsg().toStdString();
+  EXPECT_TRUE(filter()->errorMsg().contains("Set Level of Detail"))
+      << filter()->errorMsg().toStdString();
   EXPECT_FALSE(apply(kShowClusters));
   // Setting a level of detail works and brings the clusters back.
   ASSERT_TRUE(setLevel(base_));
@@ -643,6 +649,22 @@ TEST_F(FilterPomarTest, MissingAndDamagedFiles) {
       << filter()->errorMsg().toStdString();
   EXPECT_TRUE(logText().contains("damaged .pomar file"));
   EXPECT_EQ(canonical(mm->cm), before);
+
+  // Opened with "Skip damaged blocks", the same refinement succeeds around the damage, with
+  // a warning; the result is what the library gives with skip_damaged.
+  MeshModel *skip = open("bad.pomar", 1, true);
+  vcg::tri::UpdateSelection<CMeshO>::FaceAll(skip->cm);
+  ASSERT_TRUE(refine(finest_)) << filter()->errorMsg().toStdString();
+  EXPECT_TRUE(logText().contains("damaged block")) << logText().toStdString();
+  pomar::SelectiveOptions options;
+  options.skip_damaged = true;
+  pomar::SelectiveDecoder d(std::make_unique<pomar::MemorySource>(bad.data(), bad.size()), options);
+  d.want_all(finest_);
+  d.update();
+  ASSERT_FALSE(d.damaged().empty());
+  EXPECT_EQ(canonical(skip->cm), canonical(d.mesh()));
+  EXPECT_LT(skip->cm.vn, int(info_->vertices));
+  EXPECT_GT(skip->cm.vn, int(info_->clusters));
 }
 
 } // namespace
