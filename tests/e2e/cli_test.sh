@@ -477,7 +477,7 @@ expect_no_file "$WORK/t_strict.ply"
 run decode "$WORK/truncated.pomar" "$WORK/t_skip.ply" --skip-damaged
 expect_rc 3
 expect_file "$WORK/t_skip.ply"
-expect_contains "$ERR" "read past the end" "stderr"
+expect_contains "$ERR" "truncated .pomar file: the block of cluster" "stderr"
 run info "$WORK/truncated.pomar" --check
 expect_rc 3
 expect_contains "$OUT" "truncated file" "stdout of info --check"

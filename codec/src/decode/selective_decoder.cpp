@@ -198,6 +198,12 @@ size_t SelectiveDecoder::State::fetch(Cluster &k, size_t needed) {
 /// the end), otherwise bytes are read as the decoder needs them.
 void SelectiveDecoder::State::start(uint32_t c, bool whole) {
   Cluster &k = clusters[c];
+  // A truncated file (accepted with skip_damaged): nothing is allocated for a block that
+  // is not there.
+  if (index.offset[c] + index.size[c] > source->size())
+    throw Error("truncated .pomar file: the block of cluster " + std::to_string(c) +
+                " ends at byte " + std::to_string(index.offset[c] + index.size[c]) +
+                ", the file has " + std::to_string(source->size()));
   if (k.block.empty() && index.size[c] > 0)
     k.block.resize(index.size[c]);
   if (whole)
