@@ -134,8 +134,7 @@ QStringList notKept(MeshModel &mm) {
   QStringList custom;
   auto addNames = [&](const auto &attributes) {
     for (const auto &a : attributes)
-      if (!a._name.empty() && a._name != pomar::meshlab::kClusterAttribute &&
-          a._name != pomar::meshlab::kLevelAttribute && a._name != pomar::meshlab::kSourceAttribute)
+      if (!a._name.empty() && !pomar::meshlab::isPomarAttribute(a._name))
         custom << QString::fromStdString(a._name);
   };
   addNames(m.vert_attr);

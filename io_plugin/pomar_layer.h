@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 namespace pomar::meshlab {
 
@@ -18,6 +19,15 @@ constexpr const char *kSourceAttribute = "pomar_source";   ///< per mesh, absolu
 /// per mesh, int: 1 if the layer was opened with "Skip damaged blocks" (the filters then
 /// decode around damaged blocks too)
 constexpr const char *kSkipDamagedAttribute = "pomar_skip_damaged";
+
+/// The attributes above: a .pomar file re-creates them, saving does not lose them.
+inline bool isPomarAttribute(const std::string &name) {
+  for (const char *own :
+       {kClusterAttribute, kLevelAttribute, kSourceAttribute, kSkipDamagedAttribute})
+    if (name == own)
+      return true;
+  return false;
+}
 
 /// Forwards progress to MeshLab's callback at most every 10% (meshlabserver prints the
 /// label on every call).

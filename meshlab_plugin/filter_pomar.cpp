@@ -344,6 +344,9 @@ void replaceMesh(PomarFilterPlugin::Session &s, MeshModel &mm, const std::vector
   }
   auto source = vcg::tri::Allocator<CMeshO>::GetPerMeshAttribute<std::string>(m, kSourceAttr);
   source() = s.path;
+  auto skip = vcg::tri::Allocator<CMeshO>::GetPerMeshAttribute<int>(
+      m, pomar::meshlab::kSkipDamagedAttribute);
+  skip() = s.skipDamaged ? 1 : 0;
   const bool faceColor = vcg::tri::HasPerFaceColor(m);
   for (CFaceO &f : m.face) {
     if (faceColor)

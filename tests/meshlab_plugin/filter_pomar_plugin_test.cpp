@@ -665,6 +665,11 @@ TEST_F(FilterPomarTest, MissingAndDamagedFiles) {
   EXPECT_EQ(canonical(skip->cm), canonical(d.mesh()));
   EXPECT_LT(skip->cm.vn, int(info_->vertices));
   EXPECT_GT(skip->cm.vn, int(info_->clusters));
+  // The layer keeps its policy: coarsening and refining again work around the damage.
+  ASSERT_TRUE(setLevel(base_)) << filter()->errorMsg().toStdString();
+  EXPECT_EQ(skip->cm.vn, int(info_->clusters));
+  ASSERT_TRUE(setLevel(finest_)) << filter()->errorMsg().toStdString();
+  EXPECT_EQ(canonical(skip->cm), canonical(d.mesh()));
 }
 
 } // namespace
