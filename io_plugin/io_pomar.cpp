@@ -248,16 +248,11 @@ bool PomarIOPlugin::open(const QString &format, const QString &fileName, MeshMod
       damaged = decoder.damaged();
     }
     if (!damaged.empty()) {
-      QString warning = QString("%1: %2 damaged block(s) skipped, the mesh is coarser there:")
-                            .arg(path)
-                            .arg(damaged.size());
-      for (size_t i = 0; i < damaged.size() && i < 10; ++i)
-        warning += QString("\n  %1 (kept at level %2): %3")
-                       .arg(QString::fromStdString(damaged[i].block))
-                       .arg(damaged[i].level_kept)
-                       .arg(QString::fromStdString(damaged[i].problem));
-      if (damaged.size() > 10)
-        warning += QString("\n  ... and %1 more").arg(damaged.size() - 10);
+      const QString warning = QString("%1: %2 damaged block(s) skipped, the mesh is coarser "
+                                      "there:\n%3")
+                                  .arg(path)
+                                  .arg(damaged.size())
+                                  .arg(QString::fromStdString(pomar::describe_damage(damaged)));
       Log(GLLogStream::WARNING, qUtf8Printable(warning));
       qWarning("pomar: %s", qUtf8Printable(warning)); // Log() is a no-op in meshlabserver
     }

@@ -580,13 +580,11 @@ void PomarFilterPlugin::warnAboutNewDamage(Session &s) {
   const std::vector<pomar::DamagedBlock> &damaged = s.decoder->damaged();
   if (damaged.size() <= s.damageReported)
     return;
-  QString text = QString("%1: %2 damaged block(s) skipped, the mesh stays coarser there:")
-                     .arg(QFile::decodeName(s.path.c_str()))
-                     .arg(damaged.size() - s.damageReported);
-  for (size_t i = s.damageReported; i < damaged.size() && i < s.damageReported + 10; ++i)
-    text += QString("\n  %1: %2")
-                .arg(QString::fromStdString(damaged[i].block),
-                     QString::fromStdString(damaged[i].problem));
+  const QString text =
+      QString("%1: %2 damaged block(s) skipped, the mesh stays coarser there:\n%3")
+          .arg(QFile::decodeName(s.path.c_str()))
+          .arg(damaged.size() - s.damageReported)
+          .arg(QString::fromStdString(pomar::describe_damage(damaged, s.damageReported)));
   s.damageReported = damaged.size();
   Log(GLLogStream::WARNING, qUtf8Printable("POMAR: " + text));
   qWarning("pomar: %s", qUtf8Printable(text)); // Log() is a no-op in meshlabserver

@@ -213,10 +213,10 @@ constexpr int kExitDamaged = 3;
 int report_damage(const std::vector<pomar::DamagedBlock> &damaged, const std::string &out) {
   if (damaged.empty())
     return 0;
-  std::vector<const pomar::DamagedBlock *> skipped;
+  std::vector<pomar::DamagedBlock> skipped;
   for (const pomar::DamagedBlock &b : damaged) {
     if (b.level_kept >= 0)
-      skipped.push_back(&b);
+      skipped.push_back(b);
     else // damage no block check located: nothing could be skipped
       std::fprintf(stderr, "pomar: warning: %s: %s\n", out.c_str(), b.problem.c_str());
   }
@@ -224,14 +224,9 @@ int report_damage(const std::vector<pomar::DamagedBlock> &damaged, const std::st
     return kExitDamaged;
   std::fprintf(stderr,
                "pomar: warning: %zu damaged block%s skipped; %s is a valid mesh, coarser where "
-               "they were:\n",
-               skipped.size(), skipped.size() == 1 ? "" : "s", out.c_str());
-  const size_t shown = std::min<size_t>(skipped.size(), 20);
-  for (size_t i = 0; i < shown; ++i)
-    std::fprintf(stderr, "  %s (kept at level %d): %s\n", skipped[i]->block.c_str(),
-                 skipped[i]->level_kept, skipped[i]->problem.c_str());
-  if (shown < skipped.size())
-    std::fprintf(stderr, "  ... and %zu more\n", skipped.size() - shown);
+               "they were:\n%s\n",
+               skipped.size(), skipped.size() == 1 ? "" : "s", out.c_str(),
+               pomar::describe_damage(skipped, 0, 20).c_str());
   return kExitDamaged;
 }
 

@@ -155,6 +155,12 @@ struct DecodeReport {
   uint32_t clusters_below_request = 0;
 };
 
+/// One line per block of blocks[first..], "  cluster 17 (kept at level 16): problem" (no
+/// level for damage that could not be located), at most `max_lines` of them, then
+/// "  ... and N more"; lines joined by '\n', no trailing newline. For warnings.
+std::string describe_damage(const std::vector<DamagedBlock> &blocks, size_t first = 0,
+                            size_t max_lines = 10);
+
 /// decode() with options; `*report` (optional) says what was skipped.
 Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options,
             DecodeReport *report = nullptr);

@@ -101,6 +101,22 @@ FileInfo inspect(const uint8_t *data, size_t size) {
   return info;
 }
 
+std::string describe_damage(const std::vector<DamagedBlock> &blocks, size_t first,
+                            size_t max_lines) {
+  std::string out;
+  const size_t end = std::min(blocks.size(), first + max_lines);
+  for (size_t i = first; i < end; ++i) {
+    const DamagedBlock &b = blocks[i];
+    out += (i == first ? "  " : "\n  ") + b.block;
+    if (b.level_kept >= 0)
+      out += " (kept at level " + std::to_string(b.level_kept) + ")";
+    out += ": " + b.problem;
+  }
+  if (end < blocks.size())
+    out += "\n  ... and " + std::to_string(blocks.size() - end) + " more";
+  return out;
+}
+
 std::vector<DamagedBlock> check_blocks(const uint8_t *data, size_t size) {
   const FileLayout layout = read_layout(data, size, size, true);
   const FileHeader &h = layout.header;
@@ -123,7 +139,7 @@ std::vector<DamagedBlock> check_blocks(const uint8_t *data, size_t size) {
     const char *problem = nullptr;
     if (index.offset[c] + index.size[c] > size)
       problem = "missing: the file ends before this block (truncated file)";
-    else if ((checksum(data + index.offset[c], index.size[c]) & 0xFF) != index.check[c])
+    else if (!passes_block_check(data + index.offset[c], index.size[c], index.check[c]))
       problem = "checksum mismatch";
     if (problem)
       damaged.push_back({"cluster " + std::to_string(c),

@@ -186,7 +186,7 @@ size_t SelectiveDecoder::State::fetch(Cluster &k, size_t needed) {
     ++blocks_read;
   k.loaded = upto;
   if (k.loaded == size && !k.checked) {
-    if ((checksum(k.block.data(), size) & 0xFF) != index.check[k.id])
+    if (!passes_block_check(k.block.data(), size, index.check[k.id]))
       throw Error("damaged .pomar file: checksum mismatch in the block of cluster " +
                   std::to_string(k.id));
     k.checked = true;

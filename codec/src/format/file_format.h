@@ -76,6 +76,10 @@ struct FileLayout {
 };
 
 uint32_t checksum(const uint8_t *data, size_t size);
+/// A cluster block against its 8-bit check from the index (the low byte of its XXH32).
+inline bool passes_block_check(const uint8_t *block, size_t size, uint8_t check) {
+  return (checksum(block, size) & 0xFF) == check;
+}
 /// XXH32 (seed 0) of the concatenation of `blocks`, as checksum() of the whole would give.
 uint32_t checksum(const std::vector<const std::vector<uint8_t> *> &blocks);
 
