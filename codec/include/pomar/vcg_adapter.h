@@ -31,7 +31,7 @@ size_t vertex_index(const MeshType &m, const typename MeshType::VertexType *v, s
   const VertexType *first = m.vert.empty() ? nullptr : &m.vert[0];
   const std::less<const VertexType *> less;
   if (v == nullptr || first == nullptr || less(v, first) || !less(v, first + m.vert.size()))
-    throw Error("vcg mesh: face " + std::to_string(face) +
+    throw Error(Error::Kind::InvalidMesh, "vcg mesh: face " + std::to_string(face) +
                 " has a vertex pointer outside the vertex array");
   return static_cast<size_t>(v - first);
 }
@@ -56,12 +56,12 @@ template <class MeshType> Mesh from_vcg(const MeshType &m, size_t *unreferenced 
     if (face.IsD())
       continue;
     if (face.VN() != 3)
-      throw Error("vcg mesh: face " + std::to_string(f) + " has " + std::to_string(face.VN()) +
+      throw Error(Error::Kind::InvalidMesh, "vcg mesh: face " + std::to_string(f) + " has " + std::to_string(face.VN()) +
                   " vertices, expected a triangle");
     for (int k = 0; k < 3; ++k) {
       const size_t v = vcg_detail::vertex_index(m, face.cV(k), f);
       if (m.vert[v].IsD())
-        throw Error("vcg mesh: face " + std::to_string(f) + " references deleted vertex " +
+        throw Error(Error::Kind::InvalidMesh, "vcg mesh: face " + std::to_string(f) + " references deleted vertex " +
                     std::to_string(v));
       remap[v] = 0;
     }
@@ -80,7 +80,7 @@ template <class MeshType> Mesh from_vcg(const MeshType &m, size_t *unreferenced 
       continue;
     }
     if (next == kUnused)
-      throw Error("vcg mesh: too many vertices for 32-bit indices");
+      throw Error(Error::Kind::InvalidMesh, "vcg mesh: too many vertices for 32-bit indices");
     remap[v] = next++;
     const auto &p = m.vert[v].cP();
     out.positions.push_back(static_cast<float>(p[0]));
@@ -119,13 +119,13 @@ template <class MeshType> void to_vcg(const Mesh &src, MeshType &m) {
   using ScalarType = typename MeshType::ScalarType;
 
   if (src.positions.size() % 3 != 0 || src.triangles.size() % 3 != 0)
-    throw Error("to_vcg: positions and triangles must hold a multiple of 3 values");
+    throw Error(Error::Kind::InvalidMesh, "to_vcg: positions and triangles must hold a multiple of 3 values");
   const size_t nv = src.vertex_count(), nf = src.triangle_count();
   if (nv > size_t(INT_MAX) || nf > size_t(INT_MAX))
-    throw Error("to_vcg: mesh too large for vcglib (more than INT_MAX vertices or faces)");
+    throw Error(Error::Kind::InvalidMesh, "to_vcg: mesh too large for vcglib (more than INT_MAX vertices or faces)");
   for (size_t i = 0; i < src.triangles.size(); ++i)
     if (src.triangles[i] >= nv)
-      throw Error("to_vcg: triangle " + std::to_string(i / 3) + " references vertex " +
+      throw Error(Error::Kind::InvalidMesh, "to_vcg: triangle " + std::to_string(i / 3) + " references vertex " +
                   std::to_string(src.triangles[i]) + " but the mesh has " + std::to_string(nv) +
                   " vertices");
 

@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "decode/damage.h"
 #include "decode/decoder_codec.h"
 #include "refine/level_step.h"
 
@@ -27,7 +28,7 @@ LevelMesh base_level_mesh(const uint8_t *data, const FileLayout &layout) {
   try {
     build_corner_table(base.triangles.data(), h.base_faces, h.base_vertices, lm.ct);
   } catch (const Error &e) {
-    throw Error(std::string("damaged .pomar file: invalid base mesh: ") + e.what());
+    throw Error(Error::Kind::DamagedFile, std::string("damaged .pomar file: invalid base mesh: ") + e.what());
   }
   lm.init_lineage();
   return lm;
@@ -60,7 +61,7 @@ size_t decode_global_levels(const uint8_t *data, const FileLayout &layout, size_
       if (!damaged)
         throw;
       // The step checks before it applies: the mesh is still level i.
-      damaged->push_back({"level " + std::to_string(i + 1), err.what(), static_cast<int>(i)});
+      damaged->push_back(damaged_level(i + 1, err.what()));
       return i;
     }
     if (progress)

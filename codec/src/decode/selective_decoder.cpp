@@ -94,7 +94,7 @@ bool SelectiveDecoder::State::skip_cluster(uint32_t c, const Error &e) {
   // (The failed step applied nothing and released its face claims.)
   if (c == kNone || !skip_damaged)
     return false;
-  damaged.push_back({"cluster " + std::to_string(c), e.what(), global_levels});
+  damaged.push_back(damaged_cluster(c, e.what(), global_levels));
   // Levels of this cluster decoded earlier from the same block cannot be trusted either:
   // the cap coarsens it (decode_target re-decodes from the base clustered mesh then).
   cap[c] = global_levels;
@@ -106,16 +106,17 @@ bool SelectiveDecoder::State::skip_cluster(uint32_t c, const Error &e) {
     // say so once (nothing can locate it).
     if (std::none_of(damaged.begin(), damaged.end(),
                      [](const DamagedBlock &b) { return b.level_kept < 0; }))
-      damaged.push_back({"cluster data", kUnplacedDamage, -1});
+      damaged.push_back(unlocated_damage(kUnplacedDamage));
     for (uint32_t k = graph.start[c]; k < graph.start[c + 1]; ++k) {
       const uint32_t nb = graph.adj[k];
       if (cap[nb] == global_levels)
         continue;
       cap[nb] = global_levels;
-      damaged.push_back({"cluster " + std::to_string(nb),
-                         "suspect: its block passes its 8-bit check, but cluster " +
-                             std::to_string(c) + " next to it failed to decode",
-                         global_levels});
+      damaged.push_back(damaged_cluster(nb,
+                                        "suspect: its block passes its 8-bit check, but "
+                                        "cluster " + std::to_string(c) +
+                                            " next to it failed to decode",
+                                        global_levels));
     }
   }
   return true;
@@ -135,7 +136,7 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   s.source->read(0, s.global.size(), s.global.data());
   const size_t hsize = header_size(s.global.data(), s.global.size());
   if (hsize > file_size)
-    throw Error("truncated .pomar file: the header alone needs " + std::to_string(hsize) +
+    throw Error(Error::Kind::TruncatedFile, "truncated .pomar file: the header alone needs " + std::to_string(hsize) +
                 " bytes");
   s.global.resize(hsize);
   s.source->read(0, hsize, s.global.data());
@@ -205,25 +206,22 @@ uint32_t SelectiveDecoder::clusters_decoded() const {
 
 // ---------------------------------------------------------------- requests
 
-namespace {
-int check_level(int level, int finest) {
+void check_level_exists(int level, int finest) {
   if (level < 0 || level > finest)
-    throw Error("level " + std::to_string(level) + " does not exist: the file has levels 0.." +
-                std::to_string(finest));
-  return level;
+    throw Error(Error::Kind::Usage, "level " + std::to_string(level) +
+                              " does not exist: the file has levels 0.." + std::to_string(finest));
 }
-} // namespace
 
 void SelectiveDecoder::want_cluster(uint32_t cluster, int level) {
-  check_level(level, s_->finest);
+  check_level_exists(level, s_->finest);
   if (cluster >= s_->clusters.size())
-    throw Error("cluster " + std::to_string(cluster) + " does not exist: the file has " +
+    throw Error(Error::Kind::Usage, "cluster " + std::to_string(cluster) + " does not exist: the file has " +
                 std::to_string(s_->clusters.size()) + " clusters");
   s_->wanted[cluster] = std::max(s_->wanted[cluster], level);
 }
 
 void SelectiveDecoder::want_all(int level) {
-  check_level(level, s_->finest);
+  check_level_exists(level, s_->finest);
   if (!s_->clustered()) {
     s_->uniform_level = std::max(s_->uniform_level, level);
     return;
@@ -233,12 +231,12 @@ void SelectiveDecoder::want_all(int level) {
 }
 
 void SelectiveDecoder::want_vertices(const std::vector<uint32_t> &vertices, int level) {
-  check_level(level, s_->finest);
+  check_level_exists(level, s_->finest);
   if (!s_->clustered())
     return;
   for (uint32_t v : vertices) {
     if (v >= s_->mesh.vertex_count())
-      throw Error("vertex " + std::to_string(v) + " is not in the decoded mesh");
+      throw Error(Error::Kind::Usage, "vertex " + std::to_string(v) + " is not in the decoded mesh");
     int &w = s_->wanted[s_->mesh.cluster_of(v)];
     w = std::max(w, level);
   }
@@ -248,7 +246,7 @@ void SelectiveDecoder::want_faces(const std::vector<uint32_t> &faces, int level)
   std::vector<uint32_t> vertices;
   for (uint32_t f : faces) {
     if (f >= s_->mesh.ct.face_count())
-      throw Error("face " + std::to_string(f) + " is not in the decoded mesh");
+      throw Error(Error::Kind::Usage, "face " + std::to_string(f) + " is not in the decoded mesh");
     vertices.insert(vertices.end(), &s_->mesh.ct.V[3 * f], &s_->mesh.ct.V[3 * f] + 3);
   }
   want_vertices(vertices, level);
@@ -302,10 +300,10 @@ void SelectiveDecoder::clear_wanted() {
 
 void SelectiveDecoder::set_wanted(const std::vector<int> &levels) {
   if (levels.size() != s_->clusters.size())
-    throw Error("set_wanted: " + std::to_string(levels.size()) + " levels for " +
+    throw Error(Error::Kind::Usage, "set_wanted: " + std::to_string(levels.size()) + " levels for " +
                 std::to_string(s_->clusters.size()) + " clusters");
   for (int l : levels)
-    check_level(l, s_->finest);
+    check_level_exists(l, s_->finest);
   s_->wanted = levels;
 }
 
@@ -402,8 +400,8 @@ void SelectiveDecoder::State::check_cluster_data() {
   if (checksum(blocks) == h.cluster_checksum)
     return;
   if (!skip_damaged)
-    throw Error(kUnlocatedDamage);
-  damaged.push_back({"cluster data", kUnlocatedDamage, -1});
+    throw Error(Error::Kind::DamagedFile, kUnlocatedDamage);
+  damaged.push_back(unlocated_damage(kUnlocatedDamage));
 }
 
 Mesh SelectiveDecoder::mesh() const { return to_mesh(s_->mesh, s_->layout.header.grid); }

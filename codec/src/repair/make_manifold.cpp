@@ -293,7 +293,7 @@ std::vector<uint32_t> split_fans(const std::vector<uint32_t> &t, size_t nv,
         vertex_of_root[root] = v;
       } else {
         if (nv + copy_of.size() >= kNone)
-          throw Error("the repaired mesh would have too many vertices");
+          throw Error(Error::Kind::InvalidMesh, "the repaired mesh would have too many vertices");
         vertex_of_root[root] = static_cast<uint32_t>(nv + copy_of.size());
         copy_of.push_back(v);
       }
@@ -355,13 +355,13 @@ RepairReport make_manifold(Mesh &mesh) {
   RepairReport r;
   const size_t nv = mesh.vertex_count();
   if (mesh.positions.size() % 3 != 0 || mesh.triangles.size() % 3 != 0)
-    throw Error("position and triangle arrays must hold multiples of 3 values");
+    throw Error(Error::Kind::InvalidMesh, "position and triangle arrays must hold multiples of 3 values");
   if (nv >= kNone || mesh.triangles.size() >= kNone)
-    throw Error("the mesh is too large to repair (" + std::to_string(mesh.triangle_count()) +
+    throw Error(Error::Kind::InvalidMesh, "the mesh is too large to repair (" + std::to_string(mesh.triangle_count()) +
                 " triangles)");
   for (size_t c = 0; c < mesh.triangles.size(); ++c)
     if (mesh.triangles[c] >= nv)
-      throw Error("face " + std::to_string(c / 3) + " uses vertex " +
+      throw Error(Error::Kind::InvalidMesh, "face " + std::to_string(c / 3) + " uses vertex " +
                   std::to_string(mesh.triangles[c]) + " but the mesh has only " +
                   std::to_string(nv) + " vertices");
 
@@ -403,7 +403,7 @@ RepairReport make_manifold(Mesh &mesh) {
     build_corner_table(mesh.triangles.data(), mesh.triangle_count(), mesh.vertex_count(), ct);
   } catch (const Error &e) {
     if (mesh.triangle_count() != 0)
-      throw Error(std::string("internal repair error: the repaired mesh is still invalid: ") +
+      throw Error(Error::Kind::Internal, std::string("internal repair error: the repaired mesh is still invalid: ") +
                   e.what());
   }
   return r;
