@@ -44,16 +44,6 @@ pomar::Progress terminal_progress(bool quiet) {
   };
 }
 
-/// True if make_manifold() would change `mesh` (a copy): then `--repair` is worth a hint.
-bool repair_would_help(const pomar::Mesh &mesh) {
-  pomar::Mesh copy = mesh;
-  try {
-    return pomar::make_manifold(copy).changed();
-  } catch (const pomar::Error &) {
-    return false;
-  }
-}
-
 constexpr const char *kRepairHint = " (pomar encode --repair cuts it into a manifold mesh)";
 
 /// Runs make_manifold() on `mesh` and prints what it changed on stderr, one line per kind
@@ -118,7 +108,7 @@ int run_encode(const EncodeArgs &a) {
   try {
     file = pomar::encode(mesh, opt, &r);
   } catch (const pomar::Error &e) {
-    if (!a.repair && repair_would_help(mesh))
+    if (!a.repair && pomar::repair_would_change(mesh))
       throw pomar::Error(e.kind(), e.what() + std::string(kRepairHint));
     throw;
   }
@@ -476,7 +466,7 @@ int run_verify(const std::string &original, const std::string &file, const std::
   // With --repair the reference is the repaired original: what `encode --repair` encoded.
   if (repair)
     repair_and_report(ref, true);
-  const bool could_repair = !repair && repair_would_help(ref);
+  const bool could_repair = !repair && pomar::repair_would_change(ref);
   const std::vector<uint8_t> data = pomar::read_file(file);
   const pomar::FileInfo info = pomar::inspect(data.data(), data.size());
   const pomar::Mesh out =

@@ -22,18 +22,28 @@
 
 namespace pomar {
 
+/// Position of `v` in m.vert, or m.vert.size() if `v` does not point into m.vert (a face's
+/// vertex pointer -> vertex index).
+template <class MeshType>
+size_t vertex_position(const MeshType &m, const typename MeshType::VertexType *v) {
+  using VertexType = typename MeshType::VertexType;
+  const VertexType *first = m.vert.empty() ? nullptr : &m.vert[0];
+  const std::less<const VertexType *> less;
+  if (v == nullptr || first == nullptr || less(v, first) || !less(v, first + m.vert.size()))
+    return m.vert.size();
+  return static_cast<size_t>(v - first);
+}
+
 namespace vcg_detail {
 
 /// Position of `v` in m.vert, or throws if `v` does not point into m.vert.
 template <class MeshType>
 size_t vertex_index(const MeshType &m, const typename MeshType::VertexType *v, size_t face) {
-  using VertexType = typename MeshType::VertexType;
-  const VertexType *first = m.vert.empty() ? nullptr : &m.vert[0];
-  const std::less<const VertexType *> less;
-  if (v == nullptr || first == nullptr || less(v, first) || !less(v, first + m.vert.size()))
+  const size_t i = vertex_position(m, v);
+  if (i == m.vert.size())
     throw Error(Error::Kind::InvalidMesh, "vcg mesh: face " + std::to_string(face) +
                 " has a vertex pointer outside the vertex array");
-  return static_cast<size_t>(v - first);
+  return i;
 }
 
 } // namespace vcg_detail

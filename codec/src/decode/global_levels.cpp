@@ -6,15 +6,14 @@
 
 #include "decode/damage.h"
 #include "decode/decoder_codec.h"
+#include "geometry/quantize.h"
 #include "refine/level_step.h"
 
 namespace pomar {
 
 Mesh to_mesh(const LevelMesh &lm, const Quantizer &grid) {
   Mesh out;
-  out.positions.resize(lm.q.size());
-  for (size_t i = 0; i < lm.q.size(); ++i)
-    out.positions[i] = grid.dequantize(static_cast<int>(i % 3), static_cast<uint32_t>(lm.q[i]));
+  out.positions = dequantize(grid, lm.q);
   out.triangles = lm.ct.V;
   return out;
 }

@@ -8,6 +8,7 @@
 #include "decode/level_map.h"
 #include "entropy/static_tables.h"
 #include "format/file_format.h"
+#include "geometry/quantize.h"
 #include "pomar/limits.h"
 #include "pomar/random_access.h"
 #include "refine/level_step.h"
@@ -256,13 +257,10 @@ namespace {
 template <class Inside>
 std::vector<uint32_t> vertices_where(const LevelMesh &m, const Quantizer &g, Inside inside) {
   std::vector<uint32_t> out;
-  for (uint32_t v = 0; v < m.vertex_count(); ++v) {
-    const float p[3] = {g.dequantize(0, uint32_t(m.q[3 * v])),
-                        g.dequantize(1, uint32_t(m.q[3 * v + 1])),
-                        g.dequantize(2, uint32_t(m.q[3 * v + 2]))};
-    if (inside(p))
+  const std::vector<float> p = dequantize(g, m.q);
+  for (uint32_t v = 0; v < m.vertex_count(); ++v)
+    if (inside(&p[3 * v]))
       out.push_back(v);
-  }
   return out;
 }
 } // namespace

@@ -409,4 +409,13 @@ RepairReport make_manifold(Mesh &mesh) {
   return r;
 }
 
+bool repair_would_change(const Mesh &mesh) {
+  Mesh copy = mesh;
+  try {
+    return make_manifold(copy).changed();
+  } catch (const Error &) {
+    return false;
+  }
+}
+
 } // namespace pomar
