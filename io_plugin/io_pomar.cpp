@@ -322,7 +322,7 @@ bool PomarIOPlugin::save(const QString &format, const QString &fileName, MeshMod
       if (repair || !pomar::repair_would_change(mesh))
         throw;
       throw pomar::Error(e.kind(), std::string(e.what()) +
-                         " (the Repair save option cuts it into a manifold mesh)");
+                                       " (the Repair save option cuts it into a manifold mesh)");
     }
   } catch (const std::exception &e) { // pomar::Error (invalid mesh or options), std::bad_alloc
     return fail(pomar::meshlab::errorText(e, "cannot save " + path));

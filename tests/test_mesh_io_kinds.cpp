@@ -24,9 +24,7 @@ Error error_of(const std::function<void()> &f) {
   return Error("none");
 }
 
-std::string temp_path(const char *name) {
-  return testing::TempDir() + "pomar_kinds_" + name;
-}
+std::string temp_path(const char *name) { return testing::TempDir() + "pomar_kinds_" + name; }
 
 TEST(MeshIoKinds, MissingFileIsAnIoErrorNamingThePath) {
   const std::string path = temp_path("missing.ply");
@@ -62,9 +60,8 @@ TEST(MeshIoKinds, SizeCheckKeepsItsKind) {
   const std::string path = temp_path("tetra.off");
   save_mesh(path, gen::tetrahedron());
   const Error e = error_of([&] {
-    load_mesh(path, nullptr, [](uint64_t, uint64_t) {
-      throw Error(Kind::MemoryLimit, "not enough memory");
-    });
+    load_mesh(path, nullptr,
+              [](uint64_t, uint64_t) { throw Error(Kind::MemoryLimit, "not enough memory"); });
   });
   EXPECT_EQ(e.kind(), Kind::MemoryLimit);
   EXPECT_EQ(e.path(), path);

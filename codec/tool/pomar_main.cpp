@@ -167,8 +167,9 @@ std::vector<double> parse_spec(const std::string &spec, size_t count, int finest
       if (used != spec.size() - colon - 1)
         throw std::invalid_argument("level");
     } catch (const std::exception &) {
-      throw pomar::Error(pomar::Error::Kind::Usage, std::string("bad ") + what + " '" + spec +
-                         "': the level after ':' must be an integer");
+      throw pomar::Error(pomar::Error::Kind::Usage,
+                         std::string("bad ") + what + " '" + spec +
+                             "': the level after ':' must be an integer");
     }
   }
   std::vector<double> v;
@@ -183,16 +184,17 @@ std::vector<double> parse_spec(const std::string &spec, size_t count, int finest
       if (used != item.size())
         throw std::invalid_argument("number");
     } catch (const std::exception &) {
-      throw pomar::Error(pomar::Error::Kind::Usage, std::string("bad ") + what + " '" + spec + "': '" + item +
-                         "' is not a number");
+      throw pomar::Error(pomar::Error::Kind::Usage, std::string("bad ") + what + " '" + spec +
+                                                        "': '" + item + "' is not a number");
     }
     if (comma == std::string::npos)
       break;
     pos = comma + 1;
   }
   if (v.size() != count)
-    throw pomar::Error(pomar::Error::Kind::Usage, std::string("bad ") + what + " '" + spec + "': expected " +
-                       std::to_string(count) + " numbers");
+    throw pomar::Error(pomar::Error::Kind::Usage, std::string("bad ") + what + " '" + spec +
+                                                      "': expected " + std::to_string(count) +
+                                                      " numbers");
   return v;
 }
 
@@ -236,8 +238,8 @@ int report_damage(const std::vector<pomar::DamagedBlock> &damaged, const std::st
 /// so in the error.
 [[noreturn]] void rethrow_with_hint(const pomar::Error &e) {
   using Kind = pomar::Error::Kind;
-  const bool skippable = e.kind() == Kind::TruncatedFile ||
-                         (e.kind() == Kind::DamagedFile && e.in_block());
+  const bool skippable =
+      e.kind() == Kind::TruncatedFile || (e.kind() == Kind::DamagedFile && e.in_block());
   if (!skippable)
     throw e;
   pomar::Error hinted(e.kind(), e.what() + std::string(" (pomar info --check lists damaged "
@@ -254,7 +256,8 @@ int run_selective_decode(const DecodeArgs &a) {
   options.memory_limit = pomar::parse_memory_size(a.max_memory);
   pomar::SelectiveDecoder d(std::make_unique<pomar::FileSource>(a.in), options);
   if (!d.info().clustered())
-    throw pomar::Error(pomar::Error::Kind::Usage, a.in + " is a pure progressive file (encoded with --progressive): it has "
+    throw pomar::Error(pomar::Error::Kind::Usage,
+                       a.in + " is a pure progressive file (encoded with --progressive): it has "
                               "no clusters to select; use --level");
   const int finest = d.finest_level();
   if (a.level >= 0)
@@ -263,8 +266,9 @@ int run_selective_decode(const DecodeArgs &a) {
     int level;
     const std::vector<double> id = parse_spec(spec, 1, finest, level, "--cluster");
     if (id[0] < 0 || id[0] != double(uint32_t(id[0])))
-      throw pomar::Error(pomar::Error::Kind::Usage, "bad --cluster '" + spec +
-                         "': the cluster id must be a non-negative integer");
+      throw pomar::Error(pomar::Error::Kind::Usage,
+                         "bad --cluster '" + spec +
+                             "': the cluster id must be a non-negative integer");
     d.want_cluster(static_cast<uint32_t>(id[0]), level);
   }
   for (const std::string &spec : a.spheres) {

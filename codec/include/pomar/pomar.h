@@ -186,7 +186,7 @@ struct DamagedBlock {
   /// fail their checksum (format version 3) though each passes its own 8-bit check, so the
   /// damaged one cannot be located and skipped; the mesh may be wrong in places.
   int level_kept = 0;
-  int level = -1;      ///< the global level it holds (1-based), -1 for a cluster block
+  int level = -1;       ///< the global level it holds (1-based), -1 for a cluster block
   int64_t cluster = -1; ///< the cluster whose block it is, -1 for a global level
 };
 

@@ -42,7 +42,7 @@ size_t vertex_index(const MeshType &m, const typename MeshType::VertexType *v, s
   const size_t i = vertex_position(m, v);
   if (i == m.vert.size())
     throw Error(Error::Kind::InvalidMesh, "vcg mesh: face " + std::to_string(face) +
-                " has a vertex pointer outside the vertex array");
+                                              " has a vertex pointer outside the vertex array");
   return i;
 }
 
@@ -66,13 +66,15 @@ template <class MeshType> Mesh from_vcg(const MeshType &m, size_t *unreferenced 
     if (face.IsD())
       continue;
     if (face.VN() != 3)
-      throw Error(Error::Kind::InvalidMesh, "vcg mesh: face " + std::to_string(f) + " has " + std::to_string(face.VN()) +
-                  " vertices, expected a triangle");
+      throw Error(Error::Kind::InvalidMesh, "vcg mesh: face " + std::to_string(f) + " has " +
+                                                std::to_string(face.VN()) +
+                                                " vertices, expected a triangle");
     for (int k = 0; k < 3; ++k) {
       const size_t v = vcg_detail::vertex_index(m, face.cV(k), f);
       if (m.vert[v].IsD())
-        throw Error(Error::Kind::InvalidMesh, "vcg mesh: face " + std::to_string(f) + " references deleted vertex " +
-                    std::to_string(v));
+        throw Error(Error::Kind::InvalidMesh, "vcg mesh: face " + std::to_string(f) +
+                                                  " references deleted vertex " +
+                                                  std::to_string(v));
       remap[v] = 0;
     }
     ++live_faces;
@@ -129,15 +131,18 @@ template <class MeshType> void to_vcg(const Mesh &src, MeshType &m) {
   using ScalarType = typename MeshType::ScalarType;
 
   if (src.positions.size() % 3 != 0 || src.triangles.size() % 3 != 0)
-    throw Error(Error::Kind::InvalidMesh, "to_vcg: positions and triangles must hold a multiple of 3 values");
+    throw Error(Error::Kind::InvalidMesh,
+                "to_vcg: positions and triangles must hold a multiple of 3 values");
   const size_t nv = src.vertex_count(), nf = src.triangle_count();
   if (nv > size_t(INT_MAX) || nf > size_t(INT_MAX))
-    throw Error(Error::Kind::InvalidMesh, "to_vcg: mesh too large for vcglib (more than INT_MAX vertices or faces)");
+    throw Error(Error::Kind::InvalidMesh,
+                "to_vcg: mesh too large for vcglib (more than INT_MAX vertices or faces)");
   for (size_t i = 0; i < src.triangles.size(); ++i)
     if (src.triangles[i] >= nv)
-      throw Error(Error::Kind::InvalidMesh, "to_vcg: triangle " + std::to_string(i / 3) + " references vertex " +
-                  std::to_string(src.triangles[i]) + " but the mesh has " + std::to_string(nv) +
-                  " vertices");
+      throw Error(Error::Kind::InvalidMesh,
+                  "to_vcg: triangle " + std::to_string(i / 3) + " references vertex " +
+                      std::to_string(src.triangles[i]) + " but the mesh has " + std::to_string(nv) +
+                      " vertices");
 
   m.Clear();
   m.ClearAttributes();

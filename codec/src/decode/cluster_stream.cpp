@@ -44,9 +44,9 @@ void ClusterStream::start(bool whole) {
   // is not there.
   if (offset_ + size_ > source_->size())
     throw Error(Error::Kind::TruncatedFile, "truncated .pomar file: the block of cluster " +
-                                         std::to_string(id_) + " ends at byte " +
-                                         std::to_string(offset_ + size_) + ", the file has " +
-                                         std::to_string(source_->size()))
+                                                std::to_string(id_) + " ends at byte " +
+                                                std::to_string(offset_ + size_) +
+                                                ", the file has " + std::to_string(source_->size()))
         .in_block(Error::kNoBlock, id_);
   if (block_.empty() && size_ > 0)
     block_.resize(size_);

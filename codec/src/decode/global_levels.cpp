@@ -27,7 +27,8 @@ LevelMesh base_level_mesh(const uint8_t *data, const FileLayout &layout) {
   try {
     build_corner_table(base.triangles.data(), h.base_faces, h.base_vertices, lm.ct);
   } catch (const Error &e) {
-    throw Error(Error::Kind::DamagedFile, std::string("damaged .pomar file: invalid base mesh: ") + e.what());
+    throw Error(Error::Kind::DamagedFile,
+                std::string("damaged .pomar file: invalid base mesh: ") + e.what());
   }
   lm.init_lineage();
   return lm;

@@ -1,10 +1,10 @@
 // Random access (paper section 6): the level map and selective, incremental decoding.
 #include <algorithm>
 
+#include "decode/cluster_stream.h"
 #include "decode/damage.h"
 #include "decode/decoder_codec.h"
 #include "decode/global_levels.h"
-#include "decode/cluster_stream.h"
 #include "decode/level_map.h"
 #include "entropy/static_tables.h"
 #include "format/file_format.h"
@@ -115,8 +115,8 @@ bool SelectiveDecoder::State::skip_cluster(uint32_t c, const Error &e) {
       cap[nb] = global_levels;
       damaged.push_back(damaged_cluster(nb,
                                         "suspect: its block passes its 8-bit check, but "
-                                        "cluster " + std::to_string(c) +
-                                            " next to it failed to decode",
+                                        "cluster " +
+                                            std::to_string(c) + " next to it failed to decode",
                                         global_levels));
     }
   }
@@ -137,8 +137,8 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   s.source->read(0, s.global.size(), s.global.data());
   const size_t hsize = header_size(s.global.data(), s.global.size());
   if (hsize > file_size)
-    throw Error(Error::Kind::TruncatedFile, "truncated .pomar file: the header alone needs " + std::to_string(hsize) +
-                " bytes");
+    throw Error(Error::Kind::TruncatedFile, "truncated .pomar file: the header alone needs " +
+                                                std::to_string(hsize) + " bytes");
   s.global.resize(hsize);
   s.source->read(0, hsize, s.global.data());
   s.layout = read_layout(s.global.data(), hsize, file_size, options.skip_damaged);
@@ -210,14 +210,16 @@ uint32_t SelectiveDecoder::clusters_decoded() const {
 void check_level_exists(int level, int finest) {
   if (level < 0 || level > finest)
     throw Error(Error::Kind::Usage, "level " + std::to_string(level) +
-                              " does not exist: the file has levels 0.." + std::to_string(finest));
+                                        " does not exist: the file has levels 0.." +
+                                        std::to_string(finest));
 }
 
 void SelectiveDecoder::want_cluster(uint32_t cluster, int level) {
   check_level_exists(level, s_->finest);
   if (cluster >= s_->clusters.size())
-    throw Error(Error::Kind::Usage, "cluster " + std::to_string(cluster) + " does not exist: the file has " +
-                std::to_string(s_->clusters.size()) + " clusters");
+    throw Error(Error::Kind::Usage, "cluster " + std::to_string(cluster) +
+                                        " does not exist: the file has " +
+                                        std::to_string(s_->clusters.size()) + " clusters");
   s_->wanted[cluster] = std::max(s_->wanted[cluster], level);
 }
 
@@ -237,7 +239,8 @@ void SelectiveDecoder::want_vertices(const std::vector<uint32_t> &vertices, int 
     return;
   for (uint32_t v : vertices) {
     if (v >= s_->mesh.vertex_count())
-      throw Error(Error::Kind::Usage, "vertex " + std::to_string(v) + " is not in the decoded mesh");
+      throw Error(Error::Kind::Usage,
+                  "vertex " + std::to_string(v) + " is not in the decoded mesh");
     int &w = s_->wanted[s_->mesh.cluster_of(v)];
     w = std::max(w, level);
   }
@@ -298,8 +301,9 @@ void SelectiveDecoder::clear_wanted() {
 
 void SelectiveDecoder::set_wanted(const std::vector<int> &levels) {
   if (levels.size() != s_->clusters.size())
-    throw Error(Error::Kind::Usage, "set_wanted: " + std::to_string(levels.size()) + " levels for " +
-                std::to_string(s_->clusters.size()) + " clusters");
+    throw Error(Error::Kind::Usage, "set_wanted: " + std::to_string(levels.size()) +
+                                        " levels for " + std::to_string(s_->clusters.size()) +
+                                        " clusters");
   for (int l : levels)
     check_level_exists(l, s_->finest);
   s_->wanted = levels;

@@ -30,8 +30,9 @@ std::vector<float> compact_vertices(const Mesh &mesh, std::vector<uint32_t> &tri
   triangles = mesh.triangles;
   for (uint32_t &i : triangles) {
     if (i >= nv)
-      throw Error(Error::Kind::InvalidMesh, "a triangle refers to vertex " + std::to_string(i) + " but the mesh has only " +
-                  std::to_string(nv) + " vertices");
+      throw Error(Error::Kind::InvalidMesh, "a triangle refers to vertex " + std::to_string(i) +
+                                                " but the mesh has only " + std::to_string(nv) +
+                                                " vertices");
     if (remap[i] == kNone) {
       remap[i] = 0; // mark used; numbered below in input order
     }
@@ -51,10 +52,11 @@ std::vector<float> compact_vertices(const Mesh &mesh, std::vector<uint32_t> &tri
 
 void check_input(const Mesh &mesh, const EncodeOptions &options) {
   if (options.bits < 4 || options.bits > 24)
-    throw Error(Error::Kind::Usage, "quantization bits must be between 4 and 24 (got " + std::to_string(options.bits) +
-                ")");
+    throw Error(Error::Kind::Usage, "quantization bits must be between 4 and 24 (got " +
+                                        std::to_string(options.bits) + ")");
   if (mesh.positions.size() % 3 || mesh.triangles.size() % 3)
-    throw Error(Error::Kind::InvalidMesh, "position and triangle arrays must hold multiples of 3 values");
+    throw Error(Error::Kind::InvalidMesh,
+                "position and triangle arrays must hold multiples of 3 values");
   if (mesh.triangle_count() == 0)
     throw Error(Error::Kind::InvalidMesh, "the mesh contains no triangles");
   for (size_t i = 0; i < mesh.positions.size(); ++i)
@@ -67,9 +69,9 @@ void check_input(const Mesh &mesh, const EncodeOptions &options) {
 /// memory locality, connectivity built and validated.
 struct PreparedInput {
   Quantizer grid;
-  std::vector<int32_t> q;             // quantized xyz, prepared numbering
+  std::vector<int32_t> q; // quantized xyz, prepared numbering
   CornerTable ct;
-  std::vector<uint32_t> to_input;     // prepared vertex -> the caller's vertex
+  std::vector<uint32_t> to_input; // prepared vertex -> the caller's vertex
   uint32_t vertices = 0, faces = 0;
 };
 
@@ -187,7 +189,8 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
   if (global < rb.levels())
     clustered = encode_clustered_levels(rb, global, header, options.progress);
   if (rb.mesh.vertex_count() != nv || rb.mesh.ct.face_count() != nf)
-    throw Error(Error::Kind::Internal, "internal encoder error: the refined mesh does not match the input");
+    throw Error(Error::Kind::Internal,
+                "internal encoder error: the refined mesh does not match the input");
 
   std::vector<uint8_t> file = write_file(header, pack_base_mesh(base, in.grid.bits), blocks,
                                          clustered.tables, clustered.blocks);

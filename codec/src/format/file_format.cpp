@@ -102,7 +102,9 @@ std::vector<uint8_t> pack_cluster_index(const std::vector<std::vector<uint8_t>> 
   return out;
 }
 
-[[noreturn]] void bad(const std::string &what) { throw Error(Error::Kind::DamagedFile, "not a valid .pomar file: " + what); }
+[[noreturn]] void bad(const std::string &what) {
+  throw Error(Error::Kind::DamagedFile, "not a valid .pomar file: " + what);
+}
 
 } // namespace
 
@@ -222,8 +224,9 @@ FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size, boo
   h.version = r.u16();
   if (h.version != kFormatVersion && h.version != kClusteredFormatVersion &&
       h.version != kClusteredFormatVersion2)
-    throw Error(Error::Kind::Unsupported, "unsupported .pomar version " + std::to_string(h.version) +
-                " (this build reads versions 1 to 3)");
+    throw Error(Error::Kind::Unsupported, "unsupported .pomar version " +
+                                              std::to_string(h.version) +
+                                              " (this build reads versions 1 to 3)");
   h.flags = r.u16();
   if ((h.version != kFormatVersion) != h.clustered() || (h.flags & ~kFlagClustered))
     bad("unknown flags " + std::to_string(h.flags) + " for version " + std::to_string(h.version));
@@ -335,7 +338,8 @@ FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size, boo
                                            : L.base_offset + h.base_bytes;
   if (needed > file_size)
     throw Error(Error::Kind::TruncatedFile, "truncated .pomar file: " + std::to_string(file_size) +
-                " bytes, the header announces " + std::to_string(offset));
+                                                " bytes, the header announces " +
+                                                std::to_string(offset));
   if (h.vertices > 512 * uint64_t(file_size) + 64)
     bad("the announced vertex count is implausible for the file size");
   return L;
@@ -385,13 +389,14 @@ void check_level(const uint8_t *data, const FileLayout &L, size_t i) {
   const LevelEntry &e = L.header.levels[i];
   const size_t n = size_t(e.connectivity_bytes) + e.geometry_bytes;
   if (L.level_offset[i] + n > L.file_size)
-    throw Error(Error::Kind::TruncatedFile, "truncated .pomar file: level " + std::to_string(i + 1) +
-                                             " ends at byte " + std::to_string(L.level_offset[i] + n) +
-                                             ", the file has " + std::to_string(L.file_size))
+    throw Error(Error::Kind::TruncatedFile, "truncated .pomar file: level " +
+                                                std::to_string(i + 1) + " ends at byte " +
+                                                std::to_string(L.level_offset[i] + n) +
+                                                ", the file has " + std::to_string(L.file_size))
         .in_block(int(i + 1));
   if (checksum(data + L.level_offset[i], n) != e.checksum)
-    throw Error(Error::Kind::DamagedFile,
-                "damaged .pomar file: checksum mismatch in level " + std::to_string(i + 1) + " block")
+    throw Error(Error::Kind::DamagedFile, "damaged .pomar file: checksum mismatch in level " +
+                                              std::to_string(i + 1) + " block")
         .in_block(int(i + 1));
 }
 
@@ -416,16 +421,19 @@ ClusterIndex read_cluster_index(const uint8_t *data, const FileLayout &L) {
     offset += n;
     total += n;
     if (total > h.cluster_bytes)
-      throw Error(Error::Kind::DamagedFile, "damaged .pomar file: cluster index exceeds the cluster data");
+      throw Error(Error::Kind::DamagedFile,
+                  "damaged .pomar file: cluster index exceeds the cluster data");
   }
   if (total != h.cluster_bytes || rc.overrun())
-    throw Error(Error::Kind::DamagedFile, "damaged .pomar file: cluster index does not match the cluster data");
+    throw Error(Error::Kind::DamagedFile,
+                "damaged .pomar file: cluster index does not match the cluster data");
   return index;
 }
 
 void check_block(const uint8_t *data, size_t size, uint32_t expected, const char *what) {
   if (checksum(data, size) != expected)
-    throw Error(Error::Kind::DamagedFile, std::string("damaged .pomar file: ") + what + " checksum mismatch");
+    throw Error(Error::Kind::DamagedFile,
+                std::string("damaged .pomar file: ") + what + " checksum mismatch");
 }
 
 FileInfo file_info(const FileLayout &L, uint64_t file_size) {

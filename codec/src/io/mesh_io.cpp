@@ -47,7 +47,8 @@ Format format_of(const std::string &path) {
   if (ext == ".stl")
     return Format::Stl;
   if (ext.empty())
-    fail(Error::Kind::Usage, path, std::string("no file extension to tell the mesh format (") + kSupported + ")");
+    fail(Error::Kind::Usage, path,
+         std::string("no file extension to tell the mesh format (") + kSupported + ")");
   fail(Error::Kind::Usage, path, "unknown mesh file extension '" + ext + "' (" + kSupported + ")");
 }
 
