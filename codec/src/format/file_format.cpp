@@ -6,6 +6,11 @@
 #include <cstring>
 #include <new>
 #include <string>
+
+// xxhash compiled into this file (Debian's xxhash.h carries the implementation): no call
+// into the uninstrumented libxxhash.so, so ASan and the fuzzers see every byte a checksum
+// reads, and a file's bytes reach no code that sanitizers cannot check.
+#define XXH_INLINE_ALL
 #include <xxhash.h>
 
 #include "entropy/models.h"
@@ -103,6 +108,19 @@ std::vector<uint8_t> pack_cluster_index(const std::vector<std::vector<uint8_t>> 
 }
 
 [[noreturn]] void bad(const std::string &what) { throw Error("not a valid .pomar file: " + what); }
+
+// No .pomar file is this large: every size read from a header is checked against it before
+// it takes part in a sum, so offsets computed from sizes can never wrap (2^48 bytes leaves
+// room for 2^15 such sizes in a 64-bit sum).
+constexpr uint64_t kMaxFileBytes = uint64_t(1) << 48;
+
+/// offset += bytes, refusing a size no file can have (a hostile header must not make an
+/// offset wrap around and land back inside the buffer).
+void advance(uint64_t &offset, uint64_t bytes, const char *what) {
+  if (bytes > kMaxFileBytes || offset > kMaxFileBytes - bytes)
+    bad(std::string(what) + " size " + std::to_string(bytes) + " is impossible (more than 2^48 bytes)");
+  offset += bytes;
+}
 
 } // namespace
 
@@ -306,30 +324,33 @@ FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size, boo
     bad("level table does not end at the announced vertex/face counts");
   if (h.base_bytes == 0)
     bad("empty base mesh block");
+  // Offsets: every addition is checked (advance), and nothing below subtracts sizes.
   uint64_t offset = L.header_bytes;
   L.base_offset = offset;
-  offset += h.base_bytes;
+  advance(offset, h.base_bytes, "base mesh block");
   const size_t global = h.clustered() ? h.global_levels : h.levels.size();
   for (size_t i = 0; i < global; ++i) {
     L.level_offset.push_back(offset);
-    offset += uint64_t(h.levels[i].connectivity_bytes) + h.levels[i].geometry_bytes;
+    advance(offset, uint64_t(h.levels[i].connectivity_bytes) + h.levels[i].geometry_bytes,
+            "global level block");
   }
   for (size_t i = global; i < h.levels.size(); ++i)
     if (h.levels[i].connectivity_bytes || h.levels[i].geometry_bytes)
       bad("a clustered level has global data");
   if (h.clustered()) {
     L.tables_offset = offset;
-    offset += h.tables_bytes;
+    advance(offset, h.tables_bytes, "static model tables");
     L.index_offset = offset;
-    offset += h.index_bytes;
+    advance(offset, h.index_bytes, "cluster index");
     L.clusters_offset = offset;
     L.global_bytes = offset;
-    offset += h.cluster_bytes;
+    advance(offset, h.cluster_bytes, "cluster data");
   } else {
     L.global_bytes = offset;
   }
   L.file_size = file_size;
-  // With allow_truncated, only what every decode needs must be present.
+  // With allow_truncated, only what every decode needs must be present; a strict reader
+  // needs every byte the header announces.
   const uint64_t needed = !allow_truncated ? offset
                           : h.clustered()  ? L.global_bytes
                                            : L.base_offset + h.base_bytes;
