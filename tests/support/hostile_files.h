@@ -32,6 +32,15 @@ inline uint64_t get_le(const std::vector<uint8_t> &b, size_t at, int bytes) {
   return v;
 }
 
+/// Where a version 4 header's section table (its count) starts; 0 if the image has none.
+inline size_t section_table_at(const std::vector<uint8_t> &b) {
+  if (b.size() < kFixedHeaderBytes || !(get_le(b, 10, 2) & kFlagSections))
+    return 0;
+  const uint64_t levels = std::min<uint64_t>(get_le(b, 48, 4), kMaxLevels);
+  return kFixedHeaderBytes + kLevelEntryBytes * levels +
+         ((get_le(b, 10, 2) & kFlagClustered) ? kClusterHeaderBytes : 0);
+}
+
 /// Recomputes the XXH32 checksums of a (mutated) image: header, base block, global levels,
 /// tables, cluster index and (version 3) all cluster data, wherever the block lies inside the
 /// image. Without this almost every mutation dies at a checksum and the decoders proper are
@@ -42,14 +51,23 @@ inline bool repair_checksums(std::vector<uint8_t> &b) {
     if (hsize < kFixedHeaderBytes + 4 || hsize > b.size())
       return false;
     put_le(b, hsize - 4, checksum(b.data(), hsize - 4), 4);
-    // Lenient: fix what lies inside the image even when the header announces more.
-    const FileLayout L = read_layout(b.data(), b.size(), b.size(), true);
+    // Strict first (as a decoder reads it), then lenient: fix what lies inside the image
+    // even when the header announces more.
+    FileLayout L;
+    try {
+      L = read_layout(b.data(), b.size(), b.size(), false);
+    } catch (const Error &) {
+      L = read_layout(b.data(), b.size(), b.size(), true);
+    }
     const FileHeader &h = L.header;
     auto fix = [&](size_t field, uint64_t offset, uint64_t n) {
       if (offset <= b.size() && n <= b.size() - offset)
         put_le(b, field, checksum(b.data() + offset, n), 4);
     };
     fix(56, L.base_offset, h.base_bytes);
+    const size_t table = section_table_at(b);
+    for (size_t i = 0; i < L.section_offset.size(); ++i)
+      fix(table + 4 + kSectionEntryBytes * i + 16, L.section_offset[i], h.sections[i].bytes);
     for (size_t i = 0; i < L.level_offset.size(); ++i)
       fix(kFixedHeaderBytes + kLevelEntryBytes * i + 16, L.level_offset[i],
           uint64_t(h.levels[i].connectivity_bytes) + h.levels[i].geometry_bytes);
@@ -100,6 +118,17 @@ inline std::vector<Field> header_fields(const std::vector<uint8_t> &file) {
     f.push_back({"index_bytes", c + 16, 4, true});
     f.push_back({"cluster_bytes", c + 24, 8, true});
     f.push_back({"cluster_connectivity_bytes", c + 32, 4, true});
+  }
+  if (const size_t t = section_table_at(file)) {
+    f.push_back({"section count", t, 4});
+    const uint32_t n = uint32_t(std::min<uint64_t>(get_le(file, t, 4), kMaxSections));
+    for (uint32_t i = 0; i < n; ++i) {
+      const size_t e = t + 4 + kSectionEntryBytes * i;
+      const std::string name = "section " + std::to_string(i) + " ";
+      f.push_back({name + "tag", e, 4});
+      f.push_back({name + "flags", e + 4, 4});
+      f.push_back({name + "bytes", e + 8, 8, true});
+    }
   }
   return f;
 }
@@ -196,6 +225,9 @@ inline std::string layout_out_of_bounds(const std::vector<uint8_t> &b) {
   auto inside = [n](uint64_t offset, uint64_t bytes) { return offset <= n && bytes <= n - offset; };
   if (!inside(L.base_offset, h.base_bytes))
     return "base mesh block";
+  for (size_t i = 0; i < L.section_offset.size(); ++i)
+    if (!inside(L.section_offset[i], h.sections[i].bytes))
+      return "section " + std::to_string(i);
   for (size_t i = 0; i < L.level_offset.size(); ++i)
     if (!inside(L.level_offset[i],
                 uint64_t(h.levels[i].connectivity_bytes) + h.levels[i].geometry_bytes))
