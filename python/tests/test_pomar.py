@@ -163,10 +163,15 @@ def test_bad_arrays_raise_clear_errors():
     with pytest.raises(TypeError, match="numpy array"):
         pomar.encode(vertices.tolist(), faces)
     bad = faces.copy()
-    bad[3, 1] = bad[3, 0]  # a face repeating a vertex
+    bad[3, 1] = len(vertices)  # a face referring to a vertex that does not exist
     with pytest.raises(pomar.Error) as e:
         pomar.encode(vertices, bad)
-    assert e.value.kind == "invalid_mesh" and "face" in str(e.value)
+    assert e.value.kind == "invalid_mesh" and str(len(vertices)) in str(e.value)
+    nan = vertices.copy()
+    nan[7, 2] = np.nan
+    with pytest.raises(pomar.Error) as e:
+        pomar.encode(nan, faces)
+    assert e.value.kind == "invalid_mesh"
     with pytest.raises(pomar.Error) as e:
         pomar.encode(vertices, faces, bits=40)
     assert "bits" in str(e.value)
@@ -282,3 +287,13 @@ def test_no_growth_under_repeated_calls(bunny):
     gc.collect()
     # One decoded bunny is about 0.8 MB; leaking it on every call would add ~20 MB.
     assert rss_bytes() - before < 8 * 2**20
+
+
+def test_trimesh_example(monkeypatch):
+    """examples/trimesh_convert.py (quoted in the README), when trimesh is installed."""
+    pytest.importorskip("trimesh")
+    import runpy
+    repo = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
+    monkeypatch.chdir(repo)
+    result = runpy.run_path("examples/trimesh_convert.py")
+    assert len(result["back"].faces) == len(result["mesh"].faces)
