@@ -51,4 +51,5 @@ setup(
     package_dir={"pomar": "python/pomar"},
     ext_modules=[Extension("pomar._pomar", sources=[])],
     cmdclass={"build_ext": CMakeBuild},
+    options={"build": {"build_base": "build-pip"}},  # not build/, where a CMake build may be
 )

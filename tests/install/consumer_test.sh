@@ -62,7 +62,8 @@ mkdir "$work/pc"
 for e in encode_decode selective_decode; do
   "$CXX" -std=c++17 -O1 "$SRC/examples/$e.cpp" -o "$work/pc/$e" "${flags[@]}"
 done
-run_examples "$work/pc" pkgconfig
+# A shared build's libraries are found through the library path (no RPATH from pkg-config).
+LD_LIBRARY_PATH="$(dirname "$(dirname "$pc")"):${LD_LIBRARY_PATH:-}" run_examples "$work/pc" pkgconfig
 
 if [ -n "$PYTHON" ] && ! "$PYTHON" -c 'import numpy' 2>/dev/null; then
   echo "== the Python session: skipped (no numpy for $PYTHON: python3-numpy)"
