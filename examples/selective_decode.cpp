@@ -12,7 +12,7 @@ int main(int argc, char **argv) try {
   const pomar::FileInfo &info = d.info();
   const float centre[3] = {info.bbox_min[0], info.bbox_min[1], info.bbox_min[2]};
   d.want_sphere(centre, 0.5f * info.grid.extent, d.finest_level()); // or want_cluster/box
-  d.update();                 // completes the level map, reads only the blocks it needs
+  d.update();                  // completes the level map, reads only the blocks it needs
   pomar::Mesh part = d.mesh(); // + d.vertex_cluster(), d.vertex_level()
   std::printf("%zu vertices, %llu of %llu bytes read\n", part.vertex_count(),
               (unsigned long long)d.bytes_read(), (unsigned long long)info.total_bytes);

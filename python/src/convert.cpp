@@ -123,19 +123,24 @@ uint64_t memory_limit(const py::handle &value) {
   if (value.is_none())
     return 0;
   if (py::isinstance<py::str>(value))
-    return call_library("usage", [&] { return pomar::parse_memory_size(value.cast<std::string>()); });
+    return call_library("usage",
+                        [&] { return pomar::parse_memory_size(value.cast<std::string>()); });
   if (!py::isinstance<py::int_>(value) || value.cast<py::int_>() < py::int_(0))
     throw py::type_error("memory_limit must be a byte count >= 0 (0 = automatic) or a size "
                          "such as '512M', 'auto' or 'none'");
   return value.cast<uint64_t>();
 }
 
-int level_or_full(const py::handle &level) {
+int checked_level(const py::handle &level, int finest, int none_means) {
   if (level.is_none())
-    return -1;
+    return none_means;
   if (!py::isinstance<py::int_>(level))
-    throw py::type_error("level must be an int (0 = base mesh) or None (full resolution)");
-  return level.cast<int>();
+    throw py::type_error("level must be an int (0 = base mesh) or None");
+  const long l = level.cast<long>();
+  if (l < 0 || l > finest)
+    throw py::value_error("level " + std::to_string(l) +
+                          " does not exist: the file has levels 0.." + std::to_string(finest));
+  return static_cast<int>(l);
 }
 
 } // namespace pomar_python

@@ -57,7 +57,9 @@ py::dict info_dict(const pomar::FileInfo &info);
 /// "2GiB", "auto", "none").
 uint64_t memory_limit(const py::handle &value);
 
-/// Level argument: None = full resolution (-1).
-int level_or_full(const py::handle &level);
+/// Level argument: None = `none_means`; otherwise an int in 0..finest (a ValueError
+/// naming the file's levels if not). Arguments are checked here so that pomar.Error is
+/// left to what the file and the mesh are.
+int checked_level(const py::handle &level, int finest, int none_means);
 
 } // namespace pomar_python

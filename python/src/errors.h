@@ -1,9 +1,11 @@
 // pomar.Error: the library's errors as one Python exception class with a `kind`.
 //
 // pomar::Error does not carry a kind yet (issue 11 gives it one), so the kind is the
-// usual failure of the operation that raised it: "invalid_mesh" (encode, write),
-// "damaged_file" (decode, info, SelectiveDecoder), "io" (read, write), "usage" (a bad
-// option value), and "memory_limit" whenever a memory check refused the work.
+// usual failure of the operation that raised it: "invalid_mesh" (encode), "damaged_file"
+// (decode, info, SelectiveDecoder), "io" (read, write), "usage" (a memory limit text that
+// does not parse), and "memory_limit" whenever a memory check refused the work. Bad
+// arguments the binding can check itself (dtype, shape, bits, level, cluster) raise
+// TypeError / ValueError before the library is called.
 #pragma once
 
 #include <pomar/pomar.h>

@@ -14,9 +14,10 @@ using namespace pomar_python;
 
 namespace {
 
-py::bytes encode(const py::handle &vertices, const py::handle &faces, int bits,
-                 uint32_t clusters, double cluster_ratio, bool progressive,
-                 const py::handle &max_memory) {
+py::bytes encode(const py::handle &vertices, const py::handle &faces, int bits, uint32_t clusters,
+                 double cluster_ratio, bool progressive, const py::handle &max_memory) {
+  if (bits < 4 || bits > 24)
+    throw py::value_error("bits must be between 4 and 24, not " + std::to_string(bits));
   pomar::Mesh mesh = mesh_from_arrays(vertices, faces);
   pomar::EncodeOptions options;
   options.bits = bits;
@@ -35,8 +36,12 @@ py::bytes encode(const py::handle &vertices, const py::handle &faces, int bits,
 py::tuple decode(const py::handle &data, const py::handle &level, const py::handle &max_memory) {
   const ReadBuffer buffer(data, "decode()");
   pomar::DecodeOptions options;
-  options.level = level_or_full(level);
   options.memory_limit = memory_limit(max_memory);
+  if (!level.is_none()) {
+    const pomar::FileInfo i =
+        call_library("damaged_file", [&] { return pomar::inspect(buffer.data(), buffer.size()); });
+    options.level = checked_level(level, static_cast<int>(i.levels.size()), -1);
+  }
   pomar::Mesh mesh;
   {
     py::gil_scoped_release unlocked;

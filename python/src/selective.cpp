@@ -8,7 +8,6 @@
 
 #include <pomar/random_access.h>
 
-
 #include <memory>
 #include <mutex>
 #include <string>
@@ -62,9 +61,16 @@ public:
   }
 
   int level_or_finest(const py::handle &level) {
-    if (level.is_none())
-      return locked([](pomar::SelectiveDecoder &d) { return d.finest_level(); });
-    return level_or_full(level);
+    const int finest = locked([](pomar::SelectiveDecoder &d) { return d.finest_level(); });
+    return checked_level(level, finest, finest);
+  }
+
+  uint32_t checked_cluster(uint32_t cluster) {
+    const uint32_t count = locked([](pomar::SelectiveDecoder &d) { return d.cluster_count(); });
+    if (cluster >= count)
+      throw py::value_error("cluster " + std::to_string(cluster) +
+                            " does not exist: the file has " + std::to_string(count) + " clusters");
+    return cluster;
   }
 
 private:
@@ -108,18 +114,21 @@ void register_selective_decoder(py::module_ &m) {
                                pomar::FileInfo i = s.locked([](D &d) { return d.info(); });
                                return info_dict(i);
                              })
-      .def_property_readonly("cluster_count",
-                             [](Decoder &s) { return s.locked([](D &d) { return d.cluster_count(); }); })
+      .def_property_readonly(
+          "cluster_count",
+          [](Decoder &s) { return s.locked([](D &d) { return d.cluster_count(); }); })
       .def_property_readonly(
           "base_clustered_level",
           [](Decoder &s) { return s.locked([](D &d) { return d.base_clustered_level(); }); })
-      .def_property_readonly("finest_level",
-                             [](Decoder &s) { return s.locked([](D &d) { return d.finest_level(); }); })
+      .def_property_readonly(
+          "finest_level",
+          [](Decoder &s) { return s.locked([](D &d) { return d.finest_level(); }); })
       .def(
           "want_cluster",
           [](Decoder &s, uint32_t cluster, const py::handle &level) {
+            const uint32_t c = s.checked_cluster(cluster);
             const int l = s.level_or_finest(level);
-            s.locked([&](D &d) { d.want_cluster(cluster, l); });
+            s.locked([&](D &d) { d.want_cluster(c, l); });
           },
           py::arg("cluster"), py::arg("level") = py::none())
       .def(
@@ -167,9 +176,7 @@ void register_selective_decoder(py::module_ &m) {
                                return array_from_vector(std::move(l), 0);
                              })
       .def("mesh_arrays",
-           [](Decoder &s) {
-             return arrays_from_mesh(s.locked([](D &d) { return d.mesh(); }));
-           })
+           [](Decoder &s) { return arrays_from_mesh(s.locked([](D &d) { return d.mesh(); })); })
       .def("vertex_cluster",
            [](Decoder &s) {
              return array_from_vector(s.locked([](D &d) { return d.vertex_cluster(); }), 0);
@@ -180,16 +187,14 @@ void register_selective_decoder(py::module_ &m) {
            })
       .def_property_readonly(
           "damaged",
-          [](Decoder &s) {
-            return damaged_list(s.locked([](D &d) { return d.damaged(); }));
-          })
-      .def_property_readonly("bytes_read",
-                             [](Decoder &s) { return s.locked([](D &d) { return d.bytes_read(); }); })
-      .def_property_readonly("blocks_read",
-                             [](Decoder &s) { return s.locked([](D &d) { return d.blocks_read(); }); })
+          [](Decoder &s) { return damaged_list(s.locked([](D &d) { return d.damaged(); })); })
       .def_property_readonly(
-          "clusters_decoded",
-          [](Decoder &s) { return s.locked([](D &d) { return d.clusters_decoded(); }); });
+          "bytes_read", [](Decoder &s) { return s.locked([](D &d) { return d.bytes_read(); }); })
+      .def_property_readonly(
+          "blocks_read", [](Decoder &s) { return s.locked([](D &d) { return d.blocks_read(); }); })
+      .def_property_readonly("clusters_decoded", [](Decoder &s) {
+        return s.locked([](D &d) { return d.clusters_decoded(); });
+      });
 }
 
 } // namespace pomar_python

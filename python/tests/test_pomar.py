@@ -172,9 +172,20 @@ def test_bad_arrays_raise_clear_errors():
     with pytest.raises(pomar.Error) as e:
         pomar.encode(nan, faces)
     assert e.value.kind == "invalid_mesh"
-    with pytest.raises(pomar.Error) as e:
+    with pytest.raises(ValueError, match="bits must be between 4 and 24, not 40"):
         pomar.encode(vertices, faces, bits=40)
-    assert "bits" in str(e.value)
+    data = pomar.encode(vertices, faces)
+    levels = pomar.info(data)["level_count"]
+    for level in (-1, levels + 1):
+        with pytest.raises(ValueError, match=rf"level {level} does not exist: the file has levels 0..{levels}"):
+            pomar.decode(data, level)
+    d = pomar.SelectiveDecoder(data)
+    with pytest.raises(ValueError, match=rf"cluster {d.cluster_count} does not exist"):
+        d.want_cluster(d.cluster_count)
+    with pytest.raises(ValueError, match="level 99 does not exist"):
+        d.want_all(99)
+    with pytest.raises(TypeError, match="center must be 3 numbers"):
+        d.want_sphere((1, 2), 0.1)
 
 
 def test_damaged_and_wrong_data_raise_clear_errors(tmp_path):

@@ -11,6 +11,6 @@
 #define POMAR_VERSION_MINOR 1
 #define POMAR_VERSION_PATCH 0
 
-#define POMAR_MAKE_VERSION(major, minor, patch) ((major) * 10000 + (minor) * 100 + (patch))
-#define POMAR_VERSION                                                                    \
+#define POMAR_MAKE_VERSION(major, minor, patch) ((major)*10000 + (minor)*100 + (patch))
+#define POMAR_VERSION                                                                              \
   POMAR_MAKE_VERSION(POMAR_VERSION_MAJOR, POMAR_VERSION_MINOR, POMAR_VERSION_PATCH)
