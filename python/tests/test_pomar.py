@@ -308,3 +308,30 @@ def test_trimesh_example(monkeypatch):
     monkeypatch.chdir(repo)
     result = runpy.run_path("examples/trimesh_convert.py")
     assert len(result["back"].faces) == len(result["mesh"].faces)
+
+
+def test_selective_requests_by_vertices_and_faces(bunny):
+    d = pomar.SelectiveDecoder(pomar.encode(bunny))
+    base = d.mesh()
+    d.want_vertices(np.arange(0, len(base.vertices), 50, dtype=np.uint32))
+    d.want_faces([0, 1, 2], level=d.base_clustered_level + 1)
+    d.update()
+    assert (d.levels > d.base_clustered_level).sum() >= 2
+    d.clear_wanted()
+    d.update()
+    assert len(d.mesh().vertices) == len(base.vertices)
+
+
+def test_selective_decoder_around_damage(bunny):
+    data = bytearray(pomar.encode(bunny))
+    data[len(data) - 100] ^= 0x5A  # inside the last cluster blocks
+    strict = pomar.SelectiveDecoder(bytes(data))
+    strict.want_all()
+    with pytest.raises(pomar.Error) as e:
+        strict.update()
+    assert e.value.kind == "damaged_file" and "cluster" in str(e.value)
+    lenient = pomar.SelectiveDecoder(bytes(data), skip_damaged=True)
+    lenient.want_all()
+    lenient.update()
+    assert lenient.damaged and lenient.damaged[0]["block"].startswith("cluster")
+    assert len(lenient.mesh().vertices) < lenient.info["vertices"]
