@@ -16,10 +16,8 @@ install(FILES ${_pomar_headers} DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}/pomar"
 # Shared libraries: libpomar_core.so.0.1 -> libpomar_core.so.0.1.0. Before 1.0 a minor
 # version may change the ABI, so the SONAME carries MAJOR.MINOR.
 set(_pomar_libraries pomar_core)
-set(POMAR_HAS_IO OFF)
 if(TARGET pomar_io)
   list(APPEND _pomar_libraries pomar_io)
-  set(POMAR_HAS_IO ON)
 endif()
 foreach(lib ${_pomar_libraries})
   string(REPLACE "pomar_" "" export_name "${lib}")
@@ -35,16 +33,8 @@ install(TARGETS ${_pomar_libraries} EXPORT pomarTargets
 install(EXPORT pomarTargets NAMESPACE pomar:: DESTINATION "${POMAR_CMAKE_DIR}"
         COMPONENT library)
 
-# Static libraries carry their private dependencies to the program's link line:
-# xxhash (a plain -lxxhash) and, for pomar::io, tinyobjloader (found by the config file).
-get_target_property(_pomar_core_type pomar_core TYPE)
-if(_pomar_core_type STREQUAL "STATIC_LIBRARY")
-  set(POMAR_STATIC ON)
-  set(POMAR_PC_REQUIRES "Requires:")
-else()
-  set(POMAR_STATIC OFF)
-  set(POMAR_PC_REQUIRES "Requires.private:")
-endif()
+# No dependencies to find: xxhash is inlined, tinyobjloader's and vcglib's PLY code are
+# compiled into pomar_io (codec/CMakeLists.txt), so a program links pomar alone.
 configure_package_config_file("${CMAKE_CURRENT_LIST_DIR}/pomarConfig.cmake.in"
   "${PROJECT_BINARY_DIR}/pomarConfig.cmake" INSTALL_DESTINATION "${POMAR_CMAKE_DIR}")
 write_basic_package_version_file("${PROJECT_BINARY_DIR}/pomarConfigVersion.cmake"

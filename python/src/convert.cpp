@@ -110,6 +110,16 @@ py::dict info_dict(const pomar::FileInfo &i) {
   d["index_bytes"] = i.index_bytes;
   d["cluster_bytes"] = i.cluster_bytes;
   d["cluster_block_bytes"] = py::list(py::cast(i.cluster_block_bytes));
+  py::list sections;
+  for (const pomar::FileInfo::Section &section : i.sections) {
+    py::dict entry;
+    entry["name"] = section.name;
+    entry["bytes"] = section.bytes;
+    entry["bpv"] = bpv(section.bytes);
+    entry["required"] = section.required;
+    sections.append(entry);
+  }
+  d["sections"] = sections;
   d["header_bytes"] = i.header_bytes;
   d["base_bytes"] = i.base_bytes;
   d["total_bytes"] = i.total_bytes;

@@ -112,6 +112,13 @@ struct FileInfo {
   uint64_t global_bytes = 0; ///< header, base mesh, global levels, tables, index
   uint64_t tables_bytes = 0, index_bytes = 0, cluster_bytes = 0;
   std::vector<uint32_t> cluster_block_bytes; ///< filled by inspect()
+  /// Version 4: what the file carries in sections of its global part, with their sizes.
+  struct Section {
+    std::string name;      ///< four ASCII characters, e.g. "LSLS"
+    uint64_t bytes = 0;    ///< size of the section's body
+    bool required = false; ///< a reader that does not know it must refuse the file
+  };
+  std::vector<Section> sections;
   bool clustered() const { return clusters != 0; }
 };
 
