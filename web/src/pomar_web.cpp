@@ -1,0 +1,340 @@
+// The C ABI of the WebAssembly decoder (web/pomar_core.js wraps it): a SelectiveDecoder
+// whose bytes arrive over the network. The JavaScript side fetches the global part, asks
+// which cluster blocks a level map needs (pw_plan), fetches them with range requests,
+// hands them over (pw_put_block) and decodes (pw_update). Every pomar::Error (and any
+// other exception, e.g. out of memory) becomes a return code and a message
+// (pw_last_error); nothing traps.
+#include <emscripten/emscripten.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "format/file_format.h"
+#include "pomar/pomar.h"
+#include "pomar/random_access.h"
+
+namespace {
+
+std::string g_error;
+
+/// WebAssembly has at most 4 GiB of memory: a file whose base clustered mesh needs more than
+/// this is refused with a message before anything large is allocated.
+constexpr uint64_t kMemoryLimit = uint64_t(1) << 31;
+
+/// The bytes of the file the page has fetched: the global part (kept) and the cluster blocks
+/// handed over for the next update (dropped after it: the decoder keeps its own copy of
+/// every block it has read, to decode again when a cluster gets coarser).
+class StagedSource : public pomar::ByteSource {
+public:
+  StagedSource(std::vector<uint8_t> prefix, uint64_t size) : prefix_(std::move(prefix)), size_(size) {}
+  uint64_t size() const override { return size_; }
+  void read(uint64_t offset, size_t n, uint8_t *out) override {
+    if (offset > size_ || n > size_ - offset)
+      throw pomar::Error("truncated .pomar file: it ends at byte " + std::to_string(size_) +
+                         ", byte " + std::to_string(offset + n) + " is needed");
+    if (offset + n <= prefix_.size()) {
+      if (n)
+        std::memcpy(out, prefix_.data() + offset, n);
+      return;
+    }
+    auto it = staged_.upper_bound(offset);
+    if (it != staged_.begin()) {
+      --it;
+      if (offset + n <= it->first + it->second.size()) {
+        std::memcpy(out, it->second.data() + (offset - it->first), n);
+        return;
+      }
+    }
+    throw pomar::Error("bytes " + std::to_string(offset) + ".." + std::to_string(offset + n) +
+                       " were not fetched");
+  }
+  void stage(uint64_t offset, std::vector<uint8_t> bytes) { staged_[offset] = std::move(bytes); }
+  void clear() { staged_.clear(); }
+
+private:
+  std::vector<uint8_t> prefix_;
+  uint64_t size_;
+  std::map<uint64_t, std::vector<uint8_t>> staged_;
+};
+
+struct Handle {
+  StagedSource *source = nullptr; // owned by the decoder
+  std::unique_ptr<pomar::SelectiveDecoder> decoder;
+  pomar::ClusterIndex index;
+  std::vector<uint32_t> adj_start, adj; // the cluster graph (edges of the base clustered mesh)
+  std::vector<uint8_t> given;           // cluster blocks handed to the decoder so far
+  // Results kept alive for JavaScript to copy out of the heap.
+  pomar::Mesh mesh;
+  std::vector<uint32_t> vertex_cluster, vertex_level;
+  std::vector<float> bounds;
+  std::vector<uint32_t> plan;
+  std::vector<int32_t> levels;
+  std::vector<double> info;
+  std::string text;
+};
+
+template <class F> int guarded(F &&f) {
+  try {
+    return f();
+  } catch (const std::bad_alloc &) {
+    g_error = "out of memory (WebAssembly has at most 2 GiB here)";
+  } catch (const std::exception &e) {
+    g_error = e.what();
+  }
+  return -1;
+}
+
+void cluster_graph(const pomar::Mesh &base, uint32_t n, std::vector<uint32_t> &start,
+                   std::vector<uint32_t> &adj) {
+  std::vector<std::vector<uint32_t>> nb(n);
+  for (size_t f = 0; f < base.triangle_count(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t a = base.triangles[3 * f + k], b = base.triangles[3 * f + (k + 1) % 3];
+      nb[a].push_back(b);
+      nb[b].push_back(a);
+    }
+  start.assign(n + 1, 0);
+  adj.clear();
+  for (uint32_t c = 0; c < n; ++c) {
+    std::sort(nb[c].begin(), nb[c].end());
+    nb[c].erase(std::unique(nb[c].begin(), nb[c].end()), nb[c].end());
+    adj.insert(adj.end(), nb[c].begin(), nb[c].end());
+    start[c + 1] = static_cast<uint32_t>(adj.size());
+  }
+}
+
+std::vector<int> to_levels(const Handle &h, const int32_t *wanted) {
+  return std::vector<int>(wanted, wanted + h.decoder->cluster_count());
+}
+
+} // namespace
+
+extern "C" {
+
+EMSCRIPTEN_KEEPALIVE const char *pw_last_error() { return g_error.c_str(); }
+
+/// How many leading bytes of the file open needs: the header's size while `n` is too short
+/// to tell more, then the whole global part (header, base mesh, global levels, model
+/// tables, cluster index). -1 on a damaged header (pw_last_error).
+EMSCRIPTEN_KEEPALIVE double pw_global_bytes(const uint8_t *data, size_t n, double file_size) {
+  double out = -1;
+  guarded([&] {
+    const uint64_t size = static_cast<uint64_t>(file_size);
+    if (n < pomar::kFixedHeaderBytes && n < size) {
+      out = double(std::min<uint64_t>(size, pomar::kFixedHeaderBytes));
+      return 0;
+    }
+    const size_t hsize = pomar::header_size(data, n);
+    if (hsize > size)
+      throw pomar::Error("truncated .pomar file: the header alone needs " +
+                         std::to_string(hsize) + " bytes, the file has " + std::to_string(size));
+    if (n < hsize) {
+      out = double(hsize);
+      return 0;
+    }
+    const pomar::FileLayout layout = pomar::read_layout(data, hsize, size, true);
+    out = double(std::min<uint64_t>(layout.global_bytes, size));
+    return 0;
+  });
+  return out;
+}
+
+/// Decode the base clustered mesh from the file's first `n` bytes (at least
+/// pw_global_bytes) of `file_size`. Returns a handle, 0 on error (pw_last_error).
+EMSCRIPTEN_KEEPALIVE Handle *pw_open(const uint8_t *data, size_t n, double file_size) {
+  Handle *out = nullptr;
+  guarded([&] {
+    auto h = std::make_unique<Handle>();
+    const uint64_t size = static_cast<uint64_t>(file_size);
+    auto source = std::make_unique<StagedSource>(std::vector<uint8_t>(data, data + n), size);
+    h->source = source.get();
+    pomar::SelectiveOptions options;
+    options.skip_damaged = true; // damaged blocks are skipped, and listed (pw_damaged)
+    options.memory_limit = kMemoryLimit;
+    h->decoder = std::make_unique<pomar::SelectiveDecoder>(std::move(source), options);
+    const uint32_t clusters = h->decoder->cluster_count();
+    if (clusters) {
+      const size_t hsize = pomar::header_size(data, n);
+      const pomar::FileLayout layout = pomar::read_layout(data, hsize, size, true);
+      h->index = pomar::read_cluster_index(data + layout.index_offset, layout);
+      cluster_graph(h->decoder->mesh(), clusters, h->adj_start, h->adj);
+    }
+    h->given.assign(clusters, 0);
+    out = h.release();
+    return 0;
+  });
+  return out;
+}
+
+EMSCRIPTEN_KEEPALIVE void pw_close(Handle *h) { delete h; }
+
+/// Facts as doubles: [clusters, base clustered level, finest level, vertices, faces,
+/// file bytes, global bytes, bbox min xyz, bbox max xyz, version, bytes read by the decoder,
+/// blocks read, then per level 1..finest: vertices, faces].
+EMSCRIPTEN_KEEPALIVE const double *pw_info(Handle *h) {
+  const pomar::FileInfo &i = h->decoder->info();
+  h->info = {double(h->decoder->cluster_count()),
+             double(h->decoder->base_clustered_level()),
+             double(h->decoder->finest_level()),
+             double(i.vertices),
+             double(i.faces),
+             double(i.total_bytes),
+             double(i.global_bytes),
+             i.bbox_min[0],
+             i.bbox_min[1],
+             i.bbox_min[2],
+             i.bbox_max[0],
+             i.bbox_max[1],
+             i.bbox_max[2],
+             double(i.version),
+             double(h->decoder->bytes_read()),
+             double(h->decoder->blocks_read())};
+  for (const pomar::LevelInfo &l : i.levels) {
+    h->info.push_back(l.vertices);
+    h->info.push_back(l.faces);
+  }
+  return h->info.data();
+}
+EMSCRIPTEN_KEEPALIVE int pw_info_size(Handle *h) { return int(pw_info(h) ? h->info.size() : 0); }
+
+/// Where cluster c's block is in the file (offset; its size: pw_block_size).
+EMSCRIPTEN_KEEPALIVE double pw_block_offset(Handle *h, uint32_t c) {
+  return c < h->index.offset.size() ? double(h->index.offset[c]) : -1;
+}
+EMSCRIPTEN_KEEPALIVE double pw_block_size(Handle *h, uint32_t c) {
+  return c < h->index.size.size() ? double(h->index.size[c]) : -1;
+}
+
+/// The clusters whose blocks updating to `wanted` (one level per cluster) needs and that
+/// were not handed over yet: the level map is completed as update() completes it.
+/// Returns their count (ids: pw_plan_ids), -1 on error.
+EMSCRIPTEN_KEEPALIVE int pw_plan(Handle *h, const int32_t *wanted) {
+  return guarded([&] {
+    h->plan.clear();
+    const int base = h->decoder->base_clustered_level();
+    const std::vector<int> target =
+        pomar::complete_level_map(to_levels(*h, wanted), h->adj_start, h->adj, base);
+    for (uint32_t c = 0; c < target.size(); ++c)
+      if (target[c] > base && !h->given[c])
+        h->plan.push_back(c);
+    return int(h->plan.size());
+  });
+}
+EMSCRIPTEN_KEEPALIVE const uint32_t *pw_plan_ids(Handle *h) { return h->plan.data(); }
+
+/// The completed level map for `wanted` (pw_levels_out), without decoding.
+EMSCRIPTEN_KEEPALIVE int pw_complete(Handle *h, const int32_t *wanted) {
+  return guarded([&] {
+    const std::vector<int> target = pomar::complete_level_map(
+        to_levels(*h, wanted), h->adj_start, h->adj, h->decoder->base_clustered_level());
+    h->levels.assign(target.begin(), target.end());
+    return 0;
+  });
+}
+
+/// Hand over cluster c's block (`n` bytes; fewer than the index says if the file is
+/// truncated, none if its fetch failed: the decoder then skips the cluster as damaged).
+EMSCRIPTEN_KEEPALIVE int pw_put_block(Handle *h, uint32_t c, const uint8_t *data, size_t n) {
+  return guarded([&] {
+    if (c >= h->index.offset.size())
+      throw pomar::Error("cluster " + std::to_string(c) + " does not exist");
+    h->source->stage(h->index.offset[c], std::vector<uint8_t>(data, data + n));
+    h->given[c] = 1;
+    return 0;
+  });
+}
+
+/// Bring the mesh to the level map completed from `wanted` (clustered files) or to level
+/// wanted[0] everywhere (progressive files). Damaged or missing blocks are skipped
+/// (pw_damaged). Returns 0, or -1 on error (pw_last_error).
+EMSCRIPTEN_KEEPALIVE int pw_update(Handle *h, const int32_t *wanted) {
+  const int r = guarded([&] {
+    if (h->decoder->cluster_count() == 0) {
+      h->decoder->clear_wanted();
+      h->decoder->want_all(wanted[0]);
+    } else {
+      h->decoder->set_wanted(to_levels(*h, wanted));
+    }
+    h->decoder->update();
+    h->levels.assign(h->decoder->levels().begin(), h->decoder->levels().end());
+    return 0;
+  });
+  h->source->clear();
+  return r;
+}
+
+/// The level of every cluster after pw_update (or the map of pw_complete).
+EMSCRIPTEN_KEEPALIVE const int32_t *pw_levels(Handle *h) { return h->levels.data(); }
+
+/// Damaged blocks skipped so far, one line each ("" when none).
+EMSCRIPTEN_KEEPALIVE const char *pw_damaged(Handle *h) {
+  h->text = h->decoder->damaged().empty() ? "" : pomar::describe_damage(h->decoder->damaged());
+  return h->text.c_str();
+}
+EMSCRIPTEN_KEEPALIVE int pw_damaged_count(Handle *h) { return int(h->decoder->damaged().size()); }
+
+/// Extract the current mesh; then pw_positions (3 floats per vertex), pw_triangles (3
+/// indices per face), pw_vertex_cluster, pw_vertex_level point at it until the next call.
+EMSCRIPTEN_KEEPALIVE int pw_extract(Handle *h) {
+  return guarded([&] {
+    h->mesh = h->decoder->mesh();
+    h->vertex_cluster = h->decoder->vertex_cluster();
+    h->vertex_level = h->decoder->vertex_level();
+    return 0;
+  });
+}
+EMSCRIPTEN_KEEPALIVE int pw_vertex_count(Handle *h) { return int(h->mesh.vertex_count()); }
+EMSCRIPTEN_KEEPALIVE int pw_triangle_count(Handle *h) { return int(h->mesh.triangle_count()); }
+EMSCRIPTEN_KEEPALIVE const float *pw_positions(Handle *h) { return h->mesh.positions.data(); }
+EMSCRIPTEN_KEEPALIVE const uint32_t *pw_triangles(Handle *h) { return h->mesh.triangles.data(); }
+EMSCRIPTEN_KEEPALIVE const uint32_t *pw_vertex_cluster(Handle *h) {
+  return h->vertex_cluster.data();
+}
+EMSCRIPTEN_KEEPALIVE const uint32_t *pw_vertex_level(Handle *h) { return h->vertex_level.data(); }
+
+/// Per cluster of the extracted mesh, 8 floats: bounding box min xyz, max xyz, the longest
+/// edge of a face touching the cluster (the screen-space error proxy, web/README.md), and
+/// its face count (faces are counted in the cluster of their first vertex).
+EMSCRIPTEN_KEEPALIVE const float *pw_cluster_bounds(Handle *h) {
+  const uint32_t n = std::max<uint32_t>(1, h->decoder->cluster_count());
+  h->bounds.assign(size_t(n) * 8, 0.f);
+  for (uint32_t c = 0; c < n; ++c)
+    for (int k = 0; k < 3; ++k) {
+      h->bounds[8 * c + k] = 3.4e38f;
+      h->bounds[8 * c + 3 + k] = -3.4e38f;
+    }
+  const std::vector<float> &p = h->mesh.positions;
+  auto cluster = [&](uint32_t v) { return h->vertex_cluster.empty() ? 0u : h->vertex_cluster[v]; };
+  for (uint32_t v = 0; v < h->mesh.vertex_count(); ++v) {
+    float *b = &h->bounds[8 * size_t(cluster(v))];
+    for (int k = 0; k < 3; ++k) {
+      b[k] = std::min(b[k], p[3 * v + k]);
+      b[3 + k] = std::max(b[3 + k], p[3 * v + k]);
+    }
+  }
+  const std::vector<uint32_t> &t = h->mesh.triangles;
+  for (size_t f = 0; f < h->mesh.triangle_count(); ++f) {
+    h->bounds[8 * size_t(cluster(t[3 * f])) + 7] += 1;
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t a = t[3 * f + k], b = t[3 * f + (k + 1) % 3];
+      double d2 = 0;
+      for (int j = 0; j < 3; ++j) {
+        const double d = double(p[3 * a + j]) - p[3 * b + j];
+        d2 += d * d;
+      }
+      const float len = float(std::sqrt(d2));
+      for (uint32_t v : {a, b}) {
+        float &e = h->bounds[8 * size_t(cluster(v)) + 6];
+        e = std::max(e, len);
+      }
+    }
+  }
+  return h->bounds.data();
+}
+
+} // extern "C"
