@@ -57,11 +57,11 @@ export class Decoder {
     const n = M._pw_info_size(this.h);
     const d = new Float64Array(M.HEAPF64.buffer, M._pw_info(this.h), n).slice();
     const levels = [];
-    for (let i = 16; i + 1 < n; i += 2) levels.push({ vertices: d[i], faces: d[i + 1] });
+    for (let i = 18; i + 1 < n; i += 2) levels.push({ vertices: d[i], faces: d[i + 1] });
     this.info = {
       clusters: d[0], baseLevel: d[1], finestLevel: d[2], vertices: d[3], faces: d[4],
       fileBytes: d[5], globalBytes: d[6], bboxMin: [d[7], d[8], d[9]], bboxMax: [d[10], d[11], d[12]],
-      version: d[13], decoderBytesRead: d[14], blocksRead: d[15], levels,
+      version: d[13], decoderBytesRead: d[14], blocksRead: d[15], baseVertices: d[16], baseFaces: d[17], levels,
     };
     return this.info;
   }

@@ -175,7 +175,7 @@ EMSCRIPTEN_KEEPALIVE void pw_close(Handle *h) { delete h; }
 
 /// Facts as doubles: [clusters, base clustered level, finest level, vertices, faces,
 /// file bytes, global bytes, bbox min xyz, bbox max xyz, version, bytes read by the decoder,
-/// blocks read, then per level 1..finest: vertices, faces].
+/// blocks read, base mesh vertices, faces, then per level 1..finest: vertices, faces].
 EMSCRIPTEN_KEEPALIVE const double *pw_info(Handle *h) {
   const pomar::FileInfo &i = h->decoder->info();
   h->info = {double(h->decoder->cluster_count()),
@@ -193,7 +193,9 @@ EMSCRIPTEN_KEEPALIVE const double *pw_info(Handle *h) {
              i.bbox_max[2],
              double(i.version),
              double(h->decoder->bytes_read()),
-             double(h->decoder->blocks_read())};
+             double(h->decoder->blocks_read()),
+             double(i.base_vertices),
+             double(i.base_faces)};
   for (const pomar::LevelInfo &l : i.levels) {
     h->info.push_back(l.vertices);
     h->info.push_back(l.faces);
