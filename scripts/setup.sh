@@ -25,6 +25,7 @@ PACKAGES=(
   draco libdraco-dev
   time python3 clang
   imagemagick x11-utils xdotool        # scripts/gui_screenshot.sh (GUI checks under Xvfb)
+  emscripten nodejs chromium           # web/: the WebAssembly decoder and its browser test
 )
 
 log() { printf 'setup: %s\n' "$*"; }

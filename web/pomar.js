@@ -19,7 +19,8 @@ import { chooseLevels } from './view_refine.js';
 /**
  * @param source URL of a .pomar file, or a File/Blob (e.g. dropped on the page)
  * @param options {onMesh(mesh, model), onWarning(message), onError(message),
- *   maxInFlight = 4, maxGap = 0 (bytes between blocks fetched in the same request),
+ *   maxInFlight = 4, maxGap = 4 KiB (blocks this close are fetched in one request; the
+ *   blocks in between are kept for later, within prefetchBudget = 64 MiB),
  *   maxRequestBytes = 1 MiB, memoryBudget = 256 MiB (cluster blocks held; over it the
  *   worker rebuilds its decoder with only the blocks in use), firstRequestBytes = 16 KiB}
  */
@@ -30,7 +31,7 @@ export function open(source, options = {}) {
 
 export class PomarModel {
   constructor(options) {
-    this.options = { memoryBudget: 256 << 20, ...options };
+    this.options = { memoryBudget: 256 << 20, maxGap: 4096, ...options };
     this.worker = new Worker(new URL('./pomar_worker.js', import.meta.url), { type: 'module' });
     this.info = null;
     this.mesh = null;

@@ -28,6 +28,8 @@ function stats(extra = {}) {
     maxInFlightSeen: file ? file.stats.maxInFlightSeen : 0,
     blocksHeld: held.size,
     heldBytes,
+    blocksPrefetched: prefetched.size,
+    prefetchedBytes,
     rebuilds,
     damaged: decoder ? decoder.damaged().count : 0,
     ...extra,
@@ -72,17 +74,75 @@ async function open(source, opts) {
     { decodeMs: performance.now() - t0 });
 }
 
+/** Blocks fetched before they are needed (in the gaps of coalesced requests), by cluster,
+ *  oldest first; at most options.prefetchBudget bytes. */
+const prefetched = new Map();
+let prefetchedBytes = 0;
+let byOffset = null; // cluster ids sorted by block offset
+
+/** Position in byOffset of the first block starting at or after `offset`. */
+function firstBlockFrom(offset) {
+  if (!byOffset)
+    byOffset = Array.from(decoder.blockOffset.keys()).sort((a, b) => decoder.blockOffset[a] - decoder.blockOffset[b]);
+  let lo = 0;
+  let hi = byOffset.length;
+  while (lo < hi) {
+    const mid = (lo + hi) >> 1;
+    if (decoder.blockOffset[byOffset[mid]] < offset) lo = mid + 1;
+    else hi = mid;
+  }
+  return lo;
+}
+
+/** Does [start, end) hold bytes already at hand (the first request, blocks held or
+ *  prefetched)? Such gaps are not fetched again. */
+function haveSome(start, end) {
+  if (start < prefix.length) return true;
+  for (let i = firstBlockFrom(start); i < byOffset.length && decoder.blockOffset[byOffset[i]] < end; ++i)
+    if (held.has(byOffset[i]) || prefetched.has(byOffset[i])) return true;
+  return false;
+}
+
+function keepPrefetched(chunks, wanted) {
+  const budget = options.prefetchBudget ?? 64 << 20;
+  for (const { offset, bytes } of chunks) {
+    // The blocks lying whole in this response.
+    for (let i = firstBlockFrom(offset); i < byOffset.length; ++i) {
+      const c = byOffset[i];
+      const end = decoder.blockOffset[c] + decoder.blockSize[c];
+      if (end > offset + bytes.length) break;
+      if (wanted.has(c) || held.has(c) || prefetched.has(c) || decoder.blockSize[c] === 0) continue;
+      prefetched.set(c, bytes.slice(decoder.blockOffset[c] - offset, end - offset));
+      prefetchedBytes += decoder.blockSize[c];
+    }
+  }
+  for (const [c, bytes] of prefetched) {
+    if (prefetchedBytes <= budget) break;
+    prefetched.delete(c);
+    prefetchedBytes -= bytes.length;
+  }
+}
+
 /** Decode to the completed level map of `levels`, fetching the blocks it lacks. */
 async function want(id, levels) {
   const t0 = performance.now();
   const ids = decoder.info.clusters ? decoder.plan(levels) : [];
-  // What the first request brought beyond the global part is not fetched again.
+  // What the first request or an earlier gap brought is not fetched again.
   const ranges = [];
+  const got = new Map();
   for (const c of ids) {
+    if (prefetched.has(c)) {
+      got.set(c, prefetched.get(c));
+      prefetchedBytes -= prefetched.get(c).length;
+      prefetched.delete(c);
+      continue;
+    }
     const start = Math.max(decoder.blockOffset[c], prefix.length);
     ranges.push({ key: c, offset: start, size: decoder.blockOffset[c] + decoder.blockSize[c] - start });
   }
-  const got = await file.readMany(ranges);
+  const { parts, chunks } = await file.readMany(ranges, haveSome);
+  keepPrefetched(chunks, new Set(ids));
+  for (const [c, bytes] of parts) got.set(c, bytes);
   for (const c of ids) {
     const offset = decoder.blockOffset[c];
     if (offset < prefix.length && !(got.get(c) instanceof Error)) {

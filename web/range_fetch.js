@@ -6,14 +6,16 @@ export class RangeError_ extends Error {}
 
 /** Coalesce byte ranges [{key, offset, size}] (any order) into requests
  *  [{offset, size, parts}] of adjacent ranges (gap <= maxGap bytes, at most maxBytes each
- *  unless one range alone is larger). */
-export function coalesce(ranges, maxGap = 0, maxBytes = 1 << 20) {
+ *  unless one range alone is larger; a gap for which `skipGap(start, end)` is true, e.g.
+ *  one holding bytes already at hand, is never bridged). */
+export function coalesce(ranges, maxGap = 0, maxBytes = 1 << 20, skipGap = () => false) {
   const sorted = ranges.filter((r) => r.size > 0).sort((a, b) => a.offset - b.offset);
   const out = [];
   for (const r of sorted) {
     const last = out[out.length - 1];
     const end = r.offset + r.size;
-    if (last && r.offset - (last.offset + last.size) <= maxGap && end - last.offset <= maxBytes) {
+    const gap = last ? r.offset - (last.offset + last.size) : Infinity;
+    if (gap <= maxGap && end - last.offset <= maxBytes && (gap <= 0 || !skipGap(last.offset + last.size, r.offset))) {
       last.size = Math.max(last.size, end - last.offset);
       last.parts.push(r);
     } else {
@@ -108,23 +110,26 @@ export class RangeFile {
   }
 
   /** Fetch ranges [{key, offset, size}], coalesced, at most maxInFlight requests at once.
-   *  Returns Map key -> Uint8Array (shorter than asked at the end of a truncated file) or
-   *  Error (that request failed). */
-  async readMany(ranges) {
-    const out = new Map();
-    const requests = coalesce(ranges, this.maxGap, this.maxRequestBytes);
+   *  Returns {parts: Map key -> Uint8Array (shorter than asked at the end of a truncated
+   *  file) or Error (that request failed), chunks: [{offset, bytes}] (every response, gaps
+   *  between coalesced ranges included)}. */
+  async readMany(ranges, skipGap = undefined) {
+    const parts = new Map();
+    const chunks = [];
+    const requests = coalesce(ranges, this.maxGap, this.maxRequestBytes, skipGap);
     await Promise.all(requests.map(async (req) => {
       try {
         const end = this.size >= 0 ? Math.min(this.size, req.offset + req.size) : req.offset + req.size;
         const bytes = end > req.offset ? await this.read(req.offset, end - req.offset) : new Uint8Array(0);
+        chunks.push({ offset: req.offset, bytes });
         for (const p of req.parts) {
           const a = Math.min(bytes.length, p.offset - req.offset);
-          out.set(p.key, bytes.subarray(a, Math.min(bytes.length, a + p.size)));
+          parts.set(p.key, bytes.subarray(a, Math.min(bytes.length, a + p.size)));
         }
       } catch (e) {
-        for (const p of req.parts) out.set(p.key, e);
+        for (const p of req.parts) parts.set(p.key, e);
       }
     }));
-    return out;
+    return { parts, chunks };
   }
 }

@@ -184,7 +184,7 @@ async function refineLoop() {
   }
 }
 
-async function openSource(source) {
+async function openSource(source, extraOptions = {}) {
   showError('');
   $('warning').textContent = '';
   if (model) model.close();
@@ -192,6 +192,7 @@ async function openSource(source) {
   indexCount = 0;
   frame(null);
   const m = await open(source, {
+    ...extraOptions,
     onMesh: (mesh) => onMesh(mesh),
     onWarning: (message) => { $('warning').textContent = 'warning: ' + message; },
   });

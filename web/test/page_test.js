@@ -20,6 +20,10 @@ async function screenshot(name, v) {
   await post(name + '.png', blob);
   // Fraction of pixels that are not the background: the mesh is drawn.
   const gl = document.getElementById('view').getContext('webgl2');
+  if (gl.isContextLost()) {
+    note('the WebGL context is lost');
+    return -1;
+  }
   const w = gl.drawingBufferWidth;
   const h = gl.drawingBufferHeight;
   const px = new Uint8Array(4 * w * h);
@@ -39,7 +43,7 @@ function snapshot(model, covered, extra = {}) {
   const s = model.stats;
   return { bytesFetched: s.bytesFetched, fileBytes: s.fileBytes, requests: s.requests, triangles: s.triangles,
     vertices: s.vertices, minLevel: Math.min(...model.levels), maxLevel: Math.max(...model.levels),
-    maxInFlightSeen: s.maxInFlightSeen, damaged: s.damaged, covered, ...extra };
+    maxInFlightSeen: s.maxInFlightSeen, damaged: s.damaged, covered, heldBytes: s.heldBytes, blocksHeld: s.blocksHeld, ...extra };
 }
 /** Refinement steps for the current camera until the model is stable for it. */
 async function settle(v, what) {
@@ -57,14 +61,15 @@ export async function run(v) {
   try {
     $('refine').checked = false; // the test drives refinement itself
     const t0 = performance.now();
-    const model = await within(30000, v.openSource(params.get('file')), 'open');
+    const fetchOptions = params.has('maxGap') ? { maxGap: Number(params.get('maxGap')) } : {};
+    const model = await within(30000, v.openSource(params.get('file'), fetchOptions), 'open');
     result.firstFrameMs = performance.now() - t0;
     result.info = { clusters: model.info.clusters, baseLevel: model.info.baseLevel, finestLevel: model.info.finestLevel,
       fileBytes: model.info.fileBytes, globalBytes: model.info.globalBytes };
     result.base = snapshot(model, await screenshot('base', v));
     note('base clustered mesh', JSON.stringify(result.base));
 
-    // Close-up: the surface point facing the camera, seen from 4% of the model's size.
+    // Close-up: the surface point facing the camera, seen from 30% of the model's size.
     const center = v.camera.target.slice();
     const eye = v.view().eye;
     const p = model.mesh.positions;
@@ -77,10 +82,13 @@ export async function run(v) {
       if (d > bestDot) { bestDot = d; best = i; }
     }
     v.camera.target = [p[3 * best], p[3 * best + 1], p[3 * best + 2]];
-    v.camera.distance = 0.04 * v.camera.extent;
+    v.camera.distance = 0.3 * v.camera.extent;
     const before = model.stats.bytesFetched;
     result.closeupSteps = await settle(v, 'close-up');
     result.closeup = snapshot(model, await screenshot('closeup', v), { bytesForCloseup: model.stats.bytesFetched - before });
+    $('colour').value = '2'; // the same view coloured by level
+    await screenshot('closeup_levels', v);
+    $('colour').value = '0';
     note('close-up', JSON.stringify(result.closeup));
 
     // The whole model on screen: refine until the projected error is under the target.
