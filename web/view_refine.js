@@ -1,8 +1,9 @@
 // View-dependent refinement: which level each cluster should have for a camera.
 //
 // The file stores no geometric error per cluster and level, so the error of a cluster at
-// its current level is bounded from what is decoded: the longest edge of a face touching
-// the cluster (`clusterBounds[8c+6]`, computed in WebAssembly from the current mesh). The
+// its current level is bounded from what is decoded: the longest edge between two of its
+// vertices (`clusterBounds[8c+6]`, computed in WebAssembly from the current mesh; a cluster
+// that is a single vertex, as at the base clustered level, takes its incident edges). The
 // vertex splits of the finer levels move the surface inside the fans they split, i.e. by
 // about one edge of the current level near each split, so this length is a conservative
 // proxy of how far the surface may still move (not a proven Hausdorff bound; the finest
@@ -52,7 +53,7 @@ function distanceToBox(eye, lo, hi) {
  * @param view {eye [3], viewProj (16, column-major), fovY (radians), height (pixels), near}
  * @returns {levels: Int32Array wanted, changed: boolean, refine, coarsen, hidden}
  */
-export function chooseLevels(state, view, { targetPixels = 1.5, coarsenFraction = 0.5, triangleBudget = 2e6 } = {}) {
+export function chooseLevels(state, view, { targetPixels = 3, coarsenFraction = 0.5, triangleBudget = 2e6 } = {}) {
   const { info, levels, clusterBounds: b, errorSeen } = state;
   const n = info.clusters;
   const base = info.baseLevel;

@@ -40,13 +40,14 @@ layout(location=2) in uint level;
 uniform mat4 viewProj;
 uniform int colourMode;
 uniform float finest;
+uniform float base;
 out vec3 vPosition;
 flat out vec3 vColour;
 vec3 hue(float h) { return clamp(abs(mod(h * 6.0 + vec3(0, 4, 2), 6.0) - 3.0) - 1.0, 0.0, 1.0); }
 void main() {
   vPosition = position;
   if (colourMode == 1) vColour = 0.35 + 0.65 * hue(fract(float(cluster) * 0.61803));
-  else if (colourMode == 2) vColour = 0.3 + 0.7 * hue(0.7 * (1.0 - float(level) / finest));
+  else if (colourMode == 2) vColour = 0.3 + 0.7 * hue(0.66 * (1.0 - (float(level) - base) / max(1.0, finest - base)));
   else vColour = vec3(0.82, 0.80, 0.76);
   gl_Position = viewProj * vec4(position, 1.0);
 }`;
@@ -95,14 +96,19 @@ function initGL() {
   gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, buffers.index);
   gl.enable(gl.DEPTH_TEST);
 }
-function upload(mesh) {
+function upload(mesh, model) {
   gl.bindVertexArray(vao);
   gl.bindBuffer(gl.ARRAY_BUFFER, buffers.position);
   gl.bufferData(gl.ARRAY_BUFFER, mesh.positions, gl.DYNAMIC_DRAW);
   gl.bindBuffer(gl.ARRAY_BUFFER, buffers.cluster);
   gl.bufferData(gl.ARRAY_BUFFER, mesh.vertexCluster, gl.DYNAMIC_DRAW);
+  // Colour by level: the level of the vertex's cluster (the level map), not the level
+  // that created the vertex (which mixes all levels up to it in every region).
+  const levels = model ? model.levels : null;
+  const level = new Uint32Array(mesh.vertexCluster.length);
+  for (let v = 0; v < level.length; ++v) level[v] = levels && levels.length ? levels[mesh.vertexCluster[v]] : mesh.vertexLevel[v];
   gl.bindBuffer(gl.ARRAY_BUFFER, buffers.level);
-  gl.bufferData(gl.ARRAY_BUFFER, mesh.vertexLevel, gl.DYNAMIC_DRAW);
+  gl.bufferData(gl.ARRAY_BUFFER, level, gl.DYNAMIC_DRAW);
   gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, buffers.index);
   gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, mesh.triangles, gl.DYNAMIC_DRAW);
   indexCount = mesh.triangles.length;
@@ -140,6 +146,7 @@ function frame(model) {
   gl.uniform3fv(gl.getUniformLocation(program, 'eye'), v.eye);
   gl.uniform1i(gl.getUniformLocation(program, 'colourMode'), Number($('colour').value));
   gl.uniform1f(gl.getUniformLocation(program, 'finest'), model ? model.info.finestLevel : 1);
+  gl.uniform1f(gl.getUniformLocation(program, 'base'), model ? model.info.baseLevel : 0);
   gl.bindVertexArray(vao);
   gl.drawElements(gl.TRIANGLES, indexCount, gl.UNSIGNED_INT, 0);
 }
@@ -158,8 +165,8 @@ function showStats() {
     `(base clustered ${model.info.baseLevel}), ${model.info.clusters} clusters\n` +
     `blocks held ${s.blocksHeld} (${kb(s.heldBytes)}), damaged ${s.damaged}, last decode ${(s.decodeMs || 0).toFixed(0)} ms`;
 }
-function onMesh(mesh) {
-  upload(mesh);
+function onMesh(mesh, m = model) {
+  upload(mesh, m);
   frame(model);
   showStats();
 }
@@ -174,7 +181,7 @@ async function refineLoop() {
   try {
     for (let step = 0; step < 64; ++step) {
       const version = cameraVersion;
-      const r = await model.wantView(view(), { targetPixels: Number($('target').value) || 1.5 });
+      const r = await model.wantView(view(), { targetPixels: Number($('target').value) || 3 });
       if (!r.changed && version === cameraVersion) break;
     }
   } catch (e) {
@@ -193,17 +200,23 @@ async function openSource(source, extraOptions = {}) {
   frame(null);
   const m = await open(source, {
     ...extraOptions,
-    onMesh: (mesh) => onMesh(mesh),
+    onMesh: (mesh, m) => onMesh(mesh, m),
     onWarning: (message) => { $('warning').textContent = 'warning: ' + message; },
   });
   model = m;
-  const lo = m.info.bboxMin;
-  const hi = m.info.bboxMax;
+  // The header's box is the quantization cube; frame the base mesh's own box instead.
+  const p = m.mesh.positions;
+  const lo = [Infinity, Infinity, Infinity];
+  const hi = [-Infinity, -Infinity, -Infinity];
+  for (let i = 0; i < p.length; ++i) {
+    lo[i % 3] = Math.min(lo[i % 3], p[i]);
+    hi[i % 3] = Math.max(hi[i % 3], p[i]);
+  }
   camera.target = [0, 1, 2].map((k) => (lo[k] + hi[k]) / 2);
   camera.extent = Math.max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
   camera.distance = 1.6 * camera.extent;
   ++cameraVersion;
-  onMesh(m.mesh);
+  onMesh(m.mesh, m);
   if (m.info.clusters === 0) await m.want({ all: m.info.finestLevel }); // progressive: no regions
   return m;
 }

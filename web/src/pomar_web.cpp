@@ -300,8 +300,9 @@ EMSCRIPTEN_KEEPALIVE const uint32_t *pw_vertex_cluster(Handle *h) {
 EMSCRIPTEN_KEEPALIVE const uint32_t *pw_vertex_level(Handle *h) { return h->vertex_level.data(); }
 
 /// Per cluster of the extracted mesh, 8 floats: bounding box min xyz, max xyz, the longest
-/// edge of a face touching the cluster (the screen-space error proxy, web/README.md), and
-/// its face count (faces are counted in the cluster of their first vertex).
+/// edge between two of its vertices (or, if it has none, touching it: the screen-space
+/// error proxy, see web/view_refine.js), and its face count (faces are counted in the
+/// cluster of their first vertex).
 EMSCRIPTEN_KEEPALIVE const float *pw_cluster_bounds(Handle *h) {
   const uint32_t n = std::max<uint32_t>(1, h->decoder->cluster_count());
   h->bounds.assign(size_t(n) * 8, 0.f);
@@ -319,7 +320,11 @@ EMSCRIPTEN_KEEPALIVE const float *pw_cluster_bounds(Handle *h) {
       b[3 + k] = std::max(b[3 + k], p[3 * v + k]);
     }
   }
+  // Edges inside a cluster measure it; a cluster with none (a single vertex, as at the base
+  // clustered level) takes the edges around it. Edges across a border do not count where
+  // a cluster has inner edges: they belong to the coarser neighbour as much as to it.
   const std::vector<uint32_t> &t = h->mesh.triangles;
+  std::vector<float> around(n, 0.f);
   for (size_t f = 0; f < h->mesh.triangle_count(); ++f) {
     h->bounds[8 * size_t(cluster(t[3 * f])) + 7] += 1;
     for (int k = 0; k < 3; ++k) {
@@ -330,12 +335,18 @@ EMSCRIPTEN_KEEPALIVE const float *pw_cluster_bounds(Handle *h) {
         d2 += d * d;
       }
       const float len = float(std::sqrt(d2));
-      for (uint32_t v : {a, b}) {
-        float &e = h->bounds[8 * size_t(cluster(v)) + 6];
+      if (cluster(a) == cluster(b)) {
+        float &e = h->bounds[8 * size_t(cluster(a)) + 6];
         e = std::max(e, len);
+      } else {
+        around[cluster(a)] = std::max(around[cluster(a)], len);
+        around[cluster(b)] = std::max(around[cluster(b)], len);
       }
     }
   }
+  for (uint32_t c = 0; c < n; ++c)
+    if (h->bounds[8 * size_t(c) + 6] == 0)
+      h->bounds[8 * size_t(c) + 6] = around[c];
   return h->bounds.data();
 }
 

@@ -3,6 +3,8 @@
 // ?file=URL of an intact file; &missing=, &truncatedGlobal=, &truncatedBlocks=,
 // &damagedBlocks=, &noRange= URLs of the error cases.
 const params = new URLSearchParams(location.search);
+const targetPixels = Number(params.get('target') || 3);
+const closeup = Number(params.get('closeup') || 0.3);
 const $ = (id) => document.getElementById(id);
 const log = [];
 function note(...args) {
@@ -49,7 +51,7 @@ function snapshot(model, covered, extra = {}) {
 async function settle(v, what) {
   let steps = 0;
   for (; steps < 64; ++steps) {
-    const r = await within(30000, v.model().wantView(v.view(), { targetPixels: 1.5 }), what);
+    const r = await within(30000, v.model().wantView(v.view(), { targetPixels }), what);
     if (!r.changed) break;
   }
   v.frame();
@@ -69,7 +71,7 @@ export async function run(v) {
     result.base = snapshot(model, await screenshot('base', v));
     note('base clustered mesh', JSON.stringify(result.base));
 
-    // Close-up: the surface point facing the camera, seen from 30% of the model's size.
+    // Close-up: the surface point facing the camera, seen from `closeup` x the model's size.
     const center = v.camera.target.slice();
     const eye = v.view().eye;
     const p = model.mesh.positions;
@@ -82,7 +84,7 @@ export async function run(v) {
       if (d > bestDot) { bestDot = d; best = i; }
     }
     v.camera.target = [p[3 * best], p[3 * best + 1], p[3 * best + 2]];
-    v.camera.distance = 0.3 * v.camera.extent;
+    v.camera.distance = closeup * v.camera.extent;
     const before = model.stats.bytesFetched;
     result.closeupSteps = await settle(v, 'close-up');
     result.closeup = snapshot(model, await screenshot('closeup', v), { bytesForCloseup: model.stats.bytesFetched - before });
@@ -96,6 +98,9 @@ export async function run(v) {
     v.camera.distance = 1.6 * v.camera.extent;
     result.overviewSteps = await settle(v, 'overview');
     result.overview = snapshot(model, await screenshot('overview', v));
+    $('colour').value = '2';
+    await screenshot('overview_levels', v);
+    $('colour').value = '0';
     note('overview', JSON.stringify(result.overview));
 
     // Zoom out: what shrinks to a few pixels coarsens.
