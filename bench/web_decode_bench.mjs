@@ -4,7 +4,7 @@
 //
 // Times, K times (default 5; median reported), with a fresh decoder each time:
 //   open   - the base clustered mesh from the global part (pw_open)
-//   full   - then every cluster to the finest level (plan + blocks + update), as
+//   full   - then every cluster to the finest level (blocks handed over + update), as
 //            `pomar_ra_bench one`'s "full decode" does natively with a SelectiveDecoder
 //   mesh   - copying the mesh out (positions, triangles, per-vertex cluster and level)
 // Compare with the native numbers of `pomar_ra_bench one MESH` on the same file's mesh, or
@@ -41,9 +41,8 @@ for (let r = 0; r < repeat; ++r) {
   info = d.info;
   t = performance.now();
   const wanted = info.clusters ? new Array(info.clusters).fill(info.finestLevel) : [info.finestLevel];
-  if (info.clusters)
-    for (const c of d.plan(wanted))
-      d.putBlock(c, bytes.subarray(d.blockOffset[c], d.blockOffset[c] + d.blockSize[c]));
+  for (let c = 0; c < info.clusters; ++c)
+    d.putBlock(c, bytes.subarray(d.blockOffset[c], d.blockOffset[c] + d.blockSize[c]));
   d.update(wanted);
   times.full.push(performance.now() - t);
   t = performance.now();

@@ -19,10 +19,11 @@ import { chooseLevels } from './view_refine.js';
 /**
  * @param source URL of a .pomar file, or a File/Blob (e.g. dropped on the page)
  * @param options {onMesh(mesh, model), onWarning(message), onError(message),
- *   maxInFlight = 4, maxGap = 4 KiB (blocks this close are fetched in one request; the
- *   blocks in between are kept for later, within prefetchBudget = 64 MiB),
- *   maxRequestBytes = 1 MiB, memoryBudget = 256 MiB (cluster blocks held; over it the
- *   worker rebuilds its decoder with only the blocks in use), firstRequestBytes = 16 KiB}
+ *   maxInFlight = 4, maxGap = 4 KiB (ranges this close are fetched in one request; what
+ *   lies between is kept), maxRequestBytes = 1 MiB, memoryBudget = 256 MiB (block bytes
+ *   held; over it the worker rebuilds its decoder with only the blocks in use),
+ *   firstRequestBytes = 16 KiB, tolerant = false (true: fetch whole blocks from the start;
+ *   see pomar_stream.js)}
  */
 export function open(source, options = {}) {
   const model = new PomarModel(options);

@@ -37,10 +37,13 @@ export function globalBytes(M, prefix, fileSize) {
 }
 
 export class Decoder {
-  /** Decode the base clustered mesh from the file's first bytes (>= globalBytes). */
-  constructor(M, prefix, fileSize) {
+  /** Decode the base clustered mesh from the file's first bytes (>= globalBytes).
+   *  `tolerant`: skip damaged or missing cluster blocks (and read every block whole);
+   *  otherwise read blocks only as far as the wanted levels need, and fail on damage. */
+  constructor(M, prefix, fileSize, tolerant = true) {
     this.M = M;
-    this.h = withBytes(M, prefix, (p) => M._pw_open(p, prefix.length, fileSize));
+    this.tolerant = tolerant;
+    this.h = withBytes(M, prefix, (p) => M._pw_open(p, prefix.length, fileSize, tolerant ? 1 : 0));
     if (!this.h) throw new PomarError(lastError(M));
     this.refreshInfo();
     const n = this.info.clusters;
@@ -84,14 +87,6 @@ export class Decoder {
     }
   }
 
-  /** Clusters whose blocks an update to `wanted` needs and that were not handed over yet. */
-  plan(wanted) {
-    const M = this.M;
-    const n = this.withLevels(wanted, (p) => M._pw_plan(this.h, p));
-    if (n < 0) throw new PomarError(lastError(M));
-    return new Uint32Array(M.HEAPU32.buffer, M._pw_plan_ids(this.h), n).slice();
-  }
-
   /** The level map update(wanted) would decode (the level map rule applied). */
   complete(wanted) {
     const M = this.M;
@@ -100,17 +95,23 @@ export class Decoder {
     return new Int32Array(M.HEAP32.buffer, M._pw_levels(this.h), this.info.clusters).slice();
   }
 
-  /** Hand over cluster c's block (an empty or short array if it could not be fetched). */
+  /** Hand over the first bytes of cluster c's block (all of it, or what its levels need). */
   putBlock(c, bytes) {
     const M = this.M;
     if (withBytes(M, bytes, (p) => M._pw_put_block(this.h, c, p, bytes.length)) < 0)
       throw new PomarError(lastError(M));
   }
 
-  /** Decode to the completed level map of `wanted`; returns the level of every cluster. */
+  /** Decode to the completed level map of `wanted`; returns the level of every cluster.
+   *  Throws a PomarError; its `missingCluster` is the cluster whose block lacked bytes (-1 if
+   *  that was not the problem; then coarsen everything to the base level before retrying). */
   update(wanted) {
     const M = this.M;
-    if (this.withLevels(wanted, (p) => M._pw_update(this.h, p)) < 0) throw new PomarError(lastError(M));
+    if (this.withLevels(wanted, (p) => M._pw_update(this.h, p)) < 0) {
+      const e = new PomarError(lastError(M));
+      e.missingCluster = M._pw_missing_cluster(this.h);
+      throw e;
+    }
     this.refreshInfo();
     return new Int32Array(M.HEAP32.buffer, M._pw_levels(this.h), this.info.clusters).slice();
   }

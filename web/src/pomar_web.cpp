@@ -1,7 +1,8 @@
 // The C ABI of the WebAssembly decoder (web/pomar_core.js wraps it): a SelectiveDecoder
-// whose bytes arrive over the network. The JavaScript side fetches the global part, asks
-// which cluster blocks a level map needs (pw_plan), fetches them with range requests,
-// hands them over (pw_put_block) and decodes (pw_update). Every pomar::Error (and any
+// whose bytes arrive over the network. The JavaScript side (web/pomar_stream.js) fetches
+// the global part, completes the wanted level map (pw_complete), fetches what the blocks
+// of the raised clusters need with range requests, hands it over (pw_put_block) and
+// decodes (pw_update). Every pomar::Error (and any
 // other exception, e.g. out of memory) becomes a return code and a message
 // (pw_last_error); nothing traps.
 #include <emscripten/emscripten.h>
@@ -26,9 +27,10 @@ std::string g_error;
 /// this is refused with a message before anything large is allocated.
 constexpr uint64_t kMemoryLimit = uint64_t(1) << 31;
 
-/// The bytes of the file the page has fetched: the global part (kept) and the cluster blocks
-/// handed over for the next update (dropped after it: the decoder keeps its own copy of
-/// every block it has read, to decode again when a cluster gets coarser).
+/// The bytes of the file the page has fetched: the global part, and a prefix of each cluster
+/// block (the whole block, or as much as the levels wanted of it need; see pomar_stream.js).
+/// A read of bytes not handed over throws and records where (pw_missing_cluster): the page
+/// fetches them and decodes again.
 class StagedSource : public pomar::ByteSource {
 public:
   StagedSource(std::vector<uint8_t> prefix, uint64_t size) : prefix_(std::move(prefix)), size_(size) {}
@@ -50,16 +52,20 @@ public:
         return;
       }
     }
+    missing_ = offset;
     throw pomar::Error("bytes " + std::to_string(offset) + ".." + std::to_string(offset + n) +
                        " were not fetched");
   }
+  /// The first `bytes` of the block at `offset` (replacing a shorter prefix).
   void stage(uint64_t offset, std::vector<uint8_t> bytes) { staged_[offset] = std::move(bytes); }
-  void clear() { staged_.clear(); }
+  uint64_t missing() const { return missing_; }
+  void clear_missing() { missing_ = UINT64_MAX; }
 
 private:
   std::vector<uint8_t> prefix_;
   uint64_t size_;
   std::map<uint64_t, std::vector<uint8_t>> staged_;
+  uint64_t missing_ = UINT64_MAX;
 };
 
 struct Handle {
@@ -67,12 +73,10 @@ struct Handle {
   std::unique_ptr<pomar::SelectiveDecoder> decoder;
   pomar::ClusterIndex index;
   std::vector<uint32_t> adj_start, adj; // the cluster graph (edges of the base clustered mesh)
-  std::vector<uint8_t> given;           // cluster blocks handed to the decoder so far
   // Results kept alive for JavaScript to copy out of the heap.
   pomar::Mesh mesh;
   std::vector<uint32_t> vertex_cluster, vertex_level;
   std::vector<float> bounds;
-  std::vector<uint32_t> plan;
   std::vector<int32_t> levels;
   std::vector<double> info;
   std::string text;
@@ -145,8 +149,11 @@ EMSCRIPTEN_KEEPALIVE double pw_global_bytes(const uint8_t *data, size_t n, doubl
 }
 
 /// Decode the base clustered mesh from the file's first `n` bytes (at least
-/// pw_global_bytes) of `file_size`. Returns a handle, 0 on error (pw_last_error).
-EMSCRIPTEN_KEEPALIVE Handle *pw_open(const uint8_t *data, size_t n, double file_size) {
+/// pw_global_bytes) of `file_size`. `tolerant`: damaged or missing cluster blocks are
+/// skipped (SelectiveOptions::skip_damaged; every block is then read whole, to verify its
+/// check before decoding it); otherwise blocks are read only as far as the wanted levels
+/// need and any damage fails pw_update. Returns a handle, 0 on error (pw_last_error).
+EMSCRIPTEN_KEEPALIVE Handle *pw_open(const uint8_t *data, size_t n, double file_size, int tolerant) {
   Handle *out = nullptr;
   guarded([&] {
     auto h = std::make_unique<Handle>();
@@ -154,7 +161,7 @@ EMSCRIPTEN_KEEPALIVE Handle *pw_open(const uint8_t *data, size_t n, double file_
     auto source = std::make_unique<StagedSource>(std::vector<uint8_t>(data, data + n), size);
     h->source = source.get();
     pomar::SelectiveOptions options;
-    options.skip_damaged = true; // damaged blocks are skipped, and listed (pw_damaged)
+    options.skip_damaged = tolerant != 0; // damaged blocks are skipped and listed (pw_damaged)
     options.memory_limit = kMemoryLimit;
     h->decoder = std::make_unique<pomar::SelectiveDecoder>(std::move(source), options);
     const uint32_t clusters = h->decoder->cluster_count();
@@ -164,7 +171,6 @@ EMSCRIPTEN_KEEPALIVE Handle *pw_open(const uint8_t *data, size_t n, double file_
       h->index = pomar::read_cluster_index(data + layout.index_offset, layout);
       cluster_graph(h->decoder->mesh(), clusters, h->adj_start, h->adj);
     }
-    h->given.assign(clusters, 0);
     out = h.release();
     return 0;
   });
@@ -212,23 +218,6 @@ EMSCRIPTEN_KEEPALIVE double pw_block_size(Handle *h, uint32_t c) {
   return c < h->index.size.size() ? double(h->index.size[c]) : -1;
 }
 
-/// The clusters whose blocks updating to `wanted` (one level per cluster) needs and that
-/// were not handed over yet: the level map is completed as update() completes it.
-/// Returns their count (ids: pw_plan_ids), -1 on error.
-EMSCRIPTEN_KEEPALIVE int pw_plan(Handle *h, const int32_t *wanted) {
-  return guarded([&] {
-    h->plan.clear();
-    const int base = h->decoder->base_clustered_level();
-    const std::vector<int> target =
-        pomar::complete_level_map(to_levels(*h, wanted), h->adj_start, h->adj, base);
-    for (uint32_t c = 0; c < target.size(); ++c)
-      if (target[c] > base && !h->given[c])
-        h->plan.push_back(c);
-    return int(h->plan.size());
-  });
-}
-EMSCRIPTEN_KEEPALIVE const uint32_t *pw_plan_ids(Handle *h) { return h->plan.data(); }
-
 /// The completed level map for `wanted` (pw_levels_out), without decoding.
 EMSCRIPTEN_KEEPALIVE int pw_complete(Handle *h, const int32_t *wanted) {
   return guarded([&] {
@@ -239,23 +228,36 @@ EMSCRIPTEN_KEEPALIVE int pw_complete(Handle *h, const int32_t *wanted) {
   });
 }
 
-/// Hand over cluster c's block (`n` bytes; fewer than the index says if the file is
-/// truncated, none if its fetch failed: the decoder then skips the cluster as damaged).
+/// Hand over the first `n` bytes of cluster c's block (all of it, or the prefix its wanted
+/// levels need; replaces a shorter prefix handed over before).
 EMSCRIPTEN_KEEPALIVE int pw_put_block(Handle *h, uint32_t c, const uint8_t *data, size_t n) {
   return guarded([&] {
     if (c >= h->index.offset.size())
       throw pomar::Error("cluster " + std::to_string(c) + " does not exist");
     h->source->stage(h->index.offset[c], std::vector<uint8_t>(data, data + n));
-    h->given[c] = 1;
     return 0;
   });
 }
 
+/// After pw_update failed: the cluster whose block lacked bytes (-1: the failure was not a
+/// missing byte). The mesh is intact but that cluster's stream is not: coarsen everything
+/// to the base clustered level (pw_update) before decoding again.
+EMSCRIPTEN_KEEPALIVE int pw_missing_cluster(Handle *h) {
+  const uint64_t at = h->source->missing();
+  if (at == UINT64_MAX)
+    return -1;
+  for (uint32_t c = 0; c < h->index.offset.size(); ++c)
+    if (at >= h->index.offset[c] && at < h->index.offset[c] + h->index.size[c])
+      return int(c);
+  return -1;
+}
+
 /// Bring the mesh to the level map completed from `wanted` (clustered files) or to level
-/// wanted[0] everywhere (progressive files). Damaged or missing blocks are skipped
-/// (pw_damaged). Returns 0, or -1 on error (pw_last_error).
+/// wanted[0] everywhere (progressive files). Tolerant decoders skip damaged or missing
+/// blocks (pw_damaged). Returns 0, or -1 on error (pw_last_error, pw_missing_cluster).
 EMSCRIPTEN_KEEPALIVE int pw_update(Handle *h, const int32_t *wanted) {
-  const int r = guarded([&] {
+  h->source->clear_missing();
+  return guarded([&] {
     if (h->decoder->cluster_count() == 0) {
       h->decoder->clear_wanted();
       h->decoder->want_all(wanted[0]);
@@ -266,8 +268,6 @@ EMSCRIPTEN_KEEPALIVE int pw_update(Handle *h, const int32_t *wanted) {
     h->levels.assign(h->decoder->levels().begin(), h->decoder->levels().end());
     return 0;
   });
-  h->source->clear();
-  return r;
 }
 
 /// The level of every cluster after pw_update (or the map of pw_complete).

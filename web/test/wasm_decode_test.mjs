@@ -16,7 +16,9 @@ import { fileURLToPath } from 'node:url';
 import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { Decoder, PomarError, globalBytes, loadModule } from '../pomar_core.js';
+import { PomarError, loadModule } from '../pomar_core.js';
+import { PomarStream } from '../pomar_stream.js';
+import { RangeFile } from '../range_fetch.js';
 
 const [tool, ...files] = process.argv.slice(2);
 if (!tool || files.length === 0) {
@@ -126,92 +128,108 @@ function canonical(m) {
   return { positions: new Float32Array(positionBits.buffer), positionBits, triangles: Uint32Array.from(faces.flat()) };
 }
 
-/** Open `bytes` in WASM as the page does: the prefix it asks for, then the blocks of a plan. */
-function open(bytes) {
-  let n = Math.min(bytes.length, 64);
-  for (let need; (need = globalBytes(M, bytes.subarray(0, n), bytes.length)) > n;) n = need;
-  return new Decoder(M, bytes.subarray(0, n), bytes.length);
-}
-function decodeTo(d, bytes, wanted) {
-  for (const c of d.plan(wanted)) {
-    const o = d.blockOffset[c];
-    d.putBlock(c, bytes.subarray(o, Math.min(bytes.length, o + d.blockSize[c])));
-  }
-  return d.update(wanted);
+/** Open `bytes` as the page does (pomar_stream.js over a RangeFile), from a Blob. */
+function open(bytes, tolerant = false, options = {}) {
+  // wholeBlockBytes 0: every block is fetched as a prefix first (the samples' blocks are small).
+  return new PomarStream(M, new RangeFile(new Blob([bytes]), { maxGap: 64 }), { tolerant, wholeBlockBytes: 0, ...options }).open();
 }
 
 for (const file of files) {
   console.log(file);
   const bytes = new Uint8Array(readFileSync(file));
-  const d = open(bytes);
-  const info = d.info;
+  const probe = await open(bytes);
+  const info = probe.info;
+  probe.close();
   if (info.clusters > 0) {
     const base = info.baseLevel;
     const finest = info.finestLevel;
-    compare(d.mesh(), native(file, ['--level', `${base}`, '--cluster', '0:0']), 'base clustered mesh');
     const a = 5 % info.clusters;
     const b = Math.floor(info.clusters / 2);
     const selective = new Array(info.clusters).fill(base);
     selective[a] = Math.min(finest, base + 4);
     selective[b] = Math.min(finest, base + 2);
+    const nativeBase = native(file, ['--level', `${base}`, '--cluster', '0:0']);
     const nativeSelective = native(file, ['--cluster', `${a}:${selective[a]}`, '--cluster', `${b}:${selective[b]}`]);
     const nativeFull = native(file, ['--level', `${finest}`, '--cluster', '0']);
-    decodeTo(d, bytes, selective);
-    compare(d.mesh(), nativeSelective, `clusters ${a}:${selective[a]} and ${b}:${selective[b]}`);
-    const blocksSelective = d.info.blocksRead;
-    check(blocksSelective < info.clusters, `a selective decode reads some blocks (${blocksSelective} of ${info.clusters})`);
-    // Refining on top of a decoded state numbers the new vertices in decoding order: the
-    // same mesh as a fresh decode, up to vertex numbering.
-    decodeTo(d, bytes, new Array(info.clusters).fill(finest));
-    compare(canonical(d.mesh()), canonical(nativeFull), 'full resolution refined from the selective state (canonical order)');
-    check(d.info.decoderBytesRead === bytes.length, `full decode read ${d.info.decoderBytesRead} of ${bytes.length} bytes`);
-    check(d.info.blocksRead === info.clusters, `every block read exactly once (${d.info.blocksRead} of ${info.clusters})`);
-    // Coarsening decodes again from the base clustered mesh, in a fresh decode's order.
-    decodeTo(d, bytes, selective);
-    compare(d.mesh(), nativeSelective, 'coarsened back to the selective request');
-    check(d.info.blocksRead === info.clusters, 'coarsening reads no block again');
-    const fresh = open(bytes);
-    decodeTo(fresh, bytes, new Array(info.clusters).fill(finest));
-    compare(fresh.mesh(), nativeFull, 'full resolution');
-    fresh.close();
-    check(d.damaged().count === 0, 'an intact file reports no damage');
+    const fetched = {};
+    for (const tolerant of [false, true]) {
+      const mode = tolerant ? 'tolerant (whole blocks)' : 'block prefixes';
+      const s = await open(bytes, tolerant);
+      compare(s.decoder.mesh(), nativeBase, `${mode}: base clustered mesh`);
+      await s.want(selective);
+      compare(s.decoder.mesh(), nativeSelective, `${mode}: clusters ${a}:${selective[a]} and ${b}:${selective[b]}`);
+      fetched[mode] = s.stats().bytesFetched;
+      console.log(`  ${mode}: the selective request fetched ${fetched[mode]} of ${bytes.length} bytes ` +
+        `(${s.stats().blocksHeld} blocks, ${s.retries} short estimates)`);
+      check(s.decoder.info.blocksRead < info.clusters, `${mode}: a selective decode reads some blocks`);
+      // Refining on top of a decoded state numbers the new vertices in decoding order: the
+      // same mesh as a fresh decode, up to vertex numbering.
+      await s.want(new Array(info.clusters).fill(finest));
+      compare(canonical(s.decoder.mesh()), canonical(nativeFull), `${mode}: full resolution refined from the selective state (canonical order)`);
+      check(s.stats().bytesFetched === bytes.length, `${mode}: every byte fetched once (${s.stats().bytesFetched} of ${bytes.length})`);
+      check(s.decoder.info.blocksRead === info.clusters, `${mode}: every block read (${s.decoder.info.blocksRead} of ${info.clusters})`);
+      // Coarsening decodes again from the base clustered mesh, in a fresh decode's order.
+      await s.want(selective);
+      compare(s.decoder.mesh(), nativeSelective, `${mode}: coarsened back to the selective request`);
+      check(s.stats().bytesFetched === bytes.length, `${mode}: coarsening fetches nothing`);
+      check(s.decoder.damaged().count === 0 && s.tolerant === tolerant, `${mode}: an intact file reports no damage`);
+      s.close();
+      const fresh = await open(bytes, tolerant);
+      await fresh.want(new Array(info.clusters).fill(finest));
+      compare(fresh.decoder.mesh(), nativeFull, `${mode}: full resolution`);
+      fresh.close();
+    }
+    check(fetched['block prefixes'] <= fetched['tolerant (whole blocks)'], 'block prefixes fetch no more than whole blocks');
+    // Estimates far too short: the missing bytes are fetched and the map decoded again.
+    const short = await open(bytes, false, { estimateMargin: 0.2 });
+    const middle = new Array(info.clusters).fill(Math.min(finest - 1, base + 6));
+    await short.want(selective);
+    compare(short.decoder.mesh(), nativeSelective, 'short estimates: selective request');
+    await short.want(middle);
+    compare(canonical(short.decoder.mesh()), canonical(native(file, ['--level', `${middle[0]}`, '--cluster', '0:0'])),
+      `short estimates: every cluster at level ${middle[0]} (canonical order)`);
+    check(short.retries > 0 && !short.tolerant && short.decoder.damaged().count === 0,
+      `short estimates are retried (${short.retries} retries), not taken for damage`);
+    console.log(`  short estimates: ${short.retries} retries, results identical`);
+    short.close();
   } else {
-    compare(d.mesh(), native(file, ['--level', '0']), 'base mesh');
-    d.update([Math.min(10, info.finestLevel)]);
-    compare(d.mesh(), native(file, ['--level', `${Math.min(10, info.finestLevel)}`]), 'level 10');
-    d.update([info.finestLevel]);
-    compare(d.mesh(), native(file, []), 'full resolution');
+    const s = await open(bytes);
+    compare(s.decoder.mesh(), native(file, ['--level', '0']), 'base mesh');
+    const mid = Math.min(10, info.finestLevel);
+    await s.want([mid]);
+    compare(s.decoder.mesh(), native(file, ['--level', `${mid}`]), `level ${mid}`);
+    await s.want([info.finestLevel]);
+    compare(s.decoder.mesh(), native(file, []), 'full resolution');
+    s.close();
   }
-  d.close();
 
   // Damaged inputs: every outcome is a decoded mesh or a PomarError with a message.
   let messages = 0;
   let decoded = 0;
   let skipped = 0;
-  const attempt = (damaged, what) => {
-    let d2 = null;
+  const attempt = async (damaged, what) => {
+    let s = null;
     try {
-      d2 = open(damaged);
-      const top = d2.info.clusters > 0 ? new Array(d2.info.clusters).fill(d2.info.finestLevel) : [d2.info.finestLevel];
-      if (d2.info.clusters > 0) decodeTo(d2, damaged, top);
-      else d2.update(top);
-      const m = d2.mesh();
+      s = await open(damaged);
+      const top = s.info.clusters > 0 ? new Array(s.info.clusters).fill(s.info.finestLevel) : [s.info.finestLevel];
+      await s.want(top);
+      const m = s.decoder.mesh();
       check(m.triangles.every((v) => v < m.positions.length / 3), `${what}: index out of range`);
-      if (d2.damaged().count > 0) ++skipped;
+      if (s.decoder.damaged().count > 0) ++skipped;
       else ++decoded;
     } catch (e) {
       check(e instanceof PomarError && e.message.length > 0, `${what}: ${e && e.stack}`);
       ++messages;
     } finally {
-      if (d2) d2.close();
+      if (s) s.close();
     }
   };
   const cuts = [0, 10, 59, 60, 100, info.globalBytes - 1, info.globalBytes];
-  for (let k = 1; k <= 24; ++k) cuts.push(Math.floor((bytes.length * k) / 25));
-  for (const cut of cuts) if (cut < bytes.length) attempt(bytes.slice(0, cut), `truncated at ${cut}`);
+  for (let k = 1; k <= 12; ++k) cuts.push(Math.floor((bytes.length * k) / 13));
+  for (const cut of cuts) if (cut < bytes.length) await attempt(bytes.slice(0, cut), `truncated at ${cut}`);
   let seed = 12345;
   const random = () => ((seed = (seed * 1103515245 + 12345) >>> 0) / 4294967296);
-  for (let i = 0; i < 160; ++i) {
+  for (let i = 0; i < 100; ++i) {
     const copy = bytes.slice();
     const flips = 1 + Math.floor(random() * 3);
     // Half in the global part (header, base mesh, tables, index), half anywhere.
@@ -219,18 +237,18 @@ for (const file of files) {
       const range = i % 2 ? copy.length : info.globalBytes;
       copy[Math.floor(random() * range)] ^= 1 + Math.floor(random() * 255);
     }
-    attempt(copy, `corruption ${i}`);
+    await attempt(copy, `corruption ${i}`);
   }
   console.log(`  damaged inputs: ${messages} errors with a message, ${skipped} decoded around ` +
     `damaged blocks, ${decoded} decoded (damage not detected or harmless), no trap`);
   check(messages > 0 && skipped + decoded > 0, 'damaged inputs exercise both errors and skipping');
   const truncatedInBlocks = bytes.slice(0, Math.floor((bytes.length + info.globalBytes) / 2));
   if (info.clusters > 0) {
-    const d3 = open(truncatedInBlocks);
-    decodeTo(d3, truncatedInBlocks, new Array(info.clusters).fill(info.finestLevel));
-    const dmg = d3.damaged();
+    const s = await open(truncatedInBlocks);
+    await s.want(new Array(info.clusters).fill(info.finestLevel));
+    const dmg = s.decoder.damaged();
     check(dmg.count > 0 && /truncated/.test(dmg.text), `truncated cluster blocks are reported: ${dmg.text}`);
-    d3.close();
+    s.close();
   }
 }
 rmSync(work, { recursive: true, force: true });
