@@ -91,7 +91,24 @@ struct FileInfo {
   uint64_t global_bytes = 0; ///< header, base mesh, global levels, tables, index
   uint64_t tables_bytes = 0, index_bytes = 0, cluster_bytes = 0;
   std::vector<uint32_t> cluster_block_bytes; ///< filled by inspect()
+  /// Version 4: what the file carries in sections of its global part, with their sizes.
+  struct Section {
+    std::string name;      ///< four ASCII characters, e.g. "LSLS"
+    uint64_t bytes = 0;    ///< size of the section's body
+    bool required = false; ///< a reader that does not know it must refuse the file
+  };
+  std::vector<Section> sections;
   bool clustered() const { return clusters != 0; }
+};
+
+/// Ideal code lengths per symbol kind, in bits.
+struct SymbolBits {
+  double s_v = 0;        ///< split flags
+  double s_e = 0;        ///< which ring edge is v_to-v_ref
+  double faces = 0;      ///< patch size s_l + s_r
+  double s_l = 0;        ///< where the patch starts
+  double tangential = 0; ///< geometry residuals in the tangent plane (two per split)
+  double normal = 0;     ///< geometry residual along the normal
 };
 
 /// Facts about one encode, beyond what the file itself says.
@@ -100,9 +117,8 @@ struct EncodeReport {
   size_t input_vertices = 0;
   size_t unreferenced_vertices = 0; ///< dropped: no triangle uses them
   double quantize_seconds = 0, decimate_seconds = 0, encode_seconds = 0;
-  /// Ideal code length per symbol kind of the global levels, in bits (adaptive models):
-  /// s_v, s_e, s_l + s_r, s_l, tangential and normal residual components.
-  double symbol_bits[6] = {0, 0, 0, 0, 0, 0};
+  /// Ideal code length per symbol kind of the global levels (adaptive models).
+  SymbolBits symbol_bits;
   /// decoded vertex i (in a full decode) is input vertex decoded_to_input[i].
   std::vector<uint32_t> decoded_to_input;
 };
