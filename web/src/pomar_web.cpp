@@ -33,7 +33,8 @@ constexpr uint64_t kMemoryLimit = uint64_t(1) << 31;
 /// fetches them and decodes again.
 class StagedSource : public pomar::ByteSource {
 public:
-  StagedSource(std::vector<uint8_t> prefix, uint64_t size) : prefix_(std::move(prefix)), size_(size) {}
+  StagedSource(std::vector<uint8_t> prefix, uint64_t size)
+      : prefix_(std::move(prefix)), size_(size) {}
   uint64_t size() const override { return size_; }
   void read(uint64_t offset, size_t n, uint8_t *out) override {
     if (offset > size_ || n > size_ - offset)
@@ -135,8 +136,8 @@ EMSCRIPTEN_KEEPALIVE double pw_global_bytes(const uint8_t *data, size_t n, doubl
     }
     const size_t hsize = pomar::header_size(data, n);
     if (hsize > size)
-      throw pomar::Error("truncated .pomar file: the header alone needs " +
-                         std::to_string(hsize) + " bytes, the file has " + std::to_string(size));
+      throw pomar::Error("truncated .pomar file: the header alone needs " + std::to_string(hsize) +
+                         " bytes, the file has " + std::to_string(size));
     if (n < hsize) {
       out = double(hsize);
       return 0;
@@ -153,7 +154,8 @@ EMSCRIPTEN_KEEPALIVE double pw_global_bytes(const uint8_t *data, size_t n, doubl
 /// skipped (SelectiveOptions::skip_damaged; every block is then read whole, to verify its
 /// check before decoding it); otherwise blocks are read only as far as the wanted levels
 /// need and any damage fails pw_update. Returns a handle, 0 on error (pw_last_error).
-EMSCRIPTEN_KEEPALIVE Handle *pw_open(const uint8_t *data, size_t n, double file_size, int tolerant) {
+EMSCRIPTEN_KEEPALIVE Handle *pw_open(const uint8_t *data, size_t n, double file_size,
+                                     int tolerant) {
   Handle *out = nullptr;
   guarded([&] {
     auto h = std::make_unique<Handle>();
