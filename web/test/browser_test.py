@@ -142,6 +142,8 @@ def main():
               f"of which {cu['bytesForCloseup']} after the base mesh")
         check(ov['triangles'] > b['triangles'] and ov['covered'] > 0.02, 'the overview refines')
         check(zo['triangles'] < ov['triangles'] / 2 and zo['maxLevel'] <= ov['maxLevel'], 'zooming out coarsens')
+        check(r['interactive']['triangles'] > zo['triangles'] and r['interactive']['covered'] > 0.02,
+              "the viewer's own refinement loop refines the overview again")
         check(full['triangles'] > cu['triangles'] and full['minLevel'] == r['info']['finestLevel'], 'full resolution everywhere')
         check(full['bytesFetched'] == size, f"full resolution fetched {full['bytesFetched']} bytes of {size}")
         check(full['maxInFlightSeen'] <= 4, 'at most 4 requests in flight')

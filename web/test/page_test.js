@@ -61,7 +61,7 @@ async function settle(v, what) {
 export async function run(v) {
   const result = { ok: false, log };
   try {
-    $('refine').checked = false; // the test drives refinement itself
+    $('refine').checked = false; // the test drives refinement itself (but see below)
     const t0 = performance.now();
     const fetchOptions = params.has('maxGap') ? { maxGap: Number(params.get('maxGap')) } : {};
     const model = await within(30000, v.openSource(params.get('file'), fetchOptions), 'open');
@@ -108,6 +108,14 @@ export async function run(v) {
     result.zoomoutSteps = await settle(v, 'zoom out');
     result.zoomout = snapshot(model, await screenshot('zoomout', v));
     note('zoomed out', JSON.stringify(result.zoomout));
+
+    // The viewer's own loop (what orbiting and zooming run): back to the overview.
+    $('refine').checked = true;
+    v.camera.distance = 1.6 * v.camera.extent;
+    await within(60000, v.refineLoop(), 'the viewer refinement loop');
+    $('refine').checked = false;
+    result.interactive = snapshot(model, await screenshot('interactive', v));
+    note('viewer loop', JSON.stringify(result.interactive));
 
     // Full resolution everywhere: every block, each fetched once.
     v.camera.distance = 1.6 * v.camera.extent;
