@@ -5,6 +5,7 @@
 #     decoder decodes them bit for bit like the native one, and that damaged/truncated
 #     copies give messages (web/test/wasm_decode_test.mjs, Node.js);
 #  3. runs the viewer in headless Chromium (web/test/browser_test.py).
+# (Plus web/test/unit_test.mjs: request coalescing and the choice of levels for a view.)
 # Each step is skipped with a message when emscripten, Node.js or Chromium is missing.
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
@@ -21,6 +22,7 @@ mkdir -p "$samples"
 "$TOOL" encode "$REPO/samples/bunny.ply" "$samples/bunny.pomar" -q
 "$TOOL" encode "$REPO/samples/bunny.ply" "$samples/bunny_c5.pomar" --cluster-ratio 0.05 -q
 "$TOOL" encode "$REPO/samples/bunny.ply" "$samples/bunny_progressive.pomar" --progressive -q
+node "$REPO/web/test/unit_test.mjs"
 echo "web tests: WASM decode = native decode (node web/test/wasm_decode_test.mjs)"
 node "$REPO/web/test/wasm_decode_test.mjs" "$TOOL" "$samples/bunny.pomar" "$samples/bunny_c5.pomar" \
   "$samples/bunny_progressive.pomar"
