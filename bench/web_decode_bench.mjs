@@ -10,10 +10,8 @@
 // Compare with the native numbers of `pomar_ra_bench one MESH` on the same file's mesh, or
 // `pomar decode FILE out.ply --cluster 0 --level FINEST --stats`. See bench/README.md.
 import { readFileSync } from 'node:fs';
-import { createRequire } from 'node:module';
-import { dirname, join } from 'node:path';
-import { fileURLToPath } from 'node:url';
-import { Decoder, globalBytes, loadModule } from '../web/pomar_core.js';
+import { Decoder, globalBytes } from '../web/pomar_core.js';
+import { loadModuleInNode } from '../web/test/node_support.mjs';
 
 const args = process.argv.slice(2);
 const file = args.find((a) => !a.startsWith('--'));
@@ -23,11 +21,7 @@ if (!file) {
   console.error('usage: node bench/web_decode_bench.mjs FILE.pomar [--repeat K]');
   process.exit(2);
 }
-// Emscripten 3.1.6's ES module output looks for CommonJS globals when it runs in Node.
-const dist = join(dirname(fileURLToPath(import.meta.url)), '..', 'web', 'dist');
-globalThis.require = createRequire(import.meta.url);
-globalThis.__dirname = dist;
-const M = await loadModule({ wasmBinary: readFileSync(join(dist, 'pomar_decoder.wasm')) });
+const M = await loadModuleInNode();
 const bytes = new Uint8Array(readFileSync(file));
 
 const times = { open: [], full: [], mesh: [] };

@@ -2,16 +2,10 @@
 // of levels for a view (view_refine.js).   node web/test/unit_test.mjs
 import { coalesce } from '../range_fetch.js';
 import { chooseLevels } from '../view_refine.js';
+import { checker } from './node_support.mjs';
 
-let failures = 0;
-let checks = 0;
-function check(ok, what) {
-  ++checks;
-  if (!ok) {
-    ++failures;
-    console.error('FAIL: ' + what);
-  }
-}
+const result = checker();
+const check = result.check;
 const same = (a, b) => JSON.stringify(a) === JSON.stringify(b);
 
 // ---- coalesce
@@ -73,5 +67,4 @@ state = { info, levels: Int32Array.of(5, 2, 2), clusterBounds: bounds([near, far
 choice = chooseLevels(state, view, { targetPixels: 3 });
 check(choice.levels[0] === 5, 'the finest level stays');
 
-console.log(`unit tests: ${checks} checks, ${failures} failed`);
-process.exit(failures ? 1 : 0);
+result.done('unit tests');

@@ -10,36 +10,23 @@
 // truncated copies and copies with flipped bytes must open and decode or fail with a
 // pomar message, never trap.
 import { execFileSync } from 'node:child_process';
-import { createRequire } from 'node:module';
-import { dirname } from 'node:path';
-import { fileURLToPath } from 'node:url';
 import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { PomarError, loadModule } from '../pomar_core.js';
+import { PomarError } from '../pomar_core.js';
 import { PomarStream } from '../pomar_stream.js';
 import { RangeFile } from '../range_fetch.js';
+import { checker, loadModuleInNode } from './node_support.mjs';
 
 const [tool, ...files] = process.argv.slice(2);
 if (!tool || files.length === 0) {
   console.error('usage: node wasm_decode_test.mjs POMAR_TOOL FILE.pomar...');
   process.exit(2);
 }
-// Emscripten 3.1.6's ES module output looks for CommonJS globals when it runs in Node.
-globalThis.require = createRequire(import.meta.url);
-const dist = join(dirname(fileURLToPath(import.meta.url)), '..', 'dist');
-globalThis.__dirname = dist;
-const M = await loadModule({ wasmBinary: readFileSync(join(dist, 'pomar_decoder.wasm')) });
+const M = await loadModuleInNode();
 const work = mkdtempSync(join(tmpdir(), 'pomar-wasm-'));
-let failures = 0;
-let checks = 0;
-function check(ok, what) {
-  ++checks;
-  if (!ok) {
-    ++failures;
-    console.error('FAIL: ' + what);
-  }
-}
+const result = checker();
+const check = result.check;
 
 /** Vertices (as float bits) and faces of a binary little-endian PLY written by the tool. */
 function readPly(path) {
@@ -103,7 +90,7 @@ function compare(wasmMesh, nativeMesh, what) {
     `${what}: ${bits.length / 3} vertices in WASM, ${nativeMesh.positionBits.length / 3} native`);
   check(sameArrays(bits, nativeMesh.positionBits), `${what}: positions differ`);
   check(sameArrays(wasmMesh.triangles, nativeMesh.triangles), `${what}: triangles differ`);
-  if (failures === 0) console.log(`  ${what}: ${bits.length / 3} vertices, ${wasmMesh.triangles.length / 3} faces identical`);
+  if (result.failures === 0) console.log(`  ${what}: ${bits.length / 3} vertices, ${wasmMesh.triangles.length / 3} faces identical`);
 }
 
 /** The mesh with vertices sorted by position bits and faces rotated and sorted. */
@@ -252,5 +239,4 @@ for (const file of files) {
   }
 }
 rmSync(work, { recursive: true, force: true });
-console.log(`${checks} checks, ${failures} failed`);
-process.exit(failures ? 1 : 0);
+result.done('wasm decode test');
