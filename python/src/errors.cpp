@@ -16,18 +16,9 @@ void raise(const std::string &kind, const std::string &message) {
 } // namespace
 
 std::string kind_of(const pomar::Error &e, const char *operation_kind) {
-  using Kind = pomar::Error::Kind;
-  switch (e.kind()) {
-  case Kind::InvalidMesh: return "invalid_mesh";
-  case Kind::DamagedFile:
-  case Kind::TruncatedFile:
-  case Kind::Unsupported: return "damaged_file";
-  case Kind::Io: return "io";
-  case Kind::MemoryLimit: return "memory_limit";
-  case Kind::Usage: return "usage";
-  case Kind::Internal: return "internal";
-  case Kind::Other: break;
-  }
+  // The memory checks of pomar/limits.h all say "not enough memory to ...".
+  if (std::string(e.what()).rfind("not enough memory", 0) == 0)
+    return "memory_limit";
   return operation_kind;
 }
 
@@ -35,7 +26,7 @@ void register_errors(py::module_ &m) {
   error_type = PyErr_NewExceptionWithDoc(
       "pomar.Error",
       "A failure reported by the pomar library: str(e) is its one-line message, e.kind one "
-      "of 'invalid_mesh', 'damaged_file', 'io', 'memory_limit', 'usage', 'internal'.",
+      "of 'invalid_mesh', 'damaged_file', 'io', 'memory_limit', 'usage'.",
       PyExc_Exception, nullptr);
   if (!error_type)
     throw py::error_already_set();

@@ -1,12 +1,11 @@
 // pomar.Error: the library's errors as one Python exception class with a `kind`.
 //
-// The kind comes from pomar::Error::kind(): "invalid_mesh" (the mesh or mesh file cannot be
-// used), "damaged_file" (a damaged, truncated or unsupported .pomar file), "io" (a file
-// that cannot be opened, read or written), "memory_limit", "usage" (e.g. a memory limit
-// text that does not parse), "internal" (a bug in pomar); an error without a kind gets the
-// usual failure of the operation that raised it. Bad arguments the binding can check
-// itself (dtype, shape, bits, level, cluster) raise TypeError / ValueError before the
-// library is called.
+// pomar::Error does not carry a kind yet (issue 11 gives it one), so the kind is the
+// usual failure of the operation that raised it: "invalid_mesh" (encode), "damaged_file"
+// (decode, info, SelectiveDecoder), "io" (read, write), "usage" (a memory limit text that
+// does not parse), and "memory_limit" whenever a memory check refused the work. Bad
+// arguments the binding can check itself (dtype, shape, bits, level, cluster) raise
+// TypeError / ValueError before the library is called.
 #pragma once
 
 #include <pomar/pomar.h>
