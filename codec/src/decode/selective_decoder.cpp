@@ -1,4 +1,7 @@
-// Random access (paper section 6): the level map and selective, incremental decoding.
+// Random access (paper section 6), the orchestration: requests -> the level map completed
+// and limited around damage (decode/level_map.cpp) -> the missing cluster levels, level by
+// level, each through the per-level step (refine/level_step.h) on the cluster's stream
+// (decode/cluster_stream.cpp); coarsening re-decodes from the base clustered mesh.
 #include <algorithm>
 
 #include "decode/cluster_stream.h"
