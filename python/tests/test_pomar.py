@@ -72,6 +72,20 @@ def test_round_trip_arrays_lossless_on_the_grid():
     assert d.max() <= 0.5 * step * 1.01
 
 
+def test_decoded_arrays_are_not_copies():
+    """decode() hands over the library's buffers: the arrays do not own a copy, they keep
+    the C++ storage alive (their base), and stay valid after everything else is gone."""
+    vertices, faces = torus()
+    mesh = pomar.decode(pomar.encode(vertices, faces))
+    for array in (mesh.vertices, mesh.faces):
+        assert not array.flags.owndata and array.base is not None
+        assert array.flags.c_contiguous and array.flags.writeable
+    v = mesh.vertices
+    del mesh
+    gc.collect()
+    assert np.isfinite(v).all() and v.shape == vertices.shape
+
+
 def test_levels_and_info(bunny):
     data = pomar.encode(bunny)
     info = pomar.info(data)
