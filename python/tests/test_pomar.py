@@ -334,6 +334,14 @@ def test_selective_requests_by_vertices_and_faces(bunny):
     d.clear_wanted()
     d.update()
     assert len(d.mesh().vertices) == len(base.vertices)
+    wanted = np.full(d.cluster_count, d.base_clustered_level, np.int32)
+    wanted[3] = d.finest_level
+    d.set_wanted(wanted)
+    assert d.wanted[3] == d.finest_level
+    d.update()
+    assert d.levels[3] == d.finest_level
+    with pytest.raises(ValueError, match="one level per cluster"):
+        d.set_wanted([0])
 
 
 def test_selective_decoder_around_damage(bunny):
