@@ -26,11 +26,14 @@ class Mesh:
     seen from outside. Per-vertex attributes (issue 12) will be further fields, None when
     a mesh has none."""
 
-    __slots__ = ("vertices", "faces")
+    __slots__ = ("vertices", "faces", "damaged")
 
-    def __init__(self, vertices, faces):
+    def __init__(self, vertices, faces, damaged=()):
         self.vertices = vertices
         self.faces = faces
+        #: blocks a decode with skip_damaged=True decoded around: dicts with "block"
+        #: ("cluster 17", "level 9"), "problem" and "level_kept"; empty when intact.
+        self.damaged = list(damaged)
 
     def __repr__(self):
         return f"pomar.Mesh({len(self.vertices)} vertices, {len(self.faces)} faces)"
@@ -55,10 +58,14 @@ def encode(vertices, faces=None, *, bits=12, clusters=0, cluster_ratio=0.01,
                          memory_limit)
 
 
-def decode(data, level=None, *, memory_limit=None):
+def decode(data, level=None, *, skip_damaged=False, memory_limit=None):
     """Decode .pomar bytes (bytes, bytearray, memoryview) to a Mesh after `level`
-    refinement levels (0 = base mesh, None = full resolution)."""
-    return Mesh(*_pomar.decode(data, level, memory_limit))
+    refinement levels (0 = base mesh, None = full resolution).
+
+    skip_damaged=True decodes around damaged or missing blocks instead of raising (a
+    damaged global level stops before it, a damaged cluster stays coarse) and lists them
+    in mesh.damaged; damage in the header, base mesh or tables still raises pomar.Error."""
+    return Mesh(*_pomar.decode(data, level, skip_damaged, memory_limit))
 
 
 def read(path, level=None):

@@ -50,6 +50,9 @@ private:
   Py_buffer view_;
 };
 
+/// Skipped blocks as a list of dicts {"block", "problem", "level_kept"}.
+py::list damaged_list(const std::vector<pomar::DamagedBlock> &blocks);
+
 /// FileInfo as the dict `pomar info --json` prints (same keys and values).
 py::dict info_dict(const pomar::FileInfo &info);
 

@@ -33,9 +33,11 @@ py::bytes encode(const py::handle &vertices, const py::handle &faces, int bits, 
   return py::bytes(reinterpret_cast<const char *>(file.data()), file.size());
 }
 
-py::tuple decode(const py::handle &data, const py::handle &level, const py::handle &max_memory) {
+py::tuple decode(const py::handle &data, const py::handle &level, bool skip_damaged,
+                 const py::handle &max_memory) {
   const ReadBuffer buffer(data, "decode()");
   pomar::DecodeOptions options;
+  options.skip_damaged = skip_damaged;
   options.memory_limit = memory_limit(max_memory);
   if (!level.is_none()) {
     const pomar::FileInfo i =
@@ -43,12 +45,15 @@ py::tuple decode(const py::handle &data, const py::handle &level, const py::hand
     options.level = checked_level(level, static_cast<int>(i.levels.size()), -1);
   }
   pomar::Mesh mesh;
+  pomar::DecodeReport report;
   {
     py::gil_scoped_release unlocked;
-    mesh = call_library("damaged_file",
-                        [&] { return pomar::decode(buffer.data(), buffer.size(), options); });
+    mesh = call_library("damaged_file", [&] {
+      return pomar::decode(buffer.data(), buffer.size(), options, &report);
+    });
   }
-  return arrays_from_mesh(std::move(mesh));
+  py::tuple arrays = arrays_from_mesh(std::move(mesh));
+  return py::make_tuple(arrays[0], arrays[1], damaged_list(report.damaged));
 }
 
 py::dict info(const py::handle &data) {
@@ -102,7 +107,8 @@ PYBIND11_MODULE(_pomar, m) {
   m.def("encode", &encode, py::arg("vertices"), py::arg("faces"), py::arg("bits"),
         py::arg("clusters"), py::arg("cluster_ratio"), py::arg("progressive"),
         py::arg("memory_limit"));
-  m.def("decode", &decode, py::arg("data"), py::arg("level"), py::arg("memory_limit"));
+  m.def("decode", &decode, py::arg("data"), py::arg("level"), py::arg("skip_damaged"),
+        py::arg("memory_limit"));
   m.def("info", &info, py::arg("data"));
   m.def("read_mesh", &read_mesh, py::arg("path"));
   m.def("write_mesh", &write_mesh, py::arg("path"), py::arg("vertices"), py::arg("faces"),

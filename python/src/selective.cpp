@@ -89,18 +89,6 @@ std::vector<float> point(const py::handle &value, const char *name) {
   return p;
 }
 
-py::list damaged_list(const std::vector<pomar::DamagedBlock> &blocks) {
-  py::list out;
-  for (const pomar::DamagedBlock &b : blocks) {
-    py::dict d;
-    d["block"] = b.block;
-    d["problem"] = b.problem;
-    d["level_kept"] = b.level_kept;
-    out.append(d);
-  }
-  return out;
-}
-
 using D = pomar::SelectiveDecoder;
 
 } // namespace

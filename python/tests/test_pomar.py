@@ -209,6 +209,9 @@ def test_damaged_and_wrong_data_raise_clear_errors(tmp_path):
     with pytest.raises(pomar.Error) as e:
         pomar.decode(bytes(data))
     assert e.value.kind == "damaged_file"
+    around = pomar.decode(bytes(data), skip_damaged=True)
+    assert around.damaged and around.damaged[0]["problem"]
+    assert 0 < len(around.faces) and pomar.decode(pomar.encode(vertices, faces)).damaged == []
     with pytest.raises(pomar.Error) as e:
         pomar.info(b"not a pomar file")
     assert e.value.kind == "damaged_file"
