@@ -15,7 +15,8 @@ using namespace pomar_python;
 namespace {
 
 py::bytes encode(const py::handle &vertices, const py::handle &faces, int bits, uint32_t clusters,
-                 double cluster_ratio, bool progressive, const py::handle &max_memory) {
+                 double cluster_ratio, bool progressive, const py::handle &max_memory,
+                 const py::handle &progress) {
   if (bits < 4 || bits > 24)
     throw py::value_error("bits must be between 4 and 24, not " + std::to_string(bits));
   pomar::Mesh mesh = mesh_from_arrays(vertices, faces);
@@ -25,6 +26,7 @@ py::bytes encode(const py::handle &vertices, const py::handle &faces, int bits, 
   options.cluster_ratio = cluster_ratio;
   options.progressive = progressive;
   options.memory_limit = memory_limit(max_memory);
+  options.progress = python_progress(progress);
   std::vector<uint8_t> file;
   {
     py::gil_scoped_release unlocked;
@@ -34,11 +36,12 @@ py::bytes encode(const py::handle &vertices, const py::handle &faces, int bits, 
 }
 
 py::tuple decode(const py::handle &data, const py::handle &level, bool skip_damaged,
-                 const py::handle &max_memory) {
+                 const py::handle &max_memory, const py::handle &progress) {
   const ReadBuffer buffer(data, "decode()");
   pomar::DecodeOptions options;
   options.skip_damaged = skip_damaged;
   options.memory_limit = memory_limit(max_memory);
+  options.progress = python_progress(progress);
   if (!level.is_none()) {
     const pomar::FileInfo i =
         call_library("damaged_file", [&] { return pomar::inspect(buffer.data(), buffer.size()); });
@@ -106,9 +109,9 @@ PYBIND11_MODULE(_pomar, m) {
   m.attr("__version__") = pomar::version();
   m.def("encode", &encode, py::arg("vertices"), py::arg("faces"), py::arg("bits"),
         py::arg("clusters"), py::arg("cluster_ratio"), py::arg("progressive"),
-        py::arg("memory_limit"));
+        py::arg("memory_limit"), py::arg("progress"));
   m.def("decode", &decode, py::arg("data"), py::arg("level"), py::arg("skip_damaged"),
-        py::arg("memory_limit"));
+        py::arg("memory_limit"), py::arg("progress"));
   m.def("info", &info, py::arg("data"));
   m.def("read_mesh", &read_mesh, py::arg("path"));
   m.def("write_mesh", &write_mesh, py::arg("path"), py::arg("vertices"), py::arg("faces"),

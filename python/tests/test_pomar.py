@@ -360,3 +360,29 @@ def test_selective_decoder_around_damage(bunny):
     lenient.update()
     assert lenient.damaged and lenient.damaged[0]["block"].startswith("cluster")
     assert len(lenient.mesh().vertices) < lenient.info["vertices"]
+
+
+def test_progress_callback_and_interruption(bunny):
+    seen = []
+    data = pomar.encode(bunny, progress=lambda fraction, stage: seen.append((stage, fraction)))
+    assert {"encode"} <= {stage for stage, _ in seen}
+    fractions = [f for stage, f in seen if stage == "encode"]
+    assert fractions == sorted(fractions) and fractions[-1] == pytest.approx(1.0)
+    seen.clear()
+    pomar.decode(data, progress=lambda fraction, stage: seen.append(stage))
+    assert "decode" in seen
+
+    class Stop(Exception):
+        pass
+
+    def stop(fraction, stage):
+        if fraction > 0.3:
+            raise Stop(stage)
+
+    with pytest.raises(Stop):
+        pomar.encode(bunny, progress=stop)
+    with pytest.raises(Stop):
+        pomar.decode(data, progress=stop)
+    with pytest.raises(TypeError, match="callable"):
+        pomar.decode(data, progress=3)
+    assert len(pomar.decode(data).faces) == len(bunny.faces)  # nothing left behind
