@@ -7,21 +7,21 @@ namespace py = pybind11;
 namespace {
 PyObject *error_type = nullptr; // pomar.Error, alive as long as the module
 
-void raise(const std::string &kind, const std::string &message) {
+void raise(const std::string &kind, const pomar::Error &e) {
   py::object type = py::reinterpret_borrow<py::object>(error_type);
-  py::object error = type(message);
+  py::object error = type(e.what());
   error.attr("kind") = kind;
+  error.attr("path") = e.path().empty() ? py::object(py::none()) : py::str(e.path());
+  error.attr("level") =
+      e.level() == pomar::Error::kNoBlock ? py::object(py::none()) : py::int_(e.level());
+  error.attr("cluster") =
+      e.cluster() == pomar::Error::kNoBlock ? py::object(py::none()) : py::int_(e.cluster());
   PyErr_SetObject(error_type, error.ptr());
 }
 } // namespace
 
-namespace {
-
-// pomar::Error gets a kind() with issue 11 (branch arch, c28846d). Until that is on main
-// this file compiles against both: the first overload exists only when E has kind(), and
-// its body is checked only then. Once it is merged, keep only typed_kind's switch.
-template <class E> auto typed_kind(const E &e, int) -> decltype(e.kind(), std::string()) {
-  using Kind = typename E::Kind;
+std::string kind_of(const pomar::Error &e, const char *operation_kind) {
+  using Kind = pomar::Error::Kind;
   switch (e.kind()) {
   case Kind::InvalidMesh:
     return "invalid_mesh";
@@ -39,22 +39,10 @@ template <class E> auto typed_kind(const E &e, int) -> decltype(e.kind(), std::s
     return "usage";
   case Kind::Internal:
     return "internal";
-  default:
-    return ""; // Kind::Other: the operation's kind below
+  case Kind::Other:
+    break;
   }
-}
-template <class E> std::string typed_kind(const E &, long) { return ""; }
-
-} // namespace
-
-std::string kind_of(const pomar::Error &e, const char *operation_kind) {
-  const std::string typed = typed_kind(e, 0);
-  if (!typed.empty())
-    return typed;
-  // Untyped: the memory checks of pomar/limits.h all say "not enough memory to ...".
-  if (std::string(e.what()).rfind("not enough memory", 0) == 0)
-    return "memory_limit";
-  return operation_kind;
+  return operation_kind; // an error thrown without a kind
 }
 
 void register_errors(py::module_ &m) {
@@ -62,7 +50,8 @@ void register_errors(py::module_ &m) {
       "pomar.Error",
       "A failure reported by the pomar library: str(e) is its one-line message, e.kind one "
       "of 'invalid_mesh', 'damaged_file', 'truncated_file', 'unsupported', 'io', "
-      "'memory_limit', 'usage', 'internal'.",
+      "'memory_limit', 'usage', 'internal'; e.path, e.level, e.cluster: the file and the "
+      "block it names (None if none).",
       PyExc_Exception, nullptr);
   if (!error_type)
     throw py::error_already_set();
@@ -72,9 +61,9 @@ void register_errors(py::module_ &m) {
       if (p)
         std::rethrow_exception(p);
     } catch (const KindedError &e) {
-      raise(e.kind, e.message);
+      raise(e.kind, e.error);
     } catch (const pomar::Error &e) {
-      raise(kind_of(e, "error"), e.what());
+      raise(kind_of(e, "error"), e);
     }
   });
 }

@@ -224,6 +224,7 @@ def test_damaged_and_wrong_data_raise_clear_errors(tmp_path):
     with pytest.raises(pomar.Error) as e:
         pomar.read(tmp_path / "missing.ply")
     assert e.value.kind == "io" and "missing.ply" in str(e.value)
+    assert e.value.path.endswith("missing.ply") and e.value.level is None
     with pytest.raises(pomar.Error) as e:
         pomar.SelectiveDecoder(tmp_path / "missing.pomar")
     with pytest.raises(pomar.Error) as e:
@@ -355,6 +356,7 @@ def test_selective_decoder_around_damage(bunny):
     with pytest.raises(pomar.Error) as e:
         strict.update()
     assert e.value.kind == "damaged_file" and "cluster" in str(e.value)
+    assert e.value.cluster is not None and e.value.path is None
     lenient = pomar.SelectiveDecoder(bytes(data), skip_damaged=True)
     lenient.want_all()
     lenient.update()
