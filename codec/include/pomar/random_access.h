@@ -64,6 +64,9 @@ struct SelectiveOptions {
   /// Bytes the base clustered mesh may need (0 = automatic, UINT64_MAX = do not check; see
   /// pomar/limits.h). Later refinement is not checked: it decodes what is asked for.
   uint64_t memory_limit = 0;
+  /// Which stored attributes mesh() returns (AttributeMask::none(): none; the attribute
+  /// section is then never decoded). Decoded once, on the first mesh() that needs them.
+  AttributeMask attributes;
 };
 
 /// Selective, incremental decoder of a .pomar file. Levels are numbered as everywhere
@@ -116,6 +119,8 @@ public:
   const std::vector<DamagedBlock> &damaged() const;
 
   // ----- the current mesh -----
+  /// Positions, triangles and the attributes of exactly these vertices (the same values a
+  /// full decode gives them).
   Mesh mesh() const;
   /// Per vertex of mesh(): its cluster and the level that created it.
   std::vector<uint32_t> vertex_cluster() const;

@@ -2,6 +2,7 @@
 #include <memory>
 #include <string>
 
+#include "attributes/attribute_section.h"
 #include "decode/decoder_codec.h"
 #include "entropy/models.h"
 #include "format/file_format.h"
@@ -98,6 +99,8 @@ FileInfo inspect(const uint8_t *data, size_t size) {
     const ClusterIndex index = read_cluster_index(data + layout.index_offset, layout);
     info.cluster_block_bytes = index.size;
   }
+  if (const auto table = load_attribute_table(data, layout, false))
+    describe_attributes(*table, info);
   return info;
 }
 
@@ -192,6 +195,7 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
     // Checked above for the whole target level; the constructor's check is smaller.
     SelectiveOptions so;
     so.skip_damaged = options.skip_damaged;
+    so.attributes = options.attributes;
     so.memory_limit = kNoMemoryLimit;
     SelectiveDecoder d(std::make_unique<MemorySource>(data, size), so);
     d.want_all(static_cast<int>(target));
@@ -208,7 +212,10 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
   r.level = static_cast<int>(decode_global_levels(data, layout, 0, std::min(target, global), lm,
                                                   models, options.progress,
                                                   options.skip_damaged ? &r.damaged : nullptr));
-  return to_mesh(lm, h.grid);
+  Mesh out = to_mesh(lm, h.grid);
+  if (const auto table = load_attribute_table(data, layout, true, options.attributes))
+    attach_attributes(*table, lm, out);
+  return out;
 }
 
 } // namespace pomar

@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cstring>
 
+#include "attributes/attribute_section.h"
 #include "decode/decoder_codec.h"
 #include "entropy/static_tables.h"
 #include "format/file_format.h"
@@ -162,6 +163,11 @@ struct SelectiveDecoder::State {
   TraversalScratch scratch;
   std::vector<PendingSplit> splits;
 
+  // Attributes: the ATTR section, decoded on the first mesh() that wants them.
+  AttributeMask attribute_mask;
+  mutable std::unique_ptr<AttributeTable> attributes;
+  mutable bool attributes_loaded = false;
+
   bool clustered() const { return layout.header.clustered(); }
   static constexpr size_t kChunk = 4; // bytes per on-demand read of a cluster block
   size_t fetch(Cluster &k, size_t needed);
@@ -288,6 +294,7 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   State &s = *s_;
   s.source = std::move(source);
   s.skip_damaged = options.skip_damaged;
+  s.attribute_mask = options.attributes;
   const uint64_t file_size = s.source->size();
   // Header: fixed part, then its full size.
   s.global.resize(std::min<uint64_t>(file_size, kFixedHeaderBytes));
@@ -572,7 +579,17 @@ void SelectiveDecoder::State::check_cluster_data() {
   damaged.push_back({"cluster data", kUnlocatedDamage, -1});
 }
 
-Mesh SelectiveDecoder::mesh() const { return to_mesh(s_->mesh, s_->layout.header.grid); }
+Mesh SelectiveDecoder::mesh() const {
+  const State &s = *s_;
+  Mesh out = to_mesh(s.mesh, s.layout.header.grid);
+  if (!s.attributes_loaded) {
+    s.attributes = load_attribute_table(s.global.data(), s.layout, true, s.attribute_mask);
+    s.attributes_loaded = true;
+  }
+  if (s.attributes)
+    attach_attributes(*s.attributes, s.mesh, out);
+  return out;
+}
 
 std::vector<uint32_t> SelectiveDecoder::vertex_cluster() const {
   std::vector<uint32_t> out(s_->mesh.vertex_count(), 0);

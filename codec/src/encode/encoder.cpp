@@ -8,6 +8,7 @@
 #include <cmath>
 #include <string>
 
+#include "attributes/attribute_section.h"
 #include "decimate/decimate.h"
 #include "entropy/models.h"
 #include "entropy/static_tables.h"
@@ -200,6 +201,7 @@ void check_input(const Mesh &mesh, const EncodeOptions &options) {
   for (size_t i = 0; i < mesh.positions.size(); ++i)
     if (!std::isfinite(mesh.positions[i]))
       throw Error("vertex " + std::to_string(i / 3) + " has a non-finite coordinate");
+  validate_attributes(mesh, !options.attributes.exact, options.attributes.keep);
 }
 
 } // namespace
@@ -310,10 +312,12 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
   // all clusters' symbols, then every cluster is coded into its own block.
   std::vector<uint8_t> tables;
   std::vector<std::vector<uint8_t>> cluster_blocks;
+  uint32_t clustered_roots = 0; // vertices of the base clustered mesh (clustered files)
   if (G < L) {
     header.flags |= kFlagClustered;
     header.global_levels = static_cast<uint32_t>(G);
     const uint32_t clusters = lm.vertex_count();
+    clustered_roots = clusters;
     lm.local.assign(clusters, 0);
     for (uint32_t c = 0; c < clusters; ++c)
       lm.tag[c].cluster = c;
@@ -354,6 +358,12 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
   }
   if (lm.vertex_count() != nv || lm.ct.face_count() != nf)
     throw Error("internal encoder error: the refined mesh does not match the input");
+  std::vector<uint32_t> decoded_to_input(nv);
+  for (uint32_t i = 0; i < nv; ++i)
+    decoded_to_input[i] = compact_to_input[dec_to_input[i]];
+  // Attributes of the full-resolution vertices (format version 4, "ATTR" section).
+  std::vector<uint8_t> attributes = write_attributes(
+      mesh, options.attributes, lm, decoded_to_input, clustered_roots);
 
   std::vector<uint8_t> file =
       write_file(header, pack_base_mesh(base, grid.bits), blocks, tables, cluster_blocks);
@@ -367,9 +377,7 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
     report->encode_seconds = seconds_since(t2);
     for (int k = 0; k < 6; ++k)
       report->symbol_bits[k] = symbol_bits[k];
-    report->decoded_to_input.resize(nv);
-    for (uint32_t i = 0; i < nv; ++i)
-      report->decoded_to_input[i] = compact_to_input[dec_to_input[i]];
+    report->decoded_to_input = std::move(decoded_to_input);
   }
   return file;
 }
