@@ -8,7 +8,7 @@
 #include "format/file_format.h"
 #include "pomar/limits.h"
 #include "pomar/random_access.h"
-#include "refine/level_traversal.h"
+#include "refine/level_step.h"
 
 namespace pomar {
 
@@ -50,39 +50,31 @@ size_t decode_global_levels(const uint8_t *data, const FileLayout &layout, size_
                             std::vector<DamagedBlock> *damaged) {
   const FileHeader &h = layout.header;
   DecoderCodec codec(h.grid.bits);
-  TraversalScratch scratch;
-  std::vector<PendingSplit> splits;
+  LevelStep step;
   RangeDecoder conn, geom;
   for (size_t i = from; i < to; ++i) {
     const LevelEntry &e = h.levels[i];
-    bool traversing = false;
     try {
       check_level(data, layout, i);
       const uint8_t *p = data + layout.level_offset[i];
       conn.reset(p, e.connectivity_bytes);
       geom.reset(p + e.connectivity_bytes, e.geometry_bytes);
       codec.set(&models, &conn, &geom, static_cast<uint32_t>(i + 1));
-      traversing = true;
-      traverse_level(lm, codec, scratch, static_cast<uint32_t>(i + 1), splits);
-      if (conn.overrun() || geom.overrun())
-        codec.corrupt("the level's data ends too early");
-      if (lm.vertex_count() + splits.size() != e.vertices)
-        codec.corrupt("the number of vertex splits differs from the level table");
-      size_t faces = lm.ct.face_count();
-      for (const PendingSplit &ps : splits)
-        faces += size_t(ps.op.has_l) + size_t(ps.op.has_r);
-      if (faces != e.faces)
-        codec.corrupt("the face count differs from the level table");
+      step.global_level(lm, codec, static_cast<uint32_t>(i + 1), [&](const StepCounts &n) {
+        if (conn.overrun() || geom.overrun())
+          codec.corrupt("the level's data ends too early");
+        if (n.vertices != e.vertices)
+          codec.corrupt("the number of vertex splits differs from the level table");
+        if (n.faces != e.faces)
+          codec.corrupt("the face count differs from the level table");
+      });
     } catch (const Error &err) {
       if (!damaged)
         throw;
-      // Every check comes before the splits are applied: the mesh is still level i.
-      if (traversing)
-        release_claims(lm, scratch, static_cast<uint32_t>(i + 1));
+      // The step checks before it applies: the mesh is still level i.
       damaged->push_back({"level " + std::to_string(i + 1), err.what(), static_cast<int>(i)});
       return i;
     }
-    apply_splits(lm, splits, static_cast<uint32_t>(i + 1));
     if (progress)
       progress(double(i + 1) / double(to), "decode");
   }

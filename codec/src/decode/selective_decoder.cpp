@@ -9,6 +9,7 @@
 #include "format/file_format.h"
 #include "pomar/limits.h"
 #include "pomar/random_access.h"
+#include "refine/level_step.h"
 
 namespace pomar {
 
@@ -155,13 +156,10 @@ struct SelectiveDecoder::State {
   bool skip_damaged = false;
   std::vector<int> cap;
   std::vector<DamagedBlock> damaged;
-  uint32_t decoding = kNone; // the cluster being decoded, for error reports
-  bool traversing = false;   // its traversal has started (it may have claimed faces)
   bool data_checked = false; // the version 3 checksum of all cluster data was verified
   int uniform_cap = 1 << 30; // progressive files: the level before a damaged one
 
-  TraversalScratch scratch;
-  std::vector<PendingSplit> splits;
+  LevelStep step;
 
   // Attributes: the ATTR section, decoded on the first mesh() that wants them.
   AttributeMask attribute_mask;
@@ -173,8 +171,8 @@ struct SelectiveDecoder::State {
   size_t fetch(Cluster &k, size_t needed);
   void start(uint32_t c, bool whole);
   void reset_to_snapshot();
-  void decode_cluster_level(uint32_t c, int level);
-  void decode_target(const Progress &progress);
+  void decode_cluster_level(uint32_t c, int level, uint32_t older_than);
+  void decode_target(const Progress &progress, uint32_t &decoding);
   void check_cluster_data();
   bool skip_cluster(uint32_t c, const Error &e);
   std::vector<int> target; // the level map being decoded
@@ -227,37 +225,29 @@ void SelectiveDecoder::State::reset_to_snapshot() {
   }
 }
 
-void SelectiveDecoder::State::decode_cluster_level(uint32_t c, int level) {
+/// Cluster c's data of `level` (the cluster is at level - 1); a damaged block throws and
+/// leaves the mesh as it was.
+void SelectiveDecoder::State::decode_cluster_level(uint32_t c, int level, uint32_t older_than) {
   Cluster &k = clusters[c];
-  decoding = c;
   if (k.level == global_levels) // first clustered level of this cluster: (re)start its stream
     start(c, skip_damaged || target_of(c) == finest);
   DecoderCodec codec(layout.header.grid.bits);
   codec.set(&level_models[size_t(level - global_levels - 1)], &k.rc, &k.rc,
             static_cast<uint32_t>(level), c);
-  traversing = true;
-  traverse_cluster(mesh, codec, scratch, c, static_cast<uint32_t>(level), splits);
-  if (k.rc.overrun())
-    codec.corrupt("the block ends too early");
-  traversing = false;
-  // Every check is done: a damaged block leaves the mesh as it was.
-  apply_splits(mesh, splits, static_cast<uint32_t>(level), c, &k.next_local);
+  step.cluster_level(mesh, codec, {c, static_cast<uint32_t>(level), older_than}, k.next_local,
+                     [&](const StepCounts &) {
+                       if (k.rc.overrun())
+                         codec.corrupt("the block ends too early");
+                     });
   k.level = level;
-  decoding = kNone;
 }
 
 /// After `e` while decoding cluster `c` (kNone: not in a cluster): with skip_damaged,
 /// record the damage, cap the cluster at the base clustered level and return true (the
 /// caller decodes again); otherwise false (the caller rethrows).
 bool SelectiveDecoder::State::skip_cluster(uint32_t c, const Error &e) {
-  if (c == kNone)
-    return false;
-  // The failed traversal applied nothing; only its face claims need undoing.
-  if (traversing)
-    release_claims(mesh, scratch, static_cast<uint32_t>(clusters[c].level + 1));
-  traversing = false;
-  decoding = kNone;
-  if (!skip_damaged)
+  // (The failed step applied nothing and released its face claims.)
+  if (c == kNone || !skip_damaged)
     return false;
   damaged.push_back({"cluster " + std::to_string(c), e.what(), global_levels});
   // Levels of this cluster decoded earlier from the same block cannot be trusted either:
@@ -510,19 +500,20 @@ void SelectiveDecoder::update(const Progress &progress) {
   // Decode the completed level map; a damaged block caps its cluster and the map is
   // completed and decoded again (each round skips one more block, so this ends).
   for (;;) {
+    uint32_t decoding = kNone; // the cluster being decoded when an error is thrown
     try {
-      s.decode_target(progress);
+      s.decode_target(progress, decoding);
       return;
     } catch (const Error &e) {
-      if (!s.skip_cluster(s.decoding, e))
+      if (!s.skip_cluster(decoding, e))
         throw;
     }
   }
 }
 
-/// Bring the mesh to the level map completed from `wanted` and limited by the caps.
-void SelectiveDecoder::State::decode_target(const Progress &progress) {
-  decoding = kNone;
+/// Bring the mesh to the level map completed from `wanted` and limited by the caps;
+/// `decoding` names the cluster being decoded (kNone between clusters).
+void SelectiveDecoder::State::decode_target(const Progress &progress, uint32_t &decoding) {
   target = complete_level_map(wanted, adj_start, adj, global_levels);
   if (!damaged.empty()) {
     // Each damaged cluster limits the others to its cap + their distance to it, the
@@ -544,16 +535,17 @@ void SelectiveDecoder::State::decode_target(const Progress &progress) {
     int finest_now = global_levels;
     for (const auto &k : clusters)
       finest_now = std::max(finest_now, k.level);
-    mesh.older_than_level = finest_now < level ? mesh.vertex_count() : 0;
+    const uint32_t older_than = finest_now < level ? mesh.vertex_count() : 0;
     for (uint32_t c = 0; c < target.size(); ++c) {
       if (target[c] < level || clusters[c].level >= level)
         continue;
-      decode_cluster_level(c, level);
+      decoding = c;
+      decode_cluster_level(c, level, older_than);
+      decoding = kNone;
       if (progress && (++done % 64 == 0 || done == todo))
         progress(double(done) / double(todo), "decode");
     }
   }
-  mesh.older_than_level = 0;
   levels = target;
   check_cluster_data();
 }

@@ -16,7 +16,7 @@
 #include "geometry/quantize.h"
 #include "mesh/reorder.h"
 #include "pomar/limits.h"
-#include "refine/level_traversal.h"
+#include "refine/level_step.h"
 
 namespace pomar {
 namespace {
@@ -102,22 +102,15 @@ public:
     bits[4] += put_residual(*geom_, m_->geom, 0, p.context, r[0] - p.offset[0]);
     bits[4] += put_residual(*geom_, m_->geom, 0, p.context, r[1] - p.offset[1]);
     bits[5] += put_residual(*geom_, m_->geom, 1, p.context, r[2] - p.offset[2]);
-    new_vertices_.push_back(v_from);
+    // The step applies the splits in the order they are coded: v_from gets the next id.
+    input_to_dec_[v_from] = static_cast<uint32_t>(dec_to_input_.size());
+    dec_to_input_.push_back(v_from);
   }
 
   double bits[6] = {0, 0, 0, 0, 0, 0}; // ideal code lengths per symbol kind
 
   [[noreturn]] void corrupt(const char *what) {
     throw Error(std::string("internal encoder error: ") + what);
-  }
-
-  /// Number the vertices created by the splits applied since the last call.
-  void number_new_vertices() {
-    for (uint32_t v : new_vertices_) {
-      input_to_dec_[v] = static_cast<uint32_t>(dec_to_input_.size());
-      dec_to_input_.push_back(v);
-    }
-    new_vertices_.clear();
   }
 
 private:
@@ -138,7 +131,6 @@ private:
   Sink *conn_ = nullptr, *geom_ = nullptr;
   uint32_t current_ = kNone;
   size_t emitted_ = 0;
-  std::vector<uint32_t> new_vertices_;
 };
 
 /// How many levels stay global: the level whose vertex count is closest (in ratio) to the
@@ -276,8 +268,7 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
   // Global levels: one adaptive model set for the whole file, two streams per level.
   Models models;
   EncoderCodec<RangeEncoder> codec(q, dec_to_input, input_to_dec);
-  TraversalScratch scratch;
-  std::vector<PendingSplit> splits;
+  LevelStep step;
   std::vector<std::vector<uint8_t>> blocks;
   auto add_level_entry = [&](uint32_t conn_bytes, uint32_t geom_bytes) {
     LevelEntry e;
@@ -292,12 +283,10 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
     RangeEncoder conn_rc(&conn), geom_rc(&geom);
     codec.begin_level(dec.levels[L - 1 - r], &models);
     codec.set_sinks(&conn_rc, &geom_rc);
-    traverse_level(lm, codec, scratch, static_cast<uint32_t>(r + 1), splits);
+    step.global_level(lm, codec, static_cast<uint32_t>(r + 1));
     codec.end_level();
     conn_rc.finish();
     geom_rc.finish();
-    apply_splits(lm, splits, static_cast<uint32_t>(r + 1));
-    codec.number_new_vertices();
     add_level_entry(static_cast<uint32_t>(conn.size()), static_cast<uint32_t>(geom.size()));
     conn.insert(conn.end(), geom.begin(), geom.end());
     blocks.push_back(std::move(conn));
@@ -328,16 +317,13 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
     for (size_t r = G; r < L; ++r) {
       const uint32_t level = static_cast<uint32_t>(r + 1);
       ccodec.begin_level(dec.levels[L - 1 - r], &level_models[r - G]);
-      lm.older_than_level = lm.vertex_count(); // levels are encoded in order
+      const uint32_t older_than = lm.vertex_count(); // levels are encoded in order
       for (uint32_t c = 0; c < clusters; ++c) {
         RecorderStream conn{&recordings[c], 0}, geom{&recordings[c], 1};
         ccodec.set_sinks(&conn, &geom);
-        traverse_cluster(lm, ccodec, scratch, c, level, splits);
-        apply_splits(lm, splits, level, c, &next_local[c]);
-        ccodec.number_new_vertices();
+        step.cluster_level(lm, ccodec, {c, level, older_than}, next_local[c]);
       }
       ccodec.end_level();
-      lm.older_than_level = 0;
       add_level_entry(0, 0);
       if (options.progress)
         options.progress(double(r + 1) / double(L), "encode");

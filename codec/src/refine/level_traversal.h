@@ -6,7 +6,8 @@
 // clockwise order, starting from the one back to where it came from. For each vertex the
 // codec codes s_v; for a split vertex (v_to) also s_e, s_l, s_r and the position of
 // v_from as a residual to the patch barycentre in the local Frenet frame. The splits are
-// only collected here; the caller applies them after the traversal (Figure 3, step 4).
+// only collected here; refine/level_step.h runs a traversal, its checks and then applies
+// them (Figure 3, step 4): that step is the only caller.
 //
 // The Codec policy provides (encoder: writes what it knows; decoder: reads):
 //   int  split_flag(uint32_t v, int context);
@@ -44,10 +45,6 @@ struct LevelMesh {
   std::vector<Tag> tag;
   std::vector<uint32_t> parent, local;
   std::vector<uint16_t> face_claim; // per face: last level whose patch held it
-  /// Vertices below this id are known to be older than the level being decoded (0: not
-  /// known). Set when a level starts on a mesh that holds nothing finer, it spares the
-  /// view its lineage lookups (see view_of).
-  uint32_t older_than_level = 0;
   uint32_t vertex_count() const { return ct.vertex_count(); }
   uint32_t level_of(uint32_t v) const { return tag[v].level; }
   uint32_t cluster_of(uint32_t v) const { return tag[v].cluster; }
@@ -65,9 +62,17 @@ struct SplitSymbols {
   uint32_t s_e = 0, s_l = 0, s_r = 0;
 };
 
+/// What is coded per split vertex besides the split itself: the data of the new vertex
+/// v_from. code_vertex codes it (Codec::geometry), apply_splits (level_step.h) stores it
+/// with the new vertex. A per-vertex attribute adds its field here, its coding next to
+/// Codec::geometry and its storage next to LevelMesh::q.
+struct NewVertex {
+  int32_t position[3]; // quantized xyz
+};
+
 struct PendingSplit {
   SplitOp op;
-  int32_t position[3];
+  NewVertex v_from;
 };
 
 /// Where the patch of a split lies in v_to's ring (indices; kNone = the open fan's gap).
@@ -251,22 +256,30 @@ inline int sv_context(const TraversalScratch &s, const Ring &ring) {
                           valence);
 }
 
+/// The level a clustered traversal decodes, and what it can skip: vertices below
+/// `older_than` are known to be older than `level` (0: not known; set when the level
+/// starts on a mesh that holds nothing finer, it spares the view its lineage lookups).
+struct LevelView {
+  uint32_t level;
+  uint32_t older_than = 0;
+};
+
 /// The level-(l-1) view of v's one-ring while level l is being decoded: neighbours created
 /// at level l or later (by splits of neighbouring clusters already applied) stand for
 /// their parents, and the faces those splits added (degenerate in the view) are skipped.
 /// The view is the same whatever clusters were decoded before, which is what makes
 /// selective and incremental decoding equal to a full decode.
-inline uint32_t view_of(const LevelMesh &mesh, uint32_t v, uint32_t level) {
-  if (v < mesh.older_than_level)
+inline uint32_t view_of(const LevelMesh &mesh, uint32_t v, const LevelView &view) {
+  if (v < view.older_than)
     return v;
-  while (mesh.tag[v].level >= level && mesh.parent[v] != v)
+  while (mesh.tag[v].level >= view.level && mesh.parent[v] != v)
     v = mesh.parent[v];
   return v;
 }
 
 /// Like get_ring, mapping neighbours through view_of and skipping the faces that collapse
 /// in the view (one pass for an interior vertex).
-inline void get_view_ring(const LevelMesh &mesh, uint32_t v, uint32_t level, Ring &view) {
+inline void get_view_ring(const LevelMesh &mesh, uint32_t v, const LevelView &level, Ring &view) {
   const CornerTable &ct = mesh.ct;
   view.neighbour.clear();
   view.corner.clear();
@@ -335,7 +348,7 @@ void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v,
   ps.op = {v, ring.corner[p.first_face], p.faces, p.il != kNone, p.ir != kNone};
   Prediction prediction;
   predict(mesh, v, ring, p, prediction);
-  codec.geometry(v, prediction, ps.position);
+  codec.geometry(v, prediction, ps.v_from.position);
   splits.push_back(ps);
 }
 
@@ -357,12 +370,10 @@ void queue_neighbours(TraversalScratch &s, uint32_t v, uint32_t from, const Ring
 }
 
 /// Traverse the whole mesh once for global level `level` (all components, seeded by the
-/// base faces in order).
+/// base faces in order), appending the splits to `splits`. `s` is begun by the caller.
 template <class Codec>
 void traverse_level(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t level,
                     std::vector<PendingSplit> &splits) {
-  s.begin(mesh.vertex_count(), mesh.ct.face_count());
-  splits.clear();
   const auto id = [](uint32_t v) { return uint64_t(v); };
   const auto all = [](uint32_t) { return true; };
   size_t head = 0;
@@ -394,12 +405,11 @@ void traverse_level(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t
 /// Traverse one cluster for clustered level `level` (paper section 5.2): breadth-first
 /// from the cluster's root (its base clustered mesh vertex), starting clockwise from the
 /// root's neighbour of smallest key, visiting only the cluster's vertices, on the
-/// level-(l-1) view of the mesh.
+/// level-(l-1) view of the mesh, appending the splits to `splits`. `s` is begun by the
+/// caller.
 template <class Codec>
 void traverse_cluster(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t root,
-                      uint32_t level, std::vector<PendingSplit> &splits) {
-  s.begin(mesh.vertex_count(), mesh.ct.face_count());
-  splits.clear();
+                      const LevelView &level, std::vector<PendingSplit> &splits) {
   const uint32_t cluster = mesh.cluster_of(root);
   const auto key = [&](uint32_t v) { return mesh.key(v); };
   const auto mine = [&](uint32_t v) { return mesh.tag[v].cluster == cluster; };
@@ -415,33 +425,9 @@ void traverse_cluster(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32
   for (size_t head = 0; head < s.queue.size();) {
     const auto [v, came_from] = s.queue[head++];
     get_view_ring(mesh, v, level, s.ring);
-    code_vertex(mesh, codec, s, v, s.ring, level, key, splits);
+    code_vertex(mesh, codec, s, v, s.ring, level.level, key, splits);
     queue_neighbours(s, v, came_from, s.ring, mine);
   }
-}
-
-/// Apply the collected splits in traversal order; new vertices get consecutive ids.
-/// For a cluster's splits, `cluster`/`next_local` number them inside the cluster.
-/// Undo the face claims of a traversal of `level` that stopped on damaged data, so that
-/// the other clusters of the level can still claim those faces.
-inline void release_claims(LevelMesh &mesh, const TraversalScratch &s, uint32_t level) {
-  for (uint32_t f = 0; f < mesh.face_claim.size(); ++f)
-    if (s.claimed[f] == s.stamp && mesh.face_claim[f] == level)
-      mesh.face_claim[f] = static_cast<uint16_t>(level - 1);
-}
-
-inline void apply_splits(LevelMesh &mesh, const std::vector<PendingSplit> &splits, uint32_t level,
-                         uint32_t cluster = kNone, uint32_t *next_local = nullptr) {
-  for (const PendingSplit &ps : splits) {
-    const uint32_t v_from = mesh.vertex_count();
-    apply_split(mesh.ct, ps.op, v_from);
-    mesh.q.insert(mesh.q.end(), ps.position, ps.position + 3);
-    mesh.tag.push_back({cluster == kNone ? 0 : cluster, static_cast<uint16_t>(level)});
-    mesh.parent.push_back(ps.op.v_to);
-    if (cluster != kNone)
-      mesh.local.push_back((*next_local)++);
-  }
-  mesh.face_claim.resize(mesh.ct.face_count(), 0);
 }
 
 } // namespace pomar
