@@ -6,10 +6,14 @@
 #include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <map>
+#include <memory>
 #include <random>
 
 #include "attributes/attribute_quantize.h"
 #include "pomar/pomar.h"
+#include "pomar/random_access.h"
+#include "support/mesh_gen.h"
 
 namespace pomar {
 namespace {
@@ -186,6 +190,314 @@ TEST(AttributeQuantize, ValidationNamesTheProblem) {
   n.values = {0, 0, 1, 0, 0, 0, 1, 0, 0};
   expect_error(triangle_with(n), true, "of vertex 1 has length 0");
   EXPECT_NO_THROW(validate_attributes(triangle_with(n), false));
+}
+
+
+// ---------------------------------------------------------------- round trips
+
+/// Which attributes with_attributes adds.
+enum Has { kColour = 1, kAlpha = 2, kNormals = 4, kScalars = 8, kTexcoords = 16, kAll = 31 };
+
+/// `m` with smooth colours (plus noise in the low bits), normals (the radial direction,
+/// plus noise), scalars "quality" (smooth) and "confidence" (random), spherical UVs.
+Mesh with_attributes(Mesh m, int has, uint32_t seed = 1) {
+  const size_t nv = m.vertex_count();
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<int> noise(-3, 3);
+  std::uniform_real_distribution<float> unit(0, 1);
+  auto p = [&](size_t v, int k) { return m.positions[3 * v + k]; };
+  if (has & kColour) {
+    VertexAttribute a;
+    a.kind = AttributeKind::Colour;
+    a.name = "colour";
+    a.components = (has & kAlpha) ? 4 : 3;
+    for (size_t v = 0; v < nv; ++v)
+      for (uint32_t k = 0; k < a.components; ++k) {
+        const int c = int(127.5 + 120 * std::sin(2.0 * p(v, k % 3) + k)) + noise(rng);
+        a.colour.push_back(static_cast<uint8_t>(std::max(0, std::min(255, c))));
+      }
+    m.attributes.push_back(a);
+  }
+  if (has & kNormals) {
+    VertexAttribute a;
+    a.kind = AttributeKind::Normal;
+    a.name = "normal";
+    a.components = 3;
+    for (size_t v = 0; v < nv; ++v)
+      for (int k = 0; k < 3; ++k)
+        a.values.push_back(p(v, k) + 0.05f * (unit(rng) - 0.5f));
+    m.attributes.push_back(a);
+  }
+  if (has & kScalars) {
+    VertexAttribute q;
+    q.kind = AttributeKind::Scalar;
+    q.name = "quality";
+    VertexAttribute c = q;
+    c.name = "confidence";
+    for (size_t v = 0; v < nv; ++v) {
+      q.values.push_back(100.0f * p(v, 0) * p(v, 1) + 3.0f * p(v, 2));
+      c.values.push_back(unit(rng));
+    }
+    m.attributes.push_back(q);
+    m.attributes.push_back(c);
+  }
+  if (has & kTexcoords) {
+    VertexAttribute a;
+    a.kind = AttributeKind::TexCoord;
+    a.name = "texcoord";
+    a.components = 2;
+    for (size_t v = 0; v < nv; ++v) {
+      a.values.push_back(0.5f + std::atan2(p(v, 1), p(v, 0)) / 6.2831853f);
+      a.values.push_back(0.5f + 0.5f * p(v, 2));
+    }
+    m.attributes.push_back(a);
+    m.texture_files = {"skin.png", "detail map.jpg"};
+  }
+  return m;
+}
+
+struct Coded {
+  Mesh input;
+  std::vector<uint8_t> file;
+  EncodeReport report;
+};
+
+Coded encode_with(Mesh m, bool clustered, const AttributeOptions &attributes = {}) {
+  Coded c;
+  c.input = std::move(m);
+  EncodeOptions o;
+  o.bits = 16; // positions (nearly) unique: the tests match vertices by position
+  o.progressive = !clustered;
+  o.cluster_ratio = 0.02;
+  o.attributes = attributes;
+  c.file = encode(c.input, o, &c.report);
+  return c;
+}
+
+/// Decoded attribute `got` of decoded vertex v against input vertex i.
+void expect_close(const VertexAttribute &in, const VertexAttribute &got, size_t i, size_t v,
+                  bool exact) {
+  ASSERT_EQ(in.components, got.components);
+  if (in.kind == AttributeKind::Colour) {
+    for (uint32_t k = 0; k < in.components; ++k)
+      ASSERT_EQ(in.colour[i * in.components + k], got.colour[v * in.components + k])
+          << in.name << " vertex " << v;
+    return;
+  }
+  const float *a = &in.values[i * in.components], *b = &got.values[v * in.components];
+  if (exact) {
+    ASSERT_EQ(0, std::memcmp(a, b, 4 * in.components)) << in.name << " vertex " << v;
+    return;
+  }
+  if (in.kind == AttributeKind::Normal) {
+    ASSERT_LE(angle_degrees(a, b), got.bound) << in.name << " vertex " << v;
+    return;
+  }
+  for (uint32_t k = 0; k < in.components; ++k)
+    ASSERT_LE(std::fabs(double(a[k]) - b[k]), got.bound) << in.name << " vertex " << v;
+}
+
+/// Every attribute of `out` (a full decode) against the input.
+void expect_round_trip(const Coded &c, const Mesh &out, bool exact) {
+  ASSERT_EQ(out.attributes.size(), c.input.attributes.size());
+  EXPECT_EQ(out.texture_files, c.input.texture_files);
+  for (const VertexAttribute &in : c.input.attributes) {
+    const VertexAttribute *got = out.find(in.kind, in.name);
+    ASSERT_NE(got, nullptr) << in.name;
+    ASSERT_EQ(got->vertex_count(), out.vertex_count());
+    if (exact || in.kind == AttributeKind::Colour) {
+      EXPECT_EQ(got->bits, 0);
+    }
+    for (size_t v = 0; v < out.vertex_count(); ++v)
+      expect_close(in, *got, c.report.decoded_to_input[v], v, exact);
+  }
+}
+
+using Position = std::array<float, 3>;
+Position position_of(const Mesh &m, size_t v) {
+  return {m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]};
+}
+
+/// `part` (an intermediate or selective decode) has, for each of its vertices, the
+/// attributes the full decode `full` gives the vertex at the same position (a vertex keeps
+/// its position from the level that creates it on).
+void expect_same_as_full(const Mesh &part, const Mesh &full) {
+  std::map<Position, size_t> at;
+  for (size_t v = 0; v < full.vertex_count(); ++v)
+    ASSERT_TRUE(at.emplace(position_of(full, v), v).second) << "positions must be unique";
+  ASSERT_EQ(part.attributes.size(), full.attributes.size());
+  for (size_t i = 0; i < full.attributes.size(); ++i) {
+    const VertexAttribute &f = full.attributes[i], &p = part.attributes[i];
+    ASSERT_EQ(p.name, f.name);
+    ASSERT_EQ(p.vertex_count(), part.vertex_count());
+    const uint32_t n = f.components;
+    for (size_t v = 0; v < part.vertex_count(); ++v) {
+      const auto it = at.find(position_of(part, v));
+      ASSERT_NE(it, at.end());
+      if (f.kind == AttributeKind::Colour)
+        ASSERT_EQ(0, std::memcmp(&p.colour[v * n], &f.colour[it->second * n], n)) << f.name;
+      else
+        ASSERT_EQ(0, std::memcmp(&p.values[v * n], &f.values[it->second * n], 4 * n)) << f.name;
+    }
+  }
+  EXPECT_EQ(part.texture_files, full.texture_files);
+}
+
+TEST(AttributeRoundTrip, EveryCombinationProgressiveAndClustered) {
+  const Mesh sphere = gen::noisy_sphere(1500, 4, 0.1);
+  for (int has : {int(kColour), kColour | kAlpha, int(kNormals), int(kScalars), int(kTexcoords),
+                  int(kAll)})
+    for (bool clustered : {false, true}) {
+      SCOPED_TRACE("attributes " + std::to_string(has) + (clustered ? " clustered" : ""));
+      const Coded c = encode_with(with_attributes(sphere, has), clustered);
+      const FileInfo info = inspect(c.file.data(), c.file.size());
+      EXPECT_EQ(info.version, 4u);
+      EXPECT_EQ(info.clustered(), clustered);
+      EXPECT_EQ(info.attributes.size(), c.input.attributes.size());
+      EXPECT_GT(info.attribute_bytes, 0u);
+      expect_round_trip(c, decode(c.file.data(), c.file.size()), false);
+    }
+}
+
+TEST(AttributeRoundTrip, SeveralBitDepths) {
+  const Mesh m = with_attributes(gen::noisy_sphere(800, 2, 0.1), kAll);
+  for (int bits : {4, 8, 12, 16}) {
+    SCOPED_TRACE(bits);
+    AttributeOptions o;
+    o.normal_bits = bits;
+    o.scalar_bits = bits;
+    o.texcoord_bits = bits;
+    const Coded c = encode_with(m, true, o);
+    const Mesh out = decode(c.file.data(), c.file.size());
+    expect_round_trip(c, out, false);
+    EXPECT_EQ(out.find(AttributeKind::Normal)->bits, bits);
+    EXPECT_DOUBLE_EQ(out.find(AttributeKind::Normal)->bound, normal_error_bound(bits));
+  }
+}
+
+TEST(AttributeRoundTrip, ExactModeIsBitExactWithSpecialValues) {
+  Mesh m = with_attributes(gen::noisy_sphere(600, 3, 0.1), kAll);
+  VertexAttribute &q = *m.find(AttributeKind::Scalar, "quality");
+  q.values[0] = std::numeric_limits<float>::quiet_NaN();
+  q.values[1] = -std::numeric_limits<float>::infinity();
+  q.values[2] = 1e-42f; // denormal
+  q.values[3] = -0.0f;
+  VertexAttribute &n = *m.find(AttributeKind::Normal);
+  n.values[3] = n.values[4] = n.values[5] = 0; // zero-length normal
+  AttributeOptions o;
+  o.exact = true;
+  EXPECT_THROW(encode_with(m, false), Error); // quantized: NaN is an error
+  for (bool clustered : {false, true}) {
+    const Coded c = encode_with(m, clustered, o);
+    expect_round_trip(c, decode(c.file.data(), c.file.size()), true);
+  }
+}
+
+TEST(AttributeRoundTrip, IntermediateLevelsHaveTheFullDecodesAttributes) {
+  const Mesh m = with_attributes(gen::noisy_sphere(1200, 5, 0.1), kAll);
+  for (bool clustered : {false, true}) {
+    const Coded c = encode_with(m, clustered);
+    const Mesh full = decode(c.file.data(), c.file.size());
+    const FileInfo info = inspect(c.file.data(), c.file.size());
+    for (int level = 0; level <= int(info.levels.size()); ++level) {
+      SCOPED_TRACE("level " + std::to_string(level));
+      expect_same_as_full(decode(c.file.data(), c.file.size(), level), full);
+    }
+  }
+}
+
+TEST(AttributeRoundTrip, SelectiveDecodesHaveTheFullDecodesAttributes) {
+  const Coded c = encode_with(with_attributes(gen::noisy_sphere(3000, 6, 0.1), kAll), true);
+  const Mesh full = decode(c.file.data(), c.file.size());
+  SelectiveDecoder d(std::make_unique<MemorySource>(c.file.data(), c.file.size()));
+  expect_same_as_full(d.mesh(), full); // base clustered mesh
+  const float centre[3] = {1, 0, 0};
+  d.want_sphere(centre, 0.5f, d.finest_level());
+  d.update();
+  EXPECT_GT(d.clusters_decoded(), 0u);
+  EXPECT_LT(d.mesh().vertex_count(), full.vertex_count());
+  expect_same_as_full(d.mesh(), full);
+  const float other[3] = {-1, 0, 0};
+  d.want_sphere(other, 0.5f, d.finest_level() - 1); // incremental
+  d.update();
+  expect_same_as_full(d.mesh(), full);
+  d.clear_wanted(); // coarsening re-decodes
+  d.want_cluster(3, d.finest_level());
+  d.update();
+  expect_same_as_full(d.mesh(), full);
+}
+
+TEST(AttributeRoundTrip, DropAndSkip) {
+  const Mesh m = with_attributes(gen::noisy_sphere(500, 7, 0.1), kAll);
+  AttributeOptions o;
+  o.keep.colour = false;
+  o.keep.texcoords = false;
+  const Coded c = encode_with(m, true, o);
+  Mesh out = decode(c.file.data(), c.file.size());
+  EXPECT_EQ(out.find(AttributeKind::Colour), nullptr);
+  EXPECT_EQ(out.find(AttributeKind::TexCoord), nullptr);
+  EXPECT_TRUE(out.texture_files.empty());
+  EXPECT_NE(out.find(AttributeKind::Normal), nullptr);
+  EXPECT_EQ(out.attributes.size(), 3u);
+  DecodeOptions none;
+  none.attributes = AttributeMask::none();
+  for (int level : {-1, 0, 2}) {
+    none.level = level;
+    EXPECT_TRUE(decode(c.file.data(), c.file.size(), none).attributes.empty());
+  }
+  DecodeOptions scalars_only;
+  scalars_only.attributes = AttributeMask::none();
+  scalars_only.attributes.scalars = true;
+  out = decode(c.file.data(), c.file.size(), scalars_only);
+  ASSERT_EQ(out.attributes.size(), 2u);
+  EXPECT_EQ(out.attributes[1].name, "confidence");
+
+  // Nothing kept: the file is the same as without attributes (version 1/3).
+  AttributeOptions drop_all;
+  drop_all.keep = AttributeMask::none();
+  Mesh plain = m;
+  plain.attributes.clear();
+  plain.texture_files.clear();
+  EXPECT_EQ(encode_with(m, true, drop_all).file, encode_with(plain, true).file);
+  EXPECT_EQ(inspect(encode_with(plain, false).file.data(), encode_with(plain, false).file.size())
+                .version,
+            1u);
+}
+
+TEST(AttributeRoundTrip, BadInputIsRefused) {
+  Mesh m = with_attributes(gen::noisy_sphere(200, 8, 0.1), kColour | kScalars);
+  m.attributes[0].colour.pop_back();
+  EXPECT_THROW(encode(m), Error);
+  m = with_attributes(gen::noisy_sphere(200, 8, 0.1), kScalars);
+  m.attributes[0].values[5] = std::numeric_limits<float>::infinity();
+  try {
+    encode(m);
+    ADD_FAILURE();
+  } catch (const Error &e) {
+    EXPECT_NE(std::string(e.what()).find("'quality' of vertex 5 is infinite"), std::string::npos)
+        << e.what();
+  }
+  AttributeOptions dropped;
+  dropped.keep.scalars = false; // a dropped attribute is not checked
+  EncodeOptions o;
+  o.attributes = dropped;
+  EXPECT_NO_THROW(encode(m, o));
+}
+
+TEST(AttributeRoundTrip, DamagedSectionIsAClearError) {
+  const Coded c = encode_with(with_attributes(gen::noisy_sphere(300, 9, 0.1), kColour), false);
+  const FileInfo info = inspect(c.file.data(), c.file.size());
+  std::vector<uint8_t> bad = c.file;
+  bad[info.header_bytes + info.base_bytes + 3] ^= 0x10; // inside the ATTR body
+  try {
+    decode(bad.data(), bad.size());
+    ADD_FAILURE();
+  } catch (const Error &e) {
+    EXPECT_NE(std::string(e.what()).find("ATTR"), std::string::npos) << e.what();
+  }
+  DecodeOptions none;
+  none.attributes = AttributeMask::none();
+  EXPECT_NO_THROW(decode(bad.data(), bad.size(), none)); // not read at all
 }
 
 } // namespace

@@ -314,11 +314,21 @@ namespace pomar {
 
 std::unique_ptr<AttributeTable> load_attribute_table(const uint8_t *data, const FileLayout &layout,
                                                      bool decode, const AttributeMask &mask) {
-  (void)data;
-  (void)layout;
-  (void)decode;
-  (void)mask;
-  return nullptr; // PENDING: the section container (format v4) lands on main
+  if (!mask.colour && !mask.normals && !mask.scalars && !mask.texcoords)
+    return nullptr;
+  for (const SectionEntry &e : layout.sections) {
+    if (e.tag != kAttributeSectionTag)
+      continue;
+    if (e.offset + e.bytes > layout.file_size)
+      throw Error("truncated .pomar file: the ATTR section ends at byte " +
+                  std::to_string(e.offset + e.bytes));
+    check_block(data + e.offset, e.bytes, e.checksum, "ATTR section");
+    const FileHeader &h = layout.header;
+    return std::make_unique<AttributeTable>(
+        read_attributes(data + e.offset, e.bytes, h.vertices,
+                        h.clustered() ? h.clusters : 0, decode, mask));
+  }
+  return nullptr;
 }
 
 } // namespace pomar

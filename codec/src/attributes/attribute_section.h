@@ -27,7 +27,7 @@ namespace pomar {
 
 struct LevelMesh;
 
-constexpr uint32_t kAttributeSectionTag = 0x52545441; // "ATTR" in file byte order
+constexpr uint32_t kAttributeSectionTag = 0x52545441; // "ATTR": bytes A, T, T, R in the file
 constexpr uint8_t kAttributeSectionVersion = 1;
 
 /// The section of `mesh`'s attributes (empty vector: nothing to store). `lm` is the encoder's

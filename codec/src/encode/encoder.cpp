@@ -348,14 +348,19 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
   for (uint32_t i = 0; i < nv; ++i)
     decoded_to_input[i] = compact_to_input[dec_to_input[i]];
   // Attributes of the full-resolution vertices (format version 4, "ATTR" section).
-  std::vector<uint8_t> attributes = write_attributes(
-      mesh, options.attributes, lm, decoded_to_input, clustered_roots);
+  std::vector<Section> sections;
+  std::vector<uint8_t> attributes =
+      write_attributes(mesh, options.attributes, lm, decoded_to_input, clustered_roots);
+  if (!attributes.empty())
+    sections.push_back({kAttributeSectionTag, std::move(attributes)});
 
-  std::vector<uint8_t> file =
-      write_file(header, pack_base_mesh(base, grid.bits), blocks, tables, cluster_blocks);
+  std::vector<uint8_t> file = write_file(header, pack_base_mesh(base, grid.bits), blocks, tables,
+                                         cluster_blocks, sections);
   if (report) {
     const FileLayout layout = read_layout(file.data(), file.size());
     report->info = file_info(layout, file.size());
+    if (const auto table = load_attribute_table(file.data(), layout, false))
+      describe_attributes(*table, report->info);
     report->input_vertices = mesh.vertex_count();
     report->unreferenced_vertices = mesh.vertex_count() - nv;
     report->quantize_seconds = t_quantize;

@@ -520,8 +520,8 @@ FileInfo file_info(const FileLayout &L, uint64_t file_size) {
   info.header_bytes = L.header_bytes;
   info.base_bytes = h.base_bytes;
   for (const SectionEntry &e : L.sections)
-    if (e.tag == kLosslessTag)
-      info.lossless_bytes += e.bytes;
+    if (e.tag == section_tag("ATTR"))
+      info.attribute_bytes += e.bytes;
   return info;
 }
 
