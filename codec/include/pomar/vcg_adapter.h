@@ -23,6 +23,16 @@
 
 namespace pomar {
 
+/// from_vcg's attribute mask: vcg::tri::io::Mask bits IOM_VERTCOLOR (colour; RGBA when an
+/// alpha differs from 255), IOM_VERTNORMAL, IOM_VERTQUALITY (a scalar named "quality"),
+/// IOM_VERTTEXCOORD (texcoord + m.textures as texture files), plus kVcgCustomScalars:
+/// every named per-vertex float attribute becomes a scalar of that name.
+constexpr int kVcgCustomScalars = 1 << 30;
+constexpr int kVcgAllAttributes = vcg::tri::io::Mask::IOM_VERTCOLOR |
+                                  vcg::tri::io::Mask::IOM_VERTNORMAL |
+                                  vcg::tri::io::Mask::IOM_VERTQUALITY |
+                                  vcg::tri::io::Mask::IOM_VERTTEXCOORD | kVcgCustomScalars;
+
 namespace vcg_detail {
 
 /// Position of `v` in m.vert, or throws if `v` does not point into m.vert.
@@ -110,16 +120,6 @@ void take_attributes(const MeshType &m, const std::vector<uint32_t> &remap, int 
 
 } // namespace vcg_detail
 
-/// from_vcg's attribute mask: vcg::tri::io::Mask bits IOM_VERTCOLOR (colour; RGBA when an
-/// alpha differs from 255), IOM_VERTNORMAL, IOM_VERTQUALITY (a scalar named "quality"),
-/// IOM_VERTTEXCOORD (texcoord + m.textures as texture files), plus kVcgCustomScalars:
-/// every named per-vertex float attribute becomes a scalar of that name.
-constexpr int kVcgCustomScalars = 1 << 30;
-constexpr int kVcgAllAttributes = vcg::tri::io::Mask::IOM_VERTCOLOR |
-                                  vcg::tri::io::Mask::IOM_VERTNORMAL |
-                                  vcg::tri::io::Mask::IOM_VERTQUALITY |
-                                  vcg::tri::io::Mask::IOM_VERTTEXCOORD | kVcgCustomScalars;
-
 /// Convert a vcglib triangle mesh to a pomar::Mesh.
 ///
 /// Deleted vertices and faces (IsD()) are skipped. Vertices that no live face references
@@ -190,6 +190,67 @@ Mesh from_vcg(const MeshType &m, size_t *unreferenced = nullptr, int attribute_m
   return out;
 }
 
+/// Write per-vertex attributes (one value per vertex of m) into m, as to_vcg does; returns
+/// the mask of what was written (see to_vcg).
+template <class MeshType>
+int put_attributes(const std::vector<VertexAttribute> &attributes,
+                   const std::vector<std::string> &texture_files, MeshType &m) {
+  using CoordType = typename MeshType::CoordType;
+  using ScalarType = typename MeshType::ScalarType;
+  const size_t nv = m.vert.size();
+  using namespace vcg::tri::io;
+  int written = 0;
+  for (const VertexAttribute &a : attributes) {
+    if (a.vertex_count() != nv)
+      throw Error("to_vcg: attribute '" + a.name + "' does not have one value per vertex");
+    switch (a.kind) {
+    case AttributeKind::Colour:
+      if (!vcg::tri::HasPerVertexColor(m) || (written & Mask::IOM_VERTCOLOR))
+        break;
+      for (size_t v = 0; v < nv; ++v) {
+        const uint8_t *c = &a.colour[v * a.components];
+        m.vert[v].C() = vcg::Color4b(c[0], c[1], c[2], a.components == 4 ? c[3] : 255);
+      }
+      written |= Mask::IOM_VERTCOLOR;
+      break;
+    case AttributeKind::Normal:
+      if (!vcg::tri::HasPerVertexNormal(m) || (written & Mask::IOM_VERTNORMAL))
+        break;
+      for (size_t v = 0; v < nv; ++v)
+        m.vert[v].N() = CoordType(ScalarType(a.values[3 * v]), ScalarType(a.values[3 * v + 1]),
+                                  ScalarType(a.values[3 * v + 2]));
+      written |= Mask::IOM_VERTNORMAL;
+      break;
+    case AttributeKind::TexCoord:
+      if (!vcg::tri::HasPerVertexTexCoord(m) || (written & Mask::IOM_VERTTEXCOORD))
+        break;
+      for (size_t v = 0; v < nv; ++v) {
+        m.vert[v].T().U() = a.values[2 * v];
+        m.vert[v].T().V() = a.values[2 * v + 1];
+        m.vert[v].T().N() = 0;
+      }
+      if (!texture_files.empty())
+        m.textures.assign(texture_files.begin(), texture_files.end());
+      written |= Mask::IOM_VERTTEXCOORD;
+      break;
+    case AttributeKind::Scalar:
+      if (a.name == "quality" && vcg::tri::HasPerVertexQuality(m) &&
+          !(written & Mask::IOM_VERTQUALITY)) {
+        for (size_t v = 0; v < nv; ++v)
+          m.vert[v].Q() = a.values[v];
+        written |= Mask::IOM_VERTQUALITY;
+      } else {
+        auto h = vcg::tri::Allocator<MeshType>::template GetPerVertexAttribute<float>(m, a.name);
+        for (size_t v = 0; v < nv; ++v)
+          h[v] = a.values[v];
+        written |= kVcgCustomScalars;
+      }
+      break;
+    }
+  }
+  return written;
+}
+
 /// Replace the contents of vcglib mesh `m` by `src`.
 ///
 /// m is cleared first: its vertices, faces, edges and tetrahedra (TriMesh::Clear()) and
@@ -239,57 +300,7 @@ template <class MeshType> int to_vcg(const Mesh &src, MeshType &m) {
 
   vcg::tri::UpdateBounding<MeshType>::Box(m);
 
-  using namespace vcg::tri::io;
-  int written = 0;
-  for (const VertexAttribute &a : src.attributes) {
-    if (a.vertex_count() != nv)
-      throw Error("to_vcg: attribute '" + a.name + "' does not have one value per vertex");
-    switch (a.kind) {
-    case AttributeKind::Colour:
-      if (!vcg::tri::HasPerVertexColor(m) || (written & Mask::IOM_VERTCOLOR))
-        break;
-      for (size_t v = 0; v < nv; ++v) {
-        const uint8_t *c = &a.colour[v * a.components];
-        m.vert[v].C() = vcg::Color4b(c[0], c[1], c[2], a.components == 4 ? c[3] : 255);
-      }
-      written |= Mask::IOM_VERTCOLOR;
-      break;
-    case AttributeKind::Normal:
-      if (!vcg::tri::HasPerVertexNormal(m) || (written & Mask::IOM_VERTNORMAL))
-        break;
-      for (size_t v = 0; v < nv; ++v)
-        m.vert[v].N() = CoordType(ScalarType(a.values[3 * v]), ScalarType(a.values[3 * v + 1]),
-                                  ScalarType(a.values[3 * v + 2]));
-      written |= Mask::IOM_VERTNORMAL;
-      break;
-    case AttributeKind::TexCoord:
-      if (!vcg::tri::HasPerVertexTexCoord(m) || (written & Mask::IOM_VERTTEXCOORD))
-        break;
-      for (size_t v = 0; v < nv; ++v) {
-        m.vert[v].T().U() = a.values[2 * v];
-        m.vert[v].T().V() = a.values[2 * v + 1];
-        m.vert[v].T().N() = 0;
-      }
-      if (!src.texture_files.empty())
-        m.textures.assign(src.texture_files.begin(), src.texture_files.end());
-      written |= Mask::IOM_VERTTEXCOORD;
-      break;
-    case AttributeKind::Scalar:
-      if (a.name == "quality" && vcg::tri::HasPerVertexQuality(m) &&
-          !(written & Mask::IOM_VERTQUALITY)) {
-        for (size_t v = 0; v < nv; ++v)
-          m.vert[v].Q() = a.values[v];
-        written |= Mask::IOM_VERTQUALITY;
-      } else {
-        auto h = vcg::tri::Allocator<MeshType>::template GetPerVertexAttribute<float>(m, a.name);
-        for (size_t v = 0; v < nv; ++v)
-          h[v] = a.values[v];
-        written |= kVcgCustomScalars;
-      }
-      break;
-    }
-  }
-  return written;
+  return put_attributes(src.attributes, src.texture_files, m);
 }
 
 } // namespace pomar
