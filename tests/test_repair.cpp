@@ -109,6 +109,38 @@ TEST(Repair, BowtieVertexIsSplitIntoTwo) {
   expect_valid_and_lossless(m);
 }
 
+TEST(Repair, CopiesCarryTheAttributesOfTheirVertex) {
+  Mesh m;
+  add_vertex(m, 0, 0, 0);
+  add_vertex(m, 1, 0, 0);
+  add_vertex(m, 1, 1, 0);
+  add_vertex(m, 0, 1, 0);
+  add_vertex(m, -1, 0, 0);
+  add_vertex(m, -1, -1, 0);
+  add_vertex(m, 0, -1, 0);
+  add_face(m, 0, 1, 2);
+  add_face(m, 0, 2, 3);
+  add_face(m, 0, 4, 5);
+  add_face(m, 0, 5, 6);
+  VertexAttribute c;
+  c.kind = AttributeKind::Colour;
+  c.name = "colour";
+  c.components = 3;
+  for (uint8_t v = 0; v < 7; ++v)
+    c.colour.insert(c.colour.end(), {v, uint8_t(v + 10), uint8_t(v + 20)});
+  VertexAttribute q;
+  q.kind = AttributeKind::Scalar;
+  q.name = "quality";
+  q.values = {0.5f, 1, 2, 3, 4, 5, 6};
+  m.attributes = {c, q};
+  make_manifold(m);
+  ASSERT_EQ(m.vertex_count(), 8u);
+  EXPECT_NO_THROW(validate_attributes(m, true));
+  EXPECT_EQ(std::vector<uint8_t>(m.attributes[0].colour.end() - 3, m.attributes[0].colour.end()),
+            (std::vector<uint8_t>{0, 10, 20}));
+  EXPECT_EQ(m.attributes[1].values.back(), 0.5f);
+}
+
 TEST(Repair, TwoTetrahedraOnOneEdgeBecomeTwoTetrahedra) {
   // samples/tetra_nonmanifold.off: edge (0, 1) has four faces.
   Mesh m;
