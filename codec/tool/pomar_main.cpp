@@ -423,6 +423,13 @@ nlohmann::json info_json(const pomar::FileInfo &i) {
   j["index_bytes"] = i.index_bytes;
   j["cluster_bytes"] = i.cluster_bytes;
   j["cluster_block_bytes"] = i.cluster_block_bytes;
+  nlohmann::json sections = nlohmann::json::array();
+  for (const pomar::FileInfo::Section &sec : i.sections)
+    sections.push_back({{"name", sec.name},
+                        {"bytes", sec.bytes},
+                        {"bpv", bpv(sec.bytes, i.vertices)},
+                        {"required", sec.required}});
+  j["sections"] = sections;
   j["header_bytes"] = i.header_bytes;
   j["base_bytes"] = i.base_bytes;
   j["total_bytes"] = i.total_bytes;
@@ -501,6 +508,10 @@ int run_info(const std::string &in, bool json) {
                   "them all)\n",
                   i.clusters, sizes.front(), sizes[sizes.size() / 2], sizes.back());
   }
+  for (const pomar::FileInfo::Section &sec : i.sections)
+    std::printf("  section %s: %lu bytes = %.2f bits/vertex%s\n", sec.name.c_str(),
+                static_cast<unsigned long>(sec.bytes), bpv(sec.bytes, i.vertices),
+                sec.required ? " (required)" : "");
   std::printf("  level  vertices     faces  conn.bytes  geom.bytes\n");
   std::printf("  %5d %9u %9u  %10lu  (base mesh)\n", 0, i.base_vertices, i.base_faces,
               static_cast<unsigned long>(i.base_bytes));

@@ -122,6 +122,13 @@ struct FileInfo {
   std::vector<AttributeInfo> attributes;
   std::vector<std::string> texture_files;
   uint64_t attribute_bytes = 0; ///< the whole ATTR section
+  /// Version 4: what the file carries in sections of its global part, with their sizes.
+  struct Section {
+    std::string name;      ///< four ASCII characters, e.g. "LSLS"
+    uint64_t bytes = 0;    ///< size of the section's body
+    bool required = false; ///< a reader that does not know it must refuse the file
+  };
+  std::vector<Section> sections;
   bool clustered() const { return clusters != 0; }
 };
 

@@ -316,19 +316,14 @@ std::unique_ptr<AttributeTable> load_attribute_table(const uint8_t *data, const 
                                                      bool decode, const AttributeMask &mask) {
   if (!mask.colour && !mask.normals && !mask.scalars && !mask.texcoords)
     return nullptr;
-  for (const SectionEntry &e : layout.sections) {
-    if (e.tag != kAttributeSectionTag)
-      continue;
-    if (e.offset + e.bytes > layout.file_size)
-      throw Error("truncated .pomar file: the ATTR section ends at byte " +
-                  std::to_string(e.offset + e.bytes));
-    check_block(data + e.offset, e.bytes, e.checksum, "ATTR section");
-    const FileHeader &h = layout.header;
-    return std::make_unique<AttributeTable>(
-        read_attributes(data + e.offset, e.bytes, h.vertices,
-                        h.clustered() ? h.clusters : 0, decode, mask));
-  }
-  return nullptr;
+  const int i = find_section(layout, kAttributeSectionTag);
+  if (i < 0)
+    return nullptr;
+  const uint8_t *body = section_body(data, layout, size_t(i)); // checks its XXH32
+  const FileHeader &h = layout.header;
+  return std::make_unique<AttributeTable>(
+      read_attributes(body, layout.header.sections[size_t(i)].bytes, h.vertices,
+                      h.clustered() ? h.clusters : 0, decode, mask));
 }
 
 } // namespace pomar

@@ -21,13 +21,14 @@
 #include <vector>
 
 #include "attributes/attribute_quantize.h"
+#include "format/file_format.h"
 #include "pomar/pomar.h"
 
 namespace pomar {
 
 struct LevelMesh;
 
-constexpr uint32_t kAttributeSectionTag = 0x52545441; // "ATTR": bytes A, T, T, R in the file
+constexpr uint32_t kAttributeSectionTag = section_tag("ATTR"); // optional (flags 0)
 constexpr uint8_t kAttributeSectionVersion = 1;
 
 /// The section of `mesh`'s attributes (empty vector: nothing to store). `lm` is the encoder's
@@ -62,7 +63,6 @@ void attach_attributes(const AttributeTable &table, const LevelMesh &lm, Mesh &o
 /// The file's attribute summary for FileInfo.
 void describe_attributes(const AttributeTable &table, FileInfo &info);
 
-struct FileLayout;
 /// The table of the file's ATTR section (checksum checked), or nullptr if it has none or
 /// `mask` keeps nothing; `decode` as for read_attributes. `data` = the file's global part.
 std::unique_ptr<AttributeTable> load_attribute_table(const uint8_t *data, const FileLayout &layout,

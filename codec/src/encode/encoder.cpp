@@ -352,7 +352,7 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
   std::vector<uint8_t> attributes =
       write_attributes(mesh, options.attributes, lm, decoded_to_input, clustered_roots);
   if (!attributes.empty())
-    sections.push_back({kAttributeSectionTag, std::move(attributes)});
+    sections.push_back({kAttributeSectionTag, 0, std::move(attributes)}); // optional
 
   std::vector<uint8_t> file = write_file(header, pack_base_mesh(base, grid.bits), blocks, tables,
                                          cluster_blocks, sections);
