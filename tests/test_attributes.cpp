@@ -495,9 +495,30 @@ TEST(AttributeRoundTrip, DamagedSectionIsAClearError) {
   } catch (const Error &e) {
     EXPECT_NE(std::string(e.what()).find("ATTR"), std::string::npos) << e.what();
   }
+  // The base mesh's codes are there: a decode without attributes needs them too (the other
+  // vertices' codes are interleaved with their positions).
   DecodeOptions none;
   none.attributes = AttributeMask::none();
-  EXPECT_NO_THROW(decode(bad.data(), bad.size(), none)); // not read at all
+  EXPECT_THROW(decode(bad.data(), bad.size(), none), Error);
+}
+
+// Attributes are coded with the positions, in the level streams and cluster blocks: a
+// selective decode reads only the blocks of its clusters, whose size grows with them.
+TEST(AttributeRoundTrip, SelectiveDecodesReadOnlyTheirBlocks) {
+  const Mesh plain = gen::noisy_sphere(3000, 10, 0.1);
+  const Coded with = encode_with(with_attributes(plain, kAll), true);
+  const Coded without = encode_with(plain, true);
+  const FileInfo a = inspect(with.file.data(), with.file.size());
+  const FileInfo b = inspect(without.file.data(), without.file.size());
+  EXPECT_EQ(a.clusters, b.clusters);
+  EXPECT_GT(a.cluster_bytes, b.cluster_bytes + 3000); // the attributes are in the blocks
+  EXPECT_LT(a.attribute_bytes, a.total_bytes / 20);    // the section: base mesh only
+  SelectiveDecoder d(std::make_unique<MemorySource>(with.file.data(), with.file.size()));
+  d.want_cluster(0, d.base_clustered_level() + 2);
+  d.update();
+  EXPECT_LT(d.blocks_read(), a.clusters / 4);
+  EXPECT_LT(d.bytes_read(), a.global_bytes + a.cluster_bytes / 4); // not the other blocks
+  expect_same_as_full(d.mesh(), decode(with.file.data(), with.file.size()));
 }
 
 } // namespace

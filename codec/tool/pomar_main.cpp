@@ -489,9 +489,13 @@ int run_info(const std::string &in, bool json) {
               bpv(i.connectivity_bytes, i.vertices), bpv(i.geometry_bytes, i.vertices),
               bpv(i.base_bytes, i.vertices), bpv(i.header_bytes, i.vertices));
   if (!i.attributes.empty() || !i.texture_files.empty()) {
-    std::printf("  attributes %lu bytes = %.2f bits/vertex (stored for every vertex, read by "
-                "every decode):\n",
-                static_cast<unsigned long>(i.attribute_bytes), bpv(i.attribute_bytes, i.vertices));
+    uint64_t coded = 0;
+    for (const pomar::AttributeInfo &a : i.attributes)
+      coded += a.bytes;
+    std::printf("  attributes about %.2f bits/vertex, coded with the positions in the levels and "
+                "cluster blocks (encoder's estimate; ATTR section with the base mesh's: %lu "
+                "bytes):\n",
+                bpv(coded, i.vertices), static_cast<unsigned long>(i.attribute_bytes));
     print_attributes(i);
   }
   if (i.clustered()) {

@@ -1,19 +1,13 @@
-// The ATTR section (format version 4): per-vertex attributes of the full-resolution mesh.
+// Per-vertex attributes in the bitstream (format version 4).
 //
-// Every vertex has an attribute index that names it the same way in every decode:
-//   progressive files and vertices of the base clustered mesh: its vertex id (global levels
-//   number vertices identically in every decode);
-//   vertices of clustered levels: clusters + start[cluster] + local - 1, (cluster, local)
-//   being its lineage name (refine/level_traversal.h) and start[] the prefix sums of the
-//   per-cluster counts stored in the section.
-// Each attribute's integer codes (attribute_quantize.h) are predicted from the vertex's
-// parent (the v_to it was split from; base vertices: the previous base vertex) and the
-// residuals range-coded in attribute-index order, one stream per attribute, with adaptive
-// models per code component. A decoder decodes the residuals once, then rebuilds the codes
-// of exactly the vertices it holds, parents first (vertex ids grow with creation).
-//
-// NOT progressive by region: every decode reads and entropy-decodes the whole section
-// (it belongs to the global part); see docs/format.md.
+// Each vertex's attributes are integer codes (attribute_quantize.h). The codes of the base
+// mesh vertices are stored in the "ATTR" section, with the descriptors of the attributes;
+// every other vertex's codes are coded where its position is, in the level streams and
+// cluster blocks (refine/level_traversal.h code_vertex -> Codec::attributes): predicted by
+// the codes of v_to (the vertex it is split from) and the residuals range-coded with one
+// model set per code (adaptive in global levels, frozen per level in clustered levels, as
+// the geometry). So every decode (any level, any selection, incremental) holds exactly the
+// attributes of the vertices it decoded, and reads only the blocks it decodes.
 #pragma once
 
 #include <cstdint>
@@ -21,6 +15,7 @@
 #include <vector>
 
 #include "attributes/attribute_quantize.h"
+#include "entropy/models.h"
 #include "format/file_format.h"
 #include "pomar/pomar.h"
 
@@ -31,41 +26,41 @@ struct LevelMesh;
 constexpr uint32_t kAttributeSectionTag = section_tag("ATTR"); // optional (flags 0)
 constexpr uint8_t kAttributeSectionVersion = 1;
 
-/// The section of `mesh`'s attributes (empty vector: nothing to store). `lm` is the encoder's
-/// fully refined mesh in decoder numbering, `decoded_to_input[v]` the input vertex of its
-/// vertex v, `clusters` the vertex count of the base clustered mesh (0: progressive file).
-/// `bytes` (optional) gets the stream size of each stored attribute.
-std::vector<uint8_t> write_attributes(const Mesh &mesh, const AttributeOptions &options,
-                                      const LevelMesh &lm,
-                                      const std::vector<uint32_t> &decoded_to_input,
-                                      uint32_t clusters);
-
-/// A parsed section: descriptors, and (if decoded) the residuals of every vertex.
+/// The attributes of a file: descriptors, texture files and the codes of the base mesh.
 struct AttributeTable {
   std::vector<StoredAttribute> stored;
-  std::vector<uint64_t> stream_bytes;
+  std::vector<uint64_t> estimated_bytes; // per attribute, in the whole file (informative)
   std::vector<std::string> texture_files;
-  uint32_t vertices = 0, clusters = 0;
-  std::vector<uint32_t> cluster_start; // clusters + 1 prefix sums (clustered files)
-  std::vector<std::vector<int64_t>> residuals; // per attribute: codes() per attribute index
-  bool decoded = false;
+  uint32_t codes = 0;             // integer codes per vertex (all attributes)
+  std::vector<int64_t> base;      // codes of the base mesh vertices
+  uint64_t base_stream_bytes = 0; // the section's coded base codes
 };
 
-/// Parse the section body (bounds-checked; errors say "damaged .pomar file: ATTR ...").
-/// With `decode`, entropy-decode the residuals of the attributes `mask` keeps (the
-/// others are dropped from the table). `vertices`/`clusters` from the file header.
-AttributeTable read_attributes(const uint8_t *data, size_t size, uint32_t vertices,
-                               uint32_t clusters, bool decode, const AttributeMask &mask = {});
+/// The encoder's side: what is kept of `mesh`'s attributes and how (empty table: nothing).
+/// Throws pomar::Error if they need more than kMaxAttributeCodes codes per vertex.
+AttributeTable plan_attributes(const Mesh &mesh, const AttributeOptions &options);
+/// Codes of every vertex, in the order of `to_input` (to_input[i] = the mesh's vertex).
+std::vector<int64_t> attribute_codes(const Mesh &mesh, const AttributeTable &table,
+                                     const AttributeOptions &options,
+                                     const std::vector<uint32_t> &to_input);
+/// The models of the attribute codes (Models::attr) for a table.
+std::vector<AttributeCodeModels> attribute_models(const AttributeTable &table);
+/// Give `lm` (the base mesh) its attribute codes and ranges from the table.
+void init_attributes(const AttributeTable &table, LevelMesh &lm);
 
-/// Add the decoded attributes of every vertex of `lm` to `out` (and the texture files).
-void attach_attributes(const AttributeTable &table, const LevelMesh &lm, Mesh &out);
+/// The ATTR section body of `table` (table.base holds the base vertices' codes).
+std::vector<uint8_t> write_attributes(const AttributeTable &table);
+/// Parse a section body (bounds-checked; "damaged .pomar file: ATTR section ..." errors).
+AttributeTable read_attributes(const uint8_t *data, size_t size, uint32_t base_vertices);
+/// The table of the file's ATTR section (checksum checked), or nullptr if it has none.
+std::unique_ptr<AttributeTable> load_attribute_table(const uint8_t *data, const FileLayout &layout);
 
-/// The file's attribute summary for FileInfo.
+/// Add the attributes `mask` keeps of every vertex of `lm` to `out` (and the texture files).
+void attach_attributes(const AttributeTable &table, const LevelMesh &lm, const AttributeMask &mask,
+                       Mesh &out);
+
+/// The file's attribute summary for FileInfo; `bytes` per attribute from the encoder's
+/// ideal code lengths of its residuals in the whole file (0 if unknown).
 void describe_attributes(const AttributeTable &table, FileInfo &info);
-
-/// The table of the file's ATTR section (checksum checked), or nullptr if it has none or
-/// `mask` keeps nothing; `decode` as for read_attributes. `data` = the file's global part.
-std::unique_ptr<AttributeTable> load_attribute_table(const uint8_t *data, const FileLayout &layout,
-                                                     bool decode, const AttributeMask &mask = {});
 
 } // namespace pomar

@@ -91,7 +91,7 @@ FileInfo inspect(const uint8_t *data, size_t size) {
     const ClusterIndex index = read_cluster_index(data + layout.index_offset, layout);
     info.cluster_block_bytes = index.size;
   }
-  if (const auto table = load_attribute_table(data, layout, false))
+  if (const auto table = load_attribute_table(data, layout))
     describe_attributes(*table, info);
   return info;
 }
@@ -202,12 +202,18 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
   }
   LevelMesh lm = base_level_mesh(data, layout);
   Models models;
+  // Attribute codes come with the positions: decoded whatever the mask says.
+  const std::unique_ptr<AttributeTable> attributes = load_attribute_table(data, layout);
+  if (attributes) {
+    init_attributes(*attributes, lm);
+    models.attr = attribute_models(*attributes);
+  }
   r.level = static_cast<int>(decode_global_levels(data, layout, 0, std::min(target, global), lm,
                                                   models, options.progress,
                                                   options.skip_damaged ? &r.damaged : nullptr));
   Mesh out = to_mesh(lm, h.grid);
-  if (const auto table = load_attribute_table(data, layout, true, options.attributes))
-    attach_attributes(*table, lm, out);
+  if (attributes)
+    attach_attributes(*attributes, lm, options.attributes, out);
   return out;
 }
 

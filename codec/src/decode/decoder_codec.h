@@ -54,6 +54,20 @@ public:
     }
   }
 
+  /// A split vertex's attribute codes: v_to's codes plus the decoded residuals.
+  void attributes(const LevelMesh &mesh, uint32_t v_to, int64_t *codes) {
+    const uint32_t n = mesh.attr_codes;
+    const int64_t *pred = &mesh.attr[size_t(v_to) * n];
+    int64_t r[kMaxAttributeCodes];
+    for (uint32_t k = 0; k < n; ++k) {
+      AttributeCodeModels &m = m_->attr[k];
+      r[k] = get_signed(*geom_, m.classes[attribute_context(m, r, k)], m.top);
+      codes[k] = pred[k] + r[k];
+      if (codes[k] < mesh.attr_lo[k] || codes[k] > mesh.attr_hi[k])
+        corrupt("a decoded attribute lies outside its range");
+    }
+  }
+
   [[noreturn]] void corrupt(const char *what) {
     std::string where = "level " + std::to_string(level_);
     if (cluster_ != 0xFFFFFFFFu)

@@ -161,10 +161,9 @@ struct SelectiveDecoder::State {
 
   LevelStep step;
 
-  // Attributes: the ATTR section, decoded on the first mesh() that wants them.
+  // Attributes: descriptors and base codes (the other codes come with the positions).
   AttributeMask attribute_mask;
-  mutable std::unique_ptr<AttributeTable> attributes;
-  mutable bool attributes_loaded = false;
+  std::unique_ptr<AttributeTable> attributes;
 
   bool clustered() const { return layout.header.clustered(); }
   static constexpr size_t kChunk = 4; // bytes per on-demand read of a cluster block
@@ -314,6 +313,11 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   const FileHeader &h = s.layout.header;
   s.finest = static_cast<int>(h.levels.size());
   s.mesh = base_level_mesh(s.global.data(), s.layout);
+  s.attributes = load_attribute_table(s.global.data(), s.layout);
+  if (s.attributes) { // attribute codes come with the positions, whatever the mask says
+    init_attributes(*s.attributes, s.mesh);
+    s.global_models.attr = attribute_models(*s.attributes);
+  }
   if (!s.clustered()) {
     s.global_levels = 0;
     s.snapshot = s.mesh;
@@ -324,7 +328,7 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   check_block(s.global.data() + s.layout.tables_offset, h.tables_bytes, h.tables_checksum,
               "static model tables");
   s.level_models = read_tables(s.global.data() + s.layout.tables_offset, h.tables_bytes,
-                               h.levels.size() - h.global_levels);
+                               h.levels.size() - h.global_levels, s.global_models.attr);
   s.index = read_cluster_index(s.global.data() + s.layout.index_offset, s.layout);
   s.info.cluster_block_bytes = s.index.size;
   decode_global_levels(s.global.data(), s.layout, 0, h.global_levels, s.mesh, s.global_models, {});
@@ -492,6 +496,8 @@ void SelectiveDecoder::update(const Progress &progress) {
     if (s.uniform_level < have) {
       s.mesh = s.snapshot;
       s.global_models = Models();
+      if (s.attributes)
+        s.global_models.attr = attribute_models(*s.attributes);
       have = 0;
     }
     const size_t want = size_t(std::min(s.uniform_level, s.uniform_cap));
@@ -579,12 +585,8 @@ void SelectiveDecoder::State::check_cluster_data() {
 Mesh SelectiveDecoder::mesh() const {
   const State &s = *s_;
   Mesh out = to_mesh(s.mesh, s.layout.header.grid);
-  if (!s.attributes_loaded) {
-    s.attributes = load_attribute_table(s.global.data(), s.layout, true, s.attribute_mask);
-    s.attributes_loaded = true;
-  }
   if (s.attributes)
-    attach_attributes(*s.attributes, s.mesh, out);
+    attach_attributes(*s.attributes, s.mesh, s.attribute_mask, out);
   return out;
 }
 

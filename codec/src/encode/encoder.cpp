@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <string>
+#include <type_traits>
 
 #include "attributes/attribute_section.h"
 #include "decimate/decimate.h"
@@ -107,7 +108,34 @@ public:
     dec_to_input_.push_back(v_from);
   }
 
+  /// The split vertex's attribute codes (from the input), coded against v_to's.
+  void attributes(const LevelMesh &mesh, uint32_t v_to, int64_t *codes) {
+    const uint32_t n = mesh.attr_codes;
+    const uint32_t v_from = (*level_)[current_].v_from;
+    const int64_t *pred = &mesh.attr[size_t(v_to) * n];
+    int64_t r[kMaxAttributeCodes];
+    for (uint32_t k = 0; k < n; ++k) {
+      codes[k] = (*attr_codes_)[size_t(v_from) * n + k];
+      r[k] = codes[k] - pred[k];
+      AttributeCodeModels &m = m_->attr[k];
+      FrequencyModel &classes = m.classes[attribute_context(m, r, k)];
+      if constexpr (std::is_same_v<Sink, RecorderStream>) {
+        // Clustered levels: tagged per code for the statistics (code_recording).
+        RecorderStream tagged{geom_->recorder, static_cast<uint8_t>(2 + k)};
+        put_signed(tagged, classes, m.top, r[k]);
+      } else {
+        attr_bits[k] += put_signed(*geom_, classes, m.top, r[k]);
+      }
+    }
+  }
+  /// Attribute codes of every input vertex (encoder numbering), attr_codes per vertex.
+  void set_attribute_codes(const std::vector<int64_t> *codes, uint32_t n) {
+    attr_codes_ = codes;
+    attr_bits.assign(n, 0.0);
+  }
+
   double bits[6] = {0, 0, 0, 0, 0, 0}; // ideal code lengths per symbol kind
+  std::vector<double> attr_bits;       // ideal code lengths per attribute code
 
   [[noreturn]] void corrupt(const char *what) {
     throw Error(std::string("internal encoder error: ") + what);
@@ -129,6 +157,7 @@ private:
   std::vector<uint32_t> collapse_at_; // input vertex -> index of its collapse as v_to
   const std::vector<Collapse> *level_ = nullptr;
   Sink *conn_ = nullptr, *geom_ = nullptr;
+  const std::vector<int64_t> *attr_codes_ = nullptr;
   uint32_t current_ = kNone;
   size_t emitted_ = 0;
 };
@@ -255,6 +284,16 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
   lm.seed_faces = static_cast<uint32_t>(base.triangles.size() / 3);
   build_corner_table(base.triangles.data(), lm.seed_faces, dec_to_input.size(), lm.ct);
   lm.init_lineage();
+  // Attributes: codes of every vertex (encoder numbering); the base mesh's go to the ATTR
+  // section, the others are coded with their positions.
+  AttributeTable attributes = plan_attributes(mesh, options.attributes);
+  const std::vector<int64_t> codes =
+      attributes.codes ? attribute_codes(mesh, attributes, options.attributes, compact_to_input)
+                       : std::vector<int64_t>();
+  for (uint32_t v : dec_to_input)
+    attributes.base.insert(attributes.base.end(), codes.begin() + size_t(v) * attributes.codes,
+                           codes.begin() + size_t(v + 1) * attributes.codes);
+  init_attributes(attributes, lm);
 
   FileHeader header;
   header.grid = grid;
@@ -267,7 +306,9 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
 
   // Global levels: one adaptive model set for the whole file, two streams per level.
   Models models;
+  models.attr = attribute_models(attributes);
   EncoderCodec<RangeEncoder> codec(q, dec_to_input, input_to_dec);
+  codec.set_attribute_codes(&codes, attributes.codes);
   LevelStep step;
   std::vector<std::vector<uint8_t>> blocks;
   auto add_level_entry = [&](uint32_t conn_bytes, uint32_t geom_bytes) {
@@ -301,19 +342,20 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
   // all clusters' symbols, then every cluster is coded into its own block.
   std::vector<uint8_t> tables;
   std::vector<std::vector<uint8_t>> cluster_blocks;
-  uint32_t clustered_roots = 0; // vertices of the base clustered mesh (clustered files)
   if (G < L) {
     header.flags |= kFlagClustered;
     header.global_levels = static_cast<uint32_t>(G);
     const uint32_t clusters = lm.vertex_count();
-    clustered_roots = clusters;
     lm.local.assign(clusters, 0);
     for (uint32_t c = 0; c < clusters; ++c)
       lm.tag[c].cluster = c;
     std::vector<uint32_t> next_local(clusters, 1);
     std::vector<Models> level_models(L - G);
+    for (Models &m : level_models)
+      m.attr = attribute_models(attributes);
     std::vector<SymbolRecorder> recordings(clusters);
     EncoderCodec<RecorderStream> ccodec(q, dec_to_input, input_to_dec);
+    ccodec.set_attribute_codes(&codes, attributes.codes);
     for (size_t r = G; r < L; ++r) {
       const uint32_t level = static_cast<uint32_t>(r + 1);
       ccodec.begin_level(dec.levels[L - 1 - r], &level_models[r - G]);
@@ -330,17 +372,21 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
     }
     freeze_on_recordings(level_models, recordings);
     tables = write_tables(level_models);
-    double bits[2] = {0, 0};
+    // Ideal code lengths: [0] connectivity, [1] geometry, [2 + k] attribute code k.
+    double bits[2 + kMaxAttributeCodes] = {};
     cluster_blocks.reserve(clusters);
     for (const SymbolRecorder &rec : recordings)
       cluster_blocks.push_back(code_recording(rec, bits));
     uint64_t cluster_bytes = 0;
     for (const auto &b : cluster_blocks)
       cluster_bytes += b.size();
+    double all_bits = 0;
+    for (double b : bits)
+      all_bits += b;
     header.cluster_connectivity_bytes =
-        bits[0] + bits[1] > 0
-            ? static_cast<uint64_t>(double(cluster_bytes) * bits[0] / (bits[0] + bits[1]))
-            : 0;
+        all_bits > 0 ? static_cast<uint64_t>(double(cluster_bytes) * bits[0] / all_bits) : 0;
+    for (uint32_t k = 0; k < attributes.codes; ++k)
+      codec.attr_bits[k] += all_bits > 0 ? 8.0 * double(cluster_bytes) * bits[2 + k] / all_bits : 0;
   }
   if (lm.vertex_count() != nv || lm.ct.face_count() != nf)
     throw Error("internal encoder error: the refined mesh does not match the input");
@@ -349,17 +395,22 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
     decoded_to_input[i] = compact_to_input[dec_to_input[i]];
   // Attributes of the full-resolution vertices (format version 4, "ATTR" section).
   std::vector<Section> sections;
-  std::vector<uint8_t> attributes =
-      write_attributes(mesh, options.attributes, lm, decoded_to_input, clustered_roots);
-  if (!attributes.empty())
-    sections.push_back({kAttributeSectionTag, 0, std::move(attributes)}); // optional
+  if (!attributes.stored.empty() || !attributes.texture_files.empty()) {
+    for (size_t i = 0, k = 0; i < attributes.stored.size(); ++i) {
+      double bits = 0;
+      for (uint32_t c = 0; c < attributes.stored[i].codes(); ++c, ++k)
+        bits += codec.attr_bits[k];
+      attributes.estimated_bytes[i] = static_cast<uint64_t>(bits / 8.0 + 0.5);
+    }
+    sections.push_back({kAttributeSectionTag, 0, write_attributes(attributes)}); // optional
+  }
 
   std::vector<uint8_t> file = write_file(header, pack_base_mesh(base, grid.bits), blocks, tables,
                                          cluster_blocks, sections);
   if (report) {
     const FileLayout layout = read_layout(file.data(), file.size());
     report->info = file_info(layout, file.size());
-    if (const auto table = load_attribute_table(file.data(), layout, false))
+    if (const auto table = load_attribute_table(file.data(), layout))
       describe_attributes(*table, report->info);
     report->input_vertices = mesh.vertex_count();
     report->unreferenced_vertices = mesh.vertex_count() - nv;

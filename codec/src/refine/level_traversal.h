@@ -14,6 +14,7 @@
 //   void split_symbols(uint32_t v, const Ring& ring, const uint32_t* ranked,
 //                      SplitSymbols& s);      // ranked = ring indices, longest edge first
 //   void geometry(uint32_t v_to, const Prediction& prediction, int32_t position[3]);
+//   void attributes(const LevelMesh& mesh, uint32_t v_to, int64_t* codes); // if any
 //   [[noreturn]] void corrupt(const char* what);
 #pragma once
 
@@ -45,6 +46,10 @@ struct LevelMesh {
   std::vector<Tag> tag;
   std::vector<uint32_t> parent, local;
   std::vector<uint16_t> face_claim; // per face: last level whose patch held it
+  // Per-vertex attributes (attributes/): `attr_codes` integer codes per vertex, each in
+  // [attr_lo[k], attr_hi[k]]; a split vertex's codes are coded after its position.
+  uint32_t attr_codes = 0;
+  std::vector<int64_t> attr, attr_lo, attr_hi;
   uint32_t vertex_count() const { return ct.vertex_count(); }
   uint32_t level_of(uint32_t v) const { return tag[v].level; }
   uint32_t cluster_of(uint32_t v) const { return tag[v].cluster; }
@@ -66,8 +71,10 @@ struct SplitSymbols {
 /// v_from. code_vertex codes it (Codec::geometry), apply_splits (level_step.h) stores it
 /// with the new vertex. A per-vertex attribute adds its field here, its coding next to
 /// Codec::geometry and its storage next to LevelMesh::q.
+constexpr uint32_t kMaxAttributeCodes = 16; // integer codes of all attributes of a vertex
 struct NewVertex {
-  int32_t position[3]; // quantized xyz
+  int32_t position[3];               // quantized xyz
+  int64_t attr[kMaxAttributeCodes]; // attribute codes (LevelMesh::attr_codes of them)
 };
 
 struct PendingSplit {
@@ -349,6 +356,8 @@ void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v,
   Prediction prediction;
   predict(mesh, v, ring, p, prediction);
   codec.geometry(v, prediction, ps.v_from.position);
+  if (mesh.attr_codes) // predicted from v_to's codes
+    codec.attributes(mesh, v, ps.v_from.attr);
   splits.push_back(ps);
 }
 
