@@ -79,13 +79,19 @@ void init_attributes(const AttributeTable &table, LevelMesh &lm) {
   lm.attr = table.base;
   lm.attr_lo.clear();
   lm.attr_hi.clear();
-  for (const StoredAttribute &s : table.stored)
+  lm.normal_code = -1;
+  for (const StoredAttribute &s : table.stored) {
+    if (s.kind == AttributeKind::Normal && s.bits && lm.normal_code < 0) {
+      lm.normal_code = static_cast<int>(lm.attr_lo.size());
+      lm.normal_bits = s.bits;
+    }
     for (uint32_t k = 0; k < s.codes(); ++k) {
       int64_t lo, hi;
       code_range(s, k, lo, hi);
       lm.attr_lo.push_back(lo);
       lm.attr_hi.push_back(hi);
     }
+  }
 }
 
 std::vector<uint8_t> write_attributes(const AttributeTable &t) {

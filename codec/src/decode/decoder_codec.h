@@ -55,9 +55,8 @@ public:
   }
 
   /// A split vertex's attribute codes: v_to's codes plus the decoded residuals.
-  void attributes(const LevelMesh &mesh, uint32_t v_to, int64_t *codes) {
+  void attributes(const LevelMesh &mesh, const int64_t *pred, int64_t *codes) {
     const uint32_t n = mesh.attr_codes;
-    const int64_t *pred = &mesh.attr[size_t(v_to) * n];
     int64_t r[kMaxAttributeCodes];
     for (uint32_t k = 0; k < n; ++k) {
       AttributeCodeModels &m = m_->attr[k];

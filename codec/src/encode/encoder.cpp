@@ -109,10 +109,9 @@ public:
   }
 
   /// The split vertex's attribute codes (from the input), coded against v_to's.
-  void attributes(const LevelMesh &mesh, uint32_t v_to, int64_t *codes) {
+  void attributes(const LevelMesh &mesh, const int64_t *pred, int64_t *codes) {
     const uint32_t n = mesh.attr_codes;
     const uint32_t v_from = (*level_)[current_].v_from;
-    const int64_t *pred = &mesh.attr[size_t(v_to) * n];
     int64_t r[kMaxAttributeCodes];
     for (uint32_t k = 0; k < n; ++k) {
       codes[k] = (*attr_codes_)[size_t(v_from) * n + k];
