@@ -6,12 +6,12 @@
 For every mesh, each attribute's cost is measured as a file size difference: the file with
 the attribute minus the file without it (pomar: `encode --drop`; Draco: the same mesh written
 as a PLY without that property), in bits per vertex of the encoded mesh. pomar also reports
-the size of each attribute's stream (`info --json`). Draco runs with -cl 7 and -cl 10, its
+the encoder's estimate of each attribute's bytes (`info --json`). Draco runs with -cl 7 and -cl 10, its
 -qp set to pomar's --bits and -qn to pomar's --normal-bits (its octahedral normal grid has the
 same number of bits per coordinate); colour is 8-bit and exact in both. Draco's PLY reader
 keeps position, normal, colour and texture coordinates only: named scalars (confidence,
-intensity, quality) are "n/a" for it. Also: encode and decode time with and without the
-attributes (median of --runs). Markdown on stdout, progress on stderr.
+intensity, quality) are "n/a" for it. Also: encode and decode time of the mesh with and
+without its attributes (median of --runs; decode writes a binary PLY). Markdown on stdout, progress on stderr.
 """
 import argparse
 import json
@@ -42,41 +42,31 @@ def read_ply(path):
             elements.append((t[1], int(t[2]), []))
         elif t[:1] == ['property']:
             elements[-1][2].append(t[1:])
-    vertex_props, vertices, faces = [], [], []
+    pos = [end]
     if fmt == 'ascii':
         tokens = data[end:].split()
-        pos = 0
-        for name, count, props in elements:
-            for _ in range(count):
-                row = []
-                for p in props:
-                    if p[0] == 'list':
-                        n = int(tokens[pos]); pos += 1
-                        row.append([int(x) for x in tokens[pos:pos + n]]); pos += n
-                    else:
-                        v = tokens[pos]; pos += 1
-                        row.append(float(v) if TYPES[p[0]] in 'fd' else int(v))
-                if name == 'vertex':
-                    vertices.append(row)
-                elif name == 'face':
-                    faces.append(row[0])
-            if name == 'vertex':
-                vertex_props = props
-        return vertex_props, vertices, faces
-    assert fmt == 'binary_little_endian', fmt
-    pos = end
+        pos = [0]
+
+        def value(t):
+            pos[0] += 1
+            v = tokens[pos[0] - 1]
+            return float(v) if TYPES[t] in 'fd' else int(v)
+    else:
+        assert fmt == 'binary_little_endian', fmt
+
+        def value(t):
+            pos[0] += struct.calcsize(TYPES[t])
+            return struct.unpack_from('<' + TYPES[t], data, pos[0] - struct.calcsize(TYPES[t]))[0]
+    vertex_props, vertices, faces = [], [], []
     for name, count, props in elements:
         for _ in range(count):
             row = []
             for p in props:
                 if p[0] == 'list':
-                    n = struct.unpack_from('<' + TYPES[p[1]], data, pos)[0]
-                    pos += struct.calcsize(TYPES[p[1]])
-                    row.append(list(struct.unpack_from('<%d%s' % (n, TYPES[p[2]]), data, pos)))
-                    pos += n * struct.calcsize(TYPES[p[2]])
+                    n = value(p[1])
+                    row.append([value(p[2]) for _ in range(n)])
                 else:
-                    row.append(struct.unpack_from('<' + TYPES[p[0]], data, pos)[0])
-                    pos += struct.calcsize(TYPES[p[0]])
+                    row.append(value(p[0]))
             if name == 'vertex':
                 vertices.append(row)
             elif name == 'face':
@@ -165,13 +155,11 @@ def main():
             with_size = os.path.getsize(out)
             t_enc = timed(enc + [full, out], a.runs)
             t_dec = timed([pomar, 'decode', '-q', out, os.path.join(tmp, 'd.ply')], a.runs)
-            t_dec_no = timed([pomar, 'decode', '-q', '--no-attributes', out,
-                              os.path.join(tmp, 'd.ply')], a.runs)
             plain = os.path.join(tmp, 'plain.ply')
             write_ply(plain, props, vertices, faces, [])
             t_enc_no = timed(enc + [plain, out], a.runs)
             run(enc + [plain, out])
-            plain_size = os.path.getsize(out)
+            t_dec_no = timed([pomar, 'decode', '-q', out, os.path.join(tmp, 'd.ply')], a.runs)
             times.append((name, nv, t_enc_no, t_enc, t_dec_no, t_dec))
             for label, (ply_props, drop) in groups.items():
                 # pomar: the file with everything minus the file without this group
@@ -202,7 +190,7 @@ def main():
         shutil.rmtree(tmp)
 
     fmt = lambda x: 'n/a' if x is None else '%.2f' % x
-    print('| mesh | vertices | attribute | pomar precision | pomar bpv | pomar stream bpv | '
+    print('| mesh | vertices | attribute | pomar precision | pomar bpv | pomar estimate bpv | '
           'Draco -cl 7 bpv | Draco -cl 10 bpv |')
     print('|:--|--:|:--|:--|--:|--:|--:|--:|')
     for r in rows:
@@ -210,7 +198,7 @@ def main():
                                                          fmt(r[5]), fmt(r[6]), fmt(r[7])))
     print()
     print('| mesh | vertices | encode s (no attributes) | encode s (attributes) | '
-          'decode s (--no-attributes) | decode s (attributes) | decode ratio |')
+          'decode s (no attributes) | decode s (attributes) | decode ratio |')
     print('|:--|--:|--:|--:|--:|--:|--:|')
     for t in times:
         print('| %s | %d | %.3f | %.3f | %.3f | %.3f | %.2f |' % (t + (t[5] / t[4],)))

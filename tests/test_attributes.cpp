@@ -206,11 +206,15 @@ Mesh with_attributes(Mesh m, int has, uint32_t seed = 1) {
   std::uniform_int_distribution<int> noise(-3, 3);
   std::uniform_real_distribution<float> unit(0, 1);
   auto p = [&](size_t v, int k) { return m.positions[3 * v + k]; };
-  if (has & kColour) {
+  auto make = [](AttributeKind kind, const char *name, uint32_t components) {
     VertexAttribute a;
-    a.kind = AttributeKind::Colour;
-    a.name = "colour";
-    a.components = (has & kAlpha) ? 4 : 3;
+    a.kind = kind;
+    a.name = name;
+    a.components = components;
+    return a;
+  };
+  if (has & kColour) {
+    VertexAttribute a = make(AttributeKind::Colour, "colour", (has & kAlpha) ? 4 : 3);
     for (size_t v = 0; v < nv; ++v)
       for (uint32_t k = 0; k < a.components; ++k) {
         const int c = int(127.5 + 120 * std::sin(2.0 * p(v, k % 3) + k)) + noise(rng);
@@ -219,21 +223,15 @@ Mesh with_attributes(Mesh m, int has, uint32_t seed = 1) {
     m.attributes.push_back(a);
   }
   if (has & kNormals) {
-    VertexAttribute a;
-    a.kind = AttributeKind::Normal;
-    a.name = "normal";
-    a.components = 3;
+    VertexAttribute a = make(AttributeKind::Normal, "normal", 3);
     for (size_t v = 0; v < nv; ++v)
       for (int k = 0; k < 3; ++k)
         a.values.push_back(p(v, k) + 0.05f * (unit(rng) - 0.5f));
     m.attributes.push_back(a);
   }
   if (has & kScalars) {
-    VertexAttribute q;
-    q.kind = AttributeKind::Scalar;
-    q.name = "quality";
-    VertexAttribute c = q;
-    c.name = "confidence";
+    VertexAttribute q = make(AttributeKind::Scalar, "quality", 1);
+    VertexAttribute c = make(AttributeKind::Scalar, "confidence", 1);
     for (size_t v = 0; v < nv; ++v) {
       q.values.push_back(100.0f * p(v, 0) * p(v, 1) + 3.0f * p(v, 2));
       c.values.push_back(unit(rng));
@@ -242,10 +240,7 @@ Mesh with_attributes(Mesh m, int has, uint32_t seed = 1) {
     m.attributes.push_back(c);
   }
   if (has & kTexcoords) {
-    VertexAttribute a;
-    a.kind = AttributeKind::TexCoord;
-    a.name = "texcoord";
-    a.components = 2;
+    VertexAttribute a = make(AttributeKind::TexCoord, "texcoord", 2);
     for (size_t v = 0; v < nv; ++v) {
       a.values.push_back(0.5f + std::atan2(p(v, 1), p(v, 0)) / 6.2831853f);
       a.values.push_back(0.5f + 0.5f * p(v, 2));

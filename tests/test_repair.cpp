@@ -80,8 +80,8 @@ TEST(Repair, AlreadyManifoldMeshesAreUnchangedBitForBit) {
   }
 }
 
-TEST(Repair, BowtieVertexIsSplitIntoTwo) {
-  // Two fans of two triangles each around vertex 0, touching only there.
+/// Two fans of two triangles each around vertex 0, touching only there.
+Mesh bowtie() {
   Mesh m;
   add_vertex(m, 0, 0, 0);
   add_vertex(m, 1, 0, 0);
@@ -94,6 +94,11 @@ TEST(Repair, BowtieVertexIsSplitIntoTwo) {
   add_face(m, 0, 2, 3);
   add_face(m, 0, 4, 5);
   add_face(m, 0, 5, 6);
+  return m;
+}
+
+TEST(Repair, BowtieVertexIsSplitIntoTwo) {
+  Mesh m = bowtie();
   const Mesh input = m;
   const RepairReport r = make_manifold(m);
   EXPECT_EQ(counts(r), (std::vector<size_t>{0, 0, 0, 0, 0, 1, 1}));
@@ -110,18 +115,7 @@ TEST(Repair, BowtieVertexIsSplitIntoTwo) {
 }
 
 TEST(Repair, CopiesCarryTheAttributesOfTheirVertex) {
-  Mesh m;
-  add_vertex(m, 0, 0, 0);
-  add_vertex(m, 1, 0, 0);
-  add_vertex(m, 1, 1, 0);
-  add_vertex(m, 0, 1, 0);
-  add_vertex(m, -1, 0, 0);
-  add_vertex(m, -1, -1, 0);
-  add_vertex(m, 0, -1, 0);
-  add_face(m, 0, 1, 2);
-  add_face(m, 0, 2, 3);
-  add_face(m, 0, 4, 5);
-  add_face(m, 0, 5, 6);
+  Mesh m = bowtie();
   VertexAttribute c;
   c.kind = AttributeKind::Colour;
   c.name = "colour";

@@ -787,8 +787,9 @@ int main(int argc, char **argv) {
                 "intact");
   dec->add_flag("-q,--quiet", da.quiet, "Print nothing on success");
   dec->add_flag("--no-attributes", da.no_attributes,
-                "Positions and triangles only: do not decode colour, normals, scalars or "
-                "texture coordinates (faster, less memory)");
+                "Write positions and triangles only: leave out colour, normals, scalars and "
+                "texture coordinates (their codes are interleaved with the positions and are "
+                "read anyway)");
   dec->add_option("--max-memory", da.max_memory,
                   "Refuse (exit 1, no output file) a file whose decoding would need more than "
                   "SIZE of memory, checked from its header (with --cluster/--sphere/--box: for "

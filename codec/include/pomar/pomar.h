@@ -184,8 +184,8 @@ struct DecodeOptions {
   /// Peak memory allowed, in bytes, checked right after the header (0 = automatic,
   /// UINT64_MAX = do not check; see pomar/limits.h).
   uint64_t memory_limit = 0;
-  /// Which stored attributes to decode (AttributeMask::none(): positions and triangles
-  /// only, the attribute section is not decoded).
+  /// Which stored attributes the returned mesh carries (AttributeMask::none(): positions
+  /// and triangles only; the codes are interleaved with the positions and decoded anyway).
   AttributeMask attributes;
 };
 

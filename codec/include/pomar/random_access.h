@@ -64,8 +64,8 @@ struct SelectiveOptions {
   /// Bytes the base clustered mesh may need (0 = automatic, UINT64_MAX = do not check; see
   /// pomar/limits.h). Later refinement is not checked: it decodes what is asked for.
   uint64_t memory_limit = 0;
-  /// Which stored attributes mesh() returns (AttributeMask::none(): none; the attribute
-  /// section is then never decoded). Decoded once, on the first mesh() that needs them.
+  /// Which stored attributes mesh() returns (AttributeMask::none(): none). Their codes
+  /// are decoded with the positions, block by block, whatever this says.
   AttributeMask attributes;
 };
 

@@ -23,6 +23,18 @@ template <class Coder> void code_base(Coder &&code_one, uint32_t count, uint32_t
       code_one(v, k);
 }
 
+/// kind, name, components, bits and bound of a stored attribute into a VertexAttribute or
+/// an AttributeInfo.
+template <class Out> Out described(const StoredAttribute &s) {
+  Out a;
+  a.kind = s.kind;
+  a.name = s.name;
+  a.components = s.components;
+  a.bits = s.bits;
+  a.bound = s.bound();
+  return a;
+}
+
 } // namespace
 
 AttributeTable plan_attributes(const Mesh &mesh, const AttributeOptions &options) {
@@ -239,12 +251,7 @@ void attach_attributes(const AttributeTable &t, const LevelMesh &lm, const Attri
     const StoredAttribute &s = t.stored[i];
     if (!mask.keeps(s.kind))
       continue;
-    VertexAttribute a;
-    a.kind = s.kind;
-    a.name = s.name;
-    a.components = s.components;
-    a.bits = s.bits;
-    a.bound = s.bound();
+    VertexAttribute a = described<VertexAttribute>(s);
     if (s.kind == AttributeKind::Colour)
       a.colour.resize(size_t(nv) * s.components);
     else
@@ -260,12 +267,7 @@ void describe_attributes(const AttributeTable &t, FileInfo &info) {
   uint64_t total = 0;
   for (size_t i = 0; i < t.stored.size(); ++i) {
     const StoredAttribute &s = t.stored[i];
-    AttributeInfo a;
-    a.kind = s.kind;
-    a.name = s.name;
-    a.components = s.components;
-    a.bits = s.bits;
-    a.bound = s.bound();
+    AttributeInfo a = described<AttributeInfo>(s);
     a.bytes = t.estimated_bytes[i];
     total += a.bytes;
     info.attributes.push_back(a);
