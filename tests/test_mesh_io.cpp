@@ -232,7 +232,7 @@ TEST_F(MeshIoTest, ObjQuadIsFanTriangulated) {
   EXPECT_EQ(r.file_faces, 1u);
 }
 
-TEST_F(MeshIoTest, ObjRelativeIndicesSlashesGroupsAndIgnoredAttributes) {
+TEST_F(MeshIoTest, ObjRelativeIndicesSlashesGroupsAndAttributes) {
   const std::string file = write("rel.obj", "mtllib x.mtl\r\no a\r\nv 0 0 0 1 0 0\r\nv 1 0 0 1 0 0\r\n"
                                             "v 0 1 0 1 0 0\r\nvn 0 0 1\r\nvt 0 0\r\n"
                                             "g first\r\nusemtl red\r\nf -3/1/1 -2/1/1 -1/1/1\r\n"
@@ -240,10 +240,52 @@ TEST_F(MeshIoTest, ObjRelativeIndicesSlashesGroupsAndIgnoredAttributes) {
   LoadReport r;
   const Mesh m = pomar::load_mesh(file, &r);
   EXPECT_EQ(m.triangles, (std::vector<uint32_t>{0, 1, 2, 1, 3, 2}));
-  for (const char *a : {"normals", "texture coordinates", "colors", "materials"})
-    EXPECT_NE(std::find(r.ignored_attributes.begin(), r.ignored_attributes.end(), a),
-              r.ignored_attributes.end())
-        << a;
+  // Vertex colours and the one normal every corner uses are kept; the texture coordinate
+  // is missing on the second face's corners, and materials are not kept.
+  EXPECT_EQ(r.ignored_attributes,
+            (std::vector<std::string>{"texture coordinates (not given for every corner)",
+                                      "materials"}));
+  ASSERT_EQ(m.attributes.size(), 2u);
+  EXPECT_EQ(m.find(AttributeKind::Colour)->colour,
+            (std::vector<uint8_t>{255, 0, 0, 255, 0, 0, 255, 0, 0, 255, 0, 0}));
+  EXPECT_EQ(m.find(AttributeKind::Normal)->values,
+            (std::vector<float>{0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}));
+}
+
+TEST_F(MeshIoTest, ObjAttributesRoundTrip) {
+  Mesh m;
+  m.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0.5f, 9, 9, 9};
+  m.triangles = {0, 1, 2, 1, 3, 2};
+  VertexAttribute c;
+  c.kind = AttributeKind::Colour;
+  c.name = "colour";
+  c.components = 3;
+  c.colour = {1, 2, 3, 250, 251, 252, 9, 8, 7, 128, 0, 255, 5, 5, 5};
+  VertexAttribute n;
+  n.kind = AttributeKind::Normal;
+  n.name = "normal";
+  n.components = 3;
+  n.values = {0, 0, 1, 0.6f, 0, 0.8f, -1, 0, 0, 0.1f, 0.2f, 0.3f, 1, 1, 1};
+  VertexAttribute uv;
+  uv.kind = AttributeKind::TexCoord;
+  uv.name = "texcoord";
+  uv.components = 2;
+  uv.values = {0, 0, 1, 0, 0, 1, 0.333333343f, 0.7f, 5, 5};
+  m.attributes = {c, n, uv};
+  save_mesh(path("attr.obj"), m);
+  LoadReport r;
+  const Mesh back = load_mesh(path("attr.obj"), &r);
+  EXPECT_TRUE(r.ignored_attributes.empty());
+  EXPECT_EQ(r.unreferenced_vertices, 1u); // vertex 4 and its attributes are dropped
+  EXPECT_EQ(back.positions, std::vector<float>(m.positions.begin(), m.positions.end() - 3));
+  for (const VertexAttribute &a : m.attributes) {
+    const VertexAttribute *b = back.find(a.kind);
+    ASSERT_NE(b, nullptr) << a.name;
+    EXPECT_EQ(b->colour, std::vector<uint8_t>(a.colour.begin(),
+                                              a.colour.end() - (a.colour.empty() ? 0 : 3)));
+    EXPECT_EQ(b->values, std::vector<float>(a.values.begin(),
+                                            a.values.end() - (a.values.empty() ? 0 : a.components)));
+  }
 }
 
 TEST_F(MeshIoTest, ObjBadFacesAreErrors) {
