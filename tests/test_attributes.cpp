@@ -70,8 +70,17 @@ TEST(AttributeQuantize, YCoCgRIsExactOnEveryColour) {
 }
 
 TEST(AttributeQuantize, FloatCodesAreOrderedAndExact) {
-  const float values[] = {-std::numeric_limits<float>::infinity(), -1e30f, -1.0f, -1e-40f, -0.0f,
-                          0.0f, 1e-45f, 1e-40f, 0.5f, 1.0f, 3e38f,
+  const float values[] = {-std::numeric_limits<float>::infinity(),
+                          -1e30f,
+                          -1.0f,
+                          -1e-40f,
+                          -0.0f,
+                          0.0f,
+                          1e-45f,
+                          1e-40f,
+                          0.5f,
+                          1.0f,
+                          3e38f,
                           std::numeric_limits<float>::infinity()};
   for (size_t i = 0; i < sizeof(values) / sizeof(float); ++i) {
     const float back = code_float(float_code(values[i]));
@@ -191,7 +200,6 @@ TEST(AttributeQuantize, ValidationNamesTheProblem) {
   expect_error(triangle_with(n), true, "of vertex 1 has length 0");
   EXPECT_NO_THROW(validate_attributes(triangle_with(n), false));
 }
-
 
 // ---------------------------------------------------------------- round trips
 
@@ -340,8 +348,8 @@ void expect_same_as_full(const Mesh &part, const Mesh &full) {
 
 TEST(AttributeRoundTrip, EveryCombinationProgressiveAndClustered) {
   const Mesh sphere = gen::noisy_sphere(1500, 4, 0.1);
-  for (int has : {int(kColour), kColour | kAlpha, int(kNormals), int(kScalars), int(kTexcoords),
-                  int(kAll)})
+  for (int has :
+       {int(kColour), kColour | kAlpha, int(kNormals), int(kScalars), int(kTexcoords), int(kAll)})
     for (bool clustered : {false, true}) {
       SCOPED_TRACE("attributes " + std::to_string(has) + (clustered ? " clustered" : ""));
       const Coded c = encode_with(with_attributes(sphere, has), clustered);
@@ -454,9 +462,9 @@ TEST(AttributeRoundTrip, DropAndSkip) {
   plain.attributes.clear();
   plain.texture_files.clear();
   EXPECT_EQ(encode_with(m, true, drop_all).file, encode_with(plain, true).file);
-  EXPECT_EQ(inspect(encode_with(plain, false).file.data(), encode_with(plain, false).file.size())
-                .version,
-            1u);
+  EXPECT_EQ(
+      inspect(encode_with(plain, false).file.data(), encode_with(plain, false).file.size()).version,
+      1u);
 }
 
 TEST(AttributeRoundTrip, BadInputIsRefused) {
@@ -507,7 +515,7 @@ TEST(AttributeRoundTrip, SelectiveDecodesReadOnlyTheirBlocks) {
   const FileInfo b = inspect(without.file.data(), without.file.size());
   EXPECT_EQ(a.clusters, b.clusters);
   EXPECT_GT(a.cluster_bytes, b.cluster_bytes + 3000); // the attributes are in the blocks
-  EXPECT_LT(a.attribute_bytes, a.total_bytes / 20);    // the section: base mesh only
+  EXPECT_LT(a.attribute_bytes, a.total_bytes / 20);   // the section: base mesh only
   SelectiveDecoder d(std::make_unique<MemorySource>(with.file.data(), with.file.size()));
   d.want_cluster(0, d.base_clustered_level() + 2);
   d.update();

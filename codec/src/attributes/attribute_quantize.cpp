@@ -39,8 +39,8 @@ bool AttributeMask::keeps(AttributeKind kind) const {
 double normal_error_bound(int bits) {
   // Largest angle measured over 2 million normals (uniform on the sphere plus the axes,
   // the octahedron's edges and its folds) plus 5%: tests/test_attributes.cpp checks it.
-  static const double kBound[] = {/*4*/ 11.9,   /*5*/ 5.6,     /*6*/ 2.75,    /*7*/ 1.34,
-                                  /*8*/ 0.67,   /*9*/ 0.332,   /*10*/ 0.166,  /*11*/ 0.083,
+  static const double kBound[] = {/*4*/ 11.9,    /*5*/ 5.6,     /*6*/ 2.75,    /*7*/ 1.34,
+                                  /*8*/ 0.67,    /*9*/ 0.332,   /*10*/ 0.166,  /*11*/ 0.083,
                                   /*12*/ 0.0415, /*13*/ 0.0207, /*14*/ 0.0104, /*15*/ 0.0052,
                                   /*16*/ 0.0026};
   if (bits < 4 || bits > 16)
@@ -87,8 +87,7 @@ void validate_attributes(const Mesh &mesh, bool quantized, const AttributeMask &
       want = 2;
       break;
     default:
-      throw Error("attribute '" + a.name + "' has an unknown kind " +
-                  std::to_string(int(a.kind)));
+      throw Error("attribute '" + a.name + "' has an unknown kind " + std::to_string(int(a.kind)));
     }
     if (a.components != want)
       throw Error(what + " has " + std::to_string(a.components) + " components per vertex, " +
@@ -243,7 +242,7 @@ StoredAttribute describe(const VertexAttribute &a, const AttributeOptions &o) {
   s.components = a.components;
   if (a.kind == AttributeKind::Colour || o.exact)
     return s;
-  s.bits = a.kind == AttributeKind::Normal    ? o.normal_bits
+  s.bits = a.kind == AttributeKind::Normal     ? o.normal_bits
            : a.kind == AttributeKind::TexCoord ? o.texcoord_bits
                                                : o.scalar_bits;
   const int max_bits = a.kind == AttributeKind::Normal ? 16 : 24;

@@ -25,9 +25,7 @@ struct StoredAttribute {
   int bits = 0;              // 0 = exact
   std::vector<float> lo, hi; // quantized scalars / texture coordinates: range per component
   /// Integer codes per vertex.
-  uint32_t codes() const {
-    return kind == AttributeKind::Normal && bits ? 2 : components;
-  }
+  uint32_t codes() const { return kind == AttributeKind::Normal && bits ? 2 : components; }
   /// Largest error of a decoded value (degrees for normals, absolute otherwise).
   double bound() const;
 };

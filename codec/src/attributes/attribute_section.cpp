@@ -48,8 +48,8 @@ AttributeTable plan_attributes(const Mesh &mesh, const AttributeOptions &options
     throw Error("at most 255 attributes can be stored (the mesh has " +
                 std::to_string(t.stored.size()) + ")");
   if (t.codes > kMaxAttributeCodes)
-    throw Error("the attributes need " + std::to_string(t.codes) +
-                " values per vertex; at most " + std::to_string(kMaxAttributeCodes) +
+    throw Error("the attributes need " + std::to_string(t.codes) + " values per vertex; at most " +
+                std::to_string(kMaxAttributeCodes) +
                 " are supported (colour 3-4, quantized normal 2, texcoord 2, scalar 1): "
                 "drop some (--drop)");
   if (options.keep.texcoords)
@@ -180,9 +180,10 @@ AttributeTable read_attributes(const uint8_t *data, size_t size, uint32_t base_v
                           : s.kind == AttributeKind::TexCoord ? 2
                           : s.kind == AttributeKind::Scalar   ? 1
                                                               : s.components;
-    const bool bits_ok = s.kind == AttributeKind::Colour   ? s.bits == 0
-                         : s.kind == AttributeKind::Normal ? s.bits == 0 || (s.bits >= 4 && s.bits <= 16)
-                                                           : s.bits <= 24;
+    const bool bits_ok = s.kind == AttributeKind::Colour ? s.bits == 0
+                         : s.kind == AttributeKind::Normal
+                             ? s.bits == 0 || (s.bits >= 4 && s.bits <= 16)
+                             : s.bits <= 24;
     if (s.components != want || want < 1 || want > 4 ||
         (s.kind == AttributeKind::Colour && want < 3) || !bits_ok || s.name.empty())
       damaged("attribute '" + s.name + "' has an invalid descriptor");
@@ -231,13 +232,14 @@ AttributeTable read_attributes(const uint8_t *data, size_t size, uint32_t base_v
   return t;
 }
 
-std::unique_ptr<AttributeTable> load_attribute_table(const uint8_t *data, const FileLayout &layout) {
+std::unique_ptr<AttributeTable> load_attribute_table(const uint8_t *data,
+                                                     const FileLayout &layout) {
   const int i = find_section(layout, kAttributeSectionTag);
   if (i < 0)
     return nullptr;
   const uint8_t *body = section_body(data, layout, size_t(i)); // checks its XXH32
-  return std::make_unique<AttributeTable>(read_attributes(
-      body, layout.header.sections[size_t(i)].bytes, layout.header.base_vertices));
+  return std::make_unique<AttributeTable>(
+      read_attributes(body, layout.header.sections[size_t(i)].bytes, layout.header.base_vertices));
 }
 
 void attach_attributes(const AttributeTable &t, const LevelMesh &lm, const AttributeMask &mask,
