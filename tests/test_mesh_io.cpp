@@ -579,11 +579,21 @@ TEST_F(MeshIoTest, OffWithNormalsColorsAndTexCoords) {
   const Mesh m = pomar::load_mesh(write("n.off", "NOFF\n3 1 0\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n"
                                                  "3 0 1 2\n"), &r);
   EXPECT_EQ(m.triangles, (std::vector<uint32_t>{0, 1, 2}));
-  EXPECT_EQ(r.ignored_attributes, (std::vector<std::string>{"normals"}));
+  EXPECT_TRUE(r.ignored_attributes.empty()); // per-vertex normals are kept
+  ASSERT_NE(m.find(AttributeKind::Normal), nullptr);
+  EXPECT_EQ(m.find(AttributeKind::Normal)->values,
+            (std::vector<float>{0, 0, 1, 0, 0, 1, 0, 0, 1}));
   const Mesh c = pomar::load_mesh(write("c.off", "STCOFF 3 1 0\n0 0 0 255 0 0 255 0.5 0.5\n"
                                                  "1 0 0 255 0 0 255 1 0\n0 1 0 9 9 9 9 0 1\n"
                                                  "3 0 1 2 255 0 0\n"), &r);
   EXPECT_EQ(c.positions, (std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0}));
+  // Vertex colours (RGBA: an alpha is not 255) are kept; the face colour and the texture
+  // coordinates (which vcglib's importer does not store) are not.
+  EXPECT_EQ(r.ignored_attributes, (std::vector<std::string>{"colors", "texture coordinates"}));
+  ASSERT_NE(c.find(AttributeKind::Colour), nullptr);
+  EXPECT_EQ(c.find(AttributeKind::Colour)->colour,
+            (std::vector<uint8_t>{255, 0, 0, 255, 255, 0, 0, 255, 9, 9, 9, 9}));
+  EXPECT_EQ(c.find(AttributeKind::TexCoord), nullptr);
 }
 
 TEST_F(MeshIoTest, OffTruncatedFaceListIsError) {

@@ -4,8 +4,8 @@
 // Positions, triangles and per-vertex attributes (Mesh::attributes) are kept: PLY vertex
 // colour (8-bit), normals, texture coordinates, every other scalar property by its name and
 // "comment TextureFile" names; OBJ vertex colours (rounded to 8 bits) and the normals and
-// texture coordinates that are per vertex. Everything else a file may carry (face data,
-// per-corner attributes, materials, OFF colours, ...) is dropped and named in
+// texture coordinates that are per vertex; OFF vertex colours and normals. Everything else a
+// file may carry (face data, per-corner attributes, materials, ...) is dropped and named in
 // LoadReport::ignored_attributes. save_mesh writes the attributes to PLY and OBJ.
 // PLY, OFF and ASCII STL are read through vcglib's importers (so a file loads as it does
 // in MeshLab), binary STL directly, OBJ through tinyobjloader. Every failure throws
