@@ -7,6 +7,7 @@
 
 #include <common/interfaces.h>
 #include <vcg/complex/allocate.h>
+#include <common/ml_mesh_type.h>
 #include <vcg/complex/complex.h>
 
 #include <QString>
@@ -18,6 +19,7 @@
 #include <exception>
 #include <string>
 #include <vector>
+#include <utility>
 
 namespace pomar::meshlab {
 
@@ -27,11 +29,14 @@ constexpr const char *kSourceAttribute = "pomar_source";   ///< per mesh, absolu
 /// per mesh, int: 1 if the layer was opened with "Skip damaged blocks" (the filters then
 /// decode around damaged blocks too)
 constexpr const char *kSkipDamagedAttribute = "pomar_skip_damaged";
+/// per vertex, vcg::Color4b: the layer's own colours while "Show Clusters" / "Show Levels"
+/// paint the vertices; "Show Original Colours" puts them back, saving uses them.
+constexpr const char *kSavedColourAttribute = "pomar_saved_colour";
 
 /// The attributes above: a .pomar file re-creates them, saving does not lose them.
 inline bool isPomarAttribute(const std::string &name) {
-  for (const char *own :
-       {kClusterAttribute, kLevelAttribute, kSourceAttribute, kSkipDamagedAttribute})
+  for (const char *own : {kClusterAttribute, kLevelAttribute, kSourceAttribute,
+                          kSkipDamagedAttribute, kSavedColourAttribute})
     if (name == own)
       return true;
   return false;
@@ -72,6 +77,21 @@ inline QString errorText(const std::exception &e, const QString &context) {
   if (error != nullptr && !error->path().empty())
     return what;
   return QString("%1: %2").arg(context, what);
+}
+
+/// The layer's own colours saved by Show Clusters / Show Levels (invalid handle if none).
+inline CMeshO::PerVertexAttributeHandle<vcg::Color4b> savedColours(CMeshO &m) {
+  return vcg::tri::Allocator<CMeshO>::FindPerVertexAttribute<vcg::Color4b>(m,
+                                                                            kSavedColourAttribute);
+}
+
+/// Swap the vertex colours with the saved ones (no-op without saved colours).
+inline void swapSavedColours(CMeshO &m) {
+  auto saved = savedColours(m);
+  if (!vcg::tri::Allocator<CMeshO>::IsValidHandle(m, saved))
+    return;
+  for (size_t v = 0; v < m.vert.size(); ++v)
+    std::swap(m.vert[v].C(), saved[v]);
 }
 
 /// Forwards progress to MeshLab's callback at most every 10% (meshlabserver prints the

@@ -32,6 +32,7 @@ struct ScriptedCodec {
     for (int k = 0; k < 3; ++k)
       position[k] = mesh->q[3 * v_to + k];
   }
+  void attributes(const LevelMesh &, const int64_t *, int64_t *) {} // meshes without attributes
   [[noreturn]] void corrupt(const char *what) { throw Error(Error::Kind::DamagedFile, what); }
 };
 

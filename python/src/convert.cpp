@@ -150,6 +150,22 @@ py::dict info_dict(const pomar::FileInfo &i) {
   d["bpv"] = bpv(i.total_bytes);
   d["connectivity_bpv"] = bpv(i.connectivity_bytes);
   d["geometry_bpv"] = bpv(i.geometry_bytes);
+  py::list attributes;
+  for (const pomar::AttributeInfo &a : i.attributes) {
+    py::dict entry;
+    entry["kind"] = pomar::kind_name(a.kind);
+    entry["name"] = a.name;
+    entry["components"] = a.components;
+    entry["bits"] = a.bits;
+    entry["exact"] = a.bits == 0;
+    entry["bound"] = a.bound;
+    entry["bytes"] = a.bytes;
+    entry["bpv"] = bpv(a.bytes);
+    attributes.append(entry);
+  }
+  d["attributes"] = attributes;
+  d["attribute_bytes"] = i.attribute_bytes;
+  d["texture_files"] = py::list(py::cast(i.texture_files));
   return d;
 }
 

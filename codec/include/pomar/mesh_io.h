@@ -1,8 +1,12 @@
 // Reading and writing triangle meshes as PLY, OBJ, OFF and STL files.
 //
 // The format is chosen by the file extension (case-insensitive): .ply, .obj, .off, .stl.
-// Only positions and triangles are kept; everything else a file may carry (normals, colors,
-// texture coordinates, ...) is dropped and named in LoadReport::ignored_attributes.
+// Positions, triangles and per-vertex attributes (Mesh::attributes) are kept: PLY vertex
+// colour (8-bit), normals, texture coordinates, every other scalar property by its name and
+// "comment TextureFile" names; OBJ vertex colours (rounded to 8 bits) and the normals and
+// texture coordinates that are per vertex; OFF vertex colours and normals. Everything else a
+// file may carry (face data, per-corner attributes, materials, ...) is dropped and named in
+// LoadReport::ignored_attributes. save_mesh writes the attributes to PLY and OBJ.
 // PLY, OFF and ASCII STL are read through vcglib's importers (so a file loads as it does
 // in MeshLab), binary STL directly, OBJ through tinyobjloader. Every failure throws
 // pomar::Error with a one-line message that starts with the file's path.

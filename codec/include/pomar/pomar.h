@@ -29,6 +29,8 @@
 #include <string>
 #include <vector>
 
+#include "pomar/attributes.h"
+
 namespace pomar {
 
 /// The version of the library the program runs with, "MAJOR.MINOR.PATCH" (compare with
@@ -85,13 +87,25 @@ private:
 };
 
 /// A triangle mesh as flat arrays: x,y,z per vertex and three vertex indices per
-/// triangle, counter-clockwise seen from outside.
+/// triangle, counter-clockwise seen from outside; optionally per-vertex attributes
+/// (pomar/attributes.h) and the texture files the texture coordinates refer to.
 struct Mesh {
   std::vector<float> positions;    // 3 * vertex_count()
   std::vector<uint32_t> triangles; // 3 * triangle_count()
+  std::vector<VertexAttribute> attributes;
+  std::vector<std::string> texture_files; ///< metadata, kept as given
   size_t vertex_count() const { return positions.size() / 3; }
   size_t triangle_count() const { return triangles.size() / 3; }
+  /// The first attribute of this kind (and this name, if given), or nullptr.
+  const VertexAttribute *find(AttributeKind kind, const std::string &name = {}) const;
+  VertexAttribute *find(AttributeKind kind, const std::string &name = {});
 };
+
+/// Throw pomar::Error naming the attribute (and vertex) if an attribute does not fit the
+/// mesh: wrong component count, value count not matching the vertex count, empty or
+/// repeated name; with `quantized`, also NaN/infinite values and zero-length normals.
+/// Attributes whose kind `mask` drops are not checked.
+void validate_attributes(const Mesh &mesh, bool quantized, const AttributeMask &mask = {});
 
 /// Progress callback: fraction in [0,1] and a short stage name ("decimate", "encode", ...).
 using Progress = std::function<void(double fraction, const char *stage)>;
@@ -109,6 +123,9 @@ struct EncodeOptions {
   /// allocations if it would need more (pomar/limits.h). 0 = automatic (the memory
   /// available to the process), UINT64_MAX (kNoMemoryLimit) = do not check.
   uint64_t memory_limit = 0;
+  /// Which attributes are stored and how precisely (default: all, normals within 0.33°,
+  /// scalars on 16 bits, texture coordinates on 12 bits over their ranges).
+  AttributeOptions attributes;
 };
 
 /// One refinement level of a file: the mesh it produces and what it costs.
@@ -128,6 +145,16 @@ struct Quantizer {
   double step() const;
   float dequantize(int axis, uint32_t q) const;
   uint32_t quantize(int axis, float x) const; ///< nearest grid index, clamped to the grid
+};
+
+/// An attribute stored in a file (its ATTR section).
+struct AttributeInfo {
+  AttributeKind kind = AttributeKind::Scalar;
+  std::string name;
+  uint32_t components = 0;
+  int bits = 0;       ///< 0 = exact
+  double bound = 0;   ///< as VertexAttribute::bound
+  uint64_t bytes = 0; ///< its coded residuals
 };
 
 /// What a .pomar file holds (read from its header and level table only).
@@ -154,6 +181,10 @@ struct FileInfo {
   uint64_t global_bytes = 0; ///< header, base mesh, global levels, tables, index
   uint64_t tables_bytes = 0, index_bytes = 0, cluster_bytes = 0;
   std::vector<uint32_t> cluster_block_bytes; ///< filled by inspect()
+  /// Per-vertex attributes (filled by inspect(); empty if the file has none).
+  std::vector<AttributeInfo> attributes;
+  std::vector<std::string> texture_files;
+  uint64_t attribute_bytes = 0; ///< the whole ATTR section
   /// Version 4: what the file carries in sections of its global part, with their sizes.
   struct Section {
     std::string name;      ///< four ASCII characters, e.g. "LSLS"
@@ -231,6 +262,9 @@ struct DecodeOptions {
   /// Peak memory allowed, in bytes, checked right after the header (0 = automatic,
   /// UINT64_MAX = do not check; see pomar/limits.h).
   uint64_t memory_limit = 0;
+  /// Which stored attributes the returned mesh carries (AttributeMask::none(): positions
+  /// and triangles only; the codes are interleaved with the positions and decoded anyway).
+  AttributeMask attributes;
 };
 
 struct DecodeReport {

@@ -6,6 +6,8 @@
 
 #include "decode/damage.h"
 #include "decode/global_levels.h"
+#include "attributes/attribute_section.h"
+#include "decode/decoder_codec.h"
 #include "entropy/models.h"
 #include "format/file_format.h"
 #include "pomar/limits.h"
@@ -23,6 +25,8 @@ FileInfo inspect(const uint8_t *data, size_t size) {
     const ClusterIndex index = read_cluster_index(data + layout.index_offset, layout);
     info.cluster_block_bytes = index.size;
   }
+  if (const auto table = load_attribute_table(data, layout))
+    describe_attributes(*table, info);
   return info;
 }
 
@@ -117,6 +121,7 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
     // Checked above for the whole target level; the constructor's check is smaller.
     SelectiveOptions so;
     so.skip_damaged = options.skip_damaged;
+    so.attributes = options.attributes;
     so.memory_limit = kNoMemoryLimit;
     SelectiveDecoder d(std::make_unique<MemorySource>(data, size), so);
     d.want_all(static_cast<int>(target));
@@ -130,10 +135,19 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
   }
   LevelMesh lm = base_level_mesh(data, layout);
   Models models;
+  // Attribute codes come with the positions: decoded whatever the mask says.
+  const std::unique_ptr<AttributeTable> attributes = load_attribute_table(data, layout);
+  if (attributes) {
+    init_attributes(*attributes, lm);
+    models.attr = attribute_models(*attributes);
+  }
   r.level = static_cast<int>(decode_global_levels(data, layout, 0, std::min(target, global), lm,
                                                   models, options.progress,
                                                   options.skip_damaged ? &r.damaged : nullptr));
-  return to_mesh(lm, h.grid);
+  Mesh out = to_mesh(lm, h.grid);
+  if (attributes)
+    attach_attributes(*attributes, lm, options.attributes, out);
+  return out;
 }
 
 } // namespace pomar

@@ -54,6 +54,19 @@ public:
     }
   }
 
+  /// A split vertex's attribute codes: v_to's codes plus the decoded residuals.
+  void attributes(const LevelMesh &mesh, const int64_t *pred, int64_t *codes) {
+    const uint32_t n = mesh.attr_codes;
+    int64_t r[kMaxAttributeCodes];
+    for (uint32_t k = 0; k < n; ++k) {
+      AttributeCodeModels &m = m_->attr[k];
+      r[k] = get_signed(*geom_, m.classes[attribute_context(m, r, k)], m.top);
+      codes[k] = pred[k] + r[k];
+      if (codes[k] < mesh.attr_lo[k] || codes[k] > mesh.attr_hi[k])
+        corrupt("a decoded attribute lies outside its range");
+    }
+  }
+
   [[noreturn]] void corrupt(const char *what) {
     std::string where = "level " + std::to_string(level_);
     if (cluster_ != kNone)

@@ -6,6 +6,7 @@
 
 #include "decode/cluster_stream.h"
 #include "decode/damage.h"
+#include "attributes/attribute_section.h"
 #include "decode/decoder_codec.h"
 #include "decode/global_levels.h"
 #include "decode/level_map.h"
@@ -54,6 +55,10 @@ struct SelectiveDecoder::State {
   int uniform_cap = 1 << 30; // progressive files: the level before a damaged one
 
   LevelStep step;
+
+  // Attributes: descriptors and base codes (the other codes come with the positions).
+  AttributeMask attribute_mask;
+  std::unique_ptr<AttributeTable> attributes;
 
   bool clustered() const { return layout.header.clustered(); }
   void reset_to_snapshot();
@@ -134,6 +139,7 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   State &s = *s_;
   s.source = std::move(source);
   s.skip_damaged = options.skip_damaged;
+  s.attribute_mask = options.attributes;
   const uint64_t file_size = s.source->size();
   // Header: the fixed part, then as much more as header_size() asks for (version 4 needs
   // one more step: its section count says how long the section table is).
@@ -163,6 +169,11 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   const FileHeader &h = s.layout.header;
   s.finest = static_cast<int>(h.levels.size());
   s.mesh = base_level_mesh(s.global.data(), s.layout);
+  s.attributes = load_attribute_table(s.global.data(), s.layout);
+  if (s.attributes) { // attribute codes come with the positions, whatever the mask says
+    init_attributes(*s.attributes, s.mesh);
+    s.global_models.attr = attribute_models(*s.attributes);
+  }
   if (!s.clustered()) {
     s.global_levels = 0;
     s.snapshot = s.mesh;
@@ -173,7 +184,7 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   check_block(s.global.data() + s.layout.tables_offset, h.tables_bytes, h.tables_checksum,
               "static model tables");
   s.level_models = read_tables(s.global.data() + s.layout.tables_offset, h.tables_bytes,
-                               h.levels.size() - h.global_levels);
+                               h.levels.size() - h.global_levels, s.global_models.attr);
   s.index = read_cluster_index(s.global.data() + s.layout.index_offset, s.layout);
   s.info.cluster_block_bytes = s.index.size;
   decode_global_levels(s.global.data(), s.layout, 0, h.global_levels, s.mesh, s.global_models, {});
@@ -329,6 +340,8 @@ void SelectiveDecoder::update(const Progress &progress) {
     if (s.uniform_level < have) {
       s.mesh = s.snapshot;
       s.global_models = Models();
+      if (s.attributes)
+        s.global_models.attr = attribute_models(*s.attributes);
       have = 0;
     }
     const size_t want = size_t(std::min(s.uniform_level, s.uniform_cap));
@@ -414,7 +427,13 @@ void SelectiveDecoder::State::check_cluster_data() {
   damaged.push_back(unlocated_damage(kUnlocatedDamage));
 }
 
-Mesh SelectiveDecoder::mesh() const { return to_mesh(s_->mesh, s_->layout.header.grid); }
+Mesh SelectiveDecoder::mesh() const {
+  const State &s = *s_;
+  Mesh out = to_mesh(s.mesh, s.layout.header.grid);
+  if (s.attributes)
+    attach_attributes(*s.attributes, s.mesh, s.attribute_mask, out);
+  return out;
+}
 
 std::vector<uint32_t> SelectiveDecoder::vertex_cluster() const {
   std::vector<uint32_t> out(s_->mesh.vertex_count(), 0);

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 
+#include "attributes/attribute_section.h"
 #include "decimate/decimate.h"
 #include "encode/clusters.h"
 #include "encode/encoder_codec.h"
@@ -77,6 +78,7 @@ struct PreparedInput {
 
 PreparedInput prepare_input(const Mesh &mesh, const EncodeOptions &options) {
   check_input(mesh, options);
+  validate_attributes(mesh, !options.attributes.exact, options.attributes.keep);
   // The caller already holds the input mesh: an automatic check counts only the rest.
   const uint64_t held =
       mesh.positions.size() * sizeof(float) + mesh.triangles.size() * sizeof(uint32_t);
@@ -136,7 +138,9 @@ std::vector<std::vector<uint8_t>> encode_global_levels(Rebuild &rb, size_t globa
                                                        FileHeader &header, SymbolBits &bits,
                                                        const Progress &progress) {
   Models models;
+  models.attr = rb.attr_models;
   EncoderCodec<RangeEncoder> codec(rb.q, rb.dec_to_input, rb.input_to_dec);
+  codec.set_attribute_codes(rb.attr_codes, rb.attr_codes_per_vertex);
   std::vector<std::vector<uint8_t>> blocks;
   for (size_t r = 0; r < global; ++r) {
     const uint32_t level = static_cast<uint32_t>(r + 1);
@@ -156,6 +160,8 @@ std::vector<std::vector<uint8_t>> encode_global_levels(Rebuild &rb, size_t globa
       progress(double(r + 1) / double(rb.levels()), "encode");
   }
   bits = codec.bits;
+  for (size_t k = 0; k < codec.attr_bits.size(); ++k)
+    rb.attr_bits[k] += codec.attr_bits[k];
   return blocks;
 }
 
@@ -174,6 +180,20 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
   auto t2 = std::chrono::steady_clock::now();
   Rebuild rb(in.q, dec);
   const BaseMesh base = start_from_base_mesh(rb, nv);
+  // Attributes: codes of every vertex (prepared numbering); the base mesh's go to the ATTR
+  // section, the others are coded with their positions by the level steps.
+  AttributeTable attributes = plan_attributes(mesh, options.attributes);
+  const std::vector<int64_t> codes =
+      attributes.codes ? attribute_codes(mesh, attributes, options.attributes, in.to_input)
+                       : std::vector<int64_t>();
+  for (uint32_t v : rb.dec_to_input)
+    attributes.base.insert(attributes.base.end(), codes.begin() + size_t(v) * attributes.codes,
+                           codes.begin() + size_t(v + 1) * attributes.codes);
+  init_attributes(attributes, rb.mesh);
+  rb.attr_codes = &codes;
+  rb.attr_codes_per_vertex = attributes.codes;
+  rb.attr_models = attribute_models(attributes);
+  rb.attr_bits.assign(attributes.codes, 0.0);
   FileHeader header;
   header.grid = in.grid;
   header.vertices = nv;
@@ -192,11 +212,24 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
     throw Error(Error::Kind::Internal,
                 "internal encoder error: the refined mesh does not match the input");
 
+  // Attributes (format version 4, "ATTR" section): descriptors, base mesh codes, sizes.
+  std::vector<Section> sections;
+  if (!attributes.stored.empty() || !attributes.texture_files.empty()) {
+    for (size_t i = 0, k = 0; i < attributes.stored.size(); ++i) {
+      double attr_bits = 0;
+      for (uint32_t c = 0; c < attributes.stored[i].codes(); ++c, ++k)
+        attr_bits += rb.attr_bits[k];
+      attributes.estimated_bytes[i] = static_cast<uint64_t>(attr_bits / 8.0 + 0.5);
+    }
+    sections.push_back({kAttributeSectionTag, 0, write_attributes(attributes)}); // optional
+  }
   std::vector<uint8_t> file = write_file(header, pack_base_mesh(base, in.grid.bits), blocks,
-                                         clustered.tables, clustered.blocks);
+                                         clustered.tables, clustered.blocks, sections);
   if (report) {
     const FileLayout layout = read_layout(file.data(), file.size());
     report->info = file_info(layout, file.size());
+    if (const auto table = load_attribute_table(file.data(), layout))
+      describe_attributes(*table, report->info);
     report->input_vertices = mesh.vertex_count();
     report->unreferenced_vertices = mesh.vertex_count() - nv;
     report->quantize_seconds = t_quantize;

@@ -552,7 +552,7 @@ const uint8_t *section_body(const uint8_t *data, const FileLayout &L, size_t i) 
 
 const std::vector<uint32_t> &known_sections() {
   // The sections this build's decoders honour (issues 12 and 13 add theirs here).
-  static const std::vector<uint32_t> known;
+  static const std::vector<uint32_t> known = {section_tag("ATTR")};
   return known;
 }
 
@@ -638,6 +638,8 @@ FileInfo file_info(const FileLayout &L, uint64_t file_size) {
     for (int k = 0; k < 4; ++k)
       name += static_cast<char>(e.tag >> (8 * k));
     info.sections.push_back({name, e.bytes, (e.flags & kSectionRequired) != 0});
+    if (e.tag == section_tag("ATTR"))
+      info.attribute_bytes += e.bytes;
   }
   return info;
 }

@@ -256,10 +256,13 @@ class IoEdge;
 class IoFace;
 struct IoTypes : vcg::UsedTypes<vcg::Use<IoVertex>::AsVertexType, vcg::Use<IoEdge>::AsEdgeType,
                                 vcg::Use<IoFace>::AsFaceType> {};
-// The normal is only there because ImporterOFF stores the normals of an NOFF file without
-// asking whether the vertex type has them (EmptyCore::N() asserts). They are dropped.
+// Per-vertex colour, normal, quality and texture coordinates hold the attributes a file
+// keeps (PLY: read by our walk and stored here; OFF: by vcglib's importer), so that
+// from_vcg drops them with their unreferenced vertices.
 class IoVertex
-    : public vcg::Vertex<IoTypes, vcg::vertex::Coord3f, vcg::vertex::Normal3f, vcg::vertex::BitFlags> {};
+    : public vcg::Vertex<IoTypes, vcg::vertex::Coord3f, vcg::vertex::Normal3f,
+                         vcg::vertex::Color4b, vcg::vertex::Qualityf, vcg::vertex::TexCoord2f,
+                         vcg::vertex::BitFlags> {};
 // Edges only so that the PLY importer has somewhere to put an "edge" element: without an
 // edge container it asserts. They are dropped.
 class IoEdge : public vcg::Edge<IoTypes, vcg::edge::VertexRef, vcg::edge::BitFlags> {};
@@ -322,6 +325,10 @@ Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &chec
 std::string ply_ascii_text(const Mesh &mesh);
 /// Binary PLY through vcglib's exporter, via a temporary file.
 void save_ply_binary(const std::string &path, const Mesh &mesh);
+/// A PLY file (ASCII or binary little-endian) with the mesh's attributes as vertex
+/// properties (red green blue [alpha] uchar, nx ny nz, texture_u texture_v, one float per
+/// scalar by its name) and "comment TextureFile" lines.
+std::string ply_with_attributes(const Mesh &mesh, bool binary, const std::string &path);
 // off_io.cpp
 Mesh load_off(const std::string &path, LoadReport &report, const SizeCheck &check);
 std::string off_text(const Mesh &mesh);

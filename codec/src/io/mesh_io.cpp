@@ -166,9 +166,12 @@ void save_mesh(const std::string &path, const Mesh &mesh, bool binary) {
   std::string text;
   switch (format) {
   case Format::Ply:
-    if (binary)
+    if (!mesh.attributes.empty() || !mesh.texture_files.empty())
+      text = ply_with_attributes(mesh, binary, path);
+    else if (binary)
       return save_ply_binary(path, mesh);
-    text = ply_ascii_text(mesh);
+    else
+      text = ply_ascii_text(mesh);
     break;
   case Format::Stl:
     if (binary)

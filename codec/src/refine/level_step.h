@@ -96,6 +96,7 @@ private:
       const uint32_t v_from = mesh.vertex_count();
       apply_split(mesh.ct, ps.op, v_from);
       mesh.q.insert(mesh.q.end(), ps.v_from.position, ps.v_from.position + 3);
+      mesh.attr.insert(mesh.attr.end(), ps.v_from.attr, ps.v_from.attr + mesh.attr_codes);
       mesh.tag.push_back({cluster, static_cast<uint16_t>(level)});
       mesh.parent.push_back(ps.op.v_to);
       if (next_local)

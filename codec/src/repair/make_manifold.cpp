@@ -398,6 +398,21 @@ RepairReport make_manifold(Mesh &mesh) {
   for (uint32_t v : copy_of)
     for (int a = 0; a < 3; ++a)
       mesh.positions.push_back(mesh.positions[3 * v + a]);
+  // A copy carries the attributes of its vertex (attributes of another length are left
+  // alone: the encoder reports them).
+  for (VertexAttribute &attr : mesh.attributes) {
+    const size_t n = attr.components;
+    const bool colour = attr.kind == AttributeKind::Colour;
+    if (n == 0 || (colour ? attr.colour.size() : attr.values.size()) != n * nv)
+      continue;
+    for (uint32_t v : copy_of)
+      for (size_t k = 0; k < n; ++k) {
+        if (colour)
+          attr.colour.push_back(attr.colour[n * v + k]);
+        else
+          attr.values.push_back(attr.values[n * v + k]);
+      }
+  }
 
   // The codec's own check must accept the result (see the argument at the top of this
   // file); if it ever does not, say so rather than hand back a wrong mesh.
