@@ -292,12 +292,16 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   // Header: fixed part, then its full size.
   s.global.resize(std::min<uint64_t>(file_size, kFixedHeaderBytes));
   s.source->read(0, s.global.size(), s.global.data());
-  const size_t hsize = header_size(s.global.data(), s.global.size());
-  if (hsize > file_size)
-    throw Error("truncated .pomar file: the header alone needs " + std::to_string(hsize) +
-                " bytes");
-  s.global.resize(hsize);
-  s.source->read(0, hsize, s.global.data());
+  size_t hsize = header_size(s.global.data(), s.global.size());
+  for (size_t have = s.global.size(); hsize != have;) { // version 4: the section table's size
+    if (hsize > file_size)
+      throw Error("truncated .pomar file: the header alone needs " + std::to_string(hsize) +
+                  " bytes");
+    s.global.resize(hsize);
+    s.source->read(0, hsize, s.global.data());
+    have = hsize;
+    hsize = header_size(s.global.data(), s.global.size());
+  }
   s.layout = read_layout(s.global.data(), hsize, file_size, options.skip_damaged);
   // What the constructor decodes: the base clustered mesh (progressive files: the base
   // mesh). Further refinement is what the caller asks for, region by region.

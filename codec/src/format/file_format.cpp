@@ -71,6 +71,16 @@ void write_header(const FileHeader &h, std::vector<uint8_t> &out) {
     w.u32(static_cast<uint32_t>(std::min<uint64_t>(h.cluster_connectivity_bytes, 0xFFFFFFFFu)));
     w.u32(h.cluster_checksum);
   }
+  if (h.flags & kFlagSections) {
+    w.u32(static_cast<uint32_t>(h.sections.size()));
+    for (const SectionEntry &e : h.sections) {
+      w.u32(e.tag);
+      w.u32(e.flags);
+      w.u32(static_cast<uint32_t>(e.bytes));
+      w.u32(static_cast<uint32_t>(e.bytes >> 32));
+      w.u32(e.checksum);
+    }
+  }
   w.u32(checksum(out.data(), out.size()));
 }
 
@@ -159,7 +169,8 @@ std::vector<uint8_t> pack_base_mesh(const BaseMesh &base, int bits) {
 std::vector<uint8_t> write_file(FileHeader header, const std::vector<uint8_t> &base_block,
                                 const std::vector<std::vector<uint8_t>> &level_blocks,
                                 const std::vector<uint8_t> &tables,
-                                const std::vector<std::vector<uint8_t>> &cluster_blocks) {
+                                const std::vector<std::vector<uint8_t>> &cluster_blocks,
+                                const std::vector<Section> &sections) {
   header.base_bytes = static_cast<uint32_t>(base_block.size());
   header.base_checksum = checksum(base_block.data(), base_block.size());
   for (size_t i = 0; i < level_blocks.size(); ++i)
@@ -182,9 +193,18 @@ std::vector<uint8_t> write_file(FileHeader header, const std::vector<uint8_t> &b
     header.has_cluster_checksum = true;
     header.cluster_checksum = checksum(blocks);
   }
+  header.sections.clear();
+  if (!sections.empty()) {
+    header.version = kSectionsFormatVersion;
+    header.flags |= kFlagSections;
+    for (const Section &s : sections)
+      header.sections.push_back({s.tag, 0, 0, s.body.size(), checksum(s.body.data(), s.body.size())});
+  }
   std::vector<uint8_t> out;
   write_header(header, out);
   out.insert(out.end(), base_block.begin(), base_block.end());
+  for (const Section &s : sections)
+    out.insert(out.end(), s.body.begin(), s.body.end());
   for (const auto &b : level_blocks)
     out.insert(out.end(), b.begin(), b.end());
   if (header.clustered()) {
@@ -205,8 +225,14 @@ size_t header_size(const uint8_t *data, size_t size) {
   const uint16_t flags = r.u16();
   ByteReader c(data + 48, 4, "the .pomar header");
   const uint64_t levels = std::min<uint32_t>(c.u32(), kMaxLevels);
-  return kFixedHeaderBytes + kLevelEntryBytes * levels +
-         ((flags & kFlagClustered) ? kClusterHeaderBytes : 0) + 4;
+  const size_t fixed =
+      kFixedHeaderBytes + kLevelEntryBytes * levels + ((flags & kFlagClustered) ? kClusterHeaderBytes : 0);
+  if (!(flags & kFlagSections))
+    return fixed + 4;
+  if (size < fixed + 4)
+    return fixed + 4; // then the section count tells the rest
+  ByteReader n(data + fixed, 4, "the .pomar header");
+  return fixed + 4 + kSectionEntryBytes * std::min<uint32_t>(n.u32(), kMaxSections) + 4;
 }
 
 FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size, bool allow_truncated) {
@@ -221,11 +247,13 @@ FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size, boo
   FileHeader &h = L.header;
   h.version = r.u16();
   if (h.version != kFormatVersion && h.version != kClusteredFormatVersion &&
-      h.version != kClusteredFormatVersion2)
+      h.version != kClusteredFormatVersion2 && h.version != kSectionsFormatVersion)
     throw Error("unsupported .pomar version " + std::to_string(h.version) +
-                " (this build reads versions 1 to 3)");
+                " (this build reads versions 1 to 4)");
   h.flags = r.u16();
-  if ((h.version != kFormatVersion) != h.clustered() || (h.flags & ~kFlagClustered))
+  const bool v4 = h.version == kSectionsFormatVersion;
+  if ((!v4 && (h.version != kFormatVersion) != h.clustered()) ||
+      (h.flags & ~(v4 ? kFlagClustered | kFlagSections : kFlagClustered)))
     bad("unknown flags " + std::to_string(h.flags) + " for version " + std::to_string(h.version));
   h.grid.bits = r.u8();
   r.u8();
@@ -245,6 +273,17 @@ FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size, boo
     bad("level count " + std::to_string(levels) + " exceeds " + std::to_string(kMaxLevels));
   L.header_bytes =
       kFixedHeaderBytes + kLevelEntryBytes * levels + (h.clustered() ? kClusterHeaderBytes : 0) + 4;
+  uint32_t section_count = 0;
+  if (h.flags & kFlagSections) {
+    if (size < L.header_bytes)
+      bad("header is truncated");
+    ByteReader n(data + L.header_bytes - 4, 4, "the .pomar header");
+    section_count = n.u32();
+    if (section_count > kMaxSections)
+      bad("section count " + std::to_string(section_count) + " exceeds " +
+          std::to_string(kMaxSections));
+    L.header_bytes += 4 + kSectionEntryBytes * section_count;
+  }
   if (size < L.header_bytes)
     bad("header is truncated");
   const uint32_t stored = [&] {
@@ -286,6 +325,21 @@ FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size, boo
     if (h.clusters != base_clustered)
       bad("cluster count differs from the base clustered mesh's vertex count");
   }
+  if (h.flags & kFlagSections) {
+    r.u32(); // the count, read above
+    h.sections.resize(section_count);
+    for (SectionEntry &e : h.sections) {
+      e.tag = r.u32();
+      e.flags = r.u32();
+      e.bytes = r.u32();
+      e.bytes |= uint64_t(r.u32()) << 32;
+      e.checksum = r.u32();
+      if (e.flags != 0)
+        bad("unknown section flags " + std::to_string(e.flags));
+      if (e.bytes > (uint64_t(1) << 40))
+        bad("section size is implausible");
+    }
+  }
   // Sanity of the counts before anybody allocates from them.
   if (h.grid.bits < 1 || h.grid.bits > 24)
     bad("quantization bits " + std::to_string(h.grid.bits) + " outside 1..24");
@@ -309,6 +363,11 @@ FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size, boo
   uint64_t offset = L.header_bytes;
   L.base_offset = offset;
   offset += h.base_bytes;
+  for (SectionEntry e : h.sections) {
+    e.offset = offset;
+    offset += e.bytes;
+    L.sections.push_back(e);
+  }
   const size_t global = h.clustered() ? h.global_levels : h.levels.size();
   for (size_t i = 0; i < global; ++i) {
     L.level_offset.push_back(offset);
@@ -460,6 +519,9 @@ FileInfo file_info(const FileLayout &L, uint64_t file_size) {
   info.total_bytes = file_size;
   info.header_bytes = L.header_bytes;
   info.base_bytes = h.base_bytes;
+  for (const SectionEntry &e : L.sections)
+    if (e.tag == kLosslessTag)
+      info.lossless_bytes += e.bytes;
   return info;
 }
 

@@ -14,7 +14,11 @@ constexpr uint8_t kMagic[8] = {'P', 'O', 'M', 'A', 'R', '\r', '\n', 0x1A};
 constexpr uint16_t kFormatVersion = 1;           // pure progressive files
 constexpr uint16_t kClusteredFormatVersion = 3;  // files with clustered levels
 constexpr uint16_t kClusteredFormatVersion2 = 2; // read only: no cluster data checksum
+constexpr uint16_t kSectionsFormatVersion = 4;  // files with a section table
 constexpr uint16_t kFlagClustered = 1;
+constexpr uint16_t kFlagSections = 2;
+constexpr size_t kSectionEntryBytes = 20;
+constexpr uint32_t kMaxSections = 64;
 constexpr size_t kClusterHeaderBytes = 40;
 constexpr size_t kFixedHeaderBytes = 60;
 constexpr size_t kLevelEntryBytes = 20;
@@ -24,6 +28,27 @@ struct LevelEntry {
   uint32_t vertices = 0, faces = 0; // after this level
   uint32_t connectivity_bytes = 0, geometry_bytes = 0;
   uint32_t checksum = 0; // XXH32 of the level's bytes (connectivity then geometry)
+};
+
+/// A section tag from its 4 ASCII characters ("LSLS" -> bytes 'L','S','L','S' in the file).
+constexpr uint32_t section_tag(const char (&s)[5]) {
+  return uint32_t(uint8_t(s[0])) | uint32_t(uint8_t(s[1])) << 8 | uint32_t(uint8_t(s[2])) << 16 |
+         uint32_t(uint8_t(s[3])) << 24;
+}
+constexpr uint32_t kLosslessTag = section_tag("LSLS"); ///< the lossless record (issue 13)
+
+/// A global section of a version 4 file (its body follows the base mesh block).
+struct Section {
+  uint32_t tag = 0;
+  std::vector<uint8_t> body;
+};
+
+/// A section as the header's table describes it.
+struct SectionEntry {
+  uint32_t tag = 0, flags = 0;
+  uint64_t offset = 0; // absolute file offset of the body (layout only)
+  uint64_t bytes = 0;
+  uint32_t checksum = 0;
 };
 
 struct FileHeader {
@@ -48,6 +73,7 @@ struct FileHeader {
   // own 8-bit checks let 1 damaged block in 256 through).
   bool has_cluster_checksum = false;
   uint32_t cluster_checksum = 0;
+  std::vector<SectionEntry> sections; // version 4 (flags & kFlagSections)
   bool clustered() const { return (flags & kFlagClustered) != 0; }
 };
 
@@ -69,6 +95,7 @@ struct FileLayout {
   FileHeader header;
   size_t header_bytes = 0;
   size_t base_offset = 0;
+  std::vector<SectionEntry> sections; // with their offsets
   std::vector<size_t> level_offset; // start of each global level's connectivity bytes
   size_t tables_offset = 0, index_offset = 0, clusters_offset = 0;
   size_t global_bytes = 0; // everything before the first cluster block
@@ -92,7 +119,8 @@ std::vector<uint8_t> pack_base_mesh(const BaseMesh &base, int bits);
 std::vector<uint8_t> write_file(FileHeader header, const std::vector<uint8_t> &base_block,
                                 const std::vector<std::vector<uint8_t>> &level_blocks,
                                 const std::vector<uint8_t> &tables = {},
-                                const std::vector<std::vector<uint8_t>> &cluster_blocks = {});
+                                const std::vector<std::vector<uint8_t>> &cluster_blocks = {},
+                                const std::vector<Section> &sections = {});
 
 /// Bytes a header needs before it can be parsed: at least the fixed part; then
 /// header_size() tells the full size.
