@@ -41,11 +41,13 @@ size_t vertex_index(const MeshType &m, const typename MeshType::VertexType *v, s
 /// Convert a vcglib triangle mesh to a pomar::Mesh.
 ///
 /// Deleted vertices and faces (IsD()) are skipped. Vertices that no live face references
-/// are dropped and counted into `*unreferenced` (if given). The remaining vertices keep
-/// their relative order and are renumbered compactly; faces keep their order.
+/// are counted into `*unreferenced` (if given) and dropped, or kept with
+/// `keep_unreferenced` (pomar::encode stores them). The remaining vertices keep their
+/// relative order and are renumbered compactly; faces keep their order.
 /// Throws pomar::Error if a live face references a deleted vertex or a vertex outside
 /// m.vert, or if a face is not a triangle.
-template <class MeshType> Mesh from_vcg(const MeshType &m, size_t *unreferenced = nullptr) {
+template <class MeshType>
+Mesh from_vcg(const MeshType &m, size_t *unreferenced = nullptr, bool keep_unreferenced = false) {
   constexpr uint32_t kUnused = UINT32_MAX;
   std::vector<uint32_t> remap(m.vert.size(), kUnused);
   size_t live_faces = 0;
@@ -77,7 +79,8 @@ template <class MeshType> Mesh from_vcg(const MeshType &m, size_t *unreferenced 
       continue;
     if (remap[v] == kUnused) {
       ++dropped;
-      continue;
+      if (!keep_unreferenced)
+        continue;
     }
     if (next == kUnused)
       throw Error("vcg mesh: too many vertices for 32-bit indices");

@@ -5,6 +5,7 @@
 #include "decode/decoder_codec.h"
 #include "entropy/models.h"
 #include "format/file_format.h"
+#include "lossless/lossless_stage.h"
 #include "pomar/limits.h"
 #include "pomar/random_access.h"
 #include "refine/level_traversal.h"
@@ -201,14 +202,20 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
       r.level = std::max(r.level, l);
       r.clusters_below_request += l < static_cast<int>(target);
     }
-    return d.mesh();
+    Mesh mesh = d.mesh();
+    if (target == levels && r.damaged.empty())
+      undo_cut(data, layout, mesh); // the full mesh: as it was input
+    return mesh;
   }
   LevelMesh lm = base_level_mesh(data, layout);
   Models models;
   r.level = static_cast<int>(decode_global_levels(data, layout, 0, std::min(target, global), lm,
                                                   models, options.progress,
                                                   options.skip_damaged ? &r.damaged : nullptr));
-  return to_mesh(lm, h.grid);
+  Mesh mesh = to_mesh(lm, h.grid);
+  if (r.level == static_cast<int>(levels))
+    undo_cut(data, layout, mesh); // the full mesh: as it was input
+  return mesh;
 }
 
 } // namespace pomar

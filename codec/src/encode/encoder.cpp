@@ -13,6 +13,7 @@
 #include "entropy/static_tables.h"
 #include "format/file_format.h"
 #include "geometry/quantize.h"
+#include "lossless/lossless_stage.h"
 #include "mesh/reorder.h"
 #include "pomar/limits.h"
 #include "refine/level_traversal.h"
@@ -204,7 +205,8 @@ void check_input(const Mesh &mesh, const EncodeOptions &options) {
 
 } // namespace
 
-std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, EncodeReport *report) {
+std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &options,
+                                     EncodeReport *report, const LosslessHook *hook) {
   auto t0 = std::chrono::steady_clock::now();
   check_input(mesh, options);
   // The caller already holds the input mesh: an automatic check counts only the rest.
@@ -215,7 +217,7 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
   const std::vector<float> positions = compact_vertices(mesh, triangles, compact_to_input);
   const uint32_t nv = static_cast<uint32_t>(compact_to_input.size());
   const uint32_t nf = static_cast<uint32_t>(triangles.size() / 3);
-  const Quantizer grid = make_quantizer(positions.data(), nv, options.bits);
+  const Quantizer grid = hook ? hook->grid : make_quantizer(positions.data(), nv, options.bits);
   std::vector<int32_t> q = quantize(grid, positions.data(), nv);
   // Renumber for memory locality, then build (and validate) the connectivity. An invalid
   // mesh is validated again in the caller's numbering so that the message names its indices.
@@ -355,8 +357,15 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
   if (lm.vertex_count() != nv || lm.ct.face_count() != nf)
     throw Error("internal encoder error: the refined mesh does not match the input");
 
-  std::vector<uint8_t> file =
-      write_file(header, pack_base_mesh(base, grid.bits), blocks, tables, cluster_blocks);
+  std::vector<Section> sections;
+  if (hook) { // the lossless stage's record, in the decoder's numbering
+    std::vector<uint32_t> decoded_to_cut(nv);
+    for (uint32_t i = 0; i < nv; ++i)
+      decoded_to_cut[i] = compact_to_input[dec_to_input[i]];
+    sections.push_back({kLosslessTag, hook->record(decoded_to_cut)});
+  }
+  std::vector<uint8_t> file = write_file(header, pack_base_mesh(base, grid.bits), blocks, tables,
+                                         cluster_blocks, sections);
   if (report) {
     const FileLayout layout = read_layout(file.data(), file.size());
     report->info = file_info(layout, file.size());

@@ -1,0 +1,251 @@
+// The lossless stage (see lossless_stage.h): pomar::encode() cuts a messy mesh with
+// make_manifold, codes the cut mesh with the manifold encoder and stores what the cut
+// changed; a full decode undoes it.
+#include "lossless/lossless_stage.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string>
+
+#include "format/file_format.h"
+#include "geometry/quantize.h"
+#include "mesh/corner_table.h"
+
+namespace pomar {
+
+namespace {
+
+using Key = std::array<uint32_t, 3>;
+
+/// The rotation of a face starting at its smallest vertex.
+Key rotated(const uint32_t *v) {
+  const int k = v[0] < v[1] ? (v[0] < v[2] ? 0 : 2) : (v[1] < v[2] ? 1 : 2);
+  return {v[k], v[(k + 1) % 3], v[(k + 2) % 3]};
+}
+
+bool repeats_vertex(const uint32_t *v) { return v[0] == v[1] || v[1] == v[2] || v[0] == v[2]; }
+
+/// A face repeating a vertex as (a, b): the face is (a, a, b) up to rotation.
+std::array<uint32_t, 2> degenerate_form(uint32_t x, uint32_t y, uint32_t z) {
+  if (x == y)
+    return {x, z};
+  if (y == z)
+    return {y, x};
+  return {z, y}; // z == x: (z, x, y) = (z, z, y)
+}
+
+/// True when the encoder takes `mesh` as it is: every vertex used, and a valid corner table
+/// (manifold, oriented, no face repeating a vertex, no duplicate).
+bool is_clean(const Mesh &mesh) {
+  const size_t nv = mesh.vertex_count();
+  std::vector<uint8_t> used(nv, 0);
+  for (uint32_t v : mesh.triangles) {
+    if (v >= nv)
+      return false; // the manifold encoder names it
+    used[v] = 1;
+  }
+  if (std::find(used.begin(), used.end(), 0) != used.end())
+    return false;
+  try {
+    CornerTable ct;
+    build_corner_table(mesh.triangles.data(), mesh.triangle_count(), nv, ct);
+  } catch (const Error &) {
+    return false;
+  }
+  return true;
+}
+
+std::string plural(size_t n, const char *one, const char *many) {
+  return std::to_string(n) + " " + (n == 1 ? one : many);
+}
+
+} // namespace
+
+std::string LosslessReport::summary() const {
+  if (!stored)
+    return "";
+  std::vector<std::string> kept;
+  if (faces_flipped)
+    kept.push_back(plural(faces_flipped, "flipped face", "flipped faces"));
+  if (duplicate_faces)
+    kept.push_back(plural(duplicate_faces, "duplicate face", "duplicate faces"));
+  if (degenerate_faces)
+    kept.push_back(plural(degenerate_faces, "face repeating a vertex", "faces repeating a vertex"));
+  if (unreferenced_vertices)
+    kept.push_back(plural(unreferenced_vertices, "unreferenced vertex", "unreferenced vertices"));
+  if (keep_order)
+    kept.push_back("the vertex order");
+  std::string s;
+  if (vertices_split || edges_cut)
+    s = "non-manifold: " + plural(vertices_split, "vertex", "vertices") + " and " +
+        plural(edges_cut, "edge", "edges") + " stored as cuts";
+  for (size_t i = 0; i < kept.size(); ++i)
+    s += (i == 0 ? (s.empty() ? "" : "; ") : i + 1 == kept.size() ? " and " : ", ") + kept[i];
+  if (!kept.empty())
+    s += " kept";
+  return s + " (" + plural(bytes, "byte", "bytes") + ")";
+}
+
+LosslessRecord build_lossless_record(const Mesh &input, const Mesh &cut, const RepairMap &map,
+                                     const std::vector<uint32_t> &decoded_to_cut,
+                                     const Quantizer &grid, bool keep_order, Mesh &decoded,
+                                     std::vector<uint32_t> &output_to_input) {
+  const uint32_t nv = static_cast<uint32_t>(input.vertex_count());
+  const uint32_t nd = static_cast<uint32_t>(decoded_to_cut.size());
+  auto input_of_cut = [&](uint32_t c) { return c < nv ? c : map.copy_of[c - nv]; };
+  LosslessRecord r;
+
+  // Vertices: the first decoded vertex of an input vertex represents it, later ones are
+  // copies; then the input vertices no decoded vertex is.
+  std::vector<uint32_t> first(nv, kNone), input_to_output(nv, kNone);
+  std::vector<uint32_t> cut_to_decoded(cut.vertex_count(), kNone);
+  output_to_input.clear();
+  decoded.positions.resize(3 * size_t(nd));
+  for (uint32_t d = 0; d < nd; ++d) {
+    const uint32_t c = decoded_to_cut[d], v = input_of_cut(c);
+    cut_to_decoded[c] = d;
+    for (int k = 0; k < 3; ++k)
+      decoded.positions[3 * size_t(d) + k] =
+          grid.dequantize(k, grid.quantize(k, cut.positions[3 * size_t(c) + k]));
+    if (first[v] != kNone) {
+      r.copies.push_back({d, first[v]});
+      continue;
+    }
+    first[v] = d;
+    input_to_output[v] = static_cast<uint32_t>(output_to_input.size());
+    output_to_input.push_back(v);
+  }
+  for (uint32_t v = 0; v < nv; ++v) {
+    if (input_to_output[v] != kNone)
+      continue;
+    input_to_output[v] = static_cast<uint32_t>(output_to_input.size());
+    output_to_input.push_back(v);
+    for (int k = 0; k < 3; ++k)
+      r.extra_q.push_back(static_cast<int32_t>(grid.quantize(k, input.positions[3 * size_t(v) + k])));
+  }
+
+  // Faces of D, and where each cut face comes in D's canonical order.
+  const uint32_t nf = static_cast<uint32_t>(cut.triangle_count());
+  decoded.triangles.resize(cut.triangles.size());
+  for (size_t c = 0; c < cut.triangles.size(); ++c)
+    decoded.triangles[c] = cut_to_decoded[cut.triangles[c]];
+  const std::vector<uint32_t> order = canonical_face_order(decoded.triangles);
+  std::vector<uint32_t> rank(nf);
+  for (uint32_t i = 0; i < nf; ++i)
+    rank[order[i]] = i;
+  for (uint32_t f = 0; f < nf; ++f)
+    if (map.flipped[f])
+      r.flipped.push_back(rank[f]);
+  std::sort(r.flipped.begin(), r.flipped.end());
+
+  // Removed input faces: repeating a vertex, or an exact duplicate of a kept face (the one
+  // with the same rotated vertices in input numbering).
+  const uint32_t input_faces = static_cast<uint32_t>(input.triangle_count());
+  std::vector<uint8_t> kept(input_faces, 0);
+  std::vector<std::pair<Key, uint32_t>> kept_keys(nf);
+  for (uint32_t f = 0; f < nf; ++f) {
+    kept[map.face_origin[f]] = 1;
+    kept_keys[f] = {rotated(&input.triangles[3 * size_t(map.face_origin[f])]), f};
+  }
+  std::sort(kept_keys.begin(), kept_keys.end());
+  std::vector<uint32_t> extra_copies(nf, 0);
+  for (uint32_t g = 0; g < input_faces; ++g) {
+    if (kept[g])
+      continue;
+    const uint32_t *t = &input.triangles[3 * size_t(g)];
+    if (repeats_vertex(t)) {
+      r.degenerate.push_back(
+          degenerate_form(input_to_output[t[0]], input_to_output[t[1]], input_to_output[t[2]]));
+      continue;
+    }
+    const Key key = rotated(t);
+    auto it = std::lower_bound(kept_keys.begin(), kept_keys.end(), std::make_pair(key, 0u));
+    if (it == kept_keys.end() || it->first != key)
+      throw Error("internal lossless error: a removed face is neither degenerate nor a duplicate");
+    ++extra_copies[rank[it->second]];
+  }
+  for (uint32_t i = 0; i < nf; ++i)
+    if (extra_copies[i])
+      r.duplicates.push_back({i, extra_copies[i]});
+  std::sort(r.degenerate.begin(), r.degenerate.end());
+  if (keep_order)
+    r.order = output_to_input;
+  return r;
+}
+
+std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, EncodeReport *report) {
+  if (options.strict || (!options.keep_order && is_clean(mesh)))
+    return encode_manifold(mesh, options, report, nullptr);
+
+  const size_t nv = mesh.vertex_count();
+  if (mesh.positions.size() % 3 || mesh.triangles.size() % 3)
+    throw Error("position and triangle arrays must hold multiples of 3 values");
+  if (mesh.triangle_count() == 0)
+    throw Error("the mesh contains no triangles");
+  for (size_t i = 0; i < mesh.positions.size(); ++i)
+    if (!std::isfinite(mesh.positions[i]))
+      throw Error("vertex " + std::to_string(i / 3) + " has a non-finite coordinate");
+  Mesh cut = mesh;
+  RepairMap map;
+  const RepairReport repair = make_manifold(cut, &map); // checks the indices
+  if (cut.triangle_count() == 0)
+    throw Error("the mesh has no valid triangle: all " + std::to_string(mesh.triangle_count()) +
+                " faces repeat a vertex");
+
+  LosslessHook hook;
+  hook.grid = make_quantizer(mesh.positions.data(), nv, options.bits);
+  LosslessRecord record;
+  Mesh decoded;
+  std::vector<uint32_t> output_to_input;
+  hook.record = [&](const std::vector<uint32_t> &decoded_to_cut) {
+    record = build_lossless_record(mesh, cut, map, decoded_to_cut, hook.grid, options.keep_order,
+                                   decoded, output_to_input);
+    return write_lossless_record(record, decoded);
+  };
+  std::vector<uint8_t> file = encode_manifold(cut, options, report, &hook);
+  if (report) {
+    LosslessReport &l = report->lossless;
+    l = LosslessReport();
+    l.stored = true;
+    l.vertex_copies = record.copies.size();
+    l.vertices_split = repair.vertices_split;
+    l.edges_cut = repair.edges_cut;
+    l.faces_flipped = record.flipped.size();
+    for (const auto &d : record.duplicates)
+      l.duplicate_faces += d.second;
+    l.degenerate_faces = record.degenerate.size();
+    l.unreferenced_vertices = record.extra_q.size() / 3;
+    l.keep_order = options.keep_order;
+    l.bytes = report->info.lossless_bytes;
+    report->input_vertices = nv;
+    std::vector<uint8_t> used(nv, 0);
+    for (uint32_t v : mesh.triangles)
+      used[v] = 1;
+    report->unreferenced_vertices =
+        static_cast<size_t>(std::count(used.begin(), used.end(), uint8_t(0)));
+    if (options.keep_order) {
+      report->decoded_to_input.resize(nv);
+      for (uint32_t v = 0; v < nv; ++v)
+        report->decoded_to_input[v] = v;
+    } else {
+      report->decoded_to_input = output_to_input;
+    }
+  }
+  return file;
+}
+
+void undo_cut(const uint8_t *data, const FileLayout &layout, Mesh &decoded) {
+  for (const auto &s : layout.sections) {
+    if (s.tag != kLosslessTag)
+      continue;
+    if (s.offset + s.bytes > layout.file_size)
+      throw Error("truncated .pomar file: the lossless record ends past the end of the file");
+    const uint8_t *body = data + s.offset;
+    check_block(body, s.bytes, s.checksum, "lossless record");
+    const LosslessRecord r = read_lossless_record(body, s.bytes, decoded, layout.header.grid.bits);
+    decoded = apply_lossless_record(decoded, r, layout.header.grid);
+  }
+}
+
+} // namespace pomar
