@@ -1,5 +1,6 @@
 // pomar: command-line front end of the codec.
-//   pomar encode IN OUT.pomar [--bits N] [--progressive] [--repair] [--max-memory SIZE]
+//   pomar encode IN OUT.pomar [--bits N] [--progressive] [--strict | --repair] [--keep-order]
+//                [--max-memory SIZE]
 //   pomar decode IN.pomar OUT [--level L] [--cluster/--sphere/--box ...] [--skip-damaged]
 //                [--max-memory SIZE]
 //   pomar info IN.pomar [--json | --check]
@@ -9,6 +10,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <memory>
@@ -54,7 +56,9 @@ bool repair_would_help(const pomar::Mesh &mesh) {
   }
 }
 
-constexpr const char *kRepairHint = " (pomar encode --repair cuts it into a manifold mesh)";
+constexpr const char *kRepairHint =
+    " (without --strict pomar stores the cut and gives the mesh back exactly; --repair cuts it "
+    "for good)";
 
 /// Runs make_manifold() on `mesh` and prints what it changed on stderr, one line per kind
 /// of change; "nothing to repair" only when not quiet. Returns the seconds it took.
@@ -85,7 +89,7 @@ struct EncodeArgs {
   int bits = 12;
   uint32_t clusters = 0;
   double cluster_ratio = 0.01;
-  bool progressive = false, quiet = false, repair = false;
+  bool progressive = false, quiet = false, repair = false, strict = false, keep_order = false;
   std::string max_memory = "auto";
 };
 
@@ -112,13 +116,15 @@ int run_encode(const EncodeArgs &a) {
   opt.progressive = a.progressive;
   opt.progress = terminal_progress(a.quiet);
   opt.memory_limit = memory_limit;
+  opt.strict = a.strict;
+  opt.keep_order = a.keep_order;
   pomar::EncodeReport r;
   const auto t1 = Clock::now();
   std::vector<uint8_t> file;
   try {
     file = pomar::encode(mesh, opt, &r);
   } catch (const pomar::Error &e) {
-    if (!a.repair && repair_would_help(mesh))
+    if (a.strict && repair_would_help(mesh))
       throw pomar::Error(e.what() + std::string(kRepairHint));
     throw;
   }
@@ -127,9 +133,13 @@ int run_encode(const EncodeArgs &a) {
   if (a.quiet)
     return 0;
   const pomar::FileInfo &i = r.info;
-  std::printf("%s: %u vertices, %u faces", a.in.c_str(), i.vertices, i.faces);
+  if (r.lossless.stored) // the one line saying what the file keeps beyond the coded mesh
+    std::fprintf(stderr, "pomar: stored for an exact decode: %s\n", r.lossless.summary().c_str());
+  std::printf("%s: %zu vertices, %zu faces", a.in.c_str(), mesh.vertex_count(),
+              mesh.triangle_count());
   if (r.unreferenced_vertices)
-    std::printf(" (%zu unreferenced vertices dropped)", r.unreferenced_vertices);
+    std::printf(" (%zu unreferenced vertices %s)", r.unreferenced_vertices,
+                r.lossless.stored ? "kept" : "dropped");
   if (load.welded_vertices)
     std::printf(" (%zu duplicate STL corners welded)", load.welded_vertices);
   std::printf("\n%s: %zu bytes, %.2f bits/vertex (connectivity %.2f, geometry %.2f), %d-bit "
@@ -137,6 +147,11 @@ int run_encode(const EncodeArgs &a) {
               a.out.c_str(), file.size(), bpv(file.size(), i.vertices),
               bpv(i.connectivity_bytes, i.vertices), bpv(i.geometry_bytes, i.vertices), i.bits,
               i.levels.size(), i.base_vertices);
+  if (r.lossless.stored)
+    std::printf("lossless record: %lu bytes = %.3f bits/vertex (the coded mesh has %u vertices "
+                "and %u faces)\n",
+                static_cast<unsigned long>(i.lossless_bytes), bpv(i.lossless_bytes, i.vertices),
+                i.vertices, i.faces);
   if (i.clustered())
     std::printf("random access: %u clusters from level %u (global part %lu bytes, cluster "
                 "blocks %lu bytes)\n",
@@ -280,7 +295,7 @@ int run_selective_decode(const DecodeArgs &a) {
   } catch (const pomar::Error &e) {
     rethrow_with_hint(e);
   }
-  const pomar::Mesh mesh = d.mesh();
+  const pomar::Mesh mesh = d.exact_mesh(); // every region at its finest: the input exactly
   const double t_decode = since(t0);
   pomar::save_mesh(a.out, mesh, !a.ascii);
   if (a.stats || !a.quiet) {
@@ -357,6 +372,10 @@ nlohmann::json info_json(const pomar::FileInfo &i) {
   j["tables_bytes"] = i.tables_bytes;
   j["index_bytes"] = i.index_bytes;
   j["cluster_bytes"] = i.cluster_bytes;
+  j["lossless_bytes"] = i.lossless_bytes;
+  j["lossless_bits_per_vertex"] = bpv(i.lossless_bytes, i.vertices);
+  j["input_vertices"] = i.input_vertices;
+  j["input_faces"] = i.input_faces;
   j["cluster_block_bytes"] = i.cluster_block_bytes;
   j["header_bytes"] = i.header_bytes;
   j["base_bytes"] = i.base_bytes;
@@ -417,6 +436,13 @@ int run_info(const std::string &in, bool json) {
                   "them all)\n",
                   i.clusters, sizes.front(), sizes[sizes.size() / 2], sizes.back());
   }
+  if (i.lossless_bytes)
+    std::printf("  lossless record %lu bytes = %.3f bits/vertex: a full decode gives back the "
+                "input's %lu vertices and %lu faces exactly (levels and regions show the coded, "
+                "cut mesh)\n",
+                static_cast<unsigned long>(i.lossless_bytes), bpv(i.lossless_bytes, i.vertices),
+                static_cast<unsigned long>(i.input_vertices),
+                static_cast<unsigned long>(i.input_faces));
   std::printf("  level  vertices     faces  conn.bytes  geom.bytes\n");
   std::printf("  %5d %9u %9u  %10lu  (base mesh)\n", 0, i.base_vertices, i.base_faces,
               static_cast<unsigned long>(i.base_bytes));
@@ -455,15 +481,45 @@ std::vector<Triangle> triangle_multiset(const pomar::Mesh &m) {
   return out;
 }
 
+/// The vertex positions of `m`, sorted: equal for meshes with the same vertices.
+std::vector<Point> point_multiset(const pomar::Mesh &m) {
+  std::vector<Point> out(m.vertex_count());
+  for (size_t v = 0; v < out.size(); ++v)
+    out[v] = {m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]};
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+/// Drops the vertices no face uses; returns how many.
+size_t drop_unreferenced(pomar::Mesh &m) {
+  std::vector<uint32_t> index(m.vertex_count(), 0);
+  for (uint32_t v : m.triangles)
+    index[v] = 1;
+  std::vector<float> kept;
+  uint32_t next = 0;
+  for (size_t v = 0; v < index.size(); ++v)
+    if (index[v]) {
+      index[v] = next++;
+      kept.insert(kept.end(), &m.positions[3 * v], &m.positions[3 * v] + 3);
+    }
+  for (uint32_t &v : m.triangles)
+    v = index[v];
+  const size_t dropped = m.vertex_count() - next;
+  m.positions.swap(kept);
+  return dropped;
+}
+
 int run_verify(const std::string &original, const std::string &file, const std::string &decoded,
                bool repair) {
   pomar::Mesh ref = pomar::load_mesh(original);
   // With --repair the reference is the repaired original: what `encode --repair` encoded.
   if (repair)
     repair_and_report(ref, true);
-  const bool could_repair = !repair && repair_would_help(ref);
   const std::vector<uint8_t> data = pomar::read_file(file);
   const pomar::FileInfo info = pomar::inspect(data.data(), data.size());
+  // A file without a lossless record (encode --strict, or older) has no unreferenced vertex.
+  const size_t dropped = info.lossless_bytes == 0 ? drop_unreferenced(ref) : 0;
+  const bool could_repair = !repair && info.lossless_bytes == 0 && repair_would_help(ref);
   const pomar::Mesh out =
       decoded.empty() ? pomar::decode(data.data(), data.size()) : pomar::load_mesh(decoded);
   // Snap the original onto the file's grid, as the encoder did.
@@ -471,21 +527,37 @@ int run_verify(const std::string &original, const std::string &file, const std::
     const int axis = static_cast<int>(i % 3);
     ref.positions[i] = info.grid.dequantize(axis, info.grid.quantize(axis, ref.positions[i]));
   }
-  const bool same = triangle_multiset(ref) == triangle_multiset(out);
+  // STL stores triangles only (no vertex shared or unused): the triangles are compared.
+  std::string ext = decoded.size() >= 4 ? decoded.substr(decoded.size() - 4) : "";
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  const bool triangles_only = ext == ".stl";
+  const bool same = triangle_multiset(ref) == triangle_multiset(out) &&
+                    (triangles_only || (ref.vertex_count() == out.vertex_count() &&
+                                        point_multiset(ref) == point_multiset(out)));
   const std::string what = decoded.empty() ? file : decoded;
   if (!same) {
-    std::fprintf(stderr, "pomar: MISMATCH: %s differs from %s on the %d-bit grid%s\n", what.c_str(),
-                 original.c_str(), info.bits,
+    std::fprintf(stderr,
+                 "pomar: MISMATCH: %s differs from %s on the %d-bit grid (%zu vertices and %zu "
+                 "faces against %zu and %zu)%s\n",
+                 what.c_str(), original.c_str(), info.bits, out.vertex_count(),
+                 out.triangle_count(), ref.vertex_count(), ref.triangle_count(),
                  could_repair
                      ? " (the original needs a repair to be encoded: if it was encoded with "
                        "--repair, verify with --repair)"
                      : "");
     return 3;
   }
-  std::printf("OK: %s matches %s%s: the same %zu oriented triangles, every vertex on its %d-bit "
-              "grid position\n",
-              what.c_str(), original.c_str(), repair ? " after repair" : "", out.triangle_count(),
-              info.bits);
+  std::printf("OK: %s matches %s%s: the same %zu vertices and %zu oriented triangles, every vertex "
+              "on its %d-bit grid position",
+              what.c_str(), original.c_str(), repair ? " after repair" : "", out.vertex_count(),
+              out.triangle_count(), info.bits);
+  if (dropped)
+    std::printf(" (%zu unreferenced vertices of the original are not in the file: encoded with "
+                "--strict)",
+                dropped);
+  if (triangles_only)
+    std::printf(" (STL keeps triangles only: vertices not compared)");
+  std::printf("\n");
   return 0;
 }
 
@@ -500,8 +572,9 @@ int main(int argc, char **argv) {
       "  pomar decode bunny.pomar coarse.ply --level 10\n"
       "  pomar decode bunny.pomar ear.ply --sphere -0.06,0.16,0.0,0.02 --stats\n"
       "  pomar verify bunny.ply bunny.pomar          # lossless check\n"
-      "  pomar encode messy.stl messy.pomar --repair # cut a non-manifold mesh first\n"
-      "  pomar verify messy.stl messy.pomar --repair # lossless w.r.t. the repaired mesh\n"};
+      "  pomar encode messy.stl messy.pomar          # any mesh: the cut is stored, exact decode\n"
+      "  pomar encode messy.stl fixed.pomar --repair # keep the cut (manifold) mesh instead\n"
+      "  pomar verify messy.stl fixed.pomar --repair # lossless w.r.t. the repaired mesh\n"};
   app.require_subcommand(1);
   // Ctrl-C or kill during a write: no temporary file left, the old output untouched.
   pomar::remove_temporary_files_on_signals();
@@ -512,7 +585,10 @@ int main(int argc, char **argv) {
   auto *enc =
       app.add_subcommand("encode", "Compress a mesh (PLY, OBJ, OFF, STL) into a .pomar file");
   enc->add_option("input", ea.in,
-                  "Input mesh: manifold, consistently oriented triangles (or use --repair)")
+                  "Input mesh, any triangles: a non-manifold or inconsistently oriented mesh, "
+                  "duplicate faces, faces repeating a vertex and unreferenced vertices are coded "
+                  "as a manifold cut plus a record that a full decode undoes (one line on stderr "
+                  "says what was stored)")
       ->required();
   enc->add_option("output", ea.out, "Output .pomar file (written atomically)")->required();
   enc->add_option("-b,--bits", ea.bits,
@@ -534,7 +610,16 @@ int main(int argc, char **argv) {
                 "a manifold one (remove faces repeating a vertex and exact duplicate faces, "
                 "reorient faces, cut edges of more than two faces or that cannot be oriented, "
                 "split vertices joining several fans into copies at the same position) and print "
-                "every change on stderr. Positions are never moved; verify with --repair");
+                "every change on stderr. Positions are never moved; the file holds the repaired "
+                "mesh (verify with --repair)");
+  enc->add_flag("--strict", ea.strict,
+                "Refuse a mesh that needs cutting (non-manifold, inconsistently oriented, "
+                "duplicate or degenerate faces) and drop unreferenced vertices: for pipelines "
+                "that want clean input (the file is then format version 1 or 3)");
+  enc->add_flag("--keep-order", ea.keep_order,
+                "Also store the input's vertex numbering (a full decode gives the vertices back "
+                "in the input order, e.g. for per-vertex data kept elsewhere); costs a few bits "
+                "per vertex (pomar info shows it as the lossless record)");
   enc->add_flag("-q,--quiet", ea.quiet,
                 "Print nothing on success (what --repair changed is still printed)");
   enc->add_option("--max-memory", ea.max_memory,

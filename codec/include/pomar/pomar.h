@@ -118,6 +118,9 @@ struct FileInfo {
   std::vector<uint32_t> cluster_block_bytes; ///< filled by inspect()
   /// Version 4: bytes of the lossless record (0 = none): undone by a full decode.
   uint64_t lossless_bytes = 0;
+  /// What a full decode gives (the input's counts): vertices/faces above are those of the
+  /// coded mesh, which differ when the file carries a lossless record (filled by inspect()).
+  uint64_t input_vertices = 0, input_faces = 0;
   bool clustered() const { return clusters != 0; }
 };
 

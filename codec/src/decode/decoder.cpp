@@ -93,6 +93,7 @@ FileInfo inspect(const uint8_t *data, size_t size) {
   const FileLayout layout = read_layout(data, size);
   read_base_mesh(data, layout); // checks the base block too
   FileInfo info = file_info(layout, size);
+  lossless_info(data, layout, info);
   if (layout.header.clustered()) {
     check_block(data + layout.tables_offset, layout.header.tables_bytes,
                 layout.header.tables_checksum, "static model tables");
@@ -202,10 +203,7 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
       r.level = std::max(r.level, l);
       r.clusters_below_request += l < static_cast<int>(target);
     }
-    Mesh mesh = d.mesh();
-    if (target == levels && r.damaged.empty())
-      undo_cut(data, layout, mesh); // the full mesh: as it was input
-    return mesh;
+    return d.exact_mesh(); // the full mesh, intact: as it was input
   }
   LevelMesh lm = base_level_mesh(data, layout);
   Models models;

@@ -6,6 +6,7 @@
 #include "decode/decoder_codec.h"
 #include "entropy/static_tables.h"
 #include "format/file_format.h"
+#include "lossless/lossless_stage.h"
 #include "pomar/limits.h"
 #include "pomar/random_access.h"
 
@@ -577,6 +578,18 @@ void SelectiveDecoder::State::check_cluster_data() {
 }
 
 Mesh SelectiveDecoder::mesh() const { return to_mesh(s_->mesh, s_->layout.header.grid); }
+
+Mesh SelectiveDecoder::exact_mesh() const {
+  Mesh m = mesh();
+  const bool complete =
+      s_->damaged.empty() &&
+      (s_->clustered() ? std::all_of(s_->levels.begin(), s_->levels.end(),
+                                     [&](int l) { return l == s_->finest; })
+                       : s_->uniform_level == s_->finest);
+  if (complete)
+    undo_cut(s_->global.data(), s_->layout, m); // the lossless record lies in the global part
+  return m;
+}
 
 std::vector<uint32_t> SelectiveDecoder::vertex_cluster() const {
   std::vector<uint32_t> out(s_->mesh.vertex_count(), 0);

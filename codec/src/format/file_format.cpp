@@ -522,6 +522,8 @@ FileInfo file_info(const FileLayout &L, uint64_t file_size) {
   for (const SectionEntry &e : L.sections)
     if (e.tag == kLosslessTag)
       info.lossless_bytes += e.bytes;
+  info.input_vertices = h.vertices; // inspect() reads a lossless record's counts
+  info.input_faces = h.faces;
   return info;
 }
 

@@ -1,6 +1,6 @@
 // The lossless record's coding (layout: docs/format.md, "LSLS section").
 //
-// One flags byte, then one range-coded stream: the five counts, then each part in the
+// One flags byte, then one range-coded stream: the six counts, then each part in the
 // order the decoder meets it. Index lists are coded as gaps (a run of neighbouring flipped
 // faces costs almost nothing), numbers as a magnitude class (adaptive) plus the bits below
 // the leading one (the first of them adaptive, the others raw).
@@ -139,6 +139,41 @@ struct RecordModels {
 /// symbol cost very little, but not nothing): refuses absurd counts before allocating.
 uint64_t count_bound(size_t size) { return 16384 * uint64_t(size) + 1024; }
 
+LosslessCounts counts_of(const LosslessRecord &r) {
+  LosslessCounts n;
+  n.copies = r.copies.size();
+  n.flipped = r.flipped.size();
+  n.duplicated = r.duplicates.size();
+  for (const auto &d : r.duplicates)
+    n.duplicate_faces += d.second;
+  n.degenerate = r.degenerate.size();
+  n.extra = r.extra_q.size() / 3;
+  n.order = !r.order.empty();
+  return n;
+}
+
+/// The flags byte and the counts; leaves `rc` and `m` ready for the parts.
+LosslessCounts read_counts(const uint8_t *data, size_t size, RangeDecoder &rc, RecordModels &m) {
+  if (size < 1)
+    damaged("empty");
+  if (data[0] & ~kHasOrder)
+    damaged("unknown flags " + std::to_string(data[0]));
+  rc.reset(data + 1, size - 1);
+  LosslessCounts n;
+  n.order = (data[0] & kHasOrder) != 0;
+  n.copies = get_u(rc, m.counts);
+  n.flipped = get_u(rc, m.counts);
+  n.duplicated = get_u(rc, m.counts);
+  n.duplicate_faces = get_u(rc, m.counts);
+  n.degenerate = get_u(rc, m.counts);
+  n.extra = get_u(rc, m.counts);
+  const uint64_t bound = count_bound(size);
+  if (n.copies > 0xFFFFFFFFu || n.flipped > 0xFFFFFFFFu || n.duplicated > n.duplicate_faces ||
+      n.duplicate_faces > bound || n.degenerate > bound || n.extra > bound)
+    damaged("counts are larger than the record can hold");
+  return n;
+}
+
 
 /// A value in [0, total) as equally likely: up to 2^16 values in one step, else the high
 /// part (up to 2^16 values) then the low bits raw.
@@ -250,6 +285,12 @@ void order_candidates(const Neighbours &nb, const UnusedSet &unused, uint32_t pr
 
 } // namespace
 
+LosslessCounts read_lossless_counts(const uint8_t *data, size_t size) {
+  RangeDecoder rc;
+  RecordModels m;
+  return read_counts(data, size, rc, m);
+}
+
 std::vector<uint32_t> canonical_face_order(const std::vector<uint32_t> &t) {
   const uint32_t nf = static_cast<uint32_t>(t.size() / 3);
   std::vector<std::array<uint32_t, 3>> key(nf);
@@ -272,11 +313,13 @@ std::vector<uint8_t> write_lossless_record(const LosslessRecord &r, const Mesh &
   out.push_back(r.order.empty() ? 0 : kHasOrder);
   RangeEncoder rc(&out);
   RecordModels m;
-  put_u(rc, m.counts, r.copies.size());
-  put_u(rc, m.counts, r.flipped.size());
-  put_u(rc, m.counts, r.duplicates.size());
-  put_u(rc, m.counts, r.degenerate.size());
-  put_u(rc, m.counts, r.extra_q.size() / 3);
+  const LosslessCounts n = counts_of(r);
+  put_u(rc, m.counts, n.copies);
+  put_u(rc, m.counts, n.flipped);
+  put_u(rc, m.counts, n.duplicated);
+  put_u(rc, m.counts, n.duplicate_faces);
+  put_u(rc, m.counts, n.degenerate);
+  put_u(rc, m.counts, n.extra);
 
   // Copies: a gap over the vertices whose position repeats a representative's, then which
   // representative (only when there are several).
@@ -367,20 +410,15 @@ std::vector<uint8_t> write_lossless_record(const LosslessRecord &r, const Mesh &
 
 LosslessRecord read_lossless_record(const uint8_t *data, size_t size, const Mesh &decoded,
                                     int bits) {
-  if (size < 1)
-    damaged("empty");
-  if (data[0] & ~kHasOrder)
-    damaged("unknown flags " + std::to_string(data[0]));
-  RangeDecoder rc(data + 1, size - 1);
+  RangeDecoder rc;
   RecordModels m;
+  const LosslessCounts n = read_counts(data, size, rc, m);
   const uint64_t nv = decoded.vertex_count(), nf = decoded.triangle_count();
-  const uint64_t bound = count_bound(size);
-  const uint64_t copies = get_u(rc, m.counts), flipped = get_u(rc, m.counts),
-                 duplicates = get_u(rc, m.counts), degenerate = get_u(rc, m.counts),
-                 extra = get_u(rc, m.counts);
+  const uint64_t copies = n.copies, flipped = n.flipped, duplicates = n.duplicated,
+                 degenerate = n.degenerate, extra = n.extra;
   if (copies >= std::max<uint64_t>(nv, 1) || flipped > nf || duplicates > nf)
     damaged("counts do not fit the decoded mesh");
-  if (degenerate > bound || extra > bound || nv - copies + extra > 0xFFFFFFFEu)
+  if (n.vertices(nv) > 0xFFFFFFFEu || n.faces(nf) > 0xFFFFFFFEu)
     damaged("counts are larger than the record can hold");
   LosslessRecord r;
   if (copies) {
@@ -421,14 +459,16 @@ LosslessRecord read_lossless_record(const uint8_t *data, size_t size, const Mesh
   uint64_t copies_of_faces = 0;
   for (uint64_t i = 0; i < duplicates; ++i) {
     at += get_u(rc, m.dup_gap);
-    const uint64_t n = get_u(rc, m.dup_count) + 1;
-    copies_of_faces += n;
+    const uint64_t k = get_u(rc, m.dup_count) + 1;
+    copies_of_faces += k;
     if (at >= nf)
       damaged("duplicated face past the last face");
-    if (copies_of_faces > bound)
-      damaged("more duplicate faces than the record can hold");
-    r.duplicates.push_back({static_cast<uint32_t>(at++), static_cast<uint32_t>(n)});
+    if (copies_of_faces > n.duplicate_faces)
+      damaged("more duplicate faces than counted");
+    r.duplicates.push_back({static_cast<uint32_t>(at++), static_cast<uint32_t>(k)});
   }
+  if (copies_of_faces != n.duplicate_faces)
+    damaged("fewer duplicate faces than counted");
   const uint64_t out_vertices = nv - copies + extra;
   at = 0;
   r.degenerate.reserve(degenerate);

@@ -49,6 +49,18 @@ struct LosslessRecord {
   }
 };
 
+/// The counts at the start of a record (readable without the decoded mesh).
+struct LosslessCounts {
+  uint64_t copies = 0, flipped = 0;
+  uint64_t duplicated = 0, duplicate_faces = 0; ///< faces of D with duplicates; the duplicates
+  uint64_t degenerate = 0, extra = 0;
+  bool order = false;
+  /// What a full decode gives, from D's counts.
+  uint64_t vertices(uint64_t decoded) const { return decoded - copies + extra; }
+  uint64_t faces(uint64_t decoded) const { return decoded + duplicate_faces + degenerate; }
+};
+LosslessCounts read_lossless_counts(const uint8_t *data, size_t size);
+
 /// D's faces in canonical order: face indices sorted by (rotated) vertex triple.
 std::vector<uint32_t> canonical_face_order(const std::vector<uint32_t> &triangles);
 

@@ -218,6 +218,8 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
     l.unreferenced_vertices = record.extra_q.size() / 3;
     l.keep_order = options.keep_order;
     l.bytes = report->info.lossless_bytes;
+    report->info.input_vertices = nv;
+    report->info.input_faces = mesh.triangle_count();
     report->input_vertices = nv;
     std::vector<uint8_t> used(nv, 0);
     for (uint32_t v : mesh.triangles)
@@ -235,15 +237,35 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
   return file;
 }
 
-void undo_cut(const uint8_t *data, const FileLayout &layout, Mesh &decoded) {
-  for (const auto &s : layout.sections) {
+namespace {
+
+/// The lossless record's section, checked, or nullptr if the file has none.
+const SectionEntry *lossless_section(const uint8_t *data, const FileLayout &layout) {
+  for (const SectionEntry &s : layout.sections) {
     if (s.tag != kLosslessTag)
       continue;
     if (s.offset + s.bytes > layout.file_size)
       throw Error("truncated .pomar file: the lossless record ends past the end of the file");
-    const uint8_t *body = data + s.offset;
-    check_block(body, s.bytes, s.checksum, "lossless record");
-    const LosslessRecord r = read_lossless_record(body, s.bytes, decoded, layout.header.grid.bits);
+    check_block(data + s.offset, s.bytes, s.checksum, "lossless record");
+    return &s;
+  }
+  return nullptr;
+}
+
+} // namespace
+
+void lossless_info(const uint8_t *data, const FileLayout &layout, FileInfo &info) {
+  if (const SectionEntry *s = lossless_section(data, layout)) {
+    const LosslessCounts n = read_lossless_counts(data + s->offset, s->bytes);
+    info.input_vertices = n.vertices(layout.header.vertices);
+    info.input_faces = n.faces(layout.header.faces);
+  }
+}
+
+void undo_cut(const uint8_t *data, const FileLayout &layout, Mesh &decoded) {
+  if (const SectionEntry *s = lossless_section(data, layout)) {
+    const uint8_t *body = data + s->offset;
+    const LosslessRecord r = read_lossless_record(body, s->bytes, decoded, layout.header.grid.bits);
     decoded = apply_lossless_record(decoded, r, layout.header.grid);
   }
 }

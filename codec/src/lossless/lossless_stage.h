@@ -38,6 +38,10 @@ LosslessRecord build_lossless_record(const Mesh &input, const Mesh &cut, const R
                                      const Quantizer &grid, bool keep_order, Mesh &decoded,
                                      std::vector<uint32_t> &output_to_input);
 
+/// inspect(): the input's counts from a lossless record's counts, if the file has one (its
+/// checksum is checked).
+void lossless_info(const uint8_t *data, const FileLayout &layout, FileInfo &info);
+
 /// A full decode's last stage: if the file carries a lossless record, undo the cut on the
 /// decoded mesh (`data` holds the whole file).
 void undo_cut(const uint8_t *data, const FileLayout &layout, Mesh &decoded);
