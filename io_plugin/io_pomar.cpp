@@ -242,9 +242,15 @@ bool PomarIOPlugin::open(const QString &format, const QString &fileName, MeshMod
     } else {
       decoder.want_all(level);
       decoder.update(progress.function());
-      mesh = decoder.mesh();
-      cluster = decoder.vertex_cluster();
-      vertexLevel = decoder.vertex_level();
+      // At the finest level, intact: exactly what was saved (a lossless record undone);
+      // coarser levels show the coded, cut mesh.
+      std::vector<uint32_t> source;
+      mesh = decoder.exact_mesh(&source);
+      const std::vector<uint32_t> clusters = decoder.vertex_cluster(), levels = decoder.vertex_level();
+      for (uint32_t s : source) {
+        cluster.push_back(s < clusters.size() ? clusters[s] : UINT32_MAX);
+        vertexLevel.push_back(s < levels.size() ? levels[s] : UINT32_MAX);
+      }
       damaged = decoder.damaged();
     }
     if (!damaged.empty()) {
@@ -264,9 +270,9 @@ bool PomarIOPlugin::open(const QString &format, const QString &fileName, MeshMod
         m.cm, pomar::meshlab::kLevelAttribute);
     const bool haveClusters = info.clustered() && cluster.size() == mesh.vertex_count();
     const bool haveLevels = vertexLevel.size() == mesh.vertex_count();
-    for (size_t v = 0; v < mesh.vertex_count(); ++v) {
-      clusterOf[v] = haveClusters ? float(cluster[v]) : -1.0f;
-      levelOf[v] = haveLevels ? float(vertexLevel[v]) : -1.0f;
+    for (size_t v = 0; v < mesh.vertex_count(); ++v) { // -1: unknown (or a vertex no face uses)
+      clusterOf[v] = haveClusters && cluster[v] != UINT32_MAX ? float(cluster[v]) : -1.0f;
+      levelOf[v] = haveLevels && vertexLevel[v] != UINT32_MAX ? float(vertexLevel[v]) : -1.0f;
     }
     auto source = vcg::tri::Allocator<CMeshO>::GetPerMeshAttribute<std::string>(
         m.cm, pomar::meshlab::kSourceAttribute);
@@ -302,10 +308,12 @@ void PomarIOPlugin::initSaveParameter(const QString &format, MeshModel & /*m*/,
   par.addParam(RichBool("Progressive", defaults.progressive, "Pure progressive",
                         "Global levels only, no clusters: no random access."));
   par.addParam(RichBool("Repair", false, "Repair (cut into a manifold mesh)",
-                        "Opt-in: save a non-manifold or inconsistently oriented mesh by cutting it "
-                        "(faces repeating a vertex and exact duplicates removed, faces flipped, "
-                        "non-manifold vertices split into copies at the same position). Every "
-                        "change is reported as a warning; the layer itself is not modified."));
+                        "Opt-in: save the mesh cut into a manifold one instead of the mesh as it "
+                        "is (faces repeating a vertex and exact duplicates removed, faces "
+                        "flipped, non-manifold vertices split into copies at the same position). "
+                        "Without it any mesh is saved exactly: the cut is stored in the file and "
+                        "undone on open. Every change is reported as a warning; the layer itself "
+                        "is not modified."));
 }
 
 bool PomarIOPlugin::save(const QString &format, const QString &fileName, MeshModel &m,
@@ -329,26 +337,19 @@ bool PomarIOPlugin::save(const QString &format, const QString &fileName, MeshMod
   QStringList dropped = notKept(m);
   std::vector<uint8_t> bytes;
   QString repaired; // what the Repair option changed, "" if off or nothing
+  QString stored;   // what the file keeps beyond the coded mesh (any mesh saves exactly)
   try {
     progress.report(0);
-    size_t unreferenced = 0;
-    pomar::Mesh mesh = pomar::from_vcg(m.cm, &unreferenced); // skips deleted elements
-    if (unreferenced > 0)
-      dropped << QString("%1 unreferenced vertices").arg(unreferenced);
+    // Deleted elements skipped; unreferenced vertices kept (the file stores them).
+    pomar::Mesh mesh = pomar::from_vcg(m.cm, nullptr, true);
     if (repair) {
       const pomar::RepairReport report = pomar::make_manifold(mesh);
       if (report.changed())
         repaired = QString::fromStdString(report.summary()).replace('\n', "; ");
     }
-    try {
-      bytes = pomar::encode(mesh, options);
-    } catch (const pomar::Error &e) {
-      pomar::Mesh copy = mesh;
-      if (repair || !pomar::make_manifold(copy).changed())
-        throw;
-      throw pomar::Error(std::string(e.what()) +
-                         " (the Repair save option cuts it into a manifold mesh)");
-    }
+    pomar::EncodeReport report;
+    bytes = pomar::encode(mesh, options, &report);
+    stored = QString::fromStdString(report.lossless.summary());
   } catch (const std::exception &e) { // pomar::Error (invalid mesh or options), std::bad_alloc
     return fail(describe("cannot save", path, e.what()));
   }
@@ -372,6 +373,9 @@ bool PomarIOPlugin::save(const QString &format, const QString &fileName, MeshMod
     Log(GLLogStream::WARNING, qUtf8Printable(warning));
     qWarning("pomar: %s", qUtf8Printable(warning)); // Log() is a no-op in meshlabserver
   }
+  if (!stored.isEmpty())
+    Log("pomar: %s: stored for an exact decode: %s", qUtf8Printable(QFileInfo(path).fileName()),
+        qUtf8Printable(stored));
   if (!dropped.isEmpty()) {
     const QString warning =
         QString("%1: the .pomar format keeps only positions and triangles; not saved: %2")

@@ -123,8 +123,10 @@ public:
   Mesh mesh() const;
   /// mesh() with the lossless record undone once every cluster is at finest_level() and no
   /// block was skipped: then exactly the encoded input (as pomar::decode gives it);
-  /// otherwise the same as mesh().
-  Mesh exact_mesh() const;
+  /// otherwise the same as mesh(). `source` (optional) receives for each of its vertices
+  /// the vertex of mesh() it comes from (UINT32_MAX for a vertex no coded face uses), e.g.
+  /// to carry vertex_cluster() and vertex_level() over.
+  Mesh exact_mesh(std::vector<uint32_t> *source = nullptr) const;
   /// Per vertex of mesh(): its cluster and the level that created it.
   std::vector<uint32_t> vertex_cluster() const;
   std::vector<uint32_t> vertex_level() const;

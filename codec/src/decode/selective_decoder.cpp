@@ -579,15 +579,20 @@ void SelectiveDecoder::State::check_cluster_data() {
 
 Mesh SelectiveDecoder::mesh() const { return to_mesh(s_->mesh, s_->layout.header.grid); }
 
-Mesh SelectiveDecoder::exact_mesh() const {
+Mesh SelectiveDecoder::exact_mesh(std::vector<uint32_t> *source) const {
   Mesh m = mesh();
   const bool complete =
       s_->damaged.empty() &&
       (s_->clustered() ? std::all_of(s_->levels.begin(), s_->levels.end(),
                                      [&](int l) { return l == s_->finest; })
                        : s_->uniform_level == s_->finest);
-  if (complete)
-    undo_cut(s_->global.data(), s_->layout, m); // the lossless record lies in the global part
+  if (complete) {
+    undo_cut(s_->global.data(), s_->layout, m, source); // the record lies in the global part
+  } else if (source) {
+    source->resize(m.vertex_count());
+    for (uint32_t v = 0; v < source->size(); ++v)
+      (*source)[v] = v;
+  }
   return m;
 }
 

@@ -524,7 +524,8 @@ LosslessRecord read_lossless_record(const uint8_t *data, size_t size, const Mesh
   return r;
 }
 
-Mesh apply_lossless_record(const Mesh &decoded, const LosslessRecord &r, const Quantizer &grid) {
+Mesh apply_lossless_record(const Mesh &decoded, const LosslessRecord &r, const Quantizer &grid,
+                           std::vector<uint32_t> *source) {
   const uint32_t nv = static_cast<uint32_t>(decoded.vertex_count());
   std::vector<uint32_t> out_of(nv, kNone);
   Mesh out;
@@ -578,6 +579,14 @@ Mesh apply_lossless_record(const Mesh &decoded, const LosslessRecord &r, const Q
     out.positions.swap(p);
     for (uint32_t &v : out.triangles)
       v = r.order[v];
+  }
+  if (source) {
+    source->assign(out.vertex_count(), kNone);
+    for (uint32_t v = 0; v < nv; ++v) {
+      const uint32_t o = r.order.empty() ? out_of[v] : r.order[out_of[v]];
+      if ((*source)[o] == kNone)
+        (*source)[o] = v;
+    }
   }
   return out;
 }

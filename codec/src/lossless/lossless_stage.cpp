@@ -262,11 +262,16 @@ void lossless_info(const uint8_t *data, const FileLayout &layout, FileInfo &info
   }
 }
 
-void undo_cut(const uint8_t *data, const FileLayout &layout, Mesh &decoded) {
+void undo_cut(const uint8_t *data, const FileLayout &layout, Mesh &decoded,
+              std::vector<uint32_t> *source) {
   if (const SectionEntry *s = lossless_section(data, layout)) {
     const uint8_t *body = data + s->offset;
     const LosslessRecord r = read_lossless_record(body, s->bytes, decoded, layout.header.grid.bits);
-    decoded = apply_lossless_record(decoded, r, layout.header.grid);
+    decoded = apply_lossless_record(decoded, r, layout.header.grid, source);
+  } else if (source) {
+    source->resize(decoded.vertex_count());
+    for (uint32_t v = 0; v < source->size(); ++v)
+      (*source)[v] = v;
   }
 }
 

@@ -44,6 +44,8 @@ void lossless_info(const uint8_t *data, const FileLayout &layout, FileInfo &info
 
 /// A full decode's last stage: if the file carries a lossless record, undo the cut on the
 /// decoded mesh (`data` holds the whole file).
-void undo_cut(const uint8_t *data, const FileLayout &layout, Mesh &decoded);
+/// `source` (optional): see apply_lossless_record (the identity when there is no record).
+void undo_cut(const uint8_t *data, const FileLayout &layout, Mesh &decoded,
+              std::vector<uint32_t> *source = nullptr);
 
 } // namespace pomar
