@@ -304,12 +304,13 @@ TEST(Lossless, CoarserLevelsAndSelectiveDecodesShowTheCutMesh) {
 TEST(Lossless, DamagedRecordIsAnErrorNotAWrongMesh) {
   const std::vector<uint8_t> file = encode(messy_sphere(2));
   const FileLayout layout = read_layout(file.data(), file.size());
-  ASSERT_EQ(layout.sections.size(), 1u);
-  const auto &s = layout.sections[0];
+  ASSERT_EQ(layout.header.sections.size(), 1u);
+  const SectionEntry &s = layout.header.sections[0];
   EXPECT_EQ(s.tag, kLosslessTag);
+  EXPECT_EQ(s.flags, kSectionRequired);
   for (uint64_t i = 0; i < s.bytes; ++i) {
     std::vector<uint8_t> copy = file;
-    copy[s.offset + i] ^= 0x20;
+    copy[layout.section_offset[0] + i] ^= 0x20;
     EXPECT_THROW(decode(copy.data(), copy.size()), Error) << "byte " << i;
   }
 }

@@ -377,6 +377,13 @@ nlohmann::json info_json(const pomar::FileInfo &i) {
   j["input_vertices"] = i.input_vertices;
   j["input_faces"] = i.input_faces;
   j["cluster_block_bytes"] = i.cluster_block_bytes;
+  nlohmann::json sections = nlohmann::json::array();
+  for (const pomar::FileInfo::Section &sec : i.sections)
+    sections.push_back({{"name", sec.name},
+                        {"bytes", sec.bytes},
+                        {"bpv", bpv(sec.bytes, i.vertices)},
+                        {"required", sec.required}});
+  j["sections"] = sections;
   j["header_bytes"] = i.header_bytes;
   j["base_bytes"] = i.base_bytes;
   j["total_bytes"] = i.total_bytes;
@@ -436,11 +443,13 @@ int run_info(const std::string &in, bool json) {
                   "them all)\n",
                   i.clusters, sizes.front(), sizes[sizes.size() / 2], sizes.back());
   }
+  for (const pomar::FileInfo::Section &sec : i.sections)
+    std::printf("  section %s: %lu bytes = %.2f bits/vertex%s\n", sec.name.c_str(),
+                static_cast<unsigned long>(sec.bytes), bpv(sec.bytes, i.vertices),
+                sec.required ? " (required)" : "");
   if (i.lossless_bytes)
-    std::printf("  lossless record %lu bytes = %.3f bits/vertex: a full decode gives back the "
-                "input's %lu vertices and %lu faces exactly (levels and regions show the coded, "
-                "cut mesh)\n",
-                static_cast<unsigned long>(i.lossless_bytes), bpv(i.lossless_bytes, i.vertices),
+    std::printf("  lossless record (section LSLS): a full decode gives back the input's %lu "
+                "vertices and %lu faces exactly (levels and regions show the coded, cut mesh)\n",
                 static_cast<unsigned long>(i.input_vertices),
                 static_cast<unsigned long>(i.input_faces));
   std::printf("  level  vertices     faces  conn.bytes  geom.bytes\n");

@@ -235,7 +235,7 @@ expect_contains "$OUT" "the same 6 vertices and 8 oriented triangles" "stdout"
 run info "$WORK/nm/out.pomar"
 expect_rc 0
 expect_contains "$OUT" ".pomar version 4" "stdout"
-expect_contains "$OUT" "bits/vertex: a full decode gives back the input's 6 vertices and 8 faces" "stdout"
+expect_contains "$OUT" "a full decode gives back the input's 6 vertices and 8 faces exactly" "stdout"
 run info --json "$WORK/nm/out.pomar"
 expect_rc 0
 [ "$(json_get "$WORK/.out" "d['input_vertices']")" = 6 ] || fail "info --json: input_vertices is not 6"

@@ -121,6 +121,13 @@ struct FileInfo {
   /// What a full decode gives (the input's counts): vertices/faces above are those of the
   /// coded mesh, which differ when the file carries a lossless record (filled by inspect()).
   uint64_t input_vertices = 0, input_faces = 0;
+  /// Version 4: what the file carries in sections of its global part, with their sizes.
+  struct Section {
+    std::string name;      ///< four ASCII characters, e.g. "LSLS"
+    uint64_t bytes = 0;    ///< size of the section's body
+    bool required = false; ///< a reader that does not know it must refuse the file
+  };
+  std::vector<Section> sections;
   bool clustered() const { return clusters != 0; }
 };
 

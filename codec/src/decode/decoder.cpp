@@ -171,6 +171,7 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
   DecodeReport &r = report ? *report : scratch_report;
   r = DecodeReport();
   const FileLayout layout = read_layout(data, size, size, options.skip_damaged);
+  require_known_sections(layout);
   const FileHeader &h = layout.header;
   const size_t levels = h.levels.size();
   if (options.level < -1 || options.level > static_cast<int>(levels))

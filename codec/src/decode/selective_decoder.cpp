@@ -290,20 +290,21 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   s.source = std::move(source);
   s.skip_damaged = options.skip_damaged;
   const uint64_t file_size = s.source->size();
-  // Header: fixed part, then its full size.
+  // Header: the fixed part, then as much more as header_size() asks for (version 4 needs
+  // one more step: its section count says how long the section table is).
   s.global.resize(std::min<uint64_t>(file_size, kFixedHeaderBytes));
   s.source->read(0, s.global.size(), s.global.data());
-  size_t hsize = header_size(s.global.data(), s.global.size());
-  for (size_t have = s.global.size(); hsize != have;) { // version 4: the section table's size
-    if (hsize > file_size)
-      throw Error("truncated .pomar file: the header alone needs " + std::to_string(hsize) +
+  size_t hsize = s.global.size();
+  for (size_t want; (want = header_size(s.global.data(), hsize)) > hsize;) {
+    if (want > file_size)
+      throw Error("truncated .pomar file: the header alone needs " + std::to_string(want) +
                   " bytes");
-    s.global.resize(hsize);
-    s.source->read(0, hsize, s.global.data());
-    have = hsize;
-    hsize = header_size(s.global.data(), s.global.size());
+    s.global.resize(want);
+    s.source->read(hsize, want - hsize, s.global.data() + hsize);
+    hsize = want;
   }
   s.layout = read_layout(s.global.data(), hsize, file_size, options.skip_damaged);
+  require_known_sections(s.layout);
   // What the constructor decodes: the base clustered mesh (progressive files: the base
   // mesh). Further refinement is what the caller asks for, region by region.
   check_decode_memory(file_info(s.layout, file_size),

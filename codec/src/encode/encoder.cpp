@@ -362,7 +362,8 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
     std::vector<uint32_t> decoded_to_cut(nv);
     for (uint32_t i = 0; i < nv; ++i)
       decoded_to_cut[i] = compact_to_input[dec_to_input[i]];
-    sections.push_back({kLosslessTag, hook->record(decoded_to_cut)});
+    // Required: a reader that ignored it would give the cut mesh for the input.
+    sections.push_back({kLosslessTag, kSectionRequired, hook->record(decoded_to_cut)});
   }
   std::vector<uint8_t> file = write_file(header, pack_base_mesh(base, grid.bits), blocks, tables,
                                          cluster_blocks, sections);

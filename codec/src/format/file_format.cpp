@@ -3,9 +3,15 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <new>
 #include <string>
+
+// xxhash compiled into this file (Debian's xxhash.h carries the implementation): no call
+// into the uninstrumented libxxhash.so, so ASan and the fuzzers see every byte a checksum
+// reads, and a file's bytes reach no code that sanitizers cannot check.
+#define XXH_INLINE_ALL
 #include <xxhash.h>
 
 #include "entropy/models.h"
@@ -114,6 +120,19 @@ std::vector<uint8_t> pack_cluster_index(const std::vector<std::vector<uint8_t>> 
 
 [[noreturn]] void bad(const std::string &what) { throw Error("not a valid .pomar file: " + what); }
 
+// No .pomar file is this large: every size read from a header is checked against it before
+// it takes part in a sum, so offsets computed from sizes can never wrap (2^48 bytes leaves
+// room for 2^15 such sizes in a 64-bit sum).
+constexpr uint64_t kMaxFileBytes = uint64_t(1) << 48;
+
+/// offset += bytes, refusing a size no file can have (a hostile header must not make an
+/// offset wrap around and land back inside the buffer).
+void advance(uint64_t &offset, uint64_t bytes, const char *what) {
+  if (bytes > kMaxFileBytes || offset > kMaxFileBytes - bytes)
+    bad(std::string(what) + " size " + std::to_string(bytes) + " is impossible (more than 2^48 bytes)");
+  offset += bytes;
+}
+
 } // namespace
 
 // The base mesh block is one range-coded stream: positions as differences to the previous
@@ -171,13 +190,23 @@ std::vector<uint8_t> write_file(FileHeader header, const std::vector<uint8_t> &b
                                 const std::vector<uint8_t> &tables,
                                 const std::vector<std::vector<uint8_t>> &cluster_blocks,
                                 const std::vector<Section> &sections) {
+  if (sections.size() > kMaxSections)
+    throw Error("internal error: more than " + std::to_string(kMaxSections) + " sections");
+  header.version = !sections.empty() ? kSectionsFormatVersion
+                   : header.clustered() ? kClusteredFormatVersion
+                                        : kFormatVersion;
+  header.flags = static_cast<uint16_t>((header.flags & kFlagClustered) |
+                                       (sections.empty() ? 0 : kFlagSections));
+  header.sections.clear();
+  for (const Section &sec : sections)
+    header.sections.push_back(
+        {sec.tag, sec.flags, sec.body.size(), checksum(sec.body.data(), sec.body.size())});
   header.base_bytes = static_cast<uint32_t>(base_block.size());
   header.base_checksum = checksum(base_block.data(), base_block.size());
   for (size_t i = 0; i < level_blocks.size(); ++i)
     header.levels[i].checksum = checksum(level_blocks[i].data(), level_blocks[i].size());
   std::vector<uint8_t> index;
   if (header.clustered()) {
-    header.version = kClusteredFormatVersion;
     header.clusters = static_cast<uint32_t>(cluster_blocks.size());
     header.tables_bytes = static_cast<uint32_t>(tables.size());
     header.tables_checksum = checksum(tables.data(), tables.size());
@@ -193,18 +222,11 @@ std::vector<uint8_t> write_file(FileHeader header, const std::vector<uint8_t> &b
     header.has_cluster_checksum = true;
     header.cluster_checksum = checksum(blocks);
   }
-  header.sections.clear();
-  if (!sections.empty()) {
-    header.version = kSectionsFormatVersion;
-    header.flags |= kFlagSections;
-    for (const Section &s : sections)
-      header.sections.push_back({s.tag, 0, 0, s.body.size(), checksum(s.body.data(), s.body.size())});
-  }
   std::vector<uint8_t> out;
   write_header(header, out);
   out.insert(out.end(), base_block.begin(), base_block.end());
-  for (const Section &s : sections)
-    out.insert(out.end(), s.body.begin(), s.body.end());
+  for (const Section &sec : sections)
+    out.insert(out.end(), sec.body.begin(), sec.body.end());
   for (const auto &b : level_blocks)
     out.insert(out.end(), b.begin(), b.end());
   if (header.clustered()) {
@@ -225,14 +247,15 @@ size_t header_size(const uint8_t *data, size_t size) {
   const uint16_t flags = r.u16();
   ByteReader c(data + 48, 4, "the .pomar header");
   const uint64_t levels = std::min<uint32_t>(c.u32(), kMaxLevels);
-  const size_t fixed =
+  size_t bytes =
       kFixedHeaderBytes + kLevelEntryBytes * levels + ((flags & kFlagClustered) ? kClusterHeaderBytes : 0);
-  if (!(flags & kFlagSections))
-    return fixed + 4;
-  if (size < fixed + 4)
-    return fixed + 4; // then the section count tells the rest
-  ByteReader n(data + fixed, 4, "the .pomar header");
-  return fixed + 4 + kSectionEntryBytes * std::min<uint32_t>(n.u32(), kMaxSections) + 4;
+  if (flags & kFlagSections) { // version 4: the section count, then the table
+    if (size < bytes + 4)
+      return bytes + 4;
+    ByteReader n(data + bytes, 4, "the .pomar section table");
+    bytes += 4 + kSectionEntryBytes * std::min<uint32_t>(n.u32(), kMaxSections);
+  }
+  return bytes + 4;
 }
 
 FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size, bool allow_truncated) {
@@ -246,14 +269,14 @@ FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size, boo
   FileLayout L;
   FileHeader &h = L.header;
   h.version = r.u16();
-  if (h.version != kFormatVersion && h.version != kClusteredFormatVersion &&
-      h.version != kClusteredFormatVersion2 && h.version != kSectionsFormatVersion)
+  if (h.version < kFormatVersion || h.version > kSectionsFormatVersion)
     throw Error("unsupported .pomar version " + std::to_string(h.version) +
                 " (this build reads versions 1 to 4)");
   h.flags = r.u16();
   const bool v4 = h.version == kSectionsFormatVersion;
-  if ((!v4 && (h.version != kFormatVersion) != h.clustered()) ||
-      (h.flags & ~(v4 ? kFlagClustered | kFlagSections : kFlagClustered)))
+  const bool flags_ok = v4 ? (h.flags & ~(kFlagClustered | kFlagSections)) == 0 && (h.flags & kFlagSections)
+                           : (h.flags & ~kFlagClustered) == 0 && (h.version != kFormatVersion) == h.clustered();
+  if (!flags_ok)
     bad("unknown flags " + std::to_string(h.flags) + " for version " + std::to_string(h.version));
   h.grid.bits = r.u8();
   r.u8();
@@ -271,19 +294,19 @@ FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size, boo
   h.base_checksum = r.u32();
   if (levels > kMaxLevels)
     bad("level count " + std::to_string(levels) + " exceeds " + std::to_string(kMaxLevels));
-  L.header_bytes =
-      kFixedHeaderBytes + kLevelEntryBytes * levels + (h.clustered() ? kClusterHeaderBytes : 0) + 4;
-  uint32_t section_count = 0;
-  if (h.flags & kFlagSections) {
-    if (size < L.header_bytes)
+  // The header's size: fixed part, level table, cluster header, (version 4) section table.
+  const size_t table_at =
+      kFixedHeaderBytes + kLevelEntryBytes * levels + (h.clustered() ? kClusterHeaderBytes : 0);
+  uint32_t sections = 0;
+  if (v4) {
+    if (size < table_at + 4)
       bad("header is truncated");
-    ByteReader n(data + L.header_bytes - 4, 4, "the .pomar header");
-    section_count = n.u32();
-    if (section_count > kMaxSections)
-      bad("section count " + std::to_string(section_count) + " exceeds " +
-          std::to_string(kMaxSections));
-    L.header_bytes += 4 + kSectionEntryBytes * section_count;
+    ByteReader n(data + table_at, 4, "the .pomar section table");
+    sections = n.u32();
+    if (sections > kMaxSections)
+      bad("section count " + std::to_string(sections) + " exceeds " + std::to_string(kMaxSections));
   }
+  L.header_bytes = table_at + (v4 ? 4 + kSectionEntryBytes * sections : 0) + 4;
   if (size < L.header_bytes)
     bad("header is truncated");
   const uint32_t stored = [&] {
@@ -325,19 +348,21 @@ FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size, boo
     if (h.clusters != base_clustered)
       bad("cluster count differs from the base clustered mesh's vertex count");
   }
-  if (h.flags & kFlagSections) {
+  if (v4) {
     r.u32(); // the count, read above
-    h.sections.resize(section_count);
-    for (SectionEntry &e : h.sections) {
+    for (uint32_t i = 0; i < sections; ++i) {
+      SectionEntry e;
       e.tag = r.u32();
       e.flags = r.u32();
       e.bytes = r.u32();
       e.bytes |= uint64_t(r.u32()) << 32;
       e.checksum = r.u32();
-      if (e.flags != 0)
-        bad("unknown section flags " + std::to_string(e.flags));
-      if (e.bytes > (uint64_t(1) << 40))
-        bad("section size is implausible");
+      if (e.flags & ~kSectionRequired)
+        bad("section " + section_name(e.tag) + " has unknown flags " + std::to_string(e.flags));
+      for (const SectionEntry &o : h.sections)
+        if (o.tag == e.tag)
+          bad("section " + section_name(e.tag) + " appears twice");
+      h.sections.push_back(e);
     }
   }
   // Sanity of the counts before anybody allocates from them.
@@ -360,38 +385,41 @@ FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size, boo
     bad("level table does not end at the announced vertex/face counts");
   if (h.base_bytes == 0)
     bad("empty base mesh block");
+  // Offsets: every addition is checked (advance), and nothing below subtracts sizes.
   uint64_t offset = L.header_bytes;
   L.base_offset = offset;
-  offset += h.base_bytes;
-  for (SectionEntry e : h.sections) {
-    e.offset = offset;
-    offset += e.bytes;
-    L.sections.push_back(e);
+  advance(offset, h.base_bytes, "base mesh block");
+  for (const SectionEntry &e : h.sections) {
+    L.section_offset.push_back(offset);
+    advance(offset, e.bytes, "section");
   }
   const size_t global = h.clustered() ? h.global_levels : h.levels.size();
   for (size_t i = 0; i < global; ++i) {
     L.level_offset.push_back(offset);
-    offset += uint64_t(h.levels[i].connectivity_bytes) + h.levels[i].geometry_bytes;
+    advance(offset, uint64_t(h.levels[i].connectivity_bytes) + h.levels[i].geometry_bytes,
+            "global level block");
   }
   for (size_t i = global; i < h.levels.size(); ++i)
     if (h.levels[i].connectivity_bytes || h.levels[i].geometry_bytes)
       bad("a clustered level has global data");
   if (h.clustered()) {
     L.tables_offset = offset;
-    offset += h.tables_bytes;
+    advance(offset, h.tables_bytes, "static model tables");
     L.index_offset = offset;
-    offset += h.index_bytes;
+    advance(offset, h.index_bytes, "cluster index");
     L.clusters_offset = offset;
     L.global_bytes = offset;
-    offset += h.cluster_bytes;
+    advance(offset, h.cluster_bytes, "cluster data");
   } else {
     L.global_bytes = offset;
   }
   L.file_size = file_size;
-  // With allow_truncated, only what every decode needs must be present.
+  // With allow_truncated, only what every decode needs must be present; a strict reader
+  // needs every byte the header announces.
   const uint64_t needed = !allow_truncated ? offset
                           : h.clustered()  ? L.global_bytes
-                                           : L.base_offset + h.base_bytes;
+                          : L.level_offset.empty() ? L.global_bytes
+                                                   : L.level_offset[0]; // base + sections
   if (needed > file_size)
     throw Error("truncated .pomar file: " + std::to_string(file_size) +
                 " bytes, the header announces " + std::to_string(offset));
@@ -480,6 +508,82 @@ ClusterIndex read_cluster_index(const uint8_t *data, const FileLayout &L) {
   return index;
 }
 
+std::string section_name(uint32_t tag) {
+  std::string name;
+  for (int k = 0; k < 4; ++k) {
+    const char ch = static_cast<char>(tag >> (8 * k));
+    if (ch < 0x20 || ch > 0x7E) {
+      char hex[16];
+      std::snprintf(hex, sizeof hex, "0x%08X", tag);
+      return hex;
+    }
+    name += ch;
+  }
+  return "'" + name + "'";
+}
+
+int find_section(const FileLayout &L, uint32_t tag) {
+  for (size_t i = 0; i < L.header.sections.size(); ++i)
+    if (L.header.sections[i].tag == tag)
+      return static_cast<int>(i);
+  return -1;
+}
+
+const uint8_t *section_body(const uint8_t *data, const FileLayout &L, size_t i) {
+  const SectionEntry &e = L.header.sections.at(i);
+  if (L.section_offset[i] + e.bytes > L.file_size)
+    throw Error("truncated .pomar file: section " + section_name(e.tag) + " ends at byte " +
+                std::to_string(L.section_offset[i] + e.bytes) + ", the file has " +
+                std::to_string(L.file_size));
+  const uint8_t *p = data + L.section_offset[i];
+  if (checksum(p, e.bytes) != e.checksum)
+    throw Error("damaged .pomar file: checksum mismatch in section " + section_name(e.tag));
+  return p;
+}
+
+const std::vector<uint32_t> &known_sections() {
+  // The sections this build's decoders honour (issues 12 and 13 add theirs here).
+  static const std::vector<uint32_t> known = {kLosslessTag};
+  return known;
+}
+
+void require_known_sections(const FileLayout &L, const std::vector<uint32_t> &known) {
+  for (const SectionEntry &e : L.header.sections)
+    if ((e.flags & kSectionRequired) && std::find(known.begin(), known.end(), e.tag) == known.end())
+      throw Error("this build of pomar cannot read the file's section " + section_name(e.tag) +
+                  ", which it needs (written by a newer pomar?)");
+}
+
+std::vector<uint8_t> with_sections(const uint8_t *file, size_t size,
+                                   const std::vector<Section> &add) {
+  const FileLayout L = read_layout(file, size);
+  FileHeader h = L.header;
+  auto bytes = [file](uint64_t offset, uint64_t n) {
+    return std::vector<uint8_t>(file + offset, file + offset + n);
+  };
+  const std::vector<uint8_t> base = bytes(L.base_offset, h.base_bytes);
+  std::vector<Section> sections;
+  for (size_t i = 0; i < h.sections.size(); ++i) {
+    const SectionEntry &e = h.sections[i];
+    if (std::none_of(add.begin(), add.end(), [&](const Section &s) { return s.tag == e.tag; }))
+      sections.push_back({e.tag, e.flags, bytes(L.section_offset[i], e.bytes)});
+  }
+  sections.insert(sections.end(), add.begin(), add.end());
+  std::vector<std::vector<uint8_t>> levels;
+  for (size_t i = 0; i < L.level_offset.size(); ++i)
+    levels.push_back(bytes(L.level_offset[i],
+                           uint64_t(h.levels[i].connectivity_bytes) + h.levels[i].geometry_bytes));
+  std::vector<uint8_t> tables;
+  std::vector<std::vector<uint8_t>> blocks;
+  if (h.clustered()) {
+    tables = bytes(L.tables_offset, h.tables_bytes);
+    const ClusterIndex index = read_cluster_index(file + L.index_offset, L);
+    for (uint32_t c = 0; c < h.clusters; ++c)
+      blocks.push_back(bytes(index.offset[c], index.size[c]));
+  }
+  return write_file(h, base, levels, tables, blocks, sections);
+}
+
 void check_block(const uint8_t *data, size_t size, uint32_t expected, const char *what) {
   if (checksum(data, size) != expected)
     throw Error(std::string("damaged .pomar file: ") + what + " checksum mismatch");
@@ -519,9 +623,14 @@ FileInfo file_info(const FileLayout &L, uint64_t file_size) {
   info.total_bytes = file_size;
   info.header_bytes = L.header_bytes;
   info.base_bytes = h.base_bytes;
-  for (const SectionEntry &e : L.sections)
+  for (const SectionEntry &e : h.sections) {
+    std::string name;
+    for (int k = 0; k < 4; ++k)
+      name += static_cast<char>(e.tag >> (8 * k));
+    info.sections.push_back({name, e.bytes, (e.flags & kSectionRequired) != 0});
     if (e.tag == kLosslessTag)
       info.lossless_bytes += e.bytes;
+  }
   info.input_vertices = h.vertices; // inspect() reads a lossless record's counts
   info.input_faces = h.faces;
   return info;

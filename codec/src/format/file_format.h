@@ -1,9 +1,11 @@
-// The .pomar container, version 1 (byte layout: docs/format.md).
-//   header (fixed part + level table + checksum) | base mesh block | level blocks
+// The .pomar container, versions 1 to 4 (byte layout: docs/format.md).
+//   header (fixed part + level table [+ cluster header] [+ section table] + checksum)
+//   | base mesh block | [section bodies] | global level blocks | [tables | index | cluster blocks]
 // Every block carries an XXH32 checksum so damage is reported, never mis-decoded.
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "pomar/pomar.h"
@@ -14,11 +16,16 @@ constexpr uint8_t kMagic[8] = {'P', 'O', 'M', 'A', 'R', '\r', '\n', 0x1A};
 constexpr uint16_t kFormatVersion = 1;           // pure progressive files
 constexpr uint16_t kClusteredFormatVersion = 3;  // files with clustered levels
 constexpr uint16_t kClusteredFormatVersion2 = 2; // read only: no cluster data checksum
-constexpr uint16_t kSectionsFormatVersion = 4;  // files with a section table
+/// Files carrying sections (what version 1/3 cannot hold: lossless record, attributes).
+/// Progressive or clustered (kFlagClustered); files without sections stay version 1 or 3.
+constexpr uint16_t kSectionsFormatVersion = 4;
 constexpr uint16_t kFlagClustered = 1;
-constexpr uint16_t kFlagSections = 2;
+constexpr uint16_t kFlagSections = 2; // set exactly in version 4: the header has a section table
 constexpr size_t kSectionEntryBytes = 20;
 constexpr uint32_t kMaxSections = 64;
+/// Section flag: a reader that does not know the section's tag must refuse the file
+/// (otherwise it may ignore the section).
+constexpr uint32_t kSectionRequired = 1;
 constexpr size_t kClusterHeaderBytes = 40;
 constexpr size_t kFixedHeaderBytes = 60;
 constexpr size_t kLevelEntryBytes = 20;
@@ -30,25 +37,27 @@ struct LevelEntry {
   uint32_t checksum = 0; // XXH32 of the level's bytes (connectivity then geometry)
 };
 
-/// A section tag from its 4 ASCII characters ("LSLS" -> bytes 'L','S','L','S' in the file).
-constexpr uint32_t section_tag(const char (&s)[5]) {
-  return uint32_t(uint8_t(s[0])) | uint32_t(uint8_t(s[1])) << 8 | uint32_t(uint8_t(s[2])) << 16 |
-         uint32_t(uint8_t(s[3])) << 24;
+/// A section's four ASCII bytes as the little-endian u32 the table stores.
+constexpr uint32_t section_tag(const char (&name)[5]) {
+  return uint32_t(uint8_t(name[0])) | uint32_t(uint8_t(name[1])) << 8 |
+         uint32_t(uint8_t(name[2])) << 16 | uint32_t(uint8_t(name[3])) << 24;
 }
-constexpr uint32_t kLosslessTag = section_tag("LSLS"); ///< the lossless record (issue 13)
+std::string section_name(uint32_t tag); // "LSLS", or the bytes in hex if not printable
+/// The lossless record (issue 13, codec/src/lossless/): required.
+constexpr uint32_t kLosslessTag = section_tag("LSLS");
 
-/// A global section of a version 4 file (its body follows the base mesh block).
+/// A section of the global part as a writer hands it over.
 struct Section {
   uint32_t tag = 0;
+  uint32_t flags = 0; // kSectionRequired
   std::vector<uint8_t> body;
 };
 
-/// A section as the header's table describes it.
+/// A section table entry (version 4).
 struct SectionEntry {
   uint32_t tag = 0, flags = 0;
-  uint64_t offset = 0; // absolute file offset of the body (layout only)
   uint64_t bytes = 0;
-  uint32_t checksum = 0;
+  uint32_t checksum = 0; // XXH32 (seed 0) of the body
 };
 
 struct FileHeader {
@@ -73,7 +82,8 @@ struct FileHeader {
   // own 8-bit checks let 1 damaged block in 256 through).
   bool has_cluster_checksum = false;
   uint32_t cluster_checksum = 0;
-  std::vector<SectionEntry> sections; // version 4 (flags & kFlagSections)
+  // Version 4: the section table (bodies follow the base mesh block, in this order).
+  std::vector<SectionEntry> sections;
   bool clustered() const { return (flags & kFlagClustered) != 0; }
 };
 
@@ -95,7 +105,7 @@ struct FileLayout {
   FileHeader header;
   size_t header_bytes = 0;
   size_t base_offset = 0;
-  std::vector<SectionEntry> sections; // with their offsets
+  std::vector<size_t> section_offset; // start of each section's body
   std::vector<size_t> level_offset; // start of each global level's connectivity bytes
   size_t tables_offset = 0, index_offset = 0, clusters_offset = 0;
   size_t global_bytes = 0; // everything before the first cluster block
@@ -121,9 +131,15 @@ std::vector<uint8_t> write_file(FileHeader header, const std::vector<uint8_t> &b
                                 const std::vector<uint8_t> &tables = {},
                                 const std::vector<std::vector<uint8_t>> &cluster_blocks = {},
                                 const std::vector<Section> &sections = {});
+/// The same file with `sections` added (replacing any of the same tags): version 4 (the
+/// input may be version 1, 3 or 4). Stages that run after encode() (e.g. the lossless
+/// record, which needs the decoder's numbering) attach their data this way.
+std::vector<uint8_t> with_sections(const uint8_t *file, size_t size,
+                                   const std::vector<Section> &sections);
 
-/// Bytes a header needs before it can be parsed: at least the fixed part; then
-/// header_size() tells the full size.
+/// Bytes of the header needed to know more: with fewer than the fixed part, the fixed part;
+/// in version 4, up to the section count until it is present; then the whole header. A
+/// reader reads that many bytes and asks again until header_size(data, size) <= size.
 size_t header_size(const uint8_t *data, size_t size);
 
 /// Parse and check the header (magic, version, checksum, sizes against `file_size`).
@@ -139,6 +155,17 @@ ClusterIndex read_cluster_index(const uint8_t *data, const FileLayout &layout);
 BaseMesh read_base_mesh(const uint8_t *data, const FileLayout &layout);
 /// Throw if level `i` is missing (truncated file) or its checksum does not match.
 void check_level(const uint8_t *data, const FileLayout &layout, size_t i);
+/// The index of the section with `tag`, or -1.
+int find_section(const FileLayout &layout, uint32_t tag);
+/// Section `i`'s body after checking its checksum (throws a damaged-file error naming it).
+/// `data` holds the global part.
+const uint8_t *section_body(const uint8_t *data, const FileLayout &layout, size_t i);
+/// The tags of the sections this build's decoders honour.
+const std::vector<uint32_t> &known_sections();
+/// Throw if the file has a required section whose tag is not in `known` (a newer writer's
+/// data this build cannot honour).
+void require_known_sections(const FileLayout &layout,
+                            const std::vector<uint32_t> &known = known_sections());
 /// Check a global block's checksum (tables or index); `what` names it in the error.
 void check_block(const uint8_t *data, size_t size, uint32_t expected, const char *what);
 

@@ -239,24 +239,21 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
 
 namespace {
 
-/// The lossless record's section, checked, or nullptr if the file has none.
-const SectionEntry *lossless_section(const uint8_t *data, const FileLayout &layout) {
-  for (const SectionEntry &s : layout.sections) {
-    if (s.tag != kLosslessTag)
-      continue;
-    if (s.offset + s.bytes > layout.file_size)
-      throw Error("truncated .pomar file: the lossless record ends past the end of the file");
-    check_block(data + s.offset, s.bytes, s.checksum, "lossless record");
-    return &s;
-  }
-  return nullptr;
+/// The lossless record's body (its checksum checked) and size, or nullptr if there is none.
+const uint8_t *lossless_body(const uint8_t *data, const FileLayout &layout, uint64_t &bytes) {
+  const int i = find_section(layout, kLosslessTag);
+  if (i < 0)
+    return nullptr;
+  bytes = layout.header.sections[i].bytes;
+  return section_body(data, layout, static_cast<size_t>(i));
 }
 
 } // namespace
 
 void lossless_info(const uint8_t *data, const FileLayout &layout, FileInfo &info) {
-  if (const SectionEntry *s = lossless_section(data, layout)) {
-    const LosslessCounts n = read_lossless_counts(data + s->offset, s->bytes);
+  uint64_t bytes = 0;
+  if (const uint8_t *body = lossless_body(data, layout, bytes)) {
+    const LosslessCounts n = read_lossless_counts(body, bytes);
     info.input_vertices = n.vertices(layout.header.vertices);
     info.input_faces = n.faces(layout.header.faces);
   }
@@ -264,9 +261,9 @@ void lossless_info(const uint8_t *data, const FileLayout &layout, FileInfo &info
 
 void undo_cut(const uint8_t *data, const FileLayout &layout, Mesh &decoded,
               std::vector<uint32_t> *source) {
-  if (const SectionEntry *s = lossless_section(data, layout)) {
-    const uint8_t *body = data + s->offset;
-    const LosslessRecord r = read_lossless_record(body, s->bytes, decoded, layout.header.grid.bits);
+  uint64_t bytes = 0;
+  if (const uint8_t *body = lossless_body(data, layout, bytes)) {
+    const LosslessRecord r = read_lossless_record(body, bytes, decoded, layout.header.grid.bits);
     decoded = apply_lossless_record(decoded, r, layout.header.grid, source);
   } else if (source) {
     source->resize(decoded.vertex_count());

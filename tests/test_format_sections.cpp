@@ -1,0 +1,100 @@
+// Format version 4: sections in the global part (docs/format.md, "Version 4: sections").
+#include <gtest/gtest.h>
+
+#include <memory>
+
+#include "format/file_format.h"
+#include "pomar/limits.h"
+#include "pomar/random_access.h"
+#include "support/mesh_gen.h"
+
+namespace pomar {
+namespace {
+
+std::vector<uint8_t> file_of(const Mesh &m, bool progressive) {
+  EncodeOptions o;
+  o.progressive = progressive;
+  o.clusters = progressive ? 0 : 8;
+  o.memory_limit = kNoMemoryLimit;
+  return encode(m, o);
+}
+
+const Section kOptional{section_tag("TST1"), 0, {10, 20, 30}};
+const Section kRequired{section_tag("TST2"), kSectionRequired, {1}};
+
+TEST(FormatSections, FilesWithoutSectionsKeepVersion1And3) {
+  EXPECT_EQ(inspect(file_of(gen::icosphere(2), true).data(), file_of(gen::icosphere(2), true).size()).version, 1u);
+  const std::vector<uint8_t> c = file_of(gen::icosphere(2), false);
+  EXPECT_EQ(inspect(c.data(), c.size()).version, 3u);
+  // Re-assembling without sections gives back the same bytes.
+  EXPECT_EQ(with_sections(c.data(), c.size(), {}), c);
+}
+
+TEST(FormatSections, SectionsAreListedAndTheMeshDecodesUnchanged) {
+  for (bool progressive : {true, false}) {
+    const Mesh m = gen::torus(16, 10);
+    const std::vector<uint8_t> plain = file_of(m, progressive);
+    const std::vector<uint8_t> v4 = with_sections(plain.data(), plain.size(), {kOptional});
+    const FileInfo info = inspect(v4.data(), v4.size());
+    EXPECT_EQ(info.version, 4u);
+    EXPECT_EQ(info.clustered(), !progressive);
+    ASSERT_EQ(info.sections.size(), 1u);
+    EXPECT_EQ(info.sections[0].name, "TST1");
+    EXPECT_EQ(info.sections[0].bytes, 3u);
+    EXPECT_FALSE(info.sections[0].required);
+    EXPECT_EQ(v4.size(), plain.size() + 4 + kSectionEntryBytes + 3);
+    const Mesh a = decode(plain.data(), plain.size()), b = decode(v4.data(), v4.size());
+    EXPECT_EQ(a.positions, b.positions);
+    EXPECT_EQ(a.triangles, b.triangles);
+    for (int level : {0, 2})
+      EXPECT_EQ(decode(plain.data(), plain.size(), level).triangles,
+                decode(v4.data(), v4.size(), level).triangles);
+    // The selective decoder reads the longer header in steps and decodes the same.
+    SelectiveDecoder d(std::make_unique<MemorySource>(v4.data(), v4.size()));
+    d.want_all(d.finest_level());
+    d.update();
+    EXPECT_EQ(d.mesh().triangles, a.triangles);
+    // The body reads back, and a second with_sections replaces it by tag.
+    const FileLayout L = read_layout(v4.data(), v4.size());
+    const int i = find_section(L, kOptional.tag);
+    ASSERT_GE(i, 0);
+    const uint8_t *body = section_body(v4.data(), L, size_t(i));
+    EXPECT_EQ(std::vector<uint8_t>(body, body + 3), kOptional.body);
+    const Section other{kOptional.tag, 0, std::vector<uint8_t>(1, 7)};
+    const std::vector<uint8_t> again = with_sections(v4.data(), v4.size(), {other});
+    const FileInfo info2 = inspect(again.data(), again.size());
+    ASSERT_EQ(info2.sections.size(), 1u);
+    EXPECT_EQ(info2.sections[0].bytes, 1u);
+  }
+}
+
+TEST(FormatSections, AnUnknownRequiredSectionIsRefusedByName) {
+  const std::vector<uint8_t> plain = file_of(gen::icosphere(2), false);
+  const std::vector<uint8_t> v4 = with_sections(plain.data(), plain.size(), {kOptional, kRequired});
+  EXPECT_EQ(inspect(v4.data(), v4.size()).sections.size(), 2u); // info still works
+  try {
+    (void)decode(v4.data(), v4.size());
+    FAIL() << "decoded a file with an unknown required section";
+  } catch (const Error &e) {
+    EXPECT_NE(std::string(e.what()).find("'TST2'"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(SelectiveDecoder(std::make_unique<MemorySource>(v4.data(), v4.size())), Error);
+}
+
+TEST(FormatSections, ADamagedSectionBodyIsNamed) {
+  const std::vector<uint8_t> plain = file_of(gen::icosphere(2), true);
+  std::vector<uint8_t> v4 = with_sections(plain.data(), plain.size(), {kOptional});
+  const FileLayout L = read_layout(v4.data(), v4.size());
+  v4[L.section_offset[0] + 1] ^= 0x40;
+  try {
+    section_body(v4.data(), L, 0);
+    FAIL() << "a damaged section passed its checksum";
+  } catch (const Error &e) {
+    EXPECT_NE(std::string(e.what()).find("section 'TST1'"), std::string::npos) << e.what();
+  }
+  // A file cut inside the sections is truncated before anything can be decoded.
+  EXPECT_THROW(read_layout(v4.data(), L.section_offset[0] + 1, L.section_offset[0] + 1, true), Error);
+}
+
+} // namespace
+} // namespace pomar
