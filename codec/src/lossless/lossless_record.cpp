@@ -60,8 +60,6 @@ uint64_t get_u(RangeDecoder &rc, UintModel &m) {
   return v;
 }
 
-uint64_t zigzag(int64_t v) { return v < 0 ? (uint64_t(-(v + 1)) << 1) | 1 : uint64_t(v) << 1; }
-int64_t unzigzag(uint64_t u) { return u & 1 ? -int64_t(u >> 1) - 1 : int64_t(u >> 1); }
 
 /// Position groups: group[v] numbers the distinct positions of `mesh` (exact float bits).
 std::vector<uint32_t> position_groups(const Mesh &mesh) {
@@ -128,7 +126,7 @@ struct Candidates {
 struct RecordModels {
   UintModel counts, copy_gap, copy_index, flip_gap, dup_gap, dup_count, degen_gap, degen_b,
       extra[3], order_symbol;
-  BitModel degen_single;
+  BitModel degen_single, extra_sign[3]; // sorted extra vertices: x rarely goes down
 };
 
 [[noreturn]] void damaged(const std::string &what) {
@@ -371,7 +369,10 @@ std::vector<uint8_t> write_lossless_record(const LosslessRecord &r, const Mesh &
   int32_t prev[3] = {0, 0, 0};
   for (size_t i = 0; i < r.extra_q.size(); ++i) {
     const int k = static_cast<int>(i % 3);
-    put_u(rc, m.extra[k], zigzag(int64_t(r.extra_q[i]) - prev[k]));
+    const int64_t d = int64_t(r.extra_q[i]) - prev[k];
+    put_u(rc, m.extra[k], static_cast<uint64_t>(d < 0 ? -d : d));
+    if (d != 0)
+      rc.encode_bit(m.extra_sign[k], d < 0);
     prev[k] = r.extra_q[i];
   }
   if (!r.order.empty()) {
@@ -484,7 +485,10 @@ LosslessRecord read_lossless_record(const uint8_t *data, size_t size, const Mesh
   r.extra_q.reserve(3 * extra);
   for (uint64_t i = 0; i < 3 * extra; ++i) {
     const int k = static_cast<int>(i % 3);
-    const int64_t q = prev[k] + unzigzag(get_u(rc, m.extra[k]));
+    int64_t d = static_cast<int64_t>(get_u(rc, m.extra[k]));
+    if (d != 0 && rc.decode_bit(m.extra_sign[k]))
+      d = -d;
+    const int64_t q = prev[k] + d;
     if (q < 0 || q > top)
       damaged("vertex position off the grid");
     r.extra_q.push_back(static_cast<int32_t>(q));

@@ -116,13 +116,21 @@ LosslessRecord build_lossless_record(const Mesh &input, const Mesh &cut, const R
     input_to_output[v] = static_cast<uint32_t>(output_to_input.size());
     output_to_input.push_back(v);
   }
-  for (uint32_t v = 0; v < nv; ++v) {
-    if (input_to_output[v] != kNone)
-      continue;
+  // The others, sorted by grid position (their output order is free: the deltas from one
+  // to the next are then smaller; keep_order restores the input order anyway).
+  std::vector<std::pair<Key, uint32_t>> extra;
+  for (uint32_t v = 0; v < nv; ++v)
+    if (input_to_output[v] == kNone) {
+      Key q;
+      for (int k = 0; k < 3; ++k)
+        q[k] = grid.quantize(k, input.positions[3 * size_t(v) + k]);
+      extra.push_back({q, v});
+    }
+  std::sort(extra.begin(), extra.end());
+  for (const auto &[q, v] : extra) {
     input_to_output[v] = static_cast<uint32_t>(output_to_input.size());
     output_to_input.push_back(v);
-    for (int k = 0; k < 3; ++k)
-      r.extra_q.push_back(static_cast<int32_t>(grid.quantize(k, input.positions[3 * size_t(v) + k])));
+    r.extra_q.insert(r.extra_q.end(), q.begin(), q.end());
   }
 
   // Faces of D, and where each cut face comes in D's canonical order.
