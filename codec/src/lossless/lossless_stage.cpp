@@ -35,21 +35,23 @@ std::array<uint32_t, 2> degenerate_form(uint32_t x, uint32_t y, uint32_t z) {
   return {z, y}; // z == x: (z, x, y) = (z, z, y)
 }
 
-/// True when the encoder takes `mesh` as it is: every vertex used, and a valid corner table
-/// (manifold, oriented, no face repeating a vertex, no duplicate).
-bool is_clean(const Mesh &mesh) {
+/// True if every vertex is used by a face (indices out of range are left to the encoder,
+/// which names them).
+bool all_vertices_used(const Mesh &mesh) {
   const size_t nv = mesh.vertex_count();
   std::vector<uint8_t> used(nv, 0);
-  for (uint32_t v : mesh.triangles) {
-    if (v >= nv)
-      return false; // the manifold encoder names it
-    used[v] = 1;
-  }
-  if (std::find(used.begin(), used.end(), 0) != used.end())
-    return false;
+  for (uint32_t v : mesh.triangles)
+    if (v < nv)
+      used[v] = 1;
+  return std::find(used.begin(), used.end(), 0) == used.end();
+}
+
+/// True when the manifold encoder takes `mesh` as it is: a valid corner table (manifold,
+/// oriented, no face repeating a vertex, no duplicate).
+bool valid_topology(const Mesh &mesh) {
   try {
     CornerTable ct;
-    build_corner_table(mesh.triangles.data(), mesh.triangle_count(), nv, ct);
+    build_corner_table(mesh.triangles.data(), mesh.triangle_count(), mesh.vertex_count(), ct);
   } catch (const Error &) {
     return false;
   }
@@ -77,9 +79,14 @@ std::string LosslessReport::summary() const {
   if (keep_order)
     kept.push_back("the vertex order");
   std::string s;
-  if (vertices_split || edges_cut)
-    s = "non-manifold: " + plural(vertices_split, "vertex", "vertices") + " and " +
-        plural(edges_cut, "edge", "edges") + " stored as cuts";
+  if (vertices_split || edges_cut) {
+    s = "non-manifold: ";
+    if (vertices_split)
+      s += plural(vertices_split, "vertex", "vertices") + (edges_cut ? " and " : "");
+    if (edges_cut)
+      s += plural(edges_cut, "edge", "edges");
+    s += " stored as cuts";
+  }
   for (size_t i = 0; i < kept.size(); ++i)
     s += (i == 0 ? (s.empty() ? "" : "; ") : i + 1 == kept.size() ? " and " : ", ") + kept[i];
   if (!kept.empty())
@@ -183,8 +190,19 @@ LosslessRecord build_lossless_record(const Mesh &input, const Mesh &cut, const R
 }
 
 std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, EncodeReport *report) {
-  if (options.strict || (!options.keep_order && is_clean(mesh)))
+  if (options.strict)
     return encode_manifold(mesh, options, report, nullptr);
+  if (!options.keep_order && all_vertices_used(mesh)) {
+    // Most meshes are clean: code them as they are (the file is then byte for byte what
+    // strict gives). The manifold encoder checks the topology early (its corner table);
+    // only if it refuses is the topology checked here, and the mesh cut.
+    try {
+      return encode_manifold(mesh, options, report, nullptr);
+    } catch (const Error &) {
+      if (mesh.triangles.size() % 3 || valid_topology(mesh))
+        throw; // not a matter of topology: the error stands
+    }
+  }
 
   const size_t nv = mesh.vertex_count();
   if (mesh.positions.size() % 3 || mesh.triangles.size() % 3)
