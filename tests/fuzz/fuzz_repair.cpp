@@ -36,11 +36,16 @@ std::vector<std::vector<float>> triangles_by_position(const pomar::Mesh &m) {
       const uint32_t v = m.triangles[3 * f + k];
       t[k] = {m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]};
     }
-    const int r = int(std::min_element(t, t + 3) - t);
-    std::vector<float> row;
-    for (int k = 0; k < 3; ++k)
-      row.insert(row.end(), t[(r + k) % 3].begin(), t[(r + k) % 3].end());
-    out.push_back(row);
+    // The smallest of the three rotations (two corners may share a position).
+    std::vector<float> best;
+    for (int r = 0; r < 3; ++r) {
+      std::vector<float> row;
+      for (int k = 0; k < 3; ++k)
+        row.insert(row.end(), t[(r + k) % 3].begin(), t[(r + k) % 3].end());
+      if (r == 0 || row < best)
+        best = row;
+    }
+    out.push_back(best);
   }
   std::sort(out.begin(), out.end());
   return out;
