@@ -499,25 +499,6 @@ std::vector<Point> point_multiset(const pomar::Mesh &m) {
   return out;
 }
 
-/// Drops the vertices no face uses; returns how many.
-size_t drop_unreferenced(pomar::Mesh &m) {
-  std::vector<uint32_t> index(m.vertex_count(), 0);
-  for (uint32_t v : m.triangles)
-    index[v] = 1;
-  std::vector<float> kept;
-  uint32_t next = 0;
-  for (size_t v = 0; v < index.size(); ++v)
-    if (index[v]) {
-      index[v] = next++;
-      kept.insert(kept.end(), &m.positions[3 * v], &m.positions[3 * v] + 3);
-    }
-  for (uint32_t &v : m.triangles)
-    v = index[v];
-  const size_t dropped = m.vertex_count() - next;
-  m.positions.swap(kept);
-  return dropped;
-}
-
 int run_verify(const std::string &original, const std::string &file, const std::string &decoded,
                bool repair) {
   pomar::Mesh ref = pomar::load_mesh(original);
@@ -527,7 +508,7 @@ int run_verify(const std::string &original, const std::string &file, const std::
   const std::vector<uint8_t> data = pomar::read_file(file);
   const pomar::FileInfo info = pomar::inspect(data.data(), data.size());
   // A file without a lossless record (encode --strict, or older) has no unreferenced vertex.
-  const size_t dropped = info.lossless_bytes == 0 ? drop_unreferenced(ref) : 0;
+  const size_t dropped = info.lossless_bytes == 0 ? pomar::drop_unreferenced_vertices(ref) : 0;
   const bool could_repair = !repair && info.lossless_bytes == 0 && repair_would_help(ref);
   const pomar::Mesh out =
       decoded.empty() ? pomar::decode(data.data(), data.size()) : pomar::load_mesh(decoded);

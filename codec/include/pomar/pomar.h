@@ -3,7 +3,24 @@
 // This is the core API on flat arrays (positions + 32-bit triangle indices). It has no
 // dependency on vcglib; `pomar/vcg_adapter.h` converts from/to vcglib meshes and
 // `pomar/mesh_io.h` reads and writes PLY/OBJ/OFF/STL files.
+//
+// Installed as a CMake package (`find_package(pomar CONFIG)`: pomar::core for this header,
+// random_access.h, repair.h and limits.h; pomar::io adds mesh_io.h) and for pkg-config
+// (`pomar`). vcg_adapter.h is header-only and uses the program's own vcglib.
+//
+// Threads: the library has no global mutable state. Every free function (encode, decode,
+// inspect, check_blocks, make_manifold, load_mesh, save_mesh, ...) may be called from
+// several threads at once, on different or on the same (unmodified) inputs. An object
+// (SelectiveDecoder, FileSource, MemorySource) is used by one thread at a time; distinct
+// objects are independent. Callbacks (Progress, SizeCheck) run on the calling thread,
+// before the function returns. Nothing starts threads of its own.
+//
+// Ownership: functions take inputs by const reference or as (pointer, size) and do not
+// keep them after returning (exception: MemorySource, see random_access.h); results are
+// returned by value and belong to the caller.
 #pragma once
+
+#include "pomar/version.h"
 
 #include <cstddef>
 #include <cstdint>
@@ -13,6 +30,10 @@
 #include <vector>
 
 namespace pomar {
+
+/// The version of the library the program runs with, "MAJOR.MINOR.PATCH" (compare with
+/// the POMAR_VERSION_* macros of pomar/version.h, the headers it was compiled with).
+const char *version();
 
 /// Every failure of the library is reported as a pomar::Error whose what() is one line
 /// naming the problem (and, for invalid meshes, where: counts and one example).
@@ -131,6 +152,16 @@ struct FileInfo {
   bool clustered() const { return clusters != 0; }
 };
 
+/// Ideal code lengths per symbol kind, in bits.
+struct SymbolBits {
+  double s_v = 0;        ///< split flags
+  double s_e = 0;        ///< which ring edge is v_to-v_ref
+  double faces = 0;      ///< patch size s_l + s_r
+  double s_l = 0;        ///< where the patch starts
+  double tangential = 0; ///< geometry residuals in the tangent plane (two per split)
+  double normal = 0;     ///< geometry residual along the normal
+};
+
 /// Facts about one encode, beyond what the file itself says.
 struct EncodeReport {
   FileInfo info;
@@ -138,9 +169,8 @@ struct EncodeReport {
   /// No triangle uses them: dropped with `strict`, else kept in the lossless record.
   size_t unreferenced_vertices = 0;
   double quantize_seconds = 0, decimate_seconds = 0, encode_seconds = 0;
-  /// Ideal code length per symbol kind of the global levels, in bits (adaptive models):
-  /// s_v, s_e, s_l + s_r, s_l, tangential and normal residual components.
-  double symbol_bits[6] = {0, 0, 0, 0, 0, 0};
+  /// Ideal code length per symbol kind of the global levels (adaptive models).
+  SymbolBits symbol_bits;
   /// decoded vertex i (in a full decode) is input vertex decoded_to_input[i].
   std::vector<uint32_t> decoded_to_input;
   LosslessReport lossless; ///< what was stored to undo the cut
@@ -155,6 +185,10 @@ struct EncodeReport {
 /// and, with `strict`, on any mesh that needs cutting.
 std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options = {},
                             EncodeReport *report = nullptr);
+
+/// Drops the vertices no triangle uses (the others keep their order, triangles are
+/// renumbered; indices out of range are left as they are); returns how many were dropped.
+size_t drop_unreferenced_vertices(Mesh &mesh);
 
 /// Read the header, base mesh and level table of a .pomar image (checks their checksums).
 FileInfo inspect(const uint8_t *data, size_t size);

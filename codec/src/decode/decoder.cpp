@@ -1,93 +1,18 @@
-// Decoder: file -> base mesh -> global levels -> mesh.
+// pomar::decode (a global level target decodes the global levels here; a clustered target
+// goes through the SelectiveDecoder), pomar::inspect, pomar::check_blocks,
+// pomar::describe_damage.
 #include <memory>
 #include <string>
 
-#include "decode/decoder_codec.h"
+#include "decode/damage.h"
+#include "decode/global_levels.h"
 #include "entropy/models.h"
 #include "format/file_format.h"
 #include "lossless/lossless_stage.h"
 #include "pomar/limits.h"
 #include "pomar/random_access.h"
-#include "refine/level_traversal.h"
 
 namespace pomar {
-
-const char *const kUnplacedDamage =
-    "damaged .pomar file: a block that passes its 8-bit check failed to decode; it and its "
-    "neighbours were skipped, but the damage may lie in another block whose wrong data "
-    "decoded: the mesh may be wrong in places";
-
-const char *const kUnlocatedDamage =
-    "damaged .pomar file: the cluster data fails its checksum although every block passes "
-    "its 8-bit check: a damaged block cannot be located, the mesh may be wrong in places";
-
-Mesh to_mesh(const LevelMesh &lm, const Quantizer &grid) {
-  Mesh out;
-  out.positions.resize(lm.q.size());
-  for (size_t i = 0; i < lm.q.size(); ++i)
-    out.positions[i] = grid.dequantize(static_cast<int>(i % 3), static_cast<uint32_t>(lm.q[i]));
-  out.triangles = lm.ct.V;
-  return out;
-}
-
-LevelMesh base_level_mesh(const uint8_t *data, const FileLayout &layout) {
-  const FileHeader &h = layout.header;
-  const BaseMesh base = read_base_mesh(data, layout);
-  LevelMesh lm;
-  lm.q = base.q;
-  lm.seed_faces = h.base_faces;
-  try {
-    build_corner_table(base.triangles.data(), h.base_faces, h.base_vertices, lm.ct);
-  } catch (const Error &e) {
-    throw Error(std::string("damaged .pomar file: invalid base mesh: ") + e.what());
-  }
-  lm.init_lineage();
-  return lm;
-}
-
-size_t decode_global_levels(const uint8_t *data, const FileLayout &layout, size_t from, size_t to,
-                            LevelMesh &lm, Models &models, const Progress &progress,
-                            std::vector<DamagedBlock> *damaged) {
-  const FileHeader &h = layout.header;
-  DecoderCodec codec(h.grid.bits);
-  TraversalScratch scratch;
-  std::vector<PendingSplit> splits;
-  RangeDecoder conn, geom;
-  for (size_t i = from; i < to; ++i) {
-    const LevelEntry &e = h.levels[i];
-    bool traversing = false;
-    try {
-      check_level(data, layout, i);
-      const uint8_t *p = data + layout.level_offset[i];
-      conn.reset(p, e.connectivity_bytes);
-      geom.reset(p + e.connectivity_bytes, e.geometry_bytes);
-      codec.set(&models, &conn, &geom, static_cast<uint32_t>(i + 1));
-      traversing = true;
-      traverse_level(lm, codec, scratch, static_cast<uint32_t>(i + 1), splits);
-      if (conn.overrun() || geom.overrun())
-        codec.corrupt("the level's data ends too early");
-      if (lm.vertex_count() + splits.size() != e.vertices)
-        codec.corrupt("the number of vertex splits differs from the level table");
-      size_t faces = lm.ct.face_count();
-      for (const PendingSplit &ps : splits)
-        faces += size_t(ps.op.has_l) + size_t(ps.op.has_r);
-      if (faces != e.faces)
-        codec.corrupt("the face count differs from the level table");
-    } catch (const Error &err) {
-      if (!damaged)
-        throw;
-      // Every check comes before the splits are applied: the mesh is still level i.
-      if (traversing)
-        release_claims(lm, scratch, static_cast<uint32_t>(i + 1));
-      damaged->push_back({"level " + std::to_string(i + 1), err.what(), static_cast<int>(i)});
-      return i;
-    }
-    apply_splits(lm, splits, static_cast<uint32_t>(i + 1));
-    if (progress)
-      progress(double(i + 1) / double(to), "decode");
-  }
-  return to;
-}
 
 FileInfo inspect(const uint8_t *data, size_t size) {
   const FileLayout layout = read_layout(data, size);

@@ -68,23 +68,4 @@ private:
   uint32_t level_ = 0, cluster_ = 0xFFFFFFFFu;
 };
 
-/// The message for damage in the cluster data that no block's own check found.
-extern const char *const kUnlocatedDamage;
-/// The caution added when a block that passed its 8-bit check fails to decode.
-extern const char *const kUnplacedDamage;
-
-/// Decode global levels [from, to) of `mesh` (the file image must hold the global part)
-/// and return `to`. A damaged level throws pomar::Error, or, if `damaged` is given, is
-/// recorded there and ends the decoding: the mesh stays at the level before it, whose
-/// number is returned.
-size_t decode_global_levels(const uint8_t *data, const FileLayout &layout, size_t from, size_t to,
-                            LevelMesh &mesh, Models &models, const Progress &progress,
-                            std::vector<DamagedBlock> *damaged = nullptr);
-
-/// The base mesh of a file as a LevelMesh (lineage initialised).
-LevelMesh base_level_mesh(const uint8_t *data, const FileLayout &layout);
-
-/// Dequantized positions and triangles of a LevelMesh.
-Mesh to_mesh(const LevelMesh &lm, const Quantizer &grid);
-
 } // namespace pomar

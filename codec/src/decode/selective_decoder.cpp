@@ -1,119 +1,19 @@
 // Random access (paper section 6): the level map and selective, incremental decoding.
 #include <algorithm>
-#include <cerrno>
-#include <cstring>
 
+#include "decode/damage.h"
 #include "decode/decoder_codec.h"
+#include "decode/global_levels.h"
+#include "decode/cluster_stream.h"
+#include "decode/level_map.h"
 #include "entropy/static_tables.h"
 #include "format/file_format.h"
 #include "lossless/lossless_stage.h"
 #include "pomar/limits.h"
 #include "pomar/random_access.h"
+#include "refine/level_step.h"
 
 namespace pomar {
-
-// ---------------------------------------------------------------- byte sources
-
-void MemorySource::read(uint64_t offset, size_t n, uint8_t *out) {
-  if (offset > size_ || n > size_ - offset)
-    throw Error("read past the end of the .pomar data (truncated file?)");
-  if (n) // an empty source has no data pointer to copy from (found by fuzzing)
-    std::memcpy(out, data_ + offset, n);
-}
-
-FileSource::FileSource(const std::string &path) : path_(path) {
-  file_ = std::fopen(path.c_str(), "rb");
-  if (!file_)
-    throw Error("cannot open " + path + ": " + std::strerror(errno));
-  if (std::fseek(file_, 0, SEEK_END) != 0 || std::ftell(file_) < 0) {
-    std::fclose(file_);
-    throw Error("cannot read " + path + ": not a regular file");
-  }
-  size_ = static_cast<uint64_t>(std::ftell(file_));
-}
-
-FileSource::~FileSource() {
-  if (file_)
-    std::fclose(file_);
-}
-
-void FileSource::read(uint64_t offset, size_t n, uint8_t *out) {
-  if (offset > size_ || n > size_ - offset)
-    throw Error("truncated .pomar file: " + path_ + " ends before byte " +
-                std::to_string(offset + n));
-  if (n == 0)
-    return;
-  if (std::fseek(file_, static_cast<long>(offset), SEEK_SET) != 0 ||
-      std::fread(out, 1, n, file_) != n)
-    throw Error("cannot read " + path_ + ": " + std::strerror(errno));
-}
-
-// ---------------------------------------------------------------- level map
-
-std::vector<int> complete_level_map(const std::vector<int> &wanted,
-                                    const std::vector<uint32_t> &start,
-                                    const std::vector<uint32_t> &adj, int floor) {
-  const size_t n = wanted.size();
-  std::vector<int> m(n);
-  int top = floor;
-  for (size_t c = 0; c < n; ++c) {
-    m[c] = std::max(wanted[c], floor);
-    top = std::max(top, m[c]);
-  }
-  // Buckets by level, highest first: each cluster lowers its neighbours' floor to its
-  // own level - 1 (the topological distance term of section 6).
-  std::vector<std::vector<uint32_t>> bucket(size_t(top - floor + 1));
-  for (size_t c = 0; c < n; ++c)
-    if (m[c] > floor)
-      bucket[size_t(m[c] - floor)].push_back(static_cast<uint32_t>(c));
-  for (int lvl = top; lvl > floor; --lvl) {
-    for (size_t i = 0; i < bucket[size_t(lvl - floor)].size(); ++i) {
-      const uint32_t c = bucket[size_t(lvl - floor)][i];
-      if (m[c] != lvl)
-        continue;
-      for (uint32_t k = start[c]; k < start[c + 1]; ++k) {
-        const uint32_t nb = adj[k];
-        if (m[nb] < lvl - 1) {
-          m[nb] = lvl - 1;
-          if (lvl - 1 > floor)
-            bucket[size_t(lvl - 1 - floor)].push_back(nb);
-        }
-      }
-    }
-  }
-  return m;
-}
-
-/// limit[x] = min over clusters c of cap[c] + d(c, x) (d = edge distance in the cluster
-/// graph), at most `top`: the finest level map that respects every cap and the level map
-/// rule. Buckets by value, lowest first (a multi-source breadth-first search).
-static std::vector<int> cap_distance_map(const std::vector<int> &cap,
-                                         const std::vector<uint32_t> &start,
-                                         const std::vector<uint32_t> &adj, int top) {
-  std::vector<int> limit(cap.size(), top);
-  int low = top;
-  for (size_t c = 0; c < cap.size(); ++c) {
-    limit[c] = std::min(cap[c], top);
-    low = std::min(low, limit[c]);
-  }
-  std::vector<std::vector<uint32_t>> bucket(size_t(top - low + 1));
-  for (size_t c = 0; c < cap.size(); ++c)
-    if (limit[c] < top)
-      bucket[size_t(limit[c] - low)].push_back(static_cast<uint32_t>(c));
-  for (int lvl = low; lvl < top; ++lvl) {
-    for (size_t i = 0; i < bucket[size_t(lvl - low)].size(); ++i) {
-      const uint32_t c = bucket[size_t(lvl - low)][i];
-      if (limit[c] != lvl)
-        continue;
-      for (uint32_t k = start[c]; k < start[c + 1]; ++k)
-        if (limit[adj[k]] > lvl + 1) {
-          limit[adj[k]] = lvl + 1;
-          bucket[size_t(lvl + 1 - low)].push_back(adj[k]);
-        }
-    }
-  }
-  return limit;
-}
 
 // ---------------------------------------------------------------- decoder state
 
@@ -123,8 +23,7 @@ struct SelectiveDecoder::State {
   FileLayout layout;
   FileInfo info;
   int global_levels = 0, finest = 0;
-  uint64_t bytes_read = 0;
-  uint32_t blocks_read = 0;
+  ReadStats reads; // bytes_read counts the global part too
 
   // Progressive part.
   Models global_models;
@@ -135,18 +34,11 @@ struct SelectiveDecoder::State {
   // Clustered part.
   std::vector<Models> level_models;
   ClusterIndex index;
-  std::vector<uint32_t> adj_start, adj;
-  /// A cluster's block, read from the source in chunks as its decoder consumes it.
-  struct Cluster : StreamRefill {
-    State *state = nullptr;
-    uint32_t id = 0;
-    std::vector<uint8_t> block; // sized to the whole block; [0, loaded) read so far
-    size_t loaded = 0;
-    bool checked = false;
-    RangeDecoder rc;
-    int level = 0;
-    uint32_t next_local = 1;
-    size_t more(size_t needed) override { return state->fetch(*this, needed); }
+  ClusterGraph graph;
+  struct Cluster {
+    ClusterStream stream;
+    int level = 0;           // the level it is decoded to
+    uint32_t next_local = 1; // its counter of created vertices (LevelMesh::local)
   };
   std::vector<Cluster> clusters;
   std::vector<int> wanted, levels;
@@ -155,64 +47,20 @@ struct SelectiveDecoder::State {
   bool skip_damaged = false;
   std::vector<int> cap;
   std::vector<DamagedBlock> damaged;
-  uint32_t decoding = kNone; // the cluster being decoded, for error reports
-  bool traversing = false;   // its traversal has started (it may have claimed faces)
   bool data_checked = false; // the version 3 checksum of all cluster data was verified
   int uniform_cap = 1 << 30; // progressive files: the level before a damaged one
 
-  TraversalScratch scratch;
-  std::vector<PendingSplit> splits;
+  LevelStep step;
 
   bool clustered() const { return layout.header.clustered(); }
-  static constexpr size_t kChunk = 4; // bytes per on-demand read of a cluster block
-  size_t fetch(Cluster &k, size_t needed);
-  void start(uint32_t c, bool whole);
   void reset_to_snapshot();
-  void decode_cluster_level(uint32_t c, int level);
-  void decode_target(const Progress &progress);
+  void decode_cluster_level(uint32_t c, int level, uint32_t older_than);
+  void decode_target(const Progress &progress, uint32_t &decoding);
   void check_cluster_data();
   bool skip_cluster(uint32_t c, const Error &e);
   std::vector<int> target; // the level map being decoded
   int target_of(uint32_t c) const { return target.empty() ? finest : target[c]; }
 };
-
-size_t SelectiveDecoder::State::fetch(Cluster &k, size_t needed) {
-  const size_t size = k.block.size();
-  if (k.loaded >= size)
-    return k.loaded; // past the end: the decoder reads zeros (and notices overruns)
-  const size_t upto = std::min(size, std::max(needed, k.loaded + kChunk));
-  source->read(index.offset[k.id] + k.loaded, upto - k.loaded, k.block.data() + k.loaded);
-  bytes_read += upto - k.loaded;
-  if (k.loaded == 0)
-    ++blocks_read;
-  k.loaded = upto;
-  if (k.loaded == size && !k.checked) {
-    if (!passes_block_check(k.block.data(), size, index.check[k.id]))
-      throw Error("damaged .pomar file: checksum mismatch in the block of cluster " +
-                  std::to_string(k.id));
-    k.checked = true;
-  }
-  return k.loaded;
-}
-
-/// (Re)start cluster c's stream; `whole` reads its block at once (it will be decoded to
-/// the end), otherwise bytes are read as the decoder needs them.
-void SelectiveDecoder::State::start(uint32_t c, bool whole) {
-  Cluster &k = clusters[c];
-  // A truncated file (accepted with skip_damaged): nothing is allocated for a block that
-  // is not there.
-  if (index.offset[c] + index.size[c] > source->size())
-    throw Error("truncated .pomar file: the block of cluster " + std::to_string(c) +
-                " ends at byte " + std::to_string(index.offset[c] + index.size[c]) +
-                ", the file has " + std::to_string(source->size()));
-  if (k.block.empty() && index.size[c] > 0)
-    k.block.resize(index.size[c]);
-  if (whole)
-    fetch(k, k.block.size());
-  else if (k.loaded < std::min<size_t>(k.block.size(), 4))
-    fetch(k, std::min<size_t>(k.block.size(), 4));
-  k.rc.reset(k.block.data(), k.loaded, &k);
-}
 
 void SelectiveDecoder::State::reset_to_snapshot() {
   mesh = snapshot;
@@ -222,37 +70,30 @@ void SelectiveDecoder::State::reset_to_snapshot() {
   }
 }
 
-void SelectiveDecoder::State::decode_cluster_level(uint32_t c, int level) {
+/// Cluster c's data of `level` (the cluster is at level - 1); a damaged block throws and
+/// leaves the mesh as it was.
+void SelectiveDecoder::State::decode_cluster_level(uint32_t c, int level, uint32_t older_than) {
   Cluster &k = clusters[c];
-  decoding = c;
   if (k.level == global_levels) // first clustered level of this cluster: (re)start its stream
-    start(c, skip_damaged || target_of(c) == finest);
+    k.stream.start(skip_damaged || target_of(c) == finest);
+  RangeDecoder &rc = k.stream.decoder();
   DecoderCodec codec(layout.header.grid.bits);
-  codec.set(&level_models[size_t(level - global_levels - 1)], &k.rc, &k.rc,
+  codec.set(&level_models[size_t(level - global_levels - 1)], &rc, &rc,
             static_cast<uint32_t>(level), c);
-  traversing = true;
-  traverse_cluster(mesh, codec, scratch, c, static_cast<uint32_t>(level), splits);
-  if (k.rc.overrun())
-    codec.corrupt("the block ends too early");
-  traversing = false;
-  // Every check is done: a damaged block leaves the mesh as it was.
-  apply_splits(mesh, splits, static_cast<uint32_t>(level), c, &k.next_local);
+  step.cluster_level(mesh, codec, {c, static_cast<uint32_t>(level), older_than}, k.next_local,
+                     [&](const StepCounts &) {
+                       if (rc.overrun())
+                         codec.corrupt("the block ends too early");
+                     });
   k.level = level;
-  decoding = kNone;
 }
 
 /// After `e` while decoding cluster `c` (kNone: not in a cluster): with skip_damaged,
 /// record the damage, cap the cluster at the base clustered level and return true (the
 /// caller decodes again); otherwise false (the caller rethrows).
 bool SelectiveDecoder::State::skip_cluster(uint32_t c, const Error &e) {
-  if (c == kNone)
-    return false;
-  // The failed traversal applied nothing; only its face claims need undoing.
-  if (traversing)
-    release_claims(mesh, scratch, static_cast<uint32_t>(clusters[c].level + 1));
-  traversing = false;
-  decoding = kNone;
-  if (!skip_damaged)
+  // (The failed step applied nothing and released its face claims.)
+  if (c == kNone || !skip_damaged)
     return false;
   damaged.push_back({"cluster " + std::to_string(c), e.what(), global_levels});
   // Levels of this cluster decoded earlier from the same block cannot be trusted either:
@@ -261,14 +102,14 @@ bool SelectiveDecoder::State::skip_cluster(uint32_t c, const Error &e) {
   // A block that passed its 8-bit check and still fails may be intact and fail because a
   // neighbour's damaged block slipped through its own check (1 in 256) and decoded to a
   // wrong but valid state. The neighbours' blocks are suspects: keep them coarse too.
-  if (clusters[c].checked) {
+  if (clusters[c].stream.checked()) {
     // The damage may also lie further away, in a block whose wrong data happened to decode:
     // say so once (nothing can locate it).
     if (std::none_of(damaged.begin(), damaged.end(),
                      [](const DamagedBlock &b) { return b.level_kept < 0; }))
       damaged.push_back({"cluster data", kUnplacedDamage, -1});
-    for (uint32_t k = adj_start[c]; k < adj_start[c + 1]; ++k) {
-      const uint32_t nb = adj[k];
+    for (uint32_t k = graph.start[c]; k < graph.start[c + 1]; ++k) {
+      const uint32_t nb = graph.adj[k];
       if (cap[nb] == global_levels)
         continue;
       cap[nb] = global_levels;
@@ -313,7 +154,7 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   // The global part (a truncated progressive file: what is there of it).
   s.global.resize(std::min<uint64_t>(s.layout.global_bytes, file_size));
   s.source->read(hsize, s.global.size() - hsize, s.global.data() + hsize);
-  s.bytes_read = s.global.size();
+  s.reads.bytes = s.global.size();
   s.info = file_info(s.layout, file_size);
   const FileHeader &h = s.layout.header;
   s.finest = static_cast<int>(h.levels.size());
@@ -332,29 +173,19 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   s.index = read_cluster_index(s.global.data() + s.layout.index_offset, s.layout);
   s.info.cluster_block_bytes = s.index.size;
   decode_global_levels(s.global.data(), s.layout, 0, h.global_levels, s.mesh, s.global_models, {});
-  // The base clustered mesh: each vertex roots its cluster.
   const uint32_t n = h.clusters;
-  s.mesh.local.assign(n, 0);
-  for (uint32_t c = 0; c < n; ++c)
-    s.mesh.tag[c].cluster = c;
+  s.mesh.root_clusters();
   s.snapshot = s.mesh;
   s.clusters.resize(n);
   for (uint32_t c = 0; c < n; ++c) {
-    s.clusters[c].state = &s;
-    s.clusters[c].id = c;
+    s.clusters[c].stream.init(s.source.get(), c, s.index.offset[c], s.index.size[c],
+                              s.index.check[c], &s.reads);
     s.clusters[c].level = s.global_levels;
   }
   s.wanted.assign(n, s.global_levels);
   s.levels.assign(n, s.global_levels);
   s.cap.assign(n, s.finest);
-  // The cluster graph = the base clustered mesh's edges.
-  Ring ring;
-  s.adj_start.assign(n + 1, 0);
-  for (uint32_t c = 0; c < n; ++c) {
-    get_ring(s.mesh.ct, c, ring);
-    s.adj.insert(s.adj.end(), ring.neighbour.begin(), ring.neighbour.end());
-    s.adj_start[c + 1] = static_cast<uint32_t>(s.adj.size());
-  }
+  s.graph = cluster_graph(s.mesh.ct, n);
 }
 
 SelectiveDecoder::~SelectiveDecoder() = default;
@@ -368,8 +199,8 @@ int SelectiveDecoder::finest_level() const { return s_->finest; }
 const std::vector<int> &SelectiveDecoder::wanted() const { return s_->wanted; }
 const std::vector<int> &SelectiveDecoder::levels() const { return s_->levels; }
 const std::vector<DamagedBlock> &SelectiveDecoder::damaged() const { return s_->damaged; }
-uint64_t SelectiveDecoder::bytes_read() const { return s_->bytes_read; }
-uint32_t SelectiveDecoder::blocks_read() const { return s_->blocks_read; }
+uint64_t SelectiveDecoder::bytes_read() const { return s_->reads.bytes; }
+uint32_t SelectiveDecoder::blocks_read() const { return s_->reads.blocks; }
 
 uint32_t SelectiveDecoder::clusters_decoded() const {
   uint32_t n = 0;
@@ -509,24 +340,25 @@ void SelectiveDecoder::update(const Progress &progress) {
   // Decode the completed level map; a damaged block caps its cluster and the map is
   // completed and decoded again (each round skips one more block, so this ends).
   for (;;) {
+    uint32_t decoding = kNone; // the cluster being decoded when an error is thrown
     try {
-      s.decode_target(progress);
+      s.decode_target(progress, decoding);
       return;
     } catch (const Error &e) {
-      if (!s.skip_cluster(s.decoding, e))
+      if (!s.skip_cluster(decoding, e))
         throw;
     }
   }
 }
 
-/// Bring the mesh to the level map completed from `wanted` and limited by the caps.
-void SelectiveDecoder::State::decode_target(const Progress &progress) {
-  decoding = kNone;
-  target = complete_level_map(wanted, adj_start, adj, global_levels);
+/// Bring the mesh to the level map completed from `wanted` and limited by the caps;
+/// `decoding` names the cluster being decoded (kNone between clusters).
+void SelectiveDecoder::State::decode_target(const Progress &progress, uint32_t &decoding) {
+  target = complete_level_map(wanted, graph.start, graph.adj, global_levels);
   if (!damaged.empty()) {
     // Each damaged cluster limits the others to its cap + their distance to it, the
     // largest map below both the request and the caps that keeps the level map rule.
-    const std::vector<int> limit = cap_distance_map(cap, adj_start, adj, finest);
+    const std::vector<int> limit = cap_distance_map(cap, graph.start, graph.adj, finest);
     for (size_t c = 0; c < target.size(); ++c)
       target[c] = std::min(target[c], limit[c]);
   }
@@ -543,16 +375,17 @@ void SelectiveDecoder::State::decode_target(const Progress &progress) {
     int finest_now = global_levels;
     for (const auto &k : clusters)
       finest_now = std::max(finest_now, k.level);
-    mesh.older_than_level = finest_now < level ? mesh.vertex_count() : 0;
+    const uint32_t older_than = finest_now < level ? mesh.vertex_count() : 0;
     for (uint32_t c = 0; c < target.size(); ++c) {
       if (target[c] < level || clusters[c].level >= level)
         continue;
-      decode_cluster_level(c, level);
+      decoding = c;
+      decode_cluster_level(c, level, older_than);
+      decoding = kNone;
       if (progress && (++done % 64 == 0 || done == todo))
         progress(double(done) / double(todo), "decode");
     }
   }
-  mesh.older_than_level = 0;
   levels = target;
   check_cluster_data();
 }
@@ -566,9 +399,10 @@ void SelectiveDecoder::State::check_cluster_data() {
     return; // (damage found already: the cluster data cannot match)
   std::vector<const std::vector<uint8_t> *> blocks;
   for (const Cluster &k : clusters) {
-    if (k.loaded != index.size[k.id])
+    const std::vector<uint8_t> *block = k.stream.whole_block();
+    if (!block)
       return; // not everything was read
-    blocks.push_back(&k.block);
+    blocks.push_back(block);
   }
   data_checked = true;
   if (checksum(blocks) == h.cluster_checksum)

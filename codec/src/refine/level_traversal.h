@@ -6,13 +6,15 @@
 // clockwise order, starting from the one back to where it came from. For each vertex the
 // codec codes s_v; for a split vertex (v_to) also s_e, s_l, s_r and the position of
 // v_from as a residual to the patch barycentre in the local Frenet frame. The splits are
-// only collected here; the caller applies them after the traversal (Figure 3, step 4).
+// only collected here; refine/level_step.h runs a traversal, its checks and then applies
+// them (Figure 3, step 4): that step is the only caller.
 //
 // The Codec policy provides (encoder: writes what it knows; decoder: reads):
 //   int  split_flag(uint32_t v, int context);
 //   void split_symbols(uint32_t v, const Ring& ring, const uint32_t* ranked,
 //                      SplitSymbols& s);      // ranked = ring indices, longest edge first
 //   void geometry(uint32_t v_to, const Prediction& prediction, int32_t position[3]);
+//                                     // prediction: geometry/predict.h
 //   [[noreturn]] void corrupt(const char* what);
 #pragma once
 
@@ -21,190 +23,26 @@
 #include <vector>
 
 #include "entropy/models.h"
-#include "geometry/frenet_frame.h"
+#include "geometry/predict.h"
 #include "mesh/corner_table.h"
+#include "refine/level_mesh.h"
+#include "refine/patch.h"
 #include "refine/vertex_split.h"
 
 namespace pomar {
 
-/// The mesh being refined: what the decoder holds, and what the encoder replicates.
-struct LevelMesh {
-  CornerTable ct;
-  std::vector<int32_t> q;  // quantized xyz per vertex
-  uint32_t seed_faces = 0; // faces of the base mesh (traversal seeds, never removed)
-  // Lineage of every vertex: the level that created it (0 = base mesh), its cluster
-  // (clustered levels: the base clustered mesh vertex it descends from), its parent (the
-  // v_to it was split from; itself for base vertices) and its rank of creation inside its
-  // cluster. (cluster, local) names a vertex the same way whatever clusters were decoded
-  // in whatever order. Level and cluster share a cache line: the walks read both.
-  struct Tag {
-    uint32_t cluster = 0;
-    uint16_t level = 0;
-  };
-  std::vector<Tag> tag;
-  std::vector<uint32_t> parent, local;
-  std::vector<uint16_t> face_claim; // per face: last level whose patch held it
-  /// Vertices below this id are known to be older than the level being decoded (0: not
-  /// known). Set when a level starts on a mesh that holds nothing finer, it spares the
-  /// view its lineage lookups (see view_of).
-  uint32_t older_than_level = 0;
-  uint32_t vertex_count() const { return ct.vertex_count(); }
-  uint32_t level_of(uint32_t v) const { return tag[v].level; }
-  uint32_t cluster_of(uint32_t v) const { return tag[v].cluster; }
-  uint64_t key(uint32_t v) const { return (uint64_t(tag[v].cluster) << 32) | local[v]; }
-  void init_lineage() {
-    tag.assign(vertex_count(), Tag{});
-    parent.resize(vertex_count());
-    for (uint32_t v = 0; v < vertex_count(); ++v)
-      parent[v] = v;
-    face_claim.assign(ct.face_count(), 0);
-  }
-};
-
-struct SplitSymbols {
-  uint32_t s_e = 0, s_l = 0, s_r = 0;
+/// What is coded per split vertex besides the split itself: the data of the new vertex
+/// v_from. code_vertex codes it (Codec::geometry), apply_splits (level_step.h) stores it
+/// with the new vertex. A per-vertex attribute adds its field here, its coding next to
+/// Codec::geometry and its storage next to LevelMesh::q.
+struct NewVertex {
+  int32_t position[3]; // quantized xyz
 };
 
 struct PendingSplit {
   SplitOp op;
-  int32_t position[3];
+  NewVertex v_from;
 };
-
-/// Where the patch of a split lies in v_to's ring (indices; kNone = the open fan's gap).
-struct PatchRange {
-  uint32_t j;      // v_ref
-  uint32_t il, ir; // v_l, v_r
-  uint32_t first_face, faces;
-};
-
-inline int64_t squared_distance(const std::vector<int32_t> &q, uint32_t a, uint32_t b) {
-  const int64_t dx = q[3 * a] - q[3 * b], dy = q[3 * a + 1] - q[3 * b + 1],
-                dz = q[3 * a + 2] - q[3 * b + 2];
-  return dx * dx + dy * dy + dz * dz;
-}
-
-/// Ring indices sorted by decreasing edge length (ties: smaller key first).
-template <class Key>
-void rank_edges(const LevelMesh &mesh, uint32_t v, const Ring &ring, std::vector<uint32_t> &ranked,
-                std::vector<int64_t> &len2, const Key &key) {
-  const uint32_t m = ring.size();
-  ranked.resize(m);
-  len2.resize(m);
-  for (uint32_t i = 0; i < m; ++i) {
-    ranked[i] = i;
-    len2[i] = squared_distance(mesh.q, v, ring.neighbour[i]);
-  }
-  std::sort(ranked.begin(), ranked.end(), [&](uint32_t a, uint32_t b) {
-    if (len2[a] != len2[b])
-      return len2[a] > len2[b];
-    return key(ring.neighbour[a]) < key(ring.neighbour[b]);
-  });
-}
-
-/// Turn (s_e, s_l, s_r) into ring positions; false if they do not describe a valid patch.
-inline bool resolve_patch(const Ring &ring, const uint32_t *ranked, const SplitSymbols &s,
-                          PatchRange &p) {
-  const uint32_t m = ring.size();
-  if (s.s_e >= m)
-    return false;
-  p.j = ranked[s.s_e];
-  if (ring.closed) {
-    if (s.s_l >= m || s.s_r >= m || s.s_l + s.s_r == 0 || s.s_l + s.s_r > m - 1)
-      return false;
-    p.il = (p.j + m - s.s_l) % m;
-    p.ir = (p.j + s.s_r) % m;
-    p.first_face = p.il;
-    p.faces = s.s_l + s.s_r;
-    return true;
-  }
-  if (s.s_l <= p.j)
-    p.il = p.j - s.s_l;
-  else if (s.s_l == p.j + 1)
-    p.il = kNone;
-  else
-    return false;
-  if (uint64_t(p.j) + s.s_r <= m - 1)
-    p.ir = p.j + s.s_r;
-  else if (uint64_t(p.j) + s.s_r == m)
-    p.ir = kNone;
-  else
-    return false;
-  if (p.il == kNone && p.ir == kNone)
-    return false;
-  p.first_face = p.il == kNone ? 0 : p.il;
-  const uint32_t end = p.ir == kNone ? m - 1 : p.ir;
-  if (end <= p.first_face)
-    return false;
-  p.faces = end - p.first_face;
-  return true;
-}
-
-/// Integer normal of face k of the ring (v, n_k, n_k+1).
-inline void add_face_normal(const LevelMesh &mesh, uint32_t v, const Ring &ring, uint32_t k,
-                            int64_t n[3]) {
-  const auto &q = mesh.q;
-  const uint32_t a = ring.neighbour[k], b = ring.neighbour[(k + 1) % ring.size()];
-  int64_t u[3], w[3];
-  for (int i = 0; i < 3; ++i) {
-    u[i] = int64_t(q[3 * a + i]) - q[3 * v + i];
-    w[i] = int64_t(q[3 * b + i]) - q[3 * v + i];
-  }
-  n[0] += u[1] * w[2] - u[2] * w[1];
-  n[1] += u[2] * w[0] - u[0] * w[2];
-  n[2] += u[0] * w[1] - u[1] * w[0];
-}
-
-/// Prediction of v_from: the barycentre of its future neighbours (v_to and the patch ring
-/// from v_l to v_r) plus, along the normal, a curvature term; residuals are expressed in
-/// the Frenet frame built from edge v_to-v_ref and the normals of the (one or two) faces
-/// along that edge. The curvature term: on a curved surface v_from sits off the plane of
-/// its ring the same way v_to sits off its own ring, so half of v_to's umbrella vector
-/// (the barycentre of v_to's ring minus v_to, along the normal) is subtracted.
-struct Prediction {
-  int32_t barycentre[3];
-  FrenetFrame frame;
-  int64_t offset[3]; // expected residual in the local frame
-  int context;       // geometry model context (local edge length class)
-};
-
-inline void predict(const LevelMesh &mesh, uint32_t v_to, const Ring &ring, const PatchRange &p,
-                    Prediction &out) {
-  const auto &q = mesh.q;
-  const uint32_t m = ring.size();
-  int64_t sum[3] = {q[3 * v_to], q[3 * v_to + 1], q[3 * v_to + 2]};
-  int64_t count = 1;
-  for (uint32_t t = 0, i = p.first_face; t <= p.faces; ++t, i = (i + 1) % m) {
-    const uint32_t n = ring.neighbour[i];
-    for (int k = 0; k < 3; ++k)
-      sum[k] += q[3 * n + k];
-    ++count;
-  }
-  for (int k = 0; k < 3; ++k) // round to nearest; sums are non-negative
-    out.barycentre[k] = static_cast<int32_t>((2 * sum[k] + count) / (2 * count));
-  int64_t normal[3] = {0, 0, 0};
-  const uint32_t j = p.j;
-  if (ring.closed || j < ring.faces())
-    add_face_normal(mesh, v_to, ring, j, normal);
-  if (ring.closed || j > 0)
-    add_face_normal(mesh, v_to, ring, (j + m - 1) % m, normal);
-  const uint32_t ref = ring.neighbour[j];
-  int64_t edge[3];
-  for (int k = 0; k < 3; ++k)
-    edge[k] = int64_t(q[3 * ref + k]) - q[3 * v_to + k];
-  out.frame = make_frenet_frame(normal, edge);
-  out.context = geometry_context(edge[0] * edge[0] + edge[1] * edge[1] + edge[2] * edge[2]);
-  // v_to's umbrella vector (integer mean, truncated), in the local frame.
-  int64_t umbrella[3] = {0, 0, 0};
-  for (uint32_t n : ring.neighbour)
-    for (int k = 0; k < 3; ++k)
-      umbrella[k] += int64_t(q[3 * n + k]) - q[3 * v_to + k];
-  for (int k = 0; k < 3; ++k)
-    umbrella[k] /= int64_t(m);
-  to_local(out.frame, umbrella);
-  out.offset[0] = 0;
-  out.offset[1] = 0;
-  out.offset[2] = (1 - umbrella[2]) >> 1; // round(-umbrella_n / 2)
-}
 
 /// Per-vertex and per-face marks of one traversal (level stamps, reused across levels).
 struct TraversalScratch {
@@ -251,22 +89,30 @@ inline int sv_context(const TraversalScratch &s, const Ring &ring) {
                           valence);
 }
 
+/// The level a clustered traversal decodes, and what it can skip: vertices below
+/// `older_than` are known to be older than `level` (0: not known; set when the level
+/// starts on a mesh that holds nothing finer, it spares the view its lineage lookups).
+struct LevelView {
+  uint32_t level;
+  uint32_t older_than = 0;
+};
+
 /// The level-(l-1) view of v's one-ring while level l is being decoded: neighbours created
 /// at level l or later (by splits of neighbouring clusters already applied) stand for
 /// their parents, and the faces those splits added (degenerate in the view) are skipped.
 /// The view is the same whatever clusters were decoded before, which is what makes
 /// selective and incremental decoding equal to a full decode.
-inline uint32_t view_of(const LevelMesh &mesh, uint32_t v, uint32_t level) {
-  if (v < mesh.older_than_level)
+inline uint32_t view_of(const LevelMesh &mesh, uint32_t v, const LevelView &view) {
+  if (v < view.older_than)
     return v;
-  while (mesh.tag[v].level >= level && mesh.parent[v] != v)
+  while (mesh.tag[v].level >= view.level && mesh.parent[v] != v)
     v = mesh.parent[v];
   return v;
 }
 
 /// Like get_ring, mapping neighbours through view_of and skipping the faces that collapse
 /// in the view (one pass for an interior vertex).
-inline void get_view_ring(const LevelMesh &mesh, uint32_t v, uint32_t level, Ring &view) {
+inline void get_view_ring(const LevelMesh &mesh, uint32_t v, const LevelView &level, Ring &view) {
   const CornerTable &ct = mesh.ct;
   view.neighbour.clear();
   view.corner.clear();
@@ -334,8 +180,8 @@ void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v,
   PendingSplit ps;
   ps.op = {v, ring.corner[p.first_face], p.faces, p.il != kNone, p.ir != kNone};
   Prediction prediction;
-  predict(mesh, v, ring, p, prediction);
-  codec.geometry(v, prediction, ps.position);
+  predict(mesh.q, v, ring, p, prediction);
+  codec.geometry(v, prediction, ps.v_from.position);
   splits.push_back(ps);
 }
 
@@ -357,12 +203,10 @@ void queue_neighbours(TraversalScratch &s, uint32_t v, uint32_t from, const Ring
 }
 
 /// Traverse the whole mesh once for global level `level` (all components, seeded by the
-/// base faces in order).
+/// base faces in order), appending the splits to `splits`. `s` is begun by the caller.
 template <class Codec>
 void traverse_level(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t level,
                     std::vector<PendingSplit> &splits) {
-  s.begin(mesh.vertex_count(), mesh.ct.face_count());
-  splits.clear();
   const auto id = [](uint32_t v) { return uint64_t(v); };
   const auto all = [](uint32_t) { return true; };
   size_t head = 0;
@@ -394,12 +238,11 @@ void traverse_level(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t
 /// Traverse one cluster for clustered level `level` (paper section 5.2): breadth-first
 /// from the cluster's root (its base clustered mesh vertex), starting clockwise from the
 /// root's neighbour of smallest key, visiting only the cluster's vertices, on the
-/// level-(l-1) view of the mesh.
+/// level-(l-1) view of the mesh, appending the splits to `splits`. `s` is begun by the
+/// caller.
 template <class Codec>
 void traverse_cluster(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t root,
-                      uint32_t level, std::vector<PendingSplit> &splits) {
-  s.begin(mesh.vertex_count(), mesh.ct.face_count());
-  splits.clear();
+                      const LevelView &level, std::vector<PendingSplit> &splits) {
   const uint32_t cluster = mesh.cluster_of(root);
   const auto key = [&](uint32_t v) { return mesh.key(v); };
   const auto mine = [&](uint32_t v) { return mesh.tag[v].cluster == cluster; };
@@ -415,33 +258,9 @@ void traverse_cluster(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32
   for (size_t head = 0; head < s.queue.size();) {
     const auto [v, came_from] = s.queue[head++];
     get_view_ring(mesh, v, level, s.ring);
-    code_vertex(mesh, codec, s, v, s.ring, level, key, splits);
+    code_vertex(mesh, codec, s, v, s.ring, level.level, key, splits);
     queue_neighbours(s, v, came_from, s.ring, mine);
   }
-}
-
-/// Apply the collected splits in traversal order; new vertices get consecutive ids.
-/// For a cluster's splits, `cluster`/`next_local` number them inside the cluster.
-/// Undo the face claims of a traversal of `level` that stopped on damaged data, so that
-/// the other clusters of the level can still claim those faces.
-inline void release_claims(LevelMesh &mesh, const TraversalScratch &s, uint32_t level) {
-  for (uint32_t f = 0; f < mesh.face_claim.size(); ++f)
-    if (s.claimed[f] == s.stamp && mesh.face_claim[f] == level)
-      mesh.face_claim[f] = static_cast<uint16_t>(level - 1);
-}
-
-inline void apply_splits(LevelMesh &mesh, const std::vector<PendingSplit> &splits, uint32_t level,
-                         uint32_t cluster = kNone, uint32_t *next_local = nullptr) {
-  for (const PendingSplit &ps : splits) {
-    const uint32_t v_from = mesh.vertex_count();
-    apply_split(mesh.ct, ps.op, v_from);
-    mesh.q.insert(mesh.q.end(), ps.position, ps.position + 3);
-    mesh.tag.push_back({cluster == kNone ? 0 : cluster, static_cast<uint16_t>(level)});
-    mesh.parent.push_back(ps.op.v_to);
-    if (cluster != kNone)
-      mesh.local.push_back((*next_local)++);
-  }
-  mesh.face_claim.resize(mesh.ct.face_count(), 0);
 }
 
 } // namespace pomar

@@ -1,0 +1,53 @@
+// A cluster's block (paper section 5.2: each cluster's clustered levels are one range-coded
+// stream), read from the byte source in small chunks as its decoder consumes it, so that
+// a coarse request reads only the first bytes of a block.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "entropy/range_coder.h"
+#include "pomar/random_access.h"
+
+namespace pomar {
+
+/// Bytes and blocks read so far, shared by all streams of a decoder.
+struct ReadStats {
+  uint64_t bytes = 0;
+  uint32_t blocks = 0;
+};
+
+class ClusterStream : public StreamRefill {
+public:
+  static constexpr size_t kChunk = 4; // bytes per on-demand read of a cluster block
+
+  /// Cluster `id`'s block: `size` bytes at `offset` of `source`, with its 8-bit check.
+  void init(ByteSource *source, uint32_t id, uint64_t offset, uint32_t size, uint8_t check,
+            ReadStats *stats);
+  /// (Re)start the stream from its first byte; `whole` reads the block at once (it will be
+  /// decoded to the end, or its check must pass first), otherwise bytes are read as the
+  /// decoder needs them. Throws if the file ends before the block (truncated file).
+  void start(bool whole);
+  RangeDecoder &decoder() { return rc_; }
+  /// The block passed its 8-bit check (it has been read whole).
+  bool checked() const { return checked_; }
+  /// The block, if it has been read whole (else null).
+  const std::vector<uint8_t> *whole_block() const {
+    return loaded_ == size_ ? &block_ : nullptr;
+  }
+  size_t more(size_t needed) override;
+
+private:
+  ByteSource *source_ = nullptr;
+  ReadStats *stats_ = nullptr;
+  uint32_t id_ = 0, size_ = 0;
+  uint64_t offset_ = 0;
+  uint8_t check_ = 0;
+  std::vector<uint8_t> block_; // sized to the whole block; [0, loaded_) read so far
+  size_t loaded_ = 0;
+  bool checked_ = false;
+  RangeDecoder rc_;
+};
+
+} // namespace pomar

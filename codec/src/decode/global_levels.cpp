@@ -1,0 +1,72 @@
+// Decoding the global part of a file: base mesh, then global levels (paper section 5.1),
+// each through the shared per-level step.
+#include "decode/global_levels.h"
+
+#include <string>
+
+#include "decode/decoder_codec.h"
+#include "refine/level_step.h"
+
+namespace pomar {
+
+Mesh to_mesh(const LevelMesh &lm, const Quantizer &grid) {
+  Mesh out;
+  out.positions.resize(lm.q.size());
+  for (size_t i = 0; i < lm.q.size(); ++i)
+    out.positions[i] = grid.dequantize(static_cast<int>(i % 3), static_cast<uint32_t>(lm.q[i]));
+  out.triangles = lm.ct.V;
+  return out;
+}
+
+LevelMesh base_level_mesh(const uint8_t *data, const FileLayout &layout) {
+  const FileHeader &h = layout.header;
+  const BaseMesh base = read_base_mesh(data, layout);
+  LevelMesh lm;
+  lm.q = base.q;
+  lm.seed_faces = h.base_faces;
+  try {
+    build_corner_table(base.triangles.data(), h.base_faces, h.base_vertices, lm.ct);
+  } catch (const Error &e) {
+    throw Error(std::string("damaged .pomar file: invalid base mesh: ") + e.what());
+  }
+  lm.init_lineage();
+  return lm;
+}
+
+size_t decode_global_levels(const uint8_t *data, const FileLayout &layout, size_t from, size_t to,
+                            LevelMesh &lm, Models &models, const Progress &progress,
+                            std::vector<DamagedBlock> *damaged) {
+  const FileHeader &h = layout.header;
+  DecoderCodec codec(h.grid.bits);
+  LevelStep step;
+  RangeDecoder conn, geom;
+  for (size_t i = from; i < to; ++i) {
+    const LevelEntry &e = h.levels[i];
+    try {
+      check_level(data, layout, i);
+      const uint8_t *p = data + layout.level_offset[i];
+      conn.reset(p, e.connectivity_bytes);
+      geom.reset(p + e.connectivity_bytes, e.geometry_bytes);
+      codec.set(&models, &conn, &geom, static_cast<uint32_t>(i + 1));
+      step.global_level(lm, codec, static_cast<uint32_t>(i + 1), [&](const StepCounts &n) {
+        if (conn.overrun() || geom.overrun())
+          codec.corrupt("the level's data ends too early");
+        if (n.vertices != e.vertices)
+          codec.corrupt("the number of vertex splits differs from the level table");
+        if (n.faces != e.faces)
+          codec.corrupt("the face count differs from the level table");
+      });
+    } catch (const Error &err) {
+      if (!damaged)
+        throw;
+      // The step checks before it applies: the mesh is still level i.
+      damaged->push_back({"level " + std::to_string(i + 1), err.what(), static_cast<int>(i)});
+      return i;
+    }
+    if (progress)
+      progress(double(i + 1) / double(to), "decode");
+  }
+  return to;
+}
+
+} // namespace pomar

@@ -1,0 +1,73 @@
+// The clusters (paper section 5.2); see clusters.h.
+#include "encode/clusters.h"
+
+#include <cmath>
+
+#include "entropy/static_tables.h"
+
+namespace pomar {
+
+size_t choose_global_levels(const Decimation &dec, uint32_t base_vertices, uint32_t vertices,
+                            const EncodeOptions &o) {
+  const size_t L = dec.levels.size();
+  if (o.progressive || L == 0)
+    return L;
+  double wanted = o.clusters ? double(o.clusters) : o.cluster_ratio * double(vertices);
+  wanted = std::max(wanted, 1.0);
+  size_t best = 0;
+  double count = base_vertices, best_err = std::fabs(std::log(count / wanted));
+  for (size_t g = 1; g <= L; ++g) {
+    count += double(dec.levels[L - g].size()); // refinement level g re-inserts these
+    const double err = std::fabs(std::log(count / wanted));
+    if (err < best_err) {
+      best_err = err;
+      best = g;
+    }
+  }
+  return best;
+}
+
+ClusteredLevels encode_clustered_levels(Rebuild &rb, size_t global, FileHeader &header,
+                                        const Progress &progress) {
+  const size_t L = rb.levels();
+  LevelMesh &lm = rb.mesh;
+  header.flags |= kFlagClustered;
+  header.global_levels = static_cast<uint32_t>(global);
+  const uint32_t clusters = lm.vertex_count();
+  lm.root_clusters();
+  std::vector<uint32_t> next_local(clusters, 1);
+  std::vector<Models> level_models(L - global);
+  std::vector<SymbolRecorder> recordings(clusters);
+  EncoderCodec<RecorderStream> codec(rb.q, rb.dec_to_input, rb.input_to_dec);
+  for (size_t r = global; r < L; ++r) {
+    const uint32_t level = static_cast<uint32_t>(r + 1);
+    codec.begin_level(rb.collapses(level), &level_models[r - global]);
+    const uint32_t older_than = lm.vertex_count(); // levels are encoded in order
+    for (uint32_t c = 0; c < clusters; ++c) {
+      RecorderStream conn{&recordings[c], 0}, geom{&recordings[c], 1};
+      codec.set_sinks(&conn, &geom);
+      rb.step.cluster_level(lm, codec, {c, level, older_than}, next_local[c]);
+    }
+    codec.end_level();
+    add_level_entry(header, lm, 0, 0);
+    if (progress)
+      progress(double(r + 1) / double(L), "encode");
+  }
+  freeze_on_recordings(level_models, recordings);
+  ClusteredLevels out;
+  out.tables = write_tables(level_models);
+  double bits[2] = {0, 0};
+  out.blocks.reserve(clusters);
+  for (const SymbolRecorder &rec : recordings)
+    out.blocks.push_back(code_recording(rec, bits));
+  uint64_t cluster_bytes = 0;
+  for (const auto &b : out.blocks)
+    cluster_bytes += b.size();
+  header.cluster_connectivity_bytes =
+      bits[0] + bits[1] > 0
+          ? static_cast<uint64_t>(double(cluster_bytes) * bits[0] / (bits[0] + bits[1]))
+          : 0;
+  return out;
+}
+
+} // namespace pomar

@@ -1,0 +1,156 @@
+// The traversal policy of the encoder, and the mesh it rebuilds as the decoder will.
+//
+// After decimation the encoder rebuilds the mesh from the base mesh exactly as the
+// decoder will (same traversal, same splits, same vertex numbering), and at each vertex
+// writes what the decoder needs to repeat the step: the encoder is a decoder that knows
+// the answers.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "decimate/decimate.h"
+#include "entropy/models.h"
+#include "format/file_format.h"
+#include "refine/level_step.h"
+
+namespace pomar {
+
+/// The traversal policy of the encoder: it knows every collapse of the level. `Sink` is a
+/// RangeEncoder (global levels) or a RecorderStream (clustered levels, coded later).
+template <class Sink> class EncoderCodec {
+public:
+  EncoderCodec(const std::vector<int32_t> &input_q, std::vector<uint32_t> &dec_to_input,
+               std::vector<uint32_t> &input_to_dec)
+      : input_q_(input_q), dec_to_input_(dec_to_input), input_to_dec_(input_to_dec),
+        collapse_at_(input_to_dec.size(), kNone) {}
+
+  void begin_level(const std::vector<Collapse> &level, Models *models) {
+    level_ = &level;
+    m_ = models;
+    for (uint32_t i = 0; i < level.size(); ++i)
+      collapse_at_[level[i].v_to] = i;
+    emitted_ = 0;
+  }
+  void set_sinks(Sink *conn, Sink *geom) {
+    conn_ = conn;
+    geom_ = geom;
+  }
+  void end_level() {
+    for (const Collapse &c : *level_)
+      collapse_at_[c.v_to] = kNone;
+    if (emitted_ != level_->size())
+      corrupt("a collapse of the level was not reached by the traversal");
+  }
+
+  int split_flag(uint32_t v, int context) {
+    current_ = collapse_at_[dec_to_input_[v]];
+    const int flag = current_ != kNone;
+    bits.s_v += cost_bits(m_->conn.sv[context], flag);
+    conn_->encode_bit(m_->conn.sv[context], flag);
+    emitted_ += flag;
+    return flag;
+  }
+
+  void split_symbols(uint32_t v, const Ring &ring, const uint32_t *ranked, SplitSymbols &s) {
+    (void)v;
+    const Collapse &c = (*level_)[current_];
+    const uint32_t m = ring.size();
+    const uint32_t il = ring_index(ring, c.v_l), ir = ring_index(ring, c.v_r);
+    // Vertices strictly inside the patch (they get a new edge to v_to at the collapse).
+    auto inside = [&](uint32_t i) {
+      if (ring.closed)
+        return (i + m - il) % m != 0 && (i + m - il) % m < (ir + m - il) % m;
+      const uint32_t lo = il == kNone ? 0 : il + 1, hi = ir == kNone ? m - 1 : ir - 1;
+      return i >= lo && i <= hi && hi != kNone;
+    };
+    uint32_t e = kNone;
+    for (uint32_t r = 0; r < m && e == kNone; ++r)
+      if (inside(ranked[r]))
+        e = r;
+    for (uint32_t r = 0; r < m && e == kNone; ++r)
+      if (ranked[r] == il || ranked[r] == ir)
+        e = r;
+    const uint32_t j = ranked[e];
+    s.s_e = e;
+    s.s_l = ring.closed ? (j + m - il) % m : (il == kNone ? j + 1 : j - il);
+    s.s_r = ring.closed ? (ir + m - j) % m : (ir == kNone ? m - j : ir - j);
+    const uint32_t faces = s.s_l + s.s_r;
+    bits.s_e += put_small(*conn_, m_->conn.se[valence_context(m)], s.s_e);
+    bits.faces += put_small(*conn_, m_->conn.faces[faces_context(m, ring.closed)], faces);
+    bits.s_l += put_small(*conn_, m_->conn.sl[sl_context(faces)], s.s_l);
+  }
+
+  void geometry(uint32_t v_to, const Prediction &p, int32_t position[3]) {
+    (void)v_to;
+    const uint32_t v_from = (*level_)[current_].v_from;
+    int64_t r[3];
+    for (int k = 0; k < 3; ++k) {
+      position[k] = input_q_[3 * v_from + k];
+      r[k] = int64_t(position[k]) - p.barycentre[k];
+    }
+    to_local(p.frame, r);
+    bits.tangential += put_residual(*geom_, m_->geom, 0, p.context, r[0] - p.offset[0]);
+    bits.tangential += put_residual(*geom_, m_->geom, 0, p.context, r[1] - p.offset[1]);
+    bits.normal += put_residual(*geom_, m_->geom, 1, p.context, r[2] - p.offset[2]);
+    // The step applies the splits in the order they are coded: v_from gets the next id.
+    input_to_dec_[v_from] = static_cast<uint32_t>(dec_to_input_.size());
+    dec_to_input_.push_back(v_from);
+  }
+
+  SymbolBits bits; // ideal code lengths per symbol kind
+
+  [[noreturn]] void corrupt(const char *what) {
+    throw Error(std::string("internal encoder error: ") + what);
+  }
+
+private:
+  uint32_t ring_index(const Ring &ring, uint32_t input_vertex) {
+    if (input_vertex == kNone)
+      return kNone;
+    const int i = ring.index_of(input_to_dec_[input_vertex]);
+    if (i < 0)
+      corrupt("v_l/v_r is not a neighbour of v_to");
+    return static_cast<uint32_t>(i);
+  }
+
+  Models *m_ = nullptr;
+  const std::vector<int32_t> &input_q_;
+  std::vector<uint32_t> &dec_to_input_, &input_to_dec_;
+  std::vector<uint32_t> collapse_at_; // input vertex -> index of its collapse as v_to
+  const std::vector<Collapse> *level_ = nullptr;
+  Sink *conn_ = nullptr, *geom_ = nullptr;
+  uint32_t current_ = kNone;
+  size_t emitted_ = 0;
+};
+
+/// The mesh the encoder rebuilds level by level from the base mesh, in the decoder's
+/// vertex numbering, with the maps between that numbering and the input's.
+struct Rebuild {
+  Rebuild(const std::vector<int32_t> &input_q, const Decimation &decimation)
+      : q(input_q), dec(decimation), input_to_dec(input_q.size() / 3, kNone) {}
+  const std::vector<int32_t> &q; // quantized input positions (input numbering)
+  const Decimation &dec;
+  LevelMesh mesh;
+  std::vector<uint32_t> dec_to_input, input_to_dec;
+  LevelStep step;
+
+  size_t levels() const { return dec.levels.size(); }
+  /// The collapses that refinement level `level` (1 = first above the base) undoes.
+  const std::vector<Collapse> &collapses(size_t level) const {
+    return dec.levels[dec.levels.size() - level];
+  }
+};
+
+/// Append the level table entry of the level just encoded (the mesh's counts after it).
+inline void add_level_entry(FileHeader &header, const LevelMesh &mesh, uint32_t conn_bytes,
+                            uint32_t geom_bytes) {
+  LevelEntry e;
+  e.vertices = mesh.vertex_count();
+  e.faces = mesh.ct.face_count();
+  e.connectivity_bytes = conn_bytes;
+  e.geometry_bytes = geom_bytes;
+  header.levels.push_back(e);
+}
+
+} // namespace pomar

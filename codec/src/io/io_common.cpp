@@ -1,0 +1,221 @@
+// Shared helpers of the mesh readers and writers (declared in io_common.h).
+#include "io/io_common.h"
+
+#include <wrap/io_trimesh/io_mask.h>
+
+#include <charconv>
+#include <cmath>
+#include <cstdlib>
+#include <system_error>
+
+namespace pomar::io {
+
+[[noreturn]] void fail(const std::string &path, const std::string &what) {
+  throw Error(path + ": " + what);
+}
+
+void run_size_check(const SizeCheck &check, const std::string &path, uint64_t vertices,
+                    uint64_t faces) {
+  if (!check)
+    return;
+  try {
+    check(vertices, faces);
+  } catch (const Error &e) {
+    fail(path, e.what());
+  }
+}
+
+std::string errno_text(int e) { return std::generic_category().message(e); }
+
+std::string errno_suffix() { return errno ? " (" + errno_text(errno) + ")" : std::string(); }
+
+std::string num(uint64_t v) { return std::to_string(v); }
+
+void append_float(std::string &out, float v) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, 9);
+  out.append(buf, r.ptr);
+}
+
+void append_float_sci(std::string &out, float v) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::scientific, 8);
+  out.append(buf, r.ptr);
+}
+
+void append_uint(std::string &out, uint64_t v) {
+  char buf[24];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  out.append(buf, r.ptr);
+}
+
+std::string point_text(float x, float y, float z) {
+  std::string s = "(";
+  append_float(s, x);
+  s += ", ";
+  append_float(s, y);
+  s += ", ";
+  append_float(s, z);
+  return s + ")";
+}
+
+bool parse_count(const std::string &token, uint64_t max, uint64_t &value) {
+  if (token.empty() || token.size() > 19)
+    return false;
+  const auto r = std::from_chars(token.data(), token.data() + token.size(), value);
+  return r.ec == std::errc() && r.ptr == token.data() + token.size() && value <= max;
+}
+
+bool parse_int(const std::string &token, int64_t &value) {
+  const char *begin = token.data(), *end = begin + token.size();
+  if (begin != end && *begin == '+')
+    ++begin; // from_chars does not take a leading '+'
+  const auto r = std::from_chars(begin, end, value);
+  return begin != end && r.ec == std::errc() && r.ptr == end;
+}
+
+bool parse_float(const std::string &token, float &value) {
+  if (token.empty() || token.find_first_of("xX") != std::string::npos)
+    return false;
+  char *end = nullptr;
+  errno = 0;
+  value = std::strtof(token.c_str(), &end);
+  return end == token.c_str() + token.size();
+}
+
+std::vector<std::string> split_ws(const std::string &line) {
+  std::vector<std::string> out;
+  size_t i = 0;
+  while (i < line.size()) {
+    i = line.find_first_not_of(" \t\r\n", i);
+    if (i == std::string::npos)
+      break;
+    size_t j = line.find_first_of(" \t\r\n", i);
+    if (j == std::string::npos)
+      j = line.size();
+    out.push_back(line.substr(i, j - i));
+    i = j;
+  }
+  return out;
+}
+
+void add_unique(std::vector<std::string> &list, const char *name) {
+  if (std::find(list.begin(), list.end(), name) == list.end())
+    list.push_back(name);
+}
+
+void add_ignored_from_mask(int mask, std::vector<std::string> &out) {
+  using M = vcg::tri::io::Mask;
+  if (mask & (M::IOM_VERTNORMAL | M::IOM_FACENORMAL | M::IOM_WEDGNORMAL))
+    add_unique(out, "normals");
+  if (mask & (M::IOM_VERTCOLOR | M::IOM_FACECOLOR | M::IOM_WEDGCOLOR))
+    add_unique(out, "colors");
+  if (mask & (M::IOM_VERTTEXCOORD | M::IOM_WEDGTEXCOORD | M::IOM_WEDGTEXMULTI))
+    add_unique(out, "texture coordinates");
+  if (mask & (M::IOM_VERTQUALITY | M::IOM_FACEQUALITY))
+    add_unique(out, "quality");
+  if (mask & M::IOM_VERTRADIUS)
+    add_unique(out, "radius");
+  if (mask & (M::IOM_VERTFLAGS | M::IOM_FACEFLAGS))
+    add_unique(out, "flags");
+  if (mask & M::IOM_CAMERA)
+    add_unique(out, "camera");
+  if (mask & M::IOM_EDGEINDEX)
+    add_unique(out, "edges");
+}
+
+
+uint64_t check_regular_file(const std::string &path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0)
+    fail(path, "cannot open: " + errno_text(errno));
+  FdGuard guard(fd);
+  struct stat st;
+  if (::fstat(fd, &st) != 0)
+    fail(path, "cannot stat: " + errno_text(errno));
+  if (S_ISDIR(st.st_mode))
+    fail(path, "is a directory");
+  if (!S_ISREG(st.st_mode))
+    fail(path, "not a regular file");
+  return static_cast<uint64_t>(st.st_size);
+}
+
+bool write_all(int fd, const char *data, size_t size) {
+  while (size > 0) {
+    const ssize_t w = ::write(fd, data, size);
+    if (w < 0 && errno == EINTR)
+      continue;
+    if (w <= 0)
+      return false;
+    data += w, size -= static_cast<size_t>(w);
+  }
+  return true;
+}
+
+void clear_flags(IoMesh &m) {
+  for (auto &v : m.vert)
+    v.Flags() = 0;
+  for (auto &f : m.face)
+    f.Flags() = 0;
+}
+
+void check_finite(float x, float y, float z, size_t i, const std::string &path, bool stl) {
+  if (std::isfinite(x) && std::isfinite(y) && std::isfinite(z))
+    return;
+  const std::string where = stl ? " (facet " + num(i / 3) + ")" : "";
+  fail(path, "vertex " + num(i) + where + " has a non-finite coordinate " + point_text(x, y, z));
+}
+
+void check_finite(const IoMesh &m, const std::string &path, bool stl) {
+  for (size_t i = 0; i < m.vert.size(); ++i)
+    check_finite(m.vert[i].cP()[0], m.vert[i].cP()[1], m.vert[i].cP()[2], i, path, stl);
+}
+
+void check_counts(const IoMesh &m, size_t vertices, size_t triangles, const std::string &path,
+                  const char *what) {
+  if (m.vert.size() == vertices && m.face.size() == triangles)
+    return;
+  fail(path, std::string(what) + " read " + num(m.vert.size()) + " vertices and " +
+                 num(m.face.size()) + " triangles, but the file describes " + num(vertices) +
+                 " vertices and " + num(triangles) + " triangles (unsupported property type?)");
+}
+
+void append_point(std::string &out, const float *p) {
+  append_float(out, p[0]);
+  out += ' ';
+  append_float(out, p[1]);
+  out += ' ';
+  append_float(out, p[2]);
+}
+
+void append_triangles(std::string &out, const Mesh &mesh, const char *prefix, uint64_t base) {
+  for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+    out += prefix;
+    for (int k = 0; k < 3; ++k) {
+      if (k)
+        out += ' ';
+      append_uint(out, mesh.triangles[3 * t + k] + base);
+    }
+    out += '\n';
+  }
+}
+
+void append_vertices(std::string &out, const Mesh &mesh, const char *prefix) {
+  for (size_t v = 0; v < mesh.vertex_count(); ++v) {
+    out += prefix;
+    append_point(out, &mesh.positions[3 * v]);
+    out += '\n';
+  }
+}
+
+void check_written_size(const std::string &file, uint64_t expected, const std::string &target) {
+  struct stat st;
+  if (::stat(file.c_str(), &st) != 0)
+    fail(target, "cannot stat temporary file: " + errno_text(errno));
+  if (static_cast<uint64_t>(st.st_size) != expected)
+    fail(target, "short write (" + num(uint64_t(st.st_size)) + " of " + num(expected) +
+                     " bytes; disk full?)");
+}
+
+
+} // namespace pomar::io

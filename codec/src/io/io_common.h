@@ -1,0 +1,334 @@
+// Internal to pomar_io: what the per-format readers and writers (ply_io.cpp, off_io.cpp,
+// stl_io.cpp, obj_io.cpp) share: error messages that start with the path, number
+// parsing and printing, file handles, temporary files, and the vcglib mesh the importers
+// fill. The public API is <pomar/mesh_io.h>; mesh_io.cpp picks the format.
+//
+// vcglib's importers (MeshLab 2020.09) trust their input: a face index past the vertex
+// array, a PLY face with more than 255 corners, a truncated OFF face list or an STL file
+// without a line break make them read out of bounds, crash or hang. So before handing a
+// file to vcglib each reader walks its structure itself (PLY: header and every element;
+// OFF: the same token stream vcglib reads; STL: binary/ASCII detection and size) and
+// rejects what vcglib would mishandle. After the import it checks that vcglib produced
+// exactly the vertex and triangle counts the walk predicted. OBJ gets a similar line scan
+// before tinyobjloader, which silently skips short faces and does not range-check indices.
+#pragma once
+
+#include <pomar/mesh_io.h>
+
+#include "io/temp_registry.h"
+
+#include <vcg/complex/complex.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cctype>
+#include <cerrno>
+#include <cstdint>
+#include <cstring>
+#include <new>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+namespace pomar::io {
+
+// ---- Errors, names, numbers (io_common.cpp) ----
+
+/// Throws pomar::Error("<path>: <what>"): every error message starts with the path of the
+/// file concerned.
+[[noreturn]] void fail(const std::string &path, const std::string &what);
+/// Runs the caller's size check (if any), prefixing its error with the path.
+void run_size_check(const SizeCheck &check, const std::string &path, uint64_t vertices,
+                    uint64_t faces);
+std::string errno_text(int e);
+/// " (<system error>)" if errno is set, for messages after C library calls.
+std::string errno_suffix();
+std::string num(uint64_t v);
+/// A float with 9 significant digits, which reads back exactly ("%.9g", but
+/// locale-independent).
+void append_float(std::string &out, float v);
+/// A float in STL's "d.ddddddddE+xx" style with 9 significant digits (reads back exactly).
+void append_float_sci(std::string &out, float v);
+void append_uint(std::string &out, uint64_t v);
+std::string point_text(float x, float y, float z);
+/// Parses a whole token as a non-negative decimal integer no larger than `max`.
+bool parse_count(const std::string &token, uint64_t max, uint64_t &value);
+/// Parses a whole token as a (possibly negative) decimal integer.
+bool parse_int(const std::string &token, int64_t &value);
+/// Parses a whole token as a decimal float (hex floats are refused: not every reader
+/// supports them). Returns false for text that is not a number; NaN/Inf parse.
+bool parse_float(const std::string &token, float &value);
+/// Splits a line at spaces, tabs, CR and LF.
+std::vector<std::string> split_ws(const std::string &line);
+void add_unique(std::vector<std::string> &list, const char *name);
+/// Names the attributes in a vcglib import mask that the codec does not keep.
+void add_ignored_from_mask(int mask, std::vector<std::string> &out);
+
+// ---- Files ----
+
+/// Closes a file descriptor when it goes out of scope.
+struct FdGuard {
+  int fd;
+  explicit FdGuard(int f) : fd(f) {}
+  ~FdGuard() {
+    if (fd >= 0)
+      ::close(fd);
+  }
+  FdGuard(const FdGuard &) = delete;
+  FdGuard &operator=(const FdGuard &) = delete;
+};
+
+/// Opens `path` read-only and checks that it is a regular file (the walkers and vcglib
+/// each open it again, which a pipe would not survive). Returns the file size.
+uint64_t check_regular_file(const std::string &path);
+
+/// Buffered sequential reader over a regular file, used by the PLY structure walk.
+class FileReader {
+public:
+  explicit FileReader(const std::string &path) : path_(path) {
+    size_ = check_regular_file(path);
+    fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd_ < 0)
+      fail(path, "cannot open: " + errno_text(errno));
+    buf_.resize(1 << 16);
+  }
+  ~FileReader() { ::close(fd_); }
+  FileReader(const FileReader &) = delete;
+  FileReader &operator=(const FileReader &) = delete;
+
+  uint64_t pos() const { return pos_; }
+  uint64_t remaining() const { return size_ - std::min(pos_, size_); }
+
+  /// Next byte, or -1 at the end of the file.
+  int get() {
+    if (begin_ == end_ && !fill())
+      return -1;
+    ++pos_;
+    return static_cast<unsigned char>(buf_[begin_++]);
+  }
+
+  /// Copies the next n bytes to dst; false if the file ends first.
+  bool read(void *dst, size_t n) {
+    char *out = static_cast<char *>(dst);
+    while (n > 0) {
+      if (begin_ == end_ && !fill())
+        return false;
+      const size_t k = std::min(n, end_ - begin_);
+      std::memcpy(out, buf_.data() + begin_, k);
+      begin_ += k, pos_ += k, out += k, n -= k;
+    }
+    return true;
+  }
+
+  /// Skips n bytes; false if the file ends first.
+  bool skip(uint64_t n) {
+    if (n > remaining())
+      return false;
+    const uint64_t buffered = end_ - begin_;
+    if (n <= buffered) {
+      begin_ += static_cast<size_t>(n);
+    } else {
+      if (::lseek(fd_, static_cast<off_t>(pos_ + n), SEEK_SET) < 0)
+        fail(path_, "cannot seek: " + errno_text(errno));
+      begin_ = end_ = 0;
+    }
+    pos_ += n;
+    return true;
+  }
+
+  /// One line without its '\n'; false at the end of the file.
+  bool line(std::string &out) {
+    out.clear();
+    int c = get();
+    if (c < 0)
+      return false;
+    for (; c >= 0 && c != '\n'; c = get())
+      out.push_back(static_cast<char>(c));
+    return true;
+  }
+
+  /// Next whitespace-separated token; false at the end of the file.
+  bool token(std::string &out) {
+    out.clear();
+    int c = get();
+    while (c >= 0 && std::isspace(c))
+      c = get();
+    if (c < 0)
+      return false;
+    for (; c >= 0 && !std::isspace(c); c = get())
+      out.push_back(static_cast<char>(c));
+    return true;
+  }
+
+private:
+  bool fill() {
+    for (;;) {
+      const ssize_t r = ::read(fd_, buf_.data(), buf_.size());
+      if (r < 0 && errno == EINTR)
+        continue;
+      if (r < 0)
+        fail(path_, "cannot read: " + errno_text(errno));
+      begin_ = 0, end_ = static_cast<size_t>(r);
+      return r > 0;
+    }
+  }
+
+  std::string path_;
+  int fd_ = -1;
+  uint64_t size_ = 0, pos_ = 0; // pos_: offset of the next byte handed out
+  std::vector<char> buf_;
+  size_t begin_ = 0, end_ = 0;
+};
+
+/// A temporary file in the directory of `target`, removed again unless commit() renamed it
+/// over the target.
+class TempFile {
+public:
+  explicit TempFile(const std::string &target) : target_(target) {
+    static std::atomic<unsigned> counter{0};
+    const size_t slash = target.find_last_of('/');
+    dir_ = slash == std::string::npos ? "." : target.substr(0, slash + 1);
+    const std::string base = slash == std::string::npos ? target : target.substr(slash + 1);
+    if (base.empty())
+      fail(target, "not a file name");
+    const std::string prefix = slash == std::string::npos ? "" : dir_;
+    path_ = prefix + "." + base + ".tmp." + num(static_cast<uint64_t>(::getpid())) + "." +
+            num(counter++);
+    slot_ = register_temporary(path_); // removed by a signal handler, if installed
+  }
+  ~TempFile() {
+    if (!committed_)
+      ::unlink(path_.c_str());
+    unregister_temporary(slot_);
+  }
+  TempFile(const TempFile &) = delete;
+  TempFile &operator=(const TempFile &) = delete;
+
+  const std::string &path() const { return path_; }
+
+  /// Renames the temporary file over the target (after fsync'ing it if `sync`, for files
+  /// written by somebody else), then syncs the directory entry.
+  void commit(bool sync) {
+    if (sync)
+      sync_file();
+    if (::rename(path_.c_str(), target_.c_str()) != 0)
+      fail(target_, "cannot rename temporary file into place: " + errno_text(errno));
+    committed_ = true;
+    unregister_temporary(slot_);
+    slot_ = -1;
+    const int dfd = ::open(dir_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (dfd >= 0) { // best effort: the data itself is already on disk
+      ::fsync(dfd);
+      ::close(dfd);
+    }
+  }
+
+private:
+  void sync_file() {
+    const int fd = ::open(path_.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0)
+      fail(target_, "cannot reopen temporary file: " + errno_text(errno));
+    FdGuard guard(fd);
+    if (::fsync(fd) != 0)
+      fail(target_, "fsync failed: " + errno_text(errno));
+  }
+
+  std::string target_, dir_, path_;
+  bool committed_ = false;
+  int slot_ = -1;
+};
+
+/// Writes all of data to fd, retrying after signals and short writes.
+bool write_all(int fd, const char *data, size_t size);
+
+// ---- The vcglib mesh the importers fill ----
+
+class IoVertex;
+class IoEdge;
+class IoFace;
+struct IoTypes : vcg::UsedTypes<vcg::Use<IoVertex>::AsVertexType, vcg::Use<IoEdge>::AsEdgeType,
+                                vcg::Use<IoFace>::AsFaceType> {};
+// The normal is only there because ImporterOFF stores the normals of an NOFF file without
+// asking whether the vertex type has them (EmptyCore::N() asserts). They are dropped.
+class IoVertex
+    : public vcg::Vertex<IoTypes, vcg::vertex::Coord3f, vcg::vertex::Normal3f, vcg::vertex::BitFlags> {};
+// Edges only so that the PLY importer has somewhere to put an "edge" element: without an
+// edge container it asserts. They are dropped.
+class IoEdge : public vcg::Edge<IoTypes, vcg::edge::VertexRef, vcg::edge::BitFlags> {};
+class IoFace : public vcg::Face<IoTypes, vcg::face::VertexRef, vcg::face::BitFlags> {};
+class IoMesh
+    : public vcg::tri::TriMesh<std::vector<IoVertex>, std::vector<IoFace>, std::vector<IoEdge>> {};
+
+/// vcglib's message for an importer/exporter code, guarding against its off-by-one
+/// tables (codes at the table size, empty entries).
+template <class Io>
+std::string vcg_message(int code, int table_size) {
+  const char *text = code >= 0 && code < table_size ? Io::ErrorMsg(code) : nullptr;
+  if (text == nullptr || *text == '\0')
+    return "error code " + std::to_string(code);
+  return text;
+}
+
+/// The PLY importer copies a "flags" property into the bit flags, deleted bits included.
+/// Those flags mean something else outside vcglib (whose exporter never writes deleted
+/// elements), so they are ignored: every element read is kept.
+void clear_flags(IoMesh &m);
+/// Throws naming vertex i (STL: and its facet) if a coordinate is NaN or infinite.
+void check_finite(float x, float y, float z, size_t i, const std::string &path, bool stl);
+/// Throws naming the first vertex (in file order) with a NaN or infinite coordinate.
+void check_finite(const IoMesh &m, const std::string &path, bool stl);
+/// Throws unless vcglib built exactly the vertices and triangles the structure walk saw.
+void check_counts(const IoMesh &m, size_t vertices, size_t triangles, const std::string &path,
+                  const char *what);
+
+/// Runs a vcglib call, turning its C++ exceptions (bad_alloc for absurd counts, ...) into
+/// pomar::Error.
+template <class F>
+auto guarded(const std::string &path, F &&call) -> decltype(call()) {
+  try {
+    return call();
+  } catch (const Error &) {
+    throw;
+  } catch (const std::bad_alloc &) {
+    fail(path, "out of memory while reading");
+  } catch (const std::exception &e) {
+    fail(path, std::string("read failed: ") + e.what());
+  }
+}
+
+// ---- Writing (io_common.cpp) ----
+
+/// Appends "x y z" with full float precision.
+void append_point(std::string &out, const float *p);
+/// Appends the triangles as "<prefix>a b c\n" lines, indices offset by `base`.
+void append_triangles(std::string &out, const Mesh &mesh, const char *prefix, uint64_t base);
+void append_vertices(std::string &out, const Mesh &mesh, const char *prefix);
+/// Checks that a file written by a vcglib exporter has the expected size: the exporters
+/// do not report failed writes (full disk), so a short file would otherwise go unnoticed.
+void check_written_size(const std::string &file, uint64_t expected, const std::string &target);
+
+// ---- One reader and writer per format ----
+
+// ply_io.cpp
+Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &check);
+std::string ply_ascii_text(const Mesh &mesh);
+/// Binary PLY through vcglib's exporter, via a temporary file.
+void save_ply_binary(const std::string &path, const Mesh &mesh);
+// off_io.cpp
+Mesh load_off(const std::string &path, LoadReport &report, const SizeCheck &check);
+std::string off_text(const Mesh &mesh);
+// stl_io.cpp
+Mesh load_stl(const std::string &path, LoadReport &report, const SizeCheck &check);
+/// ASCII STL; the facet normal is the normalized cross product (0 for a degenerate facet).
+std::string stl_ascii_text(const Mesh &mesh);
+/// Binary STL through vcglib's exporter, via a temporary file.
+void save_stl_binary(const std::string &path, const Mesh &mesh);
+// obj_io.cpp
+Mesh load_obj(const std::string &path, LoadReport &report, const SizeCheck &check);
+std::string obj_text(const Mesh &mesh);
+
+} // namespace pomar::io

@@ -1,0 +1,200 @@
+// OBJ: a line scan with tinyobjloader's rules (it silently skips short faces and does not
+// range-check indices), then tinyobjloader itself (vcglib's OBJ importer drops faces);
+// writing formatted here (vcglib's exporter needs material code).
+#include "io/io_common.h"
+
+#include <tiny_obj_loader.h>
+
+#include <algorithm>
+#include <climits>
+#include <istream>
+#include <streambuf>
+
+namespace pomar::io {
+namespace {
+
+/// What a line scan of an OBJ file finds, using tinyobjloader's line rules.
+struct ObjScan {
+  size_t vertices = 0, faces = 0, triangles = 0, polygons = 0;
+  bool normals = false, texcoords = false, colors = false, materials = false;
+};
+
+/// Splits at spaces and tabs (tinyobjloader's separators within a line).
+std::vector<std::string> split_blanks(const char *p, const char *end) {
+  std::vector<std::string> out;
+  while (p < end) {
+    while (p < end && (*p == ' ' || *p == '\t'))
+      ++p;
+    const char *q = p;
+    while (q < end && *q != ' ' && *q != '\t')
+      ++q;
+    if (q > p)
+      out.emplace_back(p, q);
+    p = q;
+  }
+  return out;
+}
+
+/// Checks one "v" line: three finite decimal coordinates.
+void scan_obj_vertex(const std::vector<std::string> &tok, ObjScan &s, size_t line,
+                     const std::string &path) {
+  const std::string where = "line " + num(line) + ": vertex " + num(s.vertices);
+  if (tok.size() < 4)
+    fail(path, where + " has fewer than 3 coordinates");
+  float p[3];
+  for (int i = 0; i < 3; ++i)
+    if (!parse_float(tok[i + 1], p[i]))
+      fail(path, where + " has a bad coordinate '" + tok[i + 1] + "'");
+  if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+    fail(path, where + " has a non-finite coordinate " + point_text(p[0], p[1], p[2]));
+  s.colors |= tok.size() >= 7;
+  ++s.vertices;
+}
+
+/// Checks one "f" line: 3..255 corners (tinyobjloader drops shorter faces silently and
+/// stores the corner count in a byte).
+void scan_obj_face(const std::vector<std::string> &tok, ObjScan &s, size_t line,
+                   const std::string &path) {
+  const size_t n = tok.size() - 1;
+  if (n < 3 || n > 255)
+    fail(path, "line " + num(line) + ": face with " + num(n) + " vertices (3 to 255 supported)");
+  ++s.faces;
+  s.triangles += n - 2;
+  s.polygons += n > 3;
+}
+
+/// Scans the lines as tinyobjloader splits them (LF, CRLF or CR; text after a NUL byte is
+/// ignored), recording vertices, faces and the attributes that will be dropped.
+ObjScan scan_obj(const std::vector<uint8_t> &bytes, const std::string &path) {
+  ObjScan s;
+  const char *p = reinterpret_cast<const char *>(bytes.data());
+  const char *const end = p + bytes.size();
+  for (size_t line = 1; p < end; ++line) {
+    const char *eol = p;
+    while (eol < end && *eol != '\n' && *eol != '\r')
+      ++eol;
+    const char *stop = std::find(p, eol, '\0');
+    const std::vector<std::string> tok = split_blanks(p, stop);
+    p = eol + (eol < end && *eol == '\r' && eol + 1 < end && eol[1] == '\n' ? 2 : 1);
+    if (tok.empty())
+      continue;
+    const std::string &key = tok[0];
+    if (key == "v")
+      scan_obj_vertex(tok, s, line, path);
+    else if (key == "f")
+      scan_obj_face(tok, s, line, path);
+    else if (key == "vn")
+      s.normals = true;
+    else if (key == "vt")
+      s.texcoords = true;
+    else if (key == "mtllib" || key == "usemtl")
+      s.materials = true;
+  }
+  return s;
+}
+
+/// A read-only std::streambuf over memory, to feed tinyobjloader without a copy.
+class MemoryBuffer : public std::streambuf {
+public:
+  MemoryBuffer(const uint8_t *data, size_t size) {
+    char *p = const_cast<char *>(reinterpret_cast<const char *>(data));
+    setg(p, p, p + size);
+  }
+};
+
+std::string first_line(const std::string &s) {
+  const std::string line = s.substr(0, s.find('\n'));
+  return line.empty() ? "unknown error" : line;
+}
+
+/// Fan-triangulates tinyobjloader's faces (corner 0 with each following edge), checking
+/// that every index is a vertex. Returns the triangles as flat indices.
+std::vector<uint32_t> fan_triangles(const std::vector<tinyobj::shape_t> &shapes, size_t vertices,
+                                    const std::string &path) {
+  std::vector<uint32_t> tris;
+  size_t face = 0;
+  for (const auto &shape : shapes) {
+    const auto &idx = shape.mesh.indices;
+    size_t at = 0;
+    for (const unsigned char n : shape.mesh.num_face_vertices) {
+      if (n < 3 || at + n > idx.size())
+        fail(path, "tinyobjloader returned an inconsistent face " + num(face));
+      for (size_t c = 0; c < n; ++c) {
+        const int v = idx[at + c].vertex_index;
+        if (v < 0 || static_cast<size_t>(v) >= vertices)
+          fail(path, "face " + num(face) + " references vertex " + std::to_string(v + 1) +
+                         " but there are " + num(vertices) + " vertices");
+      }
+      for (size_t c = 1; c + 1 < n; ++c)
+        tris.insert(tris.end(), {uint32_t(idx[at].vertex_index), uint32_t(idx[at + c].vertex_index),
+                                 uint32_t(idx[at + c + 1].vertex_index)});
+      at += n;
+      ++face;
+    }
+  }
+  return tris;
+}
+
+/// Vertices no triangle uses (they are kept).
+size_t count_unreferenced(const Mesh &mesh) {
+  std::vector<uint8_t> used(mesh.vertex_count(), 0);
+  for (uint32_t t : mesh.triangles)
+    used[t] = 1;
+  return static_cast<size_t>(std::count(used.begin(), used.end(), uint8_t(0)));
+}
+
+} // namespace
+
+Mesh load_obj(const std::string &path, LoadReport &report, const SizeCheck &check) {
+  const std::vector<uint8_t> bytes = read_file(path);
+  const ObjScan scan = scan_obj(bytes, path);
+  run_size_check(check, path, scan.vertices, scan.triangles);
+
+  MemoryBuffer buffer(bytes.data(), bytes.size());
+  std::istream stream(&buffer);
+  tinyobj::attrib_t attrib;
+  std::vector<tinyobj::shape_t> shapes;
+  std::vector<tinyobj::material_t> materials;
+  std::string warn, err;
+  // No material reader (mtllib is ignored), no triangulation (tinyobjloader's own picks a
+  // quad diagonal by geometry), no default vertex colors.
+  const bool ok = guarded(path, [&] {
+    return tinyobj::LoadObj(&attrib, &shapes, &materials, &warn, &err, &stream, nullptr, false, false);
+  });
+  if (!ok)
+    fail(path, "OBJ parse error: " + first_line(err));
+  if (attrib.vertices.size() != 3 * scan.vertices)
+    fail(path, "tinyobjloader read " + num(attrib.vertices.size() / 3) + " vertices but the file has " +
+                   num(scan.vertices) + " 'v' lines");
+  size_t faces = 0;
+  for (const auto &shape : shapes)
+    faces += shape.mesh.num_face_vertices.size();
+  if (faces != scan.faces)
+    fail(path, "tinyobjloader read " + num(faces) + " faces but the file has " + num(scan.faces) + " 'f' lines");
+
+  Mesh mesh;
+  mesh.triangles = fan_triangles(shapes, scan.vertices, path);
+  if (mesh.triangles.size() != 3 * scan.triangles)
+    fail(path, "triangulation produced " + num(mesh.triangles.size() / 3) + " triangles, expected " +
+                   num(scan.triangles));
+  mesh.positions.assign(attrib.vertices.begin(), attrib.vertices.end());
+
+  report.file_vertices = scan.vertices;
+  report.file_faces = scan.faces;
+  report.polygons_triangulated = scan.polygons;
+  report.unreferenced_vertices = count_unreferenced(mesh);
+  if (scan.normals) add_unique(report.ignored_attributes, "normals");
+  if (scan.texcoords) add_unique(report.ignored_attributes, "texture coordinates");
+  if (scan.colors) add_unique(report.ignored_attributes, "colors");
+  if (scan.materials) add_unique(report.ignored_attributes, "materials");
+  return mesh;
+}
+
+std::string obj_text(const Mesh &mesh) {
+  std::string s = "# pomar\n";
+  append_vertices(s, mesh, "v ");
+  append_triangles(s, mesh, "f ", 1);
+  return s;
+}
+
+} // namespace pomar::io

@@ -1,0 +1,203 @@
+// OFF: the token stream vcglib's importer reads, walked first (see io_common.h), then the
+// import with count checks; writing formatted here.
+#include "io/io_common.h"
+
+#include <pomar/vcg_adapter.h>
+
+#include <wrap/io_trimesh/import_off.h>
+
+#include <climits>
+
+namespace pomar::io {
+namespace {
+
+/// The token stream of vcglib's ImporterOFF, line by line: lines that are empty or start
+/// with '#' or CR are skipped (except the last line of the file), tokens are separated by
+/// spaces and tabs. The structure walk must see exactly what vcglib will see.
+class OffLines {
+public:
+  explicit OffLines(const std::string &path) : in_(path) {
+    if (!in_)
+      fail(path, "cannot open: " + errno_text(errno));
+  }
+  bool failed() const { return in_.fail(); }
+
+  /// Tokens of the next line (empty at the end of the file).
+  const std::vector<std::string> &next() {
+    std::string line;
+    do
+      std::getline(in_, line);
+    while ((line.empty() || line[0] == '#' || line[0] == '\r') && !in_.eof());
+    tokens_.clear();
+    size_t i = 0;
+    while (i < line.size()) {
+      while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r'))
+        ++i;
+      if (i == line.size())
+        break;
+      const size_t j = std::min(line.find_first_of(" \t", i), line.size());
+      tokens_.push_back(line.substr(i, j - i));
+      i = j;
+    }
+    return tokens_;
+  }
+
+private:
+  std::ifstream in_;
+  std::vector<std::string> tokens_;
+};
+
+/// Header of an OFF file as vcglib interprets it.
+struct OffHeader {
+  bool normals = false, colors = false, texcoords = false;
+  uint64_t vertices = 0, faces = 0;
+};
+
+struct OffLayout {
+  size_t vertices = 0, faces = 0, triangles = 0, polygons = 0;
+};
+
+/// Walks an OFF file the way ImporterOFF reads it, refusing what it would read out of
+/// bounds (missing faces, bad indices) or silently misread (garbage numbers).
+class OffWalker {
+public:
+  OffWalker(const std::string &path, const SizeCheck &check)
+      : path_(path), check_(check), lines_(path) {}
+
+  OffLayout run() {
+    const OffHeader h = header();
+    run_size_check(check_, path_, h.vertices, h.faces);
+    tokens_ = lines_.next();
+    k_ = 0;
+    for (uint64_t i = 0; i < h.vertices; ++i)
+      vertex(h, i);
+    OffLayout out;
+    out.vertices = static_cast<size_t>(h.vertices);
+    out.faces = static_cast<size_t>(h.faces);
+    for (uint64_t f = 0; f < h.faces; ++f) {
+      const size_t n = face(f, h.vertices);
+      out.triangles += n - 2;
+      out.polygons += n > 3;
+    }
+    return out;
+  }
+
+private:
+  /// "[ST][C][N]OFF" and the counts line (or the counts on the keyword's line).
+  OffHeader header() {
+    std::vector<std::string> t = lines_.next();
+    const size_t at = t.empty() ? std::string::npos : t[0].rfind("OFF");
+    if (at == std::string::npos)
+      fail(path_, "not an OFF file (no OFF keyword)");
+    OffHeader h;
+    const std::string prefix = t[0].substr(0, at);
+    h.colors = prefix.find('C') != std::string::npos;
+    h.normals = prefix.find('N') != std::string::npos;
+    h.texcoords = prefix.find("ST") != std::string::npos;
+    if (prefix.find_first_of("4n") != std::string::npos)
+      fail(path_, "4OFF/nOFF (homogeneous or n-dimensional) files are not supported");
+    if (t.size() == 1)
+      t = lines_.next();
+    else
+      t.erase(t.begin());
+    if (t.size() < 3 || !parse_count(strip_cr(t[0]), INT_MAX, h.vertices) ||
+        !parse_count(strip_cr(t[1]), INT_MAX, h.faces))
+      fail(path_, "bad OFF counts line (expected: vertices faces edges)");
+    return h;
+  }
+
+  static std::string strip_cr(std::string s) {
+    while (!s.empty() && s.back() == '\r')
+      s.pop_back();
+    return s;
+  }
+
+  /// Next token, continuing on the next line when the current one is used up.
+  const std::string &token(const char *what, uint64_t index) {
+    if (k_ == tokens_.size()) {
+      tokens_ = lines_.next();
+      k_ = 0;
+      if (tokens_.empty())
+        fail(path_, std::string("truncated OFF file (") + what + " " + num(index) + ")");
+    }
+    return tokens_[k_++];
+  }
+
+  void vertex(const OffHeader &h, uint64_t i) {
+    float p[3];
+    for (float &c : p)
+      if (!parse_float(strip_cr(token("vertex", i)), c))
+        fail(path_, "OFF vertex " + num(i) + " has a bad coordinate '" + tokens_[k_ - 1] + "'");
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+      fail(path_, "vertex " + num(i) + " has a non-finite coordinate " + point_text(p[0], p[1], p[2]));
+    for (int j = 0; h.normals && j < 3; ++j)
+      token("vertex normal", i);
+    if (h.colors) { // the rest of the line, minus texture coordinates
+      const long n = long(tokens_.size()) - long(k_) - (h.texcoords ? 2 : 0);
+      if (n < 0 || n > 4)
+        fail(path_, "OFF vertex " + num(i) + " has a bad color");
+      k_ += static_cast<size_t>(n);
+    }
+    for (int j = 0; h.texcoords && j < 2; ++j)
+      token("vertex texture coordinate", i);
+  }
+
+  /// One face line: corner count, then indices (possibly continued on further lines).
+  size_t face(uint64_t f, uint64_t vertices) {
+    if (lines_.failed())
+      fail(path_, "truncated OFF file (face " + num(f) + ")");
+    tokens_ = lines_.next();
+    if (tokens_.empty())
+      fail(path_, "truncated OFF file (face " + num(f) + ")");
+    uint64_t n = 0;
+    if (!parse_count(strip_cr(tokens_[0]), INT_MAX, n) || n < 3)
+      fail(path_, "OFF face " + num(f) + " has a bad vertex count '" + tokens_[0] + "'");
+    k_ = 1;
+    for (uint64_t j = 0; j < n; ++j) {
+      uint64_t v = 0;
+      const std::string t = strip_cr(token("face", f));
+      if (!parse_count(t, UINT32_MAX, v) || v >= vertices)
+        fail(path_, "OFF face " + num(f) + " references vertex '" + t + "' but there are " +
+                        num(vertices) + " vertices");
+    }
+    return static_cast<size_t>(n);
+  }
+
+  std::string path_;
+  const SizeCheck &check_;
+  OffLines lines_;
+  std::vector<std::string> tokens_;
+  size_t k_ = 0;
+};
+
+using OffImporter = vcg::tri::io::ImporterOFF<IoMesh>;
+
+} // namespace
+
+Mesh load_off(const std::string &path, LoadReport &report, const SizeCheck &check) {
+  check_regular_file(path);
+  const OffLayout layout = OffWalker(path, check).run();
+  IoMesh m;
+  int mask = 0;
+  const int err = guarded(path, [&] { return OffImporter::Open(m, path.c_str(), mask); });
+  if (err != OffImporter::NoError)
+    fail(path, "OFF import failed: " + vcg_message<OffImporter>(err, 7));
+  add_ignored_from_mask(mask, report.ignored_attributes);
+  check_counts(m, layout.vertices, layout.triangles, path, "vcglib's OFF importer");
+  clear_flags(m); // the importer marks polygon diagonals as faux edges
+  check_finite(m, path, false);
+
+  report.file_vertices = layout.vertices;
+  report.file_faces = layout.faces;
+  report.polygons_triangulated = layout.polygons;
+  return from_vcg(m, &report.unreferenced_vertices, true); // unreferenced vertices kept
+}
+
+std::string off_text(const Mesh &mesh) {
+  std::string s = "OFF\n" + num(mesh.vertex_count()) + " " + num(mesh.triangle_count()) + " 0\n";
+  append_vertices(s, mesh, "");
+  append_triangles(s, mesh, "3 ", 0);
+  return s;
+}
+
+} // namespace pomar::io

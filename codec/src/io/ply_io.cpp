@@ -1,0 +1,556 @@
+// PLY: a walk over the header and every element before vcglib's importer sees the file
+// (see io_common.h for why), then the import with count checks; writing as ASCII
+// (formatted here: vcglib prints only 7 significant digits) or binary (vcglib's exporter).
+#include "io/io_common.h"
+
+#include <pomar/vcg_adapter.h>
+
+#include <wrap/io_trimesh/export_ply.h>
+#include <wrap/io_trimesh/import_ply.h>
+
+#include <climits>
+#include <fstream>
+
+namespace pomar::io {
+namespace {
+
+enum class PlyType { I8, U8, I16, U16, I32, U32, F32, F64 };
+
+struct PlyProperty {
+  std::string name;
+  PlyType type = PlyType::F32;       // list items for a list
+  bool is_list = false;
+  PlyType count_type = PlyType::U8;  // lists only
+};
+
+struct PlyElement {
+  std::string name;
+  uint64_t count = 0;
+  std::vector<PlyProperty> props;
+  /// The first property with that name, as plylib's FindProp picks it.
+  const PlyProperty *find(const char *prop) const {
+    for (const auto &p : props)
+      if (p.name == prop)
+        return &p;
+    return nullptr;
+  }
+};
+
+/// Whether plylib would accept property p for a descriptor with these types: it demands
+/// exactly the declared types (no conversion).
+bool is_list_of(const PlyProperty *p, PlyType item, PlyType count) {
+  return p && p->is_list && p->type == item && p->count_type == count;
+}
+bool is_scalar_of(const PlyProperty *p, PlyType type) {
+  return p && !p->is_list && p->type == type;
+}
+
+struct PlyHeader {
+  enum Encoding { Ascii, BinaryLittle, BinaryBig } encoding = Ascii;
+  std::vector<PlyElement> elements;
+};
+
+size_t type_size(PlyType t) {
+  switch (t) {
+  case PlyType::I8: case PlyType::U8: return 1;
+  case PlyType::I16: case PlyType::U16: return 2;
+  case PlyType::I32: case PlyType::U32: case PlyType::F32: return 4;
+  case PlyType::F64: return 8;
+  }
+  return 0;
+}
+
+/// The type names plylib accepts (classic and sized spellings).
+bool parse_ply_type(const std::string &s, PlyType &t) {
+  static const struct { const char *a, *b; PlyType t; } names[] = {
+      {"char", "int8", PlyType::I8},     {"uchar", "uint8", PlyType::U8},
+      {"short", "int16", PlyType::I16},  {"ushort", "uint16", PlyType::U16},
+      {"int", "int32", PlyType::I32},    {"uint", "uint32", PlyType::U32},
+      {"float", "float32", PlyType::F32}, {"double", "float64", PlyType::F64}};
+  for (const auto &n : names)
+    if (s == n.a || s == n.b) {
+      t = n.t;
+      return true;
+    }
+  return false;
+}
+
+std::string base_name(const std::string &path) {
+  const size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+/// vcglib expands "comment TextureFile <name>" into a 255-byte stack buffer, substituting
+/// the file's base name for each "<this>"; refuse comments that could overflow it.
+void check_texture_comment(const std::string &line, const std::string &path) {
+  if (line.find("TextureFile") == std::string::npos)
+    return;
+  const size_t expansions = static_cast<size_t>(std::count(line.begin(), line.end(), '<'));
+  const size_t base = base_name(path).size();
+  if (base >= 250 || line.size() + expansions * base >= 250)
+    fail(path, "PLY TextureFile comment too long for vcglib");
+}
+
+/// Handles one "element" or "property" header line.
+void add_ply_declaration(PlyHeader &h, const std::vector<std::string> &tok,
+                         const std::string &path) {
+  auto bad = [&](const std::string &why) { fail(path, "invalid PLY header: " + why); };
+  if (tok[0] == "element") {
+    uint64_t count = 0;
+    if (tok.size() < 3 || !parse_count(tok[2], INT_MAX, count))
+      bad("bad element line '" + tok[0] + " " + (tok.size() > 1 ? tok[1] : "") + " ...'");
+    h.elements.push_back({tok[1], count, {}});
+    return;
+  }
+  if (h.elements.empty())
+    bad("property before the first element");
+  PlyProperty p;
+  const bool list = tok.size() > 1 && tok[1] == "list";
+  if (list ? tok.size() < 5 : tok.size() < 3)
+    bad("incomplete property line");
+  p.is_list = list;
+  if (list && !parse_ply_type(tok[2], p.count_type))
+    bad("unknown type '" + tok[2] + "'");
+  if (!parse_ply_type(tok[list ? 3 : 1], p.type))
+    bad("unknown type '" + tok[list ? 3 : 1] + "'");
+  p.name = tok[list ? 4 : 2];
+  h.elements.back().props.push_back(p);
+}
+
+/// Parses the header, leaving `in` at the first data byte.
+PlyHeader read_ply_header(FileReader &in, const std::string &path) {
+  auto bad = [&](const std::string &why) { fail(path, "invalid PLY header: " + why); };
+  std::string line;
+  if (!in.line(line) || line.compare(0, 3, "ply") != 0)
+    fail(path, "not a PLY file (no 'ply' magic)");
+  PlyHeader h;
+  bool have_format = false;
+  for (;;) {
+    if (!in.line(line))
+      bad("no end_header");
+    if (line.size() > 500) // plylib reads header lines in 511-byte pieces
+      bad("line longer than 500 characters");
+    if (line.find('\0') != std::string::npos) // plylib's strtok would stop there
+      bad("NUL byte");
+    const std::vector<std::string> tok = split_ws(line);
+    if (tok.empty())
+      bad("empty line");
+    if (tok[0] == "comment" || tok[0] == "obj_info") {
+      check_texture_comment(line, path);
+    } else if (tok[0] == "end_header") {
+      break;
+    } else if (tok[0] == "format") {
+      if (have_format || !h.elements.empty() || tok.size() < 3)
+        bad("misplaced or incomplete format line");
+      if (tok[1] == "ascii")
+        h.encoding = PlyHeader::Ascii;
+      else if (tok[1] == "binary_little_endian")
+        h.encoding = PlyHeader::BinaryLittle;
+      else if (tok[1] == "binary_big_endian")
+        h.encoding = PlyHeader::BinaryBig;
+      else
+        bad("unknown format '" + tok[1] + "'");
+      have_format = true;
+    } else if (tok[0] == "element" || tok[0] == "property") {
+      if (!have_format)
+        bad("format line missing before '" + tok[0] + "'");
+      add_ply_declaration(h, tok, path);
+    } else {
+      bad("unexpected keyword '" + tok[0] + "'");
+    }
+  }
+  if (!have_format)
+    bad("no format line");
+  return h;
+}
+
+/// What the walk found; the triangle count is what vcglib's importer will build.
+struct PlyLayout {
+  size_t vertices = 0;
+  size_t faces = 0;     // polygons of the face element, or triangles of the strips
+  size_t triangles = 0;
+  size_t polygons = 0;  // faces with more than 3 corners
+  bool edges = false, camera = false;
+};
+
+/// Reads PLY values of any type during the walk (binary in either byte order, or ASCII).
+class PlyValues {
+public:
+  PlyValues(FileReader &in, PlyHeader::Encoding enc, const std::string &path)
+      : in_(in), enc_(enc), path_(path) {}
+
+  /// One integer value; false at the end of the file.
+  bool integer(PlyType t, int64_t &v) {
+    if (t == PlyType::F32 || t == PlyType::F64)
+      fail(path_, "PLY list count or vertex index of floating-point type");
+    if (enc_ == PlyHeader::Ascii) {
+      if (!in_.token(tok_))
+        return false;
+      if (!parse_int(tok_, v))
+        fail(path_, "bad integer '" + tok_ + "' in PLY data");
+      return true;
+    }
+    unsigned char b[4] = {0, 0, 0, 0};
+    const size_t n = type_size(t);
+    if (!in_.read(b, n))
+      return false;
+    if (enc_ == PlyHeader::BinaryBig)
+      std::reverse(b, b + n);
+    v = decode(t, b);
+    return true;
+  }
+
+  /// Skips `count` values of type t; false at the end of the file.
+  bool skip(PlyType t, uint64_t count) {
+    if (enc_ != PlyHeader::Ascii)
+      return count <= UINT64_MAX / 8 && in_.skip(count * type_size(t));
+    for (uint64_t i = 0; i < count; ++i) {
+      if (!in_.token(tok_))
+        return false;
+      check_ascii_number(t);
+    }
+    return true;
+  }
+
+  /// Whether `count` values of type t can still be in the file (a bound, to refuse absurd
+  /// list lengths before allocating: binary values take their size, ASCII ones >= 1 byte).
+  bool fits(PlyType t, uint64_t count) const {
+    const uint64_t bytes = enc_ == PlyHeader::Ascii ? 1 : type_size(t);
+    return count <= in_.remaining() / bytes;
+  }
+
+  /// Skips one property (scalar or list); false at the end of the file.
+  bool skip(const PlyProperty &p) {
+    if (!p.is_list)
+      return skip(p.type, 1);
+    int64_t n = 0;
+    if (!integer(p.count_type, n))
+      return false;
+    if (n < 0)
+      fail(path_, "negative PLY list length");
+    return skip(p.type, static_cast<uint64_t>(n));
+  }
+
+private:
+  /// plylib reads ASCII values with fscanf("%d"/"%f"), which stops inside a malformed
+  /// token and then reads the rest as the next value. Requiring every token to be a whole
+  /// number of the property's kind keeps vcglib's reading aligned with this walk.
+  void check_ascii_number(PlyType t) {
+    int64_t i = 0;
+    float f = 0;
+    const bool ok = t == PlyType::F32 || t == PlyType::F64
+                        ? tok_.find('(') == std::string::npos && parse_float(tok_, f)
+                        : parse_int(tok_, i);
+    if (!ok)
+      fail(path_, "bad number '" + tok_ + "' in PLY data");
+  }
+
+  /// Little-endian bytes (zero-padded to 4) to an integer of type t.
+  static int64_t decode(PlyType t, const unsigned char *b) {
+    const uint32_t u = b[0] | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24;
+    switch (t) {
+    case PlyType::I8: return static_cast<int8_t>(u);
+    case PlyType::I16: return static_cast<int16_t>(u);
+    case PlyType::I32: return static_cast<int32_t>(u);
+    default: return u; // U8, U16, U32
+    }
+  }
+
+  FileReader &in_;
+  PlyHeader::Encoding enc_;
+  std::string path_, tok_;
+};
+
+/// Walks the rest of the PLY body, validating the connectivity element.
+class PlyWalker {
+public:
+  PlyWalker(FileReader &in, const PlyHeader &h, const std::string &path)
+      : in_(in), h_(h), path_(path), values_(in, h.encoding, path) {}
+
+  PlyLayout run() {
+    choose_elements();
+    for (const PlyElement &e : h_.elements) {
+      if (&e == conn_)
+        walk(e, e.name == "tristrips");
+      else
+        skip_element(e);
+      layout_.edges |= e.name == "edge" && e.count > 0;
+      layout_.camera |= e.name == "camera" && e.count > 0;
+    }
+    return layout_;
+  }
+
+private:
+  /// Finds the vertex element and the list vcglib will take faces from, trying the
+  /// property types in the order of ImporterPLY::Open. vcglib reads a "face", "tristrips",
+  /// "range_grid" or "edge" element even when it registered none of its properties, into
+  /// uninitialized memory; such files are refused.
+  void choose_elements() {
+    const PlyElement *vertex = single("vertex"), *face = single("face"),
+                     *strips = single("tristrips"), *edge = single("edge");
+    single("camera");
+    if (single("range_grid"))
+      fail(path_, "PLY range grids (range_grid element) are not supported");
+    layout_.vertices = vertex ? static_cast<size_t>(vertex->count) : 0;
+    conn_ = face, conn_prop_ = face ? face_index_list(*face) : nullptr;
+    if (!conn_prop_ && strips)
+      conn_ = strips, conn_prop_ = strips->find("vertex_indices");
+    if (conn_ == strips && !is_list_of(conn_prop_, PlyType::I32, PlyType::I32))
+      conn_prop_ = nullptr;
+    if (!conn_prop_)
+      conn_ = nullptr;
+    for (const PlyElement *e : {face, strips})
+      if (e && e->count > 0 && e != conn_)
+        fail(path_, "PLY " + e->name + " element without a vertex index list of a type vcglib reads");
+    // plylib cannot byte-swap doubles (SwapDouble() is an assert(0)); these it would store.
+    for (const char *name : {"x", "y", "z", "nx", "ny", "nz"})
+      if (h_.encoding == PlyHeader::BinaryBig && vertex && is_scalar_of(vertex->find(name), PlyType::F64))
+        fail(path_, "big-endian PLY with double vertex data, which vcglib cannot read");
+    // plylib reads binary index lists with a one-byte count unless the items are int.
+    if (conn_prop_ && h_.encoding != PlyHeader::Ascii && conn_prop_->type != PlyType::I32 &&
+        type_size(conn_prop_->count_type) != 1)
+      fail(path_, "PLY " + conn_->name + " list with a count wider than a byte and non-int indices, "
+                  "which vcglib misreads in binary files");
+    if (conn_ && conn_->count > 0 && (!vertex || conn_ < vertex))
+      fail(path_, "PLY " + conn_->name + " element comes before the vertex element");
+    if (edge && edge->count > 0 &&
+        !(is_scalar_of(edge->find("vertex1"), PlyType::I32) && is_scalar_of(edge->find("vertex2"), PlyType::I32)))
+      fail(path_, "PLY edge element without int vertex1/vertex2 properties");
+  }
+
+  /// The element with that name, or null; refuses a second one (vcglib reads it without
+  /// its properties registered).
+  const PlyElement *single(const char *name) {
+    const PlyElement *found = nullptr;
+    for (const PlyElement &e : h_.elements)
+      if (e.name == name) {
+        if (found)
+          fail(path_, std::string("PLY file has two '") + name + "' elements");
+        found = &e;
+      }
+    return found;
+  }
+
+  /// The face's index list if its types are among those vcglib reads (FaceDesc 0, 13-24).
+  static const PlyProperty *face_index_list(const PlyElement &face) {
+    using T = PlyType;
+    static const struct { const char *name; T item, count; } kinds[] = {
+        {"vertex_indices", T::I32, T::U8},  {"vertex_index", T::I32, T::U8},
+        {"vertex_index", T::I32, T::I8},    {"vertex_index", T::I32, T::I32},
+        {"vertex_indices", T::I32, T::I8},  {"vertex_indices", T::I32, T::I32},
+        {"vertex_indices", T::U32, T::U8},  {"vertex_indices", T::U32, T::I8},
+        {"vertex_indices", T::U32, T::I32}, {"vertex_indices", T::U32, T::U16},
+        {"vertex_indices", T::I16, T::I8},  {"vertex_indices", T::I16, T::U8},
+        {"vertex_indices", T::I16, T::I32}};
+    for (const auto &k : kinds)
+      if (is_list_of(face.find(k.name), k.item, k.count))
+        return face.find(k.name);
+    return nullptr;
+  }
+
+  [[noreturn]] void truncated(const PlyElement &e, uint64_t item) {
+    fail(path_, "truncated PLY file (" + e.name + " " + num(item) + " of " + num(e.count) + ")");
+  }
+
+  /// Skips an element; fixed-size binary elements in one seek.
+  void skip_element(const PlyElement &e) {
+    bool fixed = h_.encoding != PlyHeader::Ascii;
+    uint64_t stride = 0;
+    for (const auto &p : e.props)
+      fixed &= !p.is_list, stride += type_size(p.type);
+    if (fixed) {
+      if (stride > 0 && (e.count > UINT64_MAX / stride || !in_.skip(e.count * stride)))
+        truncated(e, 0);
+      return;
+    }
+    for (uint64_t i = 0; i < e.count; ++i)
+      for (const auto &p : e.props)
+        if (!skip_unstored(p))
+          truncated(e, i);
+  }
+
+  /// Skips a property vcglib does not store (for our mesh type: every list except the
+  /// face/strip indices). plylib skips a binary list by reading a one-byte count, whatever
+  /// the declared count type, into a 512-byte stack buffer, and takes an empty list for the
+  /// end of the file (fread of 0 items); refuse lists it would misread.
+  bool skip_unstored(const PlyProperty &p) {
+    if (!p.is_list || h_.encoding == PlyHeader::Ascii)
+      return values_.skip(p);
+    if (type_size(p.count_type) != 1)
+      fail(path_, "PLY list '" + p.name + "' has a count wider than a byte, which vcglib misreads in binary files");
+    int64_t n = 0;
+    if (!values_.integer(p.count_type, n))
+      return false;
+    if (n < 0 || static_cast<uint64_t>(n) * type_size(p.type) > 512)
+      fail(path_, "PLY list '" + p.name + "' of " + std::to_string(n) + " items is too long for vcglib");
+    if (n == 0)
+      fail(path_, "PLY list '" + p.name + "' is empty, which vcglib cannot skip in binary files");
+    return values_.skip(p.type, static_cast<uint64_t>(n));
+  }
+
+  /// Reads every item of the connectivity element and checks its index list.
+  void walk(const PlyElement &e, bool strips) {
+    for (uint64_t i = 0; i < e.count; ++i)
+      for (const auto &p : e.props) {
+        if (&p != conn_prop_) {
+          if (!skip_unstored(p))
+            truncated(e, i);
+          continue;
+        }
+        int64_t n = 0;
+        if (!values_.integer(p.count_type, n))
+          truncated(e, i);
+        check_length(n, strips, i);
+        if (!values_.fits(p.type, static_cast<uint64_t>(n))) // before allocating the list
+          truncated(e, i);
+        list_.resize(static_cast<size_t>(n));
+        for (auto &v : list_)
+          if (!values_.integer(p.type, v))
+            truncated(e, i);
+        if (strips)
+          strip(i);
+        else
+          face(i);
+      }
+  }
+
+  /// Faces need 3..255 corners (vcglib keeps the count in a byte, the corners in int[512]).
+  void check_length(int64_t n, bool strips, uint64_t item) {
+    if (strips && (n < 0 || n > INT_MAX))
+      fail(path_, "PLY tristrip " + num(item) + " has invalid length " + std::to_string(n));
+    if (!strips && (n < 3 || n > 255))
+      fail(path_, "PLY face " + num(item) + " has " + std::to_string(n) +
+                      " vertices (3 to 255 supported)");
+  }
+
+  /// A polygon: all corners must be vertices.
+  void face(uint64_t item) {
+    for (int64_t v : list_)
+      check_index(v, "face", item);
+    ++layout_.faces;
+    layout_.triangles += list_.size() - 2;
+    layout_.polygons += list_.size() > 3;
+  }
+
+  /// A triangle strip, -1 restarting it; replays vcglib's loop to count its triangles.
+  void strip(uint64_t item) {
+    const size_t n = list_.size();
+    for (size_t k = 0; k + 2 < n; ++k) {
+      check_index(list_[k], "tristrip", item);
+      if (list_[k + 2] == -1) {
+        k += 2;
+        continue;
+      }
+      check_index(list_[k + 1], "tristrip", item);
+      check_index(list_[k + 2], "tristrip", item);
+      ++layout_.triangles;
+      ++layout_.faces;
+    }
+  }
+
+  void check_index(int64_t v, const char *what, uint64_t item) {
+    if (v < 0 || static_cast<uint64_t>(v) >= layout_.vertices)
+      fail(path_, std::string("PLY ") + what + " " + num(item) + " references vertex " +
+                      std::to_string(v) + " but there are " + num(layout_.vertices) + " vertices");
+  }
+
+  FileReader &in_;
+  const PlyHeader &h_;
+  std::string path_;
+  PlyValues values_;
+  const PlyElement *conn_ = nullptr;
+  const PlyProperty *conn_prop_ = nullptr;
+  std::vector<int64_t> list_;
+  PlyLayout layout_;
+};
+
+// ======================================================================================
+// PLY: loading
+// ======================================================================================
+
+using PlyImporter = vcg::tri::io::ImporterPLY<IoMesh>;
+
+/// The count of the first element with that name (0 if none).
+uint64_t element_count(const PlyHeader &h, const char *name) {
+  for (const PlyElement &e : h.elements)
+    if (e.name == name)
+      return e.count;
+  return 0;
+}
+
+/// Size of the header of a PLY file written by vcglib ("...end_header\n").
+uint64_t ply_header_size(const std::string &file, const std::string &target) {
+  std::ifstream in(file, std::ios::binary);
+  std::string line;
+  uint64_t size = 0;
+  while (size < 65536 && std::getline(in, line)) {
+    size += line.size() + 1;
+    if (line == "end_header")
+      return size;
+  }
+  fail(target, "vcglib wrote a PLY file without end_header");
+}
+
+} // namespace
+
+Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &check) {
+  PlyLayout layout;
+  {
+    FileReader in(path);
+    const PlyHeader header = read_ply_header(in, path);
+    const uint64_t faces = element_count(header, "face");
+    run_size_check(check, path, element_count(header, "vertex"), faces);
+    layout = PlyWalker(in, header, path).run();
+    if (layout.triangles > faces) // polygons or triangle strips
+      run_size_check(check, path, layout.vertices, layout.triangles);
+  }
+  int file_mask = 0; // what the file has, whatever our mesh type can store
+  PlyImporter::LoadMask(path.c_str(), file_mask);
+  add_ignored_from_mask(file_mask, report.ignored_attributes);
+  if (layout.edges)
+    add_unique(report.ignored_attributes, "edges");
+  if (layout.camera)
+    add_unique(report.ignored_attributes, "camera");
+
+  IoMesh m;
+  int mask = 0;
+  const int err = guarded(path, [&] { return PlyImporter::Open(m, path.c_str(), mask); });
+  if (PlyImporter::ErrorCritical(err))
+    fail(path, "PLY import failed: " +
+                   vcg_message<PlyImporter>(err, vcg::tri::io::PlyInfo::E_MAXPLYINFOERRORS));
+  check_counts(m, layout.vertices, layout.triangles, path, "vcglib's PLY importer");
+  clear_flags(m);
+  check_finite(m, path, false);
+
+  report.file_vertices = layout.vertices;
+  report.file_faces = layout.faces;
+  report.polygons_triangulated = layout.polygons;
+  return from_vcg(m, &report.unreferenced_vertices, true); // unreferenced vertices kept
+}
+
+std::string ply_ascii_text(const Mesh &mesh) {
+  std::string s = "ply\nformat ascii 1.0\ncomment pomar\nelement vertex " + num(mesh.vertex_count()) +
+                  "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
+                  num(mesh.triangle_count()) + "\nproperty list uchar int vertex_indices\nend_header\n";
+  append_vertices(s, mesh, "");
+  append_triangles(s, mesh, "3 ", 0);
+  return s;
+}
+
+
+void save_ply_binary(const std::string &path, const Mesh &mesh) {
+  IoMesh m;
+  to_vcg(mesh, m);
+  TempFile tmp(path);
+  const uint64_t nv = mesh.vertex_count(), nf = mesh.triangle_count();
+  using Exporter = vcg::tri::io::ExporterPLY<IoMesh>;
+  errno = 0;
+  const int err = Exporter::Save(m, tmp.path().c_str(), true);
+  if (err != 0)
+    fail(path, "cannot write: " + vcg_message<Exporter>(err, vcg::tri::io::PlyInfo::E_MAXPLYINFOERRORS) +
+                   errno_suffix());
+  check_written_size(tmp.path(), ply_header_size(tmp.path(), path) + 12 * nv + 13 * nf, path);
+  tmp.commit(true);
+}
+
+} // namespace pomar::io

@@ -1,0 +1,272 @@
+// STL: binary/ASCII detection, binary read here (see read_binary_stl for why), ASCII
+// through vcglib; identical corners welded. Writing ASCII formatted here, binary through
+// vcglib's exporter.
+#include "io/io_common.h"
+
+#include <pomar/vcg_adapter.h>
+
+#include <wrap/io_trimesh/io_mask.h> // export_stl.h uses it without including it
+#include <wrap/io_trimesh/export_stl.h>
+#include <wrap/io_trimesh/import_stl.h>
+
+#include <climits>
+#include <cmath>
+#include <string_view>
+#include <unordered_map>
+
+namespace pomar::io {
+namespace {
+
+using StlImporter = vcg::tri::io::ImporterSTL<IoMesh>;
+
+/// Binary or ASCII, and the facet count of a binary file.
+struct StlKind {
+  bool binary = false;
+  uint64_t facets = 0; // binary only
+};
+
+/// Tells binary from ASCII STL: binary if the size is exactly what the facet count in the
+/// header says (binary headers may start with "solid" too), else ASCII if it starts with
+/// "solid", else binary if a byte > 127 follows the header (vcglib's rule, which without
+/// the "solid" test takes an ASCII file with a non-ASCII name for binary). Refuses a
+/// truncated binary file and an ASCII one vcglib would hang on.
+StlKind classify_stl(const std::string &path) {
+  FileReader in(path);
+  const uint64_t size = in.remaining();
+  unsigned char head[84 + 1000];
+  const size_t probe = static_cast<size_t>(std::min<uint64_t>(size, sizeof head));
+  if (size < 84 || !in.read(head, probe))
+    fail(path, "too short to be an STL file (" + num(size) + " bytes)");
+  StlKind kind;
+  kind.facets = uint64_t(head[80]) | uint64_t(head[81]) << 8 | uint64_t(head[82]) << 16 |
+                uint64_t(head[83]) << 24;
+  const uint64_t expected = 84 + 50 * kind.facets;
+  const unsigned char *text = std::find_if(head, head + probe, [](unsigned char c) { return !std::isspace(c); });
+  const bool solid = head + probe - text >= 5 && std::memcmp(text, "solid", 5) == 0;
+  kind.binary = size == expected ||
+                (!solid && std::any_of(head + 84, head + probe, [](unsigned char b) { return b > 127; }));
+  if (kind.binary) {
+    if (size < expected)
+      fail(path, "truncated binary STL (header says " + num(kind.facets) +
+                     " facets, file has room for " + num((size - 84) / 50) + ")");
+    if (3 * kind.facets > UINT32_MAX)
+      fail(path, "binary STL with " + num(kind.facets) + " facets exceeds 32-bit indices");
+    return kind;
+  }
+  // vcglib skips the first line with a getc() loop that never ends without a '\n'.
+  bool newline = std::find(head, head + probe, '\n') != head + probe;
+  for (int c = 0; !newline && (c = in.get()) >= 0;)
+    newline = c == '\n';
+  if (!newline)
+    fail(path, "not an STL file (ASCII STL without line breaks)");
+  return kind;
+}
+
+/// Merges vertices with exactly equal coordinates (compared as floats, so -0 equals +0),
+/// keeping the first occurrence's position and the order of first occurrences. Returns the
+/// number of vertices merged away.
+size_t weld_identical(Mesh &mesh) {
+  struct Key {
+    float x, y, z;
+    bool operator==(const Key &o) const { return x == o.x && y == o.y && z == o.z; }
+  };
+  struct Hash {
+    size_t operator()(const Key &k) const {
+      uint32_t b[3];
+      const float c[3] = {k.x + 0.0f, k.y + 0.0f, k.z + 0.0f}; // -0 -> +0
+      std::memcpy(b, c, sizeof b);
+      return (size_t(b[0]) * 0x9E3779B1u) ^ (size_t(b[1]) * 0x85EBCA77u) ^ (size_t(b[2]) * 0xC2B2AE3Du);
+    }
+  };
+  const size_t n = mesh.vertex_count();
+  std::unordered_map<Key, uint32_t, Hash> first;
+  first.reserve(n);
+  std::vector<uint32_t> remap(n);
+  std::vector<float> kept;
+  kept.reserve(mesh.positions.size());
+  for (size_t i = 0; i < n; ++i) {
+    const Key key{mesh.positions[3 * i], mesh.positions[3 * i + 1], mesh.positions[3 * i + 2]};
+    const auto ins = first.emplace(key, static_cast<uint32_t>(kept.size() / 3));
+    if (ins.second)
+      kept.insert(kept.end(), {key.x, key.y, key.z});
+    remap[i] = ins.first->second;
+  }
+  for (auto &t : mesh.triangles)
+    t = remap[t];
+  mesh.positions.swap(kept);
+  return n - mesh.vertex_count();
+}
+
+/// Binary STL: 80-byte header, uint32 facet count, then per facet a normal, three corners
+/// (little-endian floats) and a 16-bit attribute (a color in some dialects). Read here
+/// rather than with vcglib's OpenBinary, which strlen()s the unterminated 80-byte header
+/// (a stack over-read) and leaks two FILE handles per call. Same result: 3 new vertices
+/// per facet, in file order.
+Mesh read_binary_stl(const std::string &path, uint64_t facets, bool &colored) {
+  FileReader in(path);
+  in.skip(84);
+  Mesh mesh;
+  mesh.positions.resize(static_cast<size_t>(9 * facets));
+  mesh.triangles.resize(static_cast<size_t>(3 * facets));
+  colored = false;
+  unsigned char rec[50];
+  for (size_t f = 0; f < facets; ++f) {
+    if (!in.read(rec, sizeof rec)) // classify_stl checked the size already
+      fail(path, "truncated binary STL (facet " + num(f) + ")");
+    for (size_t c = 0; c < 9; ++c) {
+      const unsigned char *b = rec + 12 + 4 * c;
+      const uint32_t bits = b[0] | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24;
+      std::memcpy(&mesh.positions[9 * f + c], &bits, 4);
+    }
+    for (uint32_t k = 0; k < 3; ++k)
+      mesh.triangles[3 * f + k] = static_cast<uint32_t>(3 * f + k);
+    colored |= rec[48] != 0 || rec[49] != 0;
+  }
+  return mesh;
+}
+
+/// The tokens of a text separated by spaces, tabs, CR and LF (as split_ws), one at a time,
+/// as views into the text: no copy of a file that may be hundreds of megabytes.
+class TokenCursor {
+public:
+  explicit TokenCursor(std::string_view text) : text_(text) {}
+  /// The next token; false at the end of the text.
+  bool next(std::string_view &out) {
+    const size_t begin = text_.find_first_not_of(" \t\r\n", pos_);
+    if (begin == std::string_view::npos)
+      return false;
+    pos_ = std::min(text_.find_first_of(" \t\r\n", begin), text_.size());
+    out = text_.substr(begin, pos_ - begin);
+    return true;
+  }
+
+private:
+  std::string_view text_;
+  size_t pos_ = 0;
+};
+
+/// Counts the occurrences of `word` in `text` (for ASCII STL: "endloop" = facets).
+uint64_t count_occurrences(std::string_view text, std::string_view word) {
+  uint64_t n = 0;
+  for (size_t at = text.find(word); at != text.npos; at = text.find(word, at + word.size()))
+    ++n;
+  return n;
+}
+
+/// ASCII STL, read here rather than by vcglib (whose reader leaks its FILE on a malformed
+/// vertex line, found by fuzzing): every "outer loop" ... "endloop" must hold exactly three
+/// "vertex x y z" lines; everything else (solid names, facet normals) is skipped. 3 new
+/// vertices per facet, in file order. The size check sees the facet count ("endloop"
+/// keywords) before the mesh is allocated.
+Mesh read_ascii_stl(const std::string &path, const SizeCheck &check) {
+  const std::vector<uint8_t> bytes = read_file(path);
+  const std::string_view text(reinterpret_cast<const char *>(bytes.data()), bytes.size());
+  const uint64_t facets = count_occurrences(text, "endloop");
+  // The text (about 250 bytes a facet) stays in memory while the facets are read: counted
+  // as one vertex per facet, twice what the welded mesh keeps (binary STL: see load_stl).
+  run_size_check(check, path, facets, facets);
+  Mesh mesh;
+  mesh.positions.reserve(static_cast<size_t>(9 * facets));
+  mesh.triangles.reserve(static_cast<size_t>(3 * facets));
+  size_t in_loop = 0, facet = 0;
+  bool looping = false;
+  TokenCursor tokens(text);
+  std::string_view tok;
+  while (tokens.next(tok)) {
+    if (tok == "loop") {
+      looping = true;
+      in_loop = 0;
+    } else if (tok == "vertex") {
+      float v[3];
+      std::string_view c;
+      for (float &x : v)
+        if (!looping || !tokens.next(c) || !parse_float(std::string(c), x))
+          fail(path, "malformed vertex in ASCII STL facet " + num(facet));
+      mesh.positions.insert(mesh.positions.end(), v, v + 3);
+      ++in_loop;
+    } else if (tok == "endloop") {
+      if (!looping || in_loop != 3)
+        fail(path, "ASCII STL facet " + num(facet) + " has " + num(in_loop) +
+                       " vertices (3 expected)");
+      const uint32_t first = static_cast<uint32_t>(mesh.positions.size() / 3 - 3);
+      mesh.triangles.insert(mesh.triangles.end(), {first, first + 1, first + 2});
+      looping = false;
+      ++facet;
+    }
+  }
+  if (looping)
+    fail(path, "ASCII STL ends inside facet " + num(facet));
+  return mesh;
+}
+
+} // namespace
+
+Mesh load_stl(const std::string &path, LoadReport &report, const SizeCheck &check) {
+  const StlKind kind = classify_stl(path);
+  // Identical corners are welded below: a closed mesh keeps about one vertex per two
+  // facets, which is what the encoder will hold (the 3 corners per facet read first cost
+  // less than its per-vertex structures).
+  if (kind.binary)
+    run_size_check(check, path, kind.facets / 2, kind.facets);
+  bool colored = false;
+  Mesh mesh =
+      kind.binary ? read_binary_stl(path, kind.facets, colored) : read_ascii_stl(path, check);
+  if (colored)
+    add_unique(report.ignored_attributes, "colors");
+  for (size_t v = 0; v < mesh.vertex_count(); ++v)
+    check_finite(mesh.positions[3 * v], mesh.positions[3 * v + 1], mesh.positions[3 * v + 2], v, path, true);
+  report.file_vertices = mesh.vertex_count();
+  report.file_faces = mesh.triangle_count();
+  report.welded_vertices = weld_identical(mesh);
+  return mesh;
+}
+
+/// ASCII STL; the facet normal is the normalized cross product (0 for a degenerate facet).
+std::string stl_ascii_text(const Mesh &mesh) {
+  std::string s = "solid pomar\n";
+  for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+    const float *p[3];
+    for (int k = 0; k < 3; ++k)
+      p[k] = &mesh.positions[3 * mesh.triangles[3 * t + k]];
+    double e1[3], e2[3], n[3];
+    for (int i = 0; i < 3; ++i)
+      e1[i] = double(p[1][i]) - p[0][i], e2[i] = double(p[2][i]) - p[0][i];
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    s += "  facet normal";
+    for (double c : n) {
+      s += ' ';
+      append_float_sci(s, len > 0 ? float(c / len) : 0.0f);
+    }
+    s += "\n    outer loop\n";
+    for (int k = 0; k < 3; ++k) {
+      s += "      vertex";
+      for (int i = 0; i < 3; ++i) {
+        s += ' ';
+        append_float_sci(s, p[k][i]);
+      }
+      s += '\n';
+    }
+    s += "    endloop\n  endfacet\n";
+  }
+  return s + "endsolid pomar\n";
+}
+
+
+void save_stl_binary(const std::string &path, const Mesh &mesh) {
+  IoMesh m;
+  to_vcg(mesh, m);
+  TempFile tmp(path);
+  const uint64_t nf = mesh.triangle_count();
+  using Exporter = vcg::tri::io::ExporterSTL<IoMesh>;
+  errno = 0;
+  const int err = Exporter::Save(m, tmp.path().c_str(), true);
+  if (err != 0)
+    fail(path, "cannot write: " + vcg_message<Exporter>(err, 3) + errno_suffix());
+  check_written_size(tmp.path(), 84 + 50 * nf, path);
+  tmp.commit(true);
+}
+
+} // namespace pomar::io

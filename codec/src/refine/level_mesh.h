@@ -1,0 +1,48 @@
+// The mesh being refined level by level, with the lineage of every vertex.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "mesh/corner_table.h"
+
+namespace pomar {
+
+/// The mesh being refined: what the decoder holds, and what the encoder replicates.
+struct LevelMesh {
+  CornerTable ct;
+  std::vector<int32_t> q;  // quantized xyz per vertex
+  uint32_t seed_faces = 0; // faces of the base mesh (traversal seeds, never removed)
+  // Lineage of every vertex: the level that created it (0 = base mesh), its cluster
+  // (clustered levels: the base clustered mesh vertex it descends from), its parent (the
+  // v_to it was split from; itself for base vertices) and its rank of creation inside its
+  // cluster. (cluster, local) names a vertex the same way whatever clusters were decoded
+  // in whatever order. Level and cluster share a cache line: the walks read both.
+  struct Tag {
+    uint32_t cluster = 0;
+    uint16_t level = 0;
+  };
+  std::vector<Tag> tag;
+  std::vector<uint32_t> parent, local;
+  std::vector<uint16_t> face_claim; // per face: last level whose patch held it
+  uint32_t vertex_count() const { return ct.vertex_count(); }
+  uint32_t level_of(uint32_t v) const { return tag[v].level; }
+  uint32_t cluster_of(uint32_t v) const { return tag[v].cluster; }
+  uint64_t key(uint32_t v) const { return (uint64_t(tag[v].cluster) << 32) | local[v]; }
+  void init_lineage() {
+    tag.assign(vertex_count(), Tag{});
+    parent.resize(vertex_count());
+    for (uint32_t v = 0; v < vertex_count(); ++v)
+      parent[v] = v;
+    face_claim.assign(ct.face_count(), 0);
+  }
+  /// Make the current mesh the base clustered mesh (paper section 5.2): each vertex
+  /// roots the cluster with its id; vertices created later inherit their v_to's cluster.
+  void root_clusters() {
+    local.assign(vertex_count(), 0);
+    for (uint32_t c = 0; c < vertex_count(); ++c)
+      tag[c].cluster = c;
+  }
+};
+
+} // namespace pomar

@@ -1,0 +1,88 @@
+// A vertex split's patch in v_to's ring, and the split symbols that name it (paper
+// section 5.1): s_e picks the edge v_to-v_ref among the ring's edges ranked longest first,
+// s_l and s_r count the patch faces on either side of it.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+#include "mesh/corner_table.h"
+#include "refine/level_mesh.h"
+
+namespace pomar {
+
+struct SplitSymbols {
+  uint32_t s_e = 0, s_l = 0, s_r = 0;
+};
+
+/// Where the patch of a split lies in v_to's ring (indices; kNone = the open fan's gap).
+struct PatchRange {
+  uint32_t j;      // v_ref
+  uint32_t il, ir; // v_l, v_r
+  uint32_t first_face, faces;
+};
+
+inline int64_t squared_distance(const std::vector<int32_t> &q, uint32_t a, uint32_t b) {
+  const int64_t dx = q[3 * a] - q[3 * b], dy = q[3 * a + 1] - q[3 * b + 1],
+                dz = q[3 * a + 2] - q[3 * b + 2];
+  return dx * dx + dy * dy + dz * dz;
+}
+
+/// Ring indices sorted by decreasing edge length (ties: smaller key first).
+template <class Key>
+void rank_edges(const LevelMesh &mesh, uint32_t v, const Ring &ring, std::vector<uint32_t> &ranked,
+                std::vector<int64_t> &len2, const Key &key) {
+  const uint32_t m = ring.size();
+  ranked.resize(m);
+  len2.resize(m);
+  for (uint32_t i = 0; i < m; ++i) {
+    ranked[i] = i;
+    len2[i] = squared_distance(mesh.q, v, ring.neighbour[i]);
+  }
+  std::sort(ranked.begin(), ranked.end(), [&](uint32_t a, uint32_t b) {
+    if (len2[a] != len2[b])
+      return len2[a] > len2[b];
+    return key(ring.neighbour[a]) < key(ring.neighbour[b]);
+  });
+}
+
+/// Turn (s_e, s_l, s_r) into ring positions; false if they do not describe a valid patch.
+inline bool resolve_patch(const Ring &ring, const uint32_t *ranked, const SplitSymbols &s,
+                          PatchRange &p) {
+  const uint32_t m = ring.size();
+  if (s.s_e >= m)
+    return false;
+  p.j = ranked[s.s_e];
+  if (ring.closed) {
+    if (s.s_l >= m || s.s_r >= m || s.s_l + s.s_r == 0 || s.s_l + s.s_r > m - 1)
+      return false;
+    p.il = (p.j + m - s.s_l) % m;
+    p.ir = (p.j + s.s_r) % m;
+    p.first_face = p.il;
+    p.faces = s.s_l + s.s_r;
+    return true;
+  }
+  if (s.s_l <= p.j)
+    p.il = p.j - s.s_l;
+  else if (s.s_l == p.j + 1)
+    p.il = kNone;
+  else
+    return false;
+  if (uint64_t(p.j) + s.s_r <= m - 1)
+    p.ir = p.j + s.s_r;
+  else if (uint64_t(p.j) + s.s_r == m)
+    p.ir = kNone;
+  else
+    return false;
+  if (p.il == kNone && p.ir == kNone)
+    return false;
+  p.first_face = p.il == kNone ? 0 : p.il;
+  const uint32_t end = p.ir == kNone ? m - 1 : p.ir;
+  if (end <= p.first_face)
+    return false;
+  p.faces = end - p.first_face;
+  return true;
+}
+
+} // namespace pomar
