@@ -569,7 +569,7 @@ int main(int argc, char **argv) {
   // Ctrl-C or kill during a write: no temporary file left, the old output untouched.
   pomar::remove_temporary_files_on_signals();
   app.set_version_flag("--version",
-                       "pomar 0.1.0 (writes .pomar format versions 1 and 3, reads 1 to 3)");
+                       "pomar 0.1.0 (writes .pomar format versions 1, 3 and 4, reads 1 to 4)");
 
   EncodeArgs ea;
   auto *enc =
