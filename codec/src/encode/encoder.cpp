@@ -160,6 +160,10 @@ std::vector<std::vector<uint8_t>> encode_global_levels(Rebuild &rb, size_t globa
 
 } // namespace
 
+void check_encode_input(const Mesh &mesh, const EncodeOptions &options) {
+  check_input(mesh, options);
+}
+
 std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &options,
                                      EncodeReport *report, const LosslessHook *hook) {
   auto t0 = std::chrono::steady_clock::now();

@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <array>
-#include <cmath>
 #include <string>
 
 #include "format/file_format.h"
@@ -205,13 +204,7 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
   }
 
   const size_t nv = mesh.vertex_count();
-  if (mesh.positions.size() % 3 || mesh.triangles.size() % 3)
-    throw Error("position and triangle arrays must hold multiples of 3 values");
-  if (mesh.triangle_count() == 0)
-    throw Error("the mesh contains no triangles");
-  for (size_t i = 0; i < mesh.positions.size(); ++i)
-    if (!std::isfinite(mesh.positions[i]))
-      throw Error("vertex " + std::to_string(i / 3) + " has a non-finite coordinate");
+  check_encode_input(mesh, options); // unreferenced vertices included
   Mesh cut = mesh;
   RepairMap map;
   const RepairReport repair = make_manifold(cut, &map); // checks the indices

@@ -30,6 +30,10 @@ struct LosslessHook {
 std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &options,
                                      EncodeReport *report, const LosslessHook *hook);
 
+/// The manifold encoder's checks of the input that do not depend on its topology (bits,
+/// array sizes, no triangle, NaN/Inf); throws pomar::Error.
+void check_encode_input(const Mesh &mesh, const EncodeOptions &options);
+
 /// The record for `input` cut into `cut` by make_manifold (with `map`), when a full decode
 /// numbers cut vertex decoded_to_cut[i] as i. `decoded` receives that full decode (D) and
 /// `output_to_input` what input vertex each vertex of the decoded output is.
