@@ -315,6 +315,27 @@ TEST(Lossless, DamagedRecordIsAnErrorNotAWrongMesh) {
   }
 }
 
+TEST(Lossless, SkipDamagedGivesTheCutMeshWhenTheRecordIsDamaged) {
+  const Mesh m = messy_sphere(2);
+  for (bool progressive : {false, true}) {
+    EncodeOptions o;
+    o.progressive = progressive;
+    EncodeReport er;
+    std::vector<uint8_t> file = encode(m, o, &er);
+    const FileLayout layout = read_layout(file.data(), file.size());
+    file[layout.section_offset[0] + 1] ^= 0x40;
+    DecodeOptions d;
+    d.skip_damaged = true;
+    DecodeReport r;
+    const Mesh out = decode(file.data(), file.size(), d, &r);
+    ASSERT_EQ(r.damaged.size(), 1u);
+    EXPECT_EQ(r.damaged[0].block, "lossless record");
+    EXPECT_NE(r.damaged[0].problem.find("the mesh is the coded one"), std::string::npos);
+    EXPECT_EQ(out.vertex_count(), er.info.vertices); // the cut mesh
+    EXPECT_THROW(decode(file.data(), file.size()), Error);
+  }
+}
+
 TEST(Lossless, RecordReaderRejectsGarbage) {
   // Bodies that pass the section checksum but hold nonsense (a hostile file): always a
   // clear error or a mesh, never a crash. The decoded mesh here is a small sphere.

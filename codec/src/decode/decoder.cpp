@@ -91,6 +91,11 @@ Mesh decode(const uint8_t *data, size_t size, int level, const Progress &progres
   return decode(data, size, options);
 }
 
+/// What a skip_damaged decode says when the lossless record is damaged.
+const char *const kCutMeshKept =
+    " (the mesh is the coded one: cut into a manifold, oriented mesh, without its duplicate and "
+    "degenerate faces and unreferenced vertices)";
+
 Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, DecodeReport *report) {
   DecodeReport scratch_report;
   DecodeReport &r = report ? *report : scratch_report;
@@ -129,7 +134,14 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
       r.level = std::max(r.level, l);
       r.clusters_below_request += l < static_cast<int>(target);
     }
-    return d.exact_mesh(); // the full mesh, intact: as it was input
+    try {
+      return d.exact_mesh(); // the full mesh, intact: as it was input
+    } catch (const Error &e) {
+      if (!options.skip_damaged)
+        throw;
+      r.damaged.push_back({"lossless record", std::string(e.what()) + kCutMeshKept, -1});
+      return d.mesh();
+    }
   }
   LevelMesh lm = base_level_mesh(data, layout);
   Models models;
@@ -137,8 +149,15 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
                                                   models, options.progress,
                                                   options.skip_damaged ? &r.damaged : nullptr));
   Mesh mesh = to_mesh(lm, h.grid);
-  if (r.level == static_cast<int>(levels))
-    undo_cut(data, layout, mesh); // the full mesh: as it was input
+  if (r.level == static_cast<int>(levels)) {
+    try {
+      undo_cut(data, layout, mesh); // the full mesh: as it was input
+    } catch (const Error &e) {
+      if (!options.skip_damaged)
+        throw;
+      r.damaged.push_back({"lossless record", std::string(e.what()) + kCutMeshKept, -1});
+    }
+  }
   return mesh;
 }
 
