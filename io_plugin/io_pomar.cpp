@@ -26,14 +26,6 @@ namespace {
 const char *const kFormatName = "POMAR progressive mesh";
 const char *const kExtension = "pomar";
 
-/// "<verb> <path>: <what>", or just `what` when the codec's message names the file already.
-QString describe(const char *verb, const QString &path, const char *what) {
-  const QString text = QString::fromStdString(what);
-  if (text.contains(path))
-    return text;
-  return QString("%1 %2: %3").arg(verb, path, text);
-}
-
 bool isPomar(const QString &format) {
   return format.compare(QLatin1String(kExtension), Qt::CaseInsensitive) == 0;
 }
@@ -49,7 +41,6 @@ bool hasOwnVertexNormals(const CMeshO &m) {
   using P = vcg::Point3f;
   std::vector<P> acc(m.vert.size(), P(0, 0, 0));
   std::vector<char> used(m.vert.size(), 0);
-  const CVertexO *first = m.vert.empty() ? nullptr : &m.vert[0];
   for (const CFaceO &f : m.face) {
     if (f.IsD())
       continue;
@@ -62,7 +53,7 @@ bool hasOwnVertexNormals(const CMeshO &m) {
     const P e0 = (p1 - p0).Normalize(), e1 = (p2 - p1).Normalize(), e2 = (p0 - p2).Normalize();
     const float w[3] = {vcg::AngleN(e0, -e2), vcg::AngleN(-e0, e1), vcg::AngleN(-e1, e2)};
     for (int k = 0; k < 3; ++k) {
-      const size_t v = size_t(f.cV(k) - first);
+      const size_t v = pomar::vertex_position(m, f.cV(k));
       if (v >= acc.size() || !std::isfinite(w[k]))
         continue;
       acc[v] += n * w[k];
@@ -215,10 +206,7 @@ bool PomarIOPlugin::open(const QString &format, const QString &fileName, MeshMod
       level = decoder.base_clustered_level();
     else if (openAt == OPEN_GLOBAL_LEVEL)
       level = wantedLevel;
-    if (level < 0 || level > decoder.finest_level())
-      throw pomar::Error("level " + std::to_string(level) +
-                         " does not exist: the file has levels 0.." +
-                         std::to_string(decoder.finest_level()));
+    pomar::check_level_exists(level, decoder.finest_level());
 
     pomar::Mesh mesh;
     std::vector<uint32_t> cluster, vertexLevel;
@@ -226,11 +214,13 @@ bool PomarIOPlugin::open(const QString &format, const QString &fileName, MeshMod
     if (info.clustered() && level < decoder.base_clustered_level()) {
       // Below the base clustered mesh only the plain decoder goes; it knows no vertex levels.
       QFile file(path);
-      if (!file.open(QIODevice::ReadOnly))
-        throw pomar::Error("cannot read " + native + ": " + file.errorString().toStdString());
-      const QByteArray bytes = file.readAll();
-      if (file.error() != QFileDevice::NoError)
-        throw pomar::Error("cannot read " + native + ": " + file.errorString().toStdString());
+      QByteArray bytes;
+      if (file.open(QIODevice::ReadOnly))
+        bytes = file.readAll();
+      if (!file.isOpen() || file.error() != QFileDevice::NoError)
+        throw pomar::Error(pomar::Error::Kind::Io,
+                           "cannot read " + native + ": " + file.errorString().toStdString())
+            .with_path(native);
       pomar::DecodeOptions options;
       options.level = level;
       options.skip_damaged = skipDamaged;
@@ -259,36 +249,22 @@ bool PomarIOPlugin::open(const QString &format, const QString &fileName, MeshMod
                                   .arg(path)
                                   .arg(damaged.size())
                                   .arg(QString::fromStdString(pomar::describe_damage(damaged)));
-      Log(GLLogStream::WARNING, qUtf8Printable(warning));
-      qWarning("pomar: %s", qUtf8Printable(warning)); // Log() is a no-op in meshlabserver
+      pomar::meshlab::warn(*this, "", warning);
     }
 
     pomar::to_vcg(mesh, m.cm); // also clears m's attributes
-    auto clusterOf = vcg::tri::Allocator<CMeshO>::GetPerVertexAttribute<float>(
-        m.cm, pomar::meshlab::kClusterAttribute);
-    auto levelOf = vcg::tri::Allocator<CMeshO>::GetPerVertexAttribute<float>(
-        m.cm, pomar::meshlab::kLevelAttribute);
-    const bool haveClusters = info.clustered() && cluster.size() == mesh.vertex_count();
-    const bool haveLevels = vertexLevel.size() == mesh.vertex_count();
-    for (size_t v = 0; v < mesh.vertex_count(); ++v) { // -1: unknown (or a vertex no face uses)
-      clusterOf[v] = haveClusters && cluster[v] != UINT32_MAX ? float(cluster[v]) : -1.0f;
-      levelOf[v] = haveLevels && vertexLevel[v] != UINT32_MAX ? float(vertexLevel[v]) : -1.0f;
-    }
-    auto source = vcg::tri::Allocator<CMeshO>::GetPerMeshAttribute<std::string>(
-        m.cm, pomar::meshlab::kSourceAttribute);
-    source() = native;
-    auto skip = vcg::tri::Allocator<CMeshO>::GetPerMeshAttribute<int>(
-        m.cm, pomar::meshlab::kSkipDamagedAttribute);
-    skip() = skipDamaged ? 1 : 0;
+    if (!info.clustered())
+      cluster.clear(); // a progressive file's vertices have no cluster
+    pomar::meshlab::setLayerAttributes(m.cm, cluster, vertexLevel, native, skipDamaged);
 
-    progress.report(100);
+    progress.done();
     Log("pomar: opened %s at level %d of %d (%s): %zu vertices, %zu faces", qUtf8Printable(path),
         level, decoder.finest_level(), info.clustered() ? "clustered file" : "progressive file",
         mesh.vertex_count(), mesh.triangle_count());
     return true;
   } catch (const std::exception &e) { // pomar::Error, or std::bad_alloc
     m.cm.Clear();
-    return fail(describe("cannot open", path, e.what()));
+    return fail(pomar::meshlab::errorText(e, "cannot open " + path));
   }
 }
 
@@ -351,7 +327,7 @@ bool PomarIOPlugin::save(const QString &format, const QString &fileName, MeshMod
     bytes = pomar::encode(mesh, options, &report);
     stored = QString::fromStdString(report.lossless.summary());
   } catch (const std::exception &e) { // pomar::Error (invalid mesh or options), std::bad_alloc
-    return fail(describe("cannot save", path, e.what()));
+    return fail(pomar::meshlab::errorText(e, "cannot save " + path));
   }
 
   // Atomic replacement: a temporary file next to the destination, renamed over it on commit.
@@ -365,24 +341,20 @@ bool PomarIOPlugin::save(const QString &format, const QString &fileName, MeshMod
     file.cancelWriting();
     return fail(QString("cannot save %1: %2").arg(path, why));
   }
-  progress.report(100);
+  progress.done();
 
-  if (!repaired.isEmpty()) {
-    const QString warning =
-        QString("%1: repaired before saving: %2").arg(QFileInfo(path).fileName(), repaired);
-    Log(GLLogStream::WARNING, qUtf8Printable(warning));
-    qWarning("pomar: %s", qUtf8Printable(warning)); // Log() is a no-op in meshlabserver
-  }
+  if (!repaired.isEmpty())
+    pomar::meshlab::warn(
+        *this, "",
+        QString("%1: repaired before saving: %2").arg(QFileInfo(path).fileName(), repaired));
   if (!stored.isEmpty())
     Log("pomar: %s: stored for an exact decode: %s", qUtf8Printable(QFileInfo(path).fileName()),
         qUtf8Printable(stored));
-  if (!dropped.isEmpty()) {
-    const QString warning =
+  if (!dropped.isEmpty())
+    pomar::meshlab::warn(
+        *this, "",
         QString("%1: the .pomar format keeps only positions and triangles; not saved: %2")
-            .arg(QFileInfo(path).fileName(), dropped.join("; "));
-    Log(GLLogStream::WARNING, qUtf8Printable(warning));
-    qWarning("pomar: %s", qUtf8Printable(warning)); // Log() is a no-op in meshlabserver
-  }
+            .arg(QFileInfo(path).fileName(), dropped.join("; ")));
   Log("pomar: saved %s: %zu bytes", qUtf8Printable(path), bytes.size());
   return true;
 }

@@ -1,15 +1,23 @@
 // What the two MeshLab plugins share about a layer opened from a .pomar file: the names of
-// the attributes the IO plugin writes and the filter plugin reads, and the relay of the
-// codec's progress to MeshLab's callback.
+// the attributes the IO plugin writes and the filter plugin reads (and writing them), the
+// relay of the codec's progress to MeshLab's callback, warnings, and error messages.
 #pragma once
 
 #include <pomar/pomar.h>
 
+#include <common/interfaces.h>
+#include <vcg/complex/allocate.h>
 #include <vcg/complex/complex.h>
+
+#include <QString>
+#include <QtGlobal>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <exception>
 #include <string>
+#include <vector>
 
 namespace pomar::meshlab {
 
@@ -27,6 +35,43 @@ inline bool isPomarAttribute(const std::string &name) {
     if (name == own)
       return true;
   return false;
+}
+
+/// Writes the attributes of a layer decoded from `source`: per vertex its cluster and the
+/// level that created it (-1 where unknown: `cluster` / `level` not one per vertex, as for a
+/// pure progressive file's clusters), per mesh the source file and the damage policy.
+template <class MeshType>
+void setLayerAttributes(MeshType &m, const std::vector<uint32_t> &cluster,
+                        const std::vector<uint32_t> &level, const std::string &source,
+                        bool skipDamaged) {
+  using Alloc = vcg::tri::Allocator<MeshType>;
+  auto clusterOf = Alloc::template GetPerVertexAttribute<float>(m, kClusterAttribute);
+  auto levelOf = Alloc::template GetPerVertexAttribute<float>(m, kLevelAttribute);
+  const bool haveClusters = cluster.size() == m.vert.size();
+  const bool haveLevels = level.size() == m.vert.size();
+  for (size_t v = 0; v < m.vert.size(); ++v) { // -1: none (UINT32_MAX: a vertex no face uses)
+    clusterOf[v] = haveClusters && cluster[v] != UINT32_MAX ? float(cluster[v]) : -1.0f;
+    levelOf[v] = haveLevels && level[v] != UINT32_MAX ? float(level[v]) : -1.0f;
+  }
+  Alloc::template GetPerMeshAttribute<std::string>(m, kSourceAttribute)() = source;
+  Alloc::template GetPerMeshAttribute<int>(m, kSkipDamagedAttribute)() = skipDamaged ? 1 : 0;
+}
+
+/// A warning in MeshLab's log (with `logPrefix`) and on stderr ("pomar: "): Log() is a
+/// no-op in meshlabserver.
+inline void warn(MeshLabInterface &plugin, const char *logPrefix, const QString &text) {
+  plugin.Log(GLLogStream::WARNING, qUtf8Printable(logPrefix + text));
+  qWarning("pomar: %s", qUtf8Printable(text));
+}
+
+/// The message of a failure while working on a file: the codec's message as it is when it
+/// names the file already (pomar::Error::path()), else "<context>: <message>".
+inline QString errorText(const std::exception &e, const QString &context) {
+  const QString what = QString::fromStdString(e.what());
+  const auto *error = dynamic_cast<const pomar::Error *>(&e);
+  if (error != nullptr && !error->path().empty())
+    return what;
+  return QString("%1: %2").arg(context, what);
 }
 
 /// Forwards progress to MeshLab's callback at most every 10% (meshlabserver prints the
@@ -50,11 +95,23 @@ public:
     };
   }
   Progress function() { return range(0, 100); }
+  /// The end: 100% with an empty label, which clears the label from MeshLab's status bar
+  /// (it would keep showing it). The destructor calls it if nobody did.
+  void done() {
+    if (cb_ != nullptr && !done_) {
+      done_ = true;
+      (*cb_)(100, "");
+    }
+  }
+  ~ProgressRelay() { done(); }
+  ProgressRelay(const ProgressRelay &) = delete;
+  ProgressRelay &operator=(const ProgressRelay &) = delete;
 
 private:
   vcg::CallBackPos *cb_;
   const char *label_;
   int last_ = -100;
+  bool done_ = false;
 };
 
 } // namespace pomar::meshlab

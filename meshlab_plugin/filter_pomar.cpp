@@ -90,15 +90,13 @@ Signature signatureOf(const CMeshO &m) {
     for (int a = 0; a < 3; ++a)
       h.add(float(m.vert[v].cP()[a]));
   }
-  const CVertexO *first = m.vert.empty() ? nullptr : &m.vert[0];
   for (const CFaceO &f : m.face) {
     if (f.IsD())
       continue;
     ++fn;
     for (int k = 0; k < f.VN(); ++k) {
-      const CVertexO *v = f.cV(k);
-      const bool inside = first != nullptr && v >= first && v < first + m.vert.size();
-      h.add(inside ? index[size_t(v - first)] : kNone);
+      const size_t v = pomar::vertex_position(m, f.cV(k));
+      h.add(v < index.size() ? index[v] : kNone);
     }
   }
   return {vn, fn, h.value()};
@@ -272,9 +270,7 @@ PomarFilterPlugin::Session *PomarFilterPlugin::session(const std::string &path, 
     try {
       s->open();
     } catch (const std::exception &e) { // pomar::Error, std::bad_alloc
-      const QString what = QString::fromStdString(e.what());
-      error = what.contains(fi.filePath()) ? what
-                                           : QString("cannot read %1: %2").arg(fi.filePath(), what);
+      error = pomar::meshlab::errorText(e, "cannot read " + fi.filePath());
       return nullptr;
     }
     while (sessions_.size() >= kMaxSessions) {
@@ -348,26 +344,23 @@ void replaceMesh(PomarFilterPlugin::Session &s, MeshModel &mm, const std::vector
   const pomar::Mesh mesh = s.decoder->exact_mesh(&from);
   const std::vector<uint32_t> cluster = s.decoder->vertex_cluster();
   const std::vector<uint32_t> level = s.decoder->vertex_level();
+  // The attributes of each vertex of `mesh` (UINT32_MAX: a vertex no face uses).
+  std::vector<uint32_t> clusterOf(mesh.vertex_count(), UINT32_MAX), levelOf = clusterOf;
+  for (size_t v = 0; v < mesh.vertex_count(); ++v)
+    if (from[v] < level.size()) {
+      clusterOf[v] = s.clustered ? cluster[from[v]] : UINT32_MAX;
+      levelOf[v] = level[from[v]];
+    }
   CMeshO &m = mm.cm;
   pomar::to_vcg(mesh, m); // Clear() + ClearAttributes(), then the new vertices and faces
-
-  auto clusterOf = vcg::tri::Allocator<CMeshO>::GetPerVertexAttribute<float>(m, kClusterAttr);
-  auto levelOf = vcg::tri::Allocator<CMeshO>::GetPerVertexAttribute<float>(m, kLevelAttr);
+  pomar::meshlab::setLayerAttributes(m, s.clustered ? clusterOf : std::vector<uint32_t>(), levelOf,
+                                     s.path, s.skipDamaged);
   for (size_t v = 0; v < mesh.vertex_count(); ++v) {
-    const uint32_t f = from[v];
-    const bool coded = f < level.size();
-    clusterOf[v] = s.clustered && coded ? float(cluster[f]) : -1.0f;
-    levelOf[v] = coded ? float(level[f]) : -1.0f;
     m.vert[v].C() = vcg::Color4b(vcg::Color4b::White);
     m.vert[v].Q() = 0;
-    if (select != nullptr && s.clustered && coded && (*select)[cluster[f]])
+    if (select != nullptr && s.clustered && clusterOf[v] != UINT32_MAX && (*select)[clusterOf[v]])
       m.vert[v].SetS();
   }
-  auto source = vcg::tri::Allocator<CMeshO>::GetPerMeshAttribute<std::string>(m, kSourceAttr);
-  source() = s.path;
-  auto skip = vcg::tri::Allocator<CMeshO>::GetPerMeshAttribute<int>(
-      m, pomar::meshlab::kSkipDamagedAttribute);
-  skip() = s.skipDamaged ? 1 : 0;
   const bool faceColor = vcg::tri::HasPerFaceColor(m);
   for (CFaceO &f : m.face) {
     if (faceColor)
@@ -540,8 +533,7 @@ void PomarFilterPlugin::initParameterSet(QAction *a, MeshModel &m, RichParameter
 
 bool PomarFilterPlugin::fail(const QString &text) {
   errorMessage = text;
-  Log(GLLogStream::WARNING, qUtf8Printable("POMAR: " + text));
-  qWarning("pomar: %s", qUtf8Printable(text));
+  pomar::meshlab::warn(*this, "POMAR: ", text);
   return false;
 }
 
@@ -589,9 +581,7 @@ bool PomarFilterPlugin::applyFilter(QAction *a, MeshDocument &md, const RichPara
     // The decoder may be half way through an update: forget it. The layer is unchanged
     // (it is replaced only after a successful update).
     sessions_.erase(path);
-    const QString what = QString::fromStdString(e.what());
-    const QString file = QFile::decodeName(path.c_str());
-    return fail(what.contains(file) ? what : QString("%1: %2").arg(file, what));
+    return fail(pomar::meshlab::errorText(e, QFile::decodeName(path.c_str())));
   }
 }
 
@@ -607,8 +597,7 @@ void PomarFilterPlugin::warnAboutNewDamage(Session &s) {
           .arg(damaged.size() - s.damageReported)
           .arg(QString::fromStdString(pomar::describe_damage(damaged, s.damageReported)));
   s.damageReported = damaged.size();
-  Log(GLLogStream::WARNING, qUtf8Printable("POMAR: " + text));
-  qWarning("pomar: %s", qUtf8Printable(text)); // Log() is a no-op in meshlabserver
+  pomar::meshlab::warn(*this, "POMAR: ", text);
 }
 
 bool PomarFilterPlugin::refineOrCoarsen(bool refine, MeshModel &mm, Session &s, int requested,
@@ -628,16 +617,14 @@ bool PomarFilterPlugin::refineOrCoarsen(bool refine, MeshModel &mm, Session &s, 
   // The clusters of the selected faces (or, with no face selected, of the selected vertices).
   std::vector<char> chosen(s.clusters, 0);
   size_t faces = 0;
-  const CVertexO *first = m.vert.empty() ? nullptr : &m.vert[0];
   for (const CFaceO &f : m.face) {
     if (f.IsD() || !f.IsS())
       continue;
     ++faces;
     for (int k = 0; k < f.VN(); ++k) {
-      const CVertexO *v = f.cV(k);
-      if (first != nullptr && v >= first && v < first + m.vert.size() &&
-          cluster[size_t(v - first)] >= 0)
-        chosen[size_t(cluster[size_t(v - first)])] = 1;
+      const size_t v = pomar::vertex_position(m, f.cV(k));
+      if (v < cluster.size() && cluster[v] >= 0)
+        chosen[size_t(cluster[v])] = 1;
     }
   }
   size_t vertices = 0;
@@ -685,7 +672,7 @@ bool PomarFilterPlugin::refineOrCoarsen(bool refine, MeshModel &mm, Session &s, 
     reached += chosen[c] && after[c] == target;
   }
   replaceMesh(s, mm, &chosen);
-  progress.report(100);
+  progress.done();
 
   const double ms = msSince(t0);
   Log("POMAR: %s %zu clusters in %.1f ms (to level %d, from %zu selected %s; %s; decode %.1f "
@@ -726,7 +713,7 @@ bool PomarFilterPlugin::setLevel(MeshModel &mm, Session &s, int requested, vcg::
   d.update(progress.range(0, 95));
   const double decodeMs = msSince(t0);
   replaceMesh(s, mm, nullptr);
-  progress.report(100);
+  progress.done();
   Log("POMAR: set level of detail %d%s in %.1f ms (decode %.1f ms): %d vertices, %d faces; read "
       "%.1f KB more of the file",
       level,

@@ -62,7 +62,8 @@ EncodeReport expect_exact(const Mesh &input, EncodeOptions options = {}) {
       EXPECT_EQ(map[i], i);
     }
     for (int k = 0; k < 3; ++k) {
-      const float want = info.grid.dequantize(k, info.grid.quantize(k, input.positions[3 * map[i] + k]));
+      const float want =
+          info.grid.dequantize(k, info.grid.quantize(k, input.positions[3 * map[i] + k]));
       EXPECT_EQ(out.positions[3 * i + k], want) << "vertex " << i << " axis " << k;
     }
   }
@@ -92,7 +93,7 @@ Mesh messy_sphere(int subdivisions) {
   const uint32_t *t0 = &m.triangles[0];
   const uint32_t a = t0[0], b = t0[1];
   const uint32_t fin = add_vertex(m, 0.0, 0.0, 2.0);
-  add_face(m, a, b, fin);                                   // a fin: edge (a, b) has 3 faces
+  add_face(m, a, b, fin);                                    // a fin: edge (a, b) has 3 faces
   std::swap(m.triangles[3 * 7 + 1], m.triangles[3 * 7 + 2]); // a flipped face
   const Tri f9 = {m.triangles[27], m.triangles[28], m.triangles[29]};
   add_face(m, f9[0], f9[1], f9[2]); // exact duplicate
@@ -126,7 +127,7 @@ TEST(Lossless, EachKindOfDefectRoundTripsExactly) {
   Mesh isolated = gen::tetrahedron();
   add_vertex(isolated, 9, 9, 9);
   add_vertex(isolated, -3, 0.25, 1);
-  add_vertex(isolated, 0, 0, 0); // on an existing vertex's position
+  add_vertex(isolated, 0, 0, 0);        // on an existing vertex's position
   Mesh coincident = gen::tetrahedron(); // a fan pinched at a vertex with a twin position
   add_vertex(coincident, 0, 0, 0);
   const Case cases[] = {

@@ -46,16 +46,6 @@ pomar::Progress terminal_progress(bool quiet) {
   };
 }
 
-/// True if make_manifold() would change `mesh` (a copy): then `--repair` is worth a hint.
-bool repair_would_help(const pomar::Mesh &mesh) {
-  pomar::Mesh copy = mesh;
-  try {
-    return pomar::make_manifold(copy).changed();
-  } catch (const pomar::Error &) {
-    return false;
-  }
-}
-
 constexpr const char *kRepairHint =
     " (without --strict pomar stores the cut and gives the mesh back exactly; --repair cuts it "
     "for good)";
@@ -124,8 +114,8 @@ int run_encode(const EncodeArgs &a) {
   try {
     file = pomar::encode(mesh, opt, &r);
   } catch (const pomar::Error &e) {
-    if (a.strict && repair_would_help(mesh))
-      throw pomar::Error(e.what() + std::string(kRepairHint));
+    if (a.strict && pomar::repair_would_change(mesh))
+      throw pomar::Error(e.kind(), e.what() + std::string(kRepairHint));
     throw;
   }
   const double t_encode = since(t1);
@@ -192,8 +182,9 @@ std::vector<double> parse_spec(const std::string &spec, size_t count, int finest
       if (used != spec.size() - colon - 1)
         throw std::invalid_argument("level");
     } catch (const std::exception &) {
-      throw pomar::Error(std::string("bad ") + what + " '" + spec +
-                         "': the level after ':' must be an integer");
+      throw pomar::Error(pomar::Error::Kind::Usage,
+                         std::string("bad ") + what + " '" + spec +
+                             "': the level after ':' must be an integer");
     }
   }
   std::vector<double> v;
@@ -208,21 +199,34 @@ std::vector<double> parse_spec(const std::string &spec, size_t count, int finest
       if (used != item.size())
         throw std::invalid_argument("number");
     } catch (const std::exception &) {
-      throw pomar::Error(std::string("bad ") + what + " '" + spec + "': '" + item +
-                         "' is not a number");
+      throw pomar::Error(pomar::Error::Kind::Usage, std::string("bad ") + what + " '" + spec +
+                                                        "': '" + item + "' is not a number");
     }
     if (comma == std::string::npos)
       break;
     pos = comma + 1;
   }
   if (v.size() != count)
-    throw pomar::Error(std::string("bad ") + what + " '" + spec + "': expected " +
-                       std::to_string(count) + " numbers");
+    throw pomar::Error(pomar::Error::Kind::Usage, std::string("bad ") + what + " '" + spec +
+                                                      "': expected " + std::to_string(count) +
+                                                      " numbers");
   return v;
 }
 
-/// Exit status of a decode that skipped damaged blocks (the output is written).
+// Exit statuses (README "Exit codes"). Errors exit 1 whatever their pomar::Error kind
+// (invalid mesh, damaged or truncated file, I/O, memory limit, bad argument): scripts and
+// the end-to-end tests rely on that; only a broken invariant of the codec (a bug) gets its
+// own status. exit_status() is the one place that maps kinds to statuses.
+constexpr int kExitError = 1;
+/// verify: the mesh differs; info --check / decode --skip-damaged: damaged blocks found
+/// (the decode still wrote its output).
+constexpr int kExitMismatch = 3;
 constexpr int kExitDamaged = 3;
+constexpr int kExitInternal = 70; // EX_SOFTWARE
+
+int exit_status(const pomar::Error &e) {
+  return e.kind() == pomar::Error::Kind::Internal ? kExitInternal : kExitError;
+}
 
 /// List skipped blocks on stderr; returns the exit status (0 or kExitDamaged).
 int report_damage(const std::vector<pomar::DamagedBlock> &damaged, const std::string &out) {
@@ -245,16 +249,19 @@ int report_damage(const std::vector<pomar::DamagedBlock> &damaged, const std::st
   return kExitDamaged;
 }
 
-/// A damaged or missing level or cluster block can be skipped; say so in the error.
+/// A damaged or missing level or cluster block (or a truncated file) can be skipped; say
+/// so in the error.
 [[noreturn]] void rethrow_with_hint(const pomar::Error &e) {
-  const std::string m = e.what();
-  const bool block = m.find("level ") != std::string::npos ||
-                     m.find("cluster ") != std::string::npos ||
-                     m.rfind("truncated .pomar file", 0) == 0;
-  if (block && (m.rfind("damaged", 0) == 0 || m.rfind("truncated", 0) == 0))
-    throw pomar::Error(m + " (pomar info --check lists damaged blocks; pomar decode "
-                           "--skip-damaged decodes the rest)");
-  throw e;
+  using Kind = pomar::Error::Kind;
+  const bool skippable =
+      e.kind() == Kind::TruncatedFile || (e.kind() == Kind::DamagedFile && e.in_block());
+  if (!skippable)
+    throw e;
+  pomar::Error hinted(e.kind(), e.what() + std::string(" (pomar info --check lists damaged "
+                                                       "blocks; pomar decode --skip-damaged "
+                                                       "decodes the rest)"));
+  hinted.with_path(e.path()).in_block(e.level(), e.cluster());
+  throw hinted;
 }
 
 int run_selective_decode(const DecodeArgs &a) {
@@ -264,7 +271,8 @@ int run_selective_decode(const DecodeArgs &a) {
   options.memory_limit = pomar::parse_memory_size(a.max_memory);
   pomar::SelectiveDecoder d(std::make_unique<pomar::FileSource>(a.in), options);
   if (!d.info().clustered())
-    throw pomar::Error(a.in + " is a pure progressive file (encoded with --progressive): it has "
+    throw pomar::Error(pomar::Error::Kind::Usage,
+                       a.in + " is a pure progressive file (encoded with --progressive): it has "
                               "no clusters to select; use --level");
   const int finest = d.finest_level();
   if (a.level >= 0)
@@ -273,8 +281,9 @@ int run_selective_decode(const DecodeArgs &a) {
     int level;
     const std::vector<double> id = parse_spec(spec, 1, finest, level, "--cluster");
     if (id[0] < 0 || id[0] != double(uint32_t(id[0])))
-      throw pomar::Error("bad --cluster '" + spec +
-                         "': the cluster id must be a non-negative integer");
+      throw pomar::Error(pomar::Error::Kind::Usage,
+                         "bad --cluster '" + spec +
+                             "': the cluster id must be a non-negative integer");
     d.want_cluster(static_cast<uint32_t>(id[0]), level);
   }
   for (const std::string &spec : a.spheres) {
@@ -509,7 +518,7 @@ int run_verify(const std::string &original, const std::string &file, const std::
   const pomar::FileInfo info = pomar::inspect(data.data(), data.size());
   // A file without a lossless record (encode --strict, or older) has no unreferenced vertex.
   const size_t dropped = info.lossless_bytes == 0 ? pomar::drop_unreferenced_vertices(ref) : 0;
-  const bool could_repair = !repair && info.lossless_bytes == 0 && repair_would_help(ref);
+  const bool could_repair = !repair && info.lossless_bytes == 0 && pomar::repair_would_change(ref);
   const pomar::Mesh out =
       decoded.empty() ? pomar::decode(data.data(), data.size()) : pomar::load_mesh(decoded);
   // Snap the original onto the file's grid, as the encoder did.
@@ -535,7 +544,7 @@ int run_verify(const std::string &original, const std::string &file, const std::
                      ? " (the original needs a repair to be encoded: if it was encoded with "
                        "--repair, verify with --repair)"
                      : "");
-    return 3;
+    return kExitMismatch;
   }
   std::printf("OK: %s matches %s%s: the same %zu vertices and %zu oriented triangles, every vertex "
               "on its %d-bit grid position",
@@ -700,10 +709,10 @@ int main(int argc, char **argv) {
       return run_verify(v_orig, v_file, v_decoded, v_repair);
   } catch (const pomar::Error &e) {
     std::fprintf(stderr, "pomar: error: %s\n", e.what());
-    return 1;
+    return exit_status(e);
   } catch (const std::exception &e) {
     std::fprintf(stderr, "pomar: error: %s\n", e.what());
-    return 1;
+    return kExitError;
   }
   return 0;
 }

@@ -69,6 +69,30 @@ ReadBuffer::ReadBuffer(const py::handle &object, const char *what) {
 
 ReadBuffer::~ReadBuffer() { PyBuffer_Release(&view_); }
 
+pomar::Progress python_progress(const py::handle &callback) {
+  if (!callback.is_none() && !PyCallable_Check(callback.ptr()))
+    throw py::type_error("progress must be a callable(fraction, stage) or None");
+  return [callback](double fraction, const char *stage) {
+    py::gil_scoped_acquire locked;
+    if (PyErr_CheckSignals() != 0)
+      throw py::error_already_set();
+    if (!callback.is_none())
+      callback(fraction, stage);
+  };
+}
+
+py::list damaged_list(const std::vector<pomar::DamagedBlock> &blocks) {
+  py::list out;
+  for (const pomar::DamagedBlock &b : blocks) {
+    py::dict d;
+    d["block"] = b.block;
+    d["problem"] = b.problem;
+    d["level_kept"] = b.level_kept;
+    out.append(d);
+  }
+  return out;
+}
+
 py::dict info_dict(const pomar::FileInfo &i) {
   auto bpv = [&](uint64_t bytes) {
     return i.vertices ? 8.0 * double(bytes) / double(i.vertices) : 0.0;

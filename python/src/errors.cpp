@@ -15,8 +15,43 @@ void raise(const std::string &kind, const std::string &message) {
 }
 } // namespace
 
+namespace {
+
+// pomar::Error gets a kind() with issue 11 (branch arch, c28846d). Until that is on main
+// this file compiles against both: the first overload exists only when E has kind(), and
+// its body is checked only then. Once it is merged, keep only typed_kind's switch.
+template <class E> auto typed_kind(const E &e, int) -> decltype(e.kind(), std::string()) {
+  using Kind = typename E::Kind;
+  switch (e.kind()) {
+  case Kind::InvalidMesh:
+    return "invalid_mesh";
+  case Kind::DamagedFile:
+    return "damaged_file";
+  case Kind::TruncatedFile:
+    return "truncated_file";
+  case Kind::Unsupported:
+    return "unsupported";
+  case Kind::Io:
+    return "io";
+  case Kind::MemoryLimit:
+    return "memory_limit";
+  case Kind::Usage:
+    return "usage";
+  case Kind::Internal:
+    return "internal";
+  default:
+    return ""; // Kind::Other: the operation's kind below
+  }
+}
+template <class E> std::string typed_kind(const E &, long) { return ""; }
+
+} // namespace
+
 std::string kind_of(const pomar::Error &e, const char *operation_kind) {
-  // The memory checks of pomar/limits.h all say "not enough memory to ...".
+  const std::string typed = typed_kind(e, 0);
+  if (!typed.empty())
+    return typed;
+  // Untyped: the memory checks of pomar/limits.h all say "not enough memory to ...".
   if (std::string(e.what()).rfind("not enough memory", 0) == 0)
     return "memory_limit";
   return operation_kind;
@@ -26,7 +61,8 @@ void register_errors(py::module_ &m) {
   error_type = PyErr_NewExceptionWithDoc(
       "pomar.Error",
       "A failure reported by the pomar library: str(e) is its one-line message, e.kind one "
-      "of 'invalid_mesh', 'damaged_file', 'io', 'memory_limit', 'usage'.",
+      "of 'invalid_mesh', 'damaged_file', 'truncated_file', 'unsupported', 'io', "
+      "'memory_limit', 'usage', 'internal'.",
       PyExc_Exception, nullptr);
   if (!error_type)
     throw py::error_already_set();

@@ -1,11 +1,10 @@
-// pomar.Error: the library's errors as one Python exception class with a `kind`.
-//
-// pomar::Error does not carry a kind yet (issue 11 gives it one), so the kind is the
-// usual failure of the operation that raised it: "invalid_mesh" (encode), "damaged_file"
-// (decode, info, SelectiveDecoder), "io" (read, write), "usage" (a memory limit text that
-// does not parse), and "memory_limit" whenever a memory check refused the work. Bad
-// arguments the binding can check itself (dtype, shape, bits, level, cluster) raise
-// TypeError / ValueError before the library is called.
+// pomar.Error: the library's errors as one Python exception class with a `kind`: the
+// library's own kind (pomar::Error::kind(), issue 11) as snake_case text; for errors without
+// one (kind Other, or a library from before typed errors) the usual failure of the operation
+// that raised it: "invalid_mesh" (encode), "damaged_file" (decode, info, SelectiveDecoder),
+// "io" (read, write), "usage" (a memory limit text that does not parse), and "memory_limit"
+// whenever a memory check refused the work. Bad arguments the binding can check itself
+// (dtype, shape, bits, level, cluster) raise TypeError / ValueError before the library runs.
 #pragma once
 
 #include <pomar/pomar.h>

@@ -19,7 +19,7 @@ inline Mesh moebius(int n) {
     const double u = 2 * pi * i / n;
     for (double s : {-0.3, 0.3}) // vertex 2i: s = -0.3, vertex 2i+1: s = +0.3
       detail::add_vertex(m, (1 + s * std::cos(u / 2)) * std::cos(u),
-                 (1 + s * std::cos(u / 2)) * std::sin(u), s * std::sin(u / 2));
+                         (1 + s * std::cos(u / 2)) * std::sin(u), s * std::sin(u / 2));
   }
   for (int i = 0; i < n; ++i) {
     const uint32_t a = 2 * i, b = 2 * i + 1;
@@ -60,9 +60,7 @@ inline Mesh klein_bottle(int n, int m) {
 inline Mesh soup(uint32_t seed, uint32_t vertices, uint32_t faces) {
   Mesh m;
   uint64_t key = 0;
-  auto pick = [&](uint32_t n) {
-    return static_cast<uint32_t>(detail::unit_hash(seed, key++) * n);
-  };
+  auto pick = [&](uint32_t n) { return static_cast<uint32_t>(detail::unit_hash(seed, key++) * n); };
   for (uint32_t v = 0; v < vertices; ++v)
     detail::add_vertex(m, pick(1000) / 100.0, pick(1000) / 100.0, pick(1000) / 100.0);
   for (uint32_t f = 0; f < faces; ++f) {
@@ -86,9 +84,7 @@ inline Mesh soup(uint32_t seed, uint32_t vertices, uint32_t faces) {
 inline Mesh glued_disk(uint32_t seed) {
   Mesh m = flat_disk(2 + seed % 2);
   uint64_t key = 1u << 20;
-  auto pick = [&](uint32_t n) {
-    return static_cast<uint32_t>(detail::unit_hash(seed, key++) * n);
-  };
+  auto pick = [&](uint32_t n) { return static_cast<uint32_t>(detail::unit_hash(seed, key++) * n); };
   const uint32_t nv = static_cast<uint32_t>(m.vertex_count());
   for (uint32_t k = 0, glues = 1 + seed % 5; k < glues; ++k) {
     const uint32_t from = pick(nv), to = pick(nv);

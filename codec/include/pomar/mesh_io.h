@@ -51,8 +51,8 @@ using SizeCheck = std::function<void(uint64_t vertices, uint64_t faces)>;
 /// exactly equal positions are welded, vertices no face uses are kept. Vertex and face
 /// order of the file is kept. `*report` is reset first. Throws pomar::Error if
 /// the file is missing, unreadable, malformed, has a NaN/Inf coordinate or contains no
-/// triangles, and for files vcglib would misread (see codec/src/io/io_common.h), and when `size_check`
-/// throws.
+/// triangles, and for files vcglib would misread (see codec/src/io/io_common.h), and when
+/// `size_check` throws.
 Mesh load_mesh(const std::string &path, LoadReport *report = nullptr,
                const SizeCheck &size_check = {});
 

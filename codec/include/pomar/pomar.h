@@ -36,10 +36,52 @@ namespace pomar {
 const char *version();
 
 /// Every failure of the library is reported as a pomar::Error whose what() is one line
-/// naming the problem (and, for invalid meshes, where: counts and one example).
+/// naming the problem (and, for invalid meshes, where: counts and one example). kind()
+/// says what sort of failure it is, for callers that react differently (the tool's exit
+/// status, a plugin's message) without reading the text.
 class Error : public std::runtime_error {
 public:
-  using std::runtime_error::runtime_error;
+  enum class Kind {
+    Other,         ///< none of the below (errors thrown by callers with a message only)
+    InvalidMesh,   ///< an input mesh or mesh file that cannot be used: not manifold, NaN,
+                   ///< no triangles, indices out of range, a malformed PLY/OBJ/OFF/STL file
+    DamagedFile,   ///< a .pomar file that fails its checks or is not one at all
+    TruncatedFile, ///< a .pomar file that ends before the data asked for
+    Unsupported,   ///< a .pomar version (or feature) this library cannot read
+    Io,            ///< a file that cannot be opened, read, written or renamed
+    MemoryLimit,   ///< the work would need more memory than allowed (see pomar/limits.h)
+    Usage,         ///< a bad argument: a level or cluster that does not exist, a bad option
+    Internal,      ///< a broken invariant of the codec itself (a bug: please report it)
+  };
+  /// No location: block() is kNoBlock.
+  static constexpr int kNoBlock = -1;
+
+  explicit Error(const std::string &what) : std::runtime_error(what) {}
+  Error(Kind kind, const std::string &what) : std::runtime_error(what), kind_(kind) {}
+  Kind kind() const noexcept { return kind_; }
+
+  /// The file the message names, if any (mesh files; .pomar files read by path).
+  const std::string &path() const noexcept { return path_; }
+  Error &with_path(const std::string &path) {
+    path_ = path;
+    return *this;
+  }
+  /// DamagedFile / TruncatedFile: the level or cluster block the damage is in, which a
+  /// decode with skip_damaged can decode around (kNoBlock: elsewhere, or not known).
+  int level() const noexcept { return level_; }
+  int64_t cluster() const noexcept { return cluster_; }
+  Error &in_block(int level, int64_t cluster = kNoBlock) {
+    level_ = level;
+    cluster_ = cluster;
+    return *this;
+  }
+  bool in_block() const noexcept { return level_ != kNoBlock || cluster_ != kNoBlock; }
+
+private:
+  Kind kind_ = Kind::Other;
+  std::string path_;
+  int level_ = kNoBlock;
+  int64_t cluster_ = kNoBlock;
 };
 
 /// A triangle mesh as flat arrays: x,y,z per vertex and three vertex indices per
@@ -200,6 +242,10 @@ FileInfo inspect(const uint8_t *data, size_t size);
 Mesh decode(const uint8_t *data, size_t size, int level = -1, const Progress &progress = {},
             uint64_t memory_limit = 0);
 
+/// Throws pomar::Error (Kind::Usage) "level L does not exist: the file has levels 0..F"
+/// unless 0 <= level <= finest.
+void check_level_exists(int level, int finest);
+
 /// A block of a .pomar file that failed its checks (checksum, structure, or missing from a
 /// truncated file) and was skipped by a decode with `skip_damaged`.
 struct DamagedBlock {
@@ -209,6 +255,8 @@ struct DamagedBlock {
   /// fail their checksum (format version 3) though each passes its own 8-bit check, so the
   /// damaged one cannot be located and skipped; the mesh may be wrong in places.
   int level_kept = 0;
+  int level = -1;       ///< the global level it holds (1-based), -1 for a cluster block
+  int64_t cluster = -1; ///< the cluster whose block it is, -1 for a global level
 };
 
 struct DecodeOptions {

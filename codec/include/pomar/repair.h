@@ -82,4 +82,8 @@ struct RepairMap {
 /// changed).
 RepairReport make_manifold(Mesh &mesh, RepairMap *map = nullptr);
 
+/// True if make_manifold() would change `mesh` (run on a copy; false if it throws): when an
+/// encode fails, whether the repair is worth suggesting.
+bool repair_would_change(const Mesh &mesh);
+
 } // namespace pomar

@@ -22,18 +22,28 @@
 
 namespace pomar {
 
+/// Position of `v` in m.vert, or m.vert.size() if `v` does not point into m.vert (a face's
+/// vertex pointer -> vertex index).
+template <class MeshType>
+size_t vertex_position(const MeshType &m, const typename MeshType::VertexType *v) {
+  using VertexType = typename MeshType::VertexType;
+  const VertexType *first = m.vert.empty() ? nullptr : &m.vert[0];
+  const std::less<const VertexType *> less;
+  if (v == nullptr || first == nullptr || less(v, first) || !less(v, first + m.vert.size()))
+    return m.vert.size();
+  return static_cast<size_t>(v - first);
+}
+
 namespace vcg_detail {
 
 /// Position of `v` in m.vert, or throws if `v` does not point into m.vert.
 template <class MeshType>
 size_t vertex_index(const MeshType &m, const typename MeshType::VertexType *v, size_t face) {
-  using VertexType = typename MeshType::VertexType;
-  const VertexType *first = m.vert.empty() ? nullptr : &m.vert[0];
-  const std::less<const VertexType *> less;
-  if (v == nullptr || first == nullptr || less(v, first) || !less(v, first + m.vert.size()))
-    throw Error("vcg mesh: face " + std::to_string(face) +
-                " has a vertex pointer outside the vertex array");
-  return static_cast<size_t>(v - first);
+  const size_t i = vertex_position(m, v);
+  if (i == m.vert.size())
+    throw Error(Error::Kind::InvalidMesh, "vcg mesh: face " + std::to_string(face) +
+                                              " has a vertex pointer outside the vertex array");
+  return i;
 }
 
 } // namespace vcg_detail
@@ -58,13 +68,15 @@ Mesh from_vcg(const MeshType &m, size_t *unreferenced = nullptr, bool keep_unref
     if (face.IsD())
       continue;
     if (face.VN() != 3)
-      throw Error("vcg mesh: face " + std::to_string(f) + " has " + std::to_string(face.VN()) +
-                  " vertices, expected a triangle");
+      throw Error(Error::Kind::InvalidMesh, "vcg mesh: face " + std::to_string(f) + " has " +
+                                                std::to_string(face.VN()) +
+                                                " vertices, expected a triangle");
     for (int k = 0; k < 3; ++k) {
       const size_t v = vcg_detail::vertex_index(m, face.cV(k), f);
       if (m.vert[v].IsD())
-        throw Error("vcg mesh: face " + std::to_string(f) + " references deleted vertex " +
-                    std::to_string(v));
+        throw Error(Error::Kind::InvalidMesh, "vcg mesh: face " + std::to_string(f) +
+                                                  " references deleted vertex " +
+                                                  std::to_string(v));
       remap[v] = 0;
     }
     ++live_faces;
@@ -83,7 +95,7 @@ Mesh from_vcg(const MeshType &m, size_t *unreferenced = nullptr, bool keep_unref
         continue;
     }
     if (next == kUnused)
-      throw Error("vcg mesh: too many vertices for 32-bit indices");
+      throw Error(Error::Kind::InvalidMesh, "vcg mesh: too many vertices for 32-bit indices");
     remap[v] = next++;
     const auto &p = m.vert[v].cP();
     out.positions.push_back(static_cast<float>(p[0]));
@@ -122,15 +134,18 @@ template <class MeshType> void to_vcg(const Mesh &src, MeshType &m) {
   using ScalarType = typename MeshType::ScalarType;
 
   if (src.positions.size() % 3 != 0 || src.triangles.size() % 3 != 0)
-    throw Error("to_vcg: positions and triangles must hold a multiple of 3 values");
+    throw Error(Error::Kind::InvalidMesh,
+                "to_vcg: positions and triangles must hold a multiple of 3 values");
   const size_t nv = src.vertex_count(), nf = src.triangle_count();
   if (nv > size_t(INT_MAX) || nf > size_t(INT_MAX))
-    throw Error("to_vcg: mesh too large for vcglib (more than INT_MAX vertices or faces)");
+    throw Error(Error::Kind::InvalidMesh,
+                "to_vcg: mesh too large for vcglib (more than INT_MAX vertices or faces)");
   for (size_t i = 0; i < src.triangles.size(); ++i)
     if (src.triangles[i] >= nv)
-      throw Error("to_vcg: triangle " + std::to_string(i / 3) + " references vertex " +
-                  std::to_string(src.triangles[i]) + " but the mesh has " + std::to_string(nv) +
-                  " vertices");
+      throw Error(Error::Kind::InvalidMesh,
+                  "to_vcg: triangle " + std::to_string(i / 3) + " references vertex " +
+                      std::to_string(src.triangles[i]) + " but the mesh has " + std::to_string(nv) +
+                      " vertices");
 
   m.Clear();
   m.ClearAttributes();

@@ -54,7 +54,7 @@ std::vector<DamagedBlock> check_blocks(const uint8_t *data, size_t size) {
     try {
       check_level(data, layout, i);
     } catch (const Error &e) {
-      damaged.push_back({"level " + std::to_string(i + 1), e.what(), static_cast<int>(i)});
+      damaged.push_back(damaged_level(i + 1, e.what()));
     }
   }
   if (!h.clustered())
@@ -69,16 +69,16 @@ std::vector<DamagedBlock> check_blocks(const uint8_t *data, size_t size) {
     else if (!passes_block_check(data + index.offset[c], index.size[c], index.check[c]))
       problem = "checksum mismatch";
     if (problem)
-      damaged.push_back({"cluster " + std::to_string(c),
-                         std::string("damaged .pomar file: block of cluster ") + std::to_string(c) +
-                             ": " + problem,
-                         static_cast<int>(h.global_levels)});
+      damaged.push_back(damaged_cluster(c,
+                                        std::string("damaged .pomar file: block of cluster ") +
+                                            std::to_string(c) + ": " + problem,
+                                        static_cast<int>(h.global_levels)));
   }
   // Version 3: the cluster data as a whole (catches what the 8-bit checks let through).
   const uint64_t end = layout.clusters_offset + h.cluster_bytes;
   if (damaged.empty() && h.has_cluster_checksum && end <= size &&
       checksum(data + layout.clusters_offset, h.cluster_bytes) != h.cluster_checksum)
-    damaged.push_back({"cluster data", kUnlocatedDamage, -1});
+    damaged.push_back(unlocated_damage(kUnlocatedDamage));
   return damaged;
 }
 
@@ -104,9 +104,8 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
   require_known_sections(layout);
   const FileHeader &h = layout.header;
   const size_t levels = h.levels.size();
-  if (options.level < -1 || options.level > static_cast<int>(levels))
-    throw Error("level " + std::to_string(options.level) +
-                " does not exist: the file has levels 0.." + std::to_string(levels));
+  if (options.level != -1) // -1: full resolution
+    check_level_exists(options.level, static_cast<int>(levels));
   check_decode_memory(file_info(layout, size), options.level, options.memory_limit);
   const size_t target = options.level < 0 ? levels : static_cast<size_t>(options.level);
   const size_t global = h.clustered() ? h.global_levels : levels;

@@ -18,7 +18,7 @@ public:
   /// Streams and models of what is decoded next: global level `level` (cluster kNone) or
   /// cluster `cluster`'s data of level `level` (named in error messages).
   void set(Models *models, RangeDecoder *conn, RangeDecoder *geom, uint32_t level,
-           uint32_t cluster = 0xFFFFFFFFu) {
+           uint32_t cluster = kNone) {
     m_ = models;
     conn_ = conn;
     geom_ = geom;
@@ -56,16 +56,18 @@ public:
 
   [[noreturn]] void corrupt(const char *what) {
     std::string where = "level " + std::to_string(level_);
-    if (cluster_ != 0xFFFFFFFFu)
+    if (cluster_ != kNone)
       where = "cluster " + std::to_string(cluster_) + " " + where;
-    throw Error("damaged .pomar file: " + where + ": " + what);
+    throw Error(Error::Kind::DamagedFile, "damaged .pomar file: " + where + ": " + what)
+        .in_block(cluster_ == kNone ? int(level_) : Error::kNoBlock,
+                  cluster_ == kNone ? Error::kNoBlock : int64_t(cluster_));
   }
 
 private:
   Models *m_ = nullptr;
   RangeDecoder *conn_ = nullptr, *geom_ = nullptr;
   int64_t top_;
-  uint32_t level_ = 0, cluster_ = 0xFFFFFFFFu;
+  uint32_t level_ = 0, cluster_ = kNone;
 };
 
 } // namespace pomar

@@ -4,16 +4,16 @@
 
 #include <string>
 
+#include "decode/damage.h"
 #include "decode/decoder_codec.h"
+#include "geometry/quantize.h"
 #include "refine/level_step.h"
 
 namespace pomar {
 
 Mesh to_mesh(const LevelMesh &lm, const Quantizer &grid) {
   Mesh out;
-  out.positions.resize(lm.q.size());
-  for (size_t i = 0; i < lm.q.size(); ++i)
-    out.positions[i] = grid.dequantize(static_cast<int>(i % 3), static_cast<uint32_t>(lm.q[i]));
+  out.positions = dequantize(grid, lm.q);
   out.triangles = lm.ct.V;
   return out;
 }
@@ -27,7 +27,8 @@ LevelMesh base_level_mesh(const uint8_t *data, const FileLayout &layout) {
   try {
     build_corner_table(base.triangles.data(), h.base_faces, h.base_vertices, lm.ct);
   } catch (const Error &e) {
-    throw Error(std::string("damaged .pomar file: invalid base mesh: ") + e.what());
+    throw Error(Error::Kind::DamagedFile,
+                std::string("damaged .pomar file: invalid base mesh: ") + e.what());
   }
   lm.init_lineage();
   return lm;
@@ -60,7 +61,7 @@ size_t decode_global_levels(const uint8_t *data, const FileLayout &layout, size_
       if (!damaged)
         throw;
       // The step checks before it applies: the mesh is still level i.
-      damaged->push_back({"level " + std::to_string(i + 1), err.what(), static_cast<int>(i)});
+      damaged->push_back(damaged_level(i + 1, err.what()));
       return i;
     }
     if (progress)

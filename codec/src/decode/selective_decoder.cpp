@@ -1,13 +1,17 @@
-// Random access (paper section 6): the level map and selective, incremental decoding.
+// Random access (paper section 6), the orchestration: requests -> the level map completed
+// and limited around damage (decode/level_map.cpp) -> the missing cluster levels, level by
+// level, each through the per-level step (refine/level_step.h) on the cluster's stream
+// (decode/cluster_stream.cpp); coarsening re-decodes from the base clustered mesh.
 #include <algorithm>
 
+#include "decode/cluster_stream.h"
 #include "decode/damage.h"
 #include "decode/decoder_codec.h"
 #include "decode/global_levels.h"
-#include "decode/cluster_stream.h"
 #include "decode/level_map.h"
 #include "entropy/static_tables.h"
 #include "format/file_format.h"
+#include "geometry/quantize.h"
 #include "lossless/lossless_stage.h"
 #include "pomar/limits.h"
 #include "pomar/random_access.h"
@@ -95,7 +99,7 @@ bool SelectiveDecoder::State::skip_cluster(uint32_t c, const Error &e) {
   // (The failed step applied nothing and released its face claims.)
   if (c == kNone || !skip_damaged)
     return false;
-  damaged.push_back({"cluster " + std::to_string(c), e.what(), global_levels});
+  damaged.push_back(damaged_cluster(c, e.what(), global_levels));
   // Levels of this cluster decoded earlier from the same block cannot be trusted either:
   // the cap coarsens it (decode_target re-decodes from the base clustered mesh then).
   cap[c] = global_levels;
@@ -107,16 +111,17 @@ bool SelectiveDecoder::State::skip_cluster(uint32_t c, const Error &e) {
     // say so once (nothing can locate it).
     if (std::none_of(damaged.begin(), damaged.end(),
                      [](const DamagedBlock &b) { return b.level_kept < 0; }))
-      damaged.push_back({"cluster data", kUnplacedDamage, -1});
+      damaged.push_back(unlocated_damage(kUnplacedDamage));
     for (uint32_t k = graph.start[c]; k < graph.start[c + 1]; ++k) {
       const uint32_t nb = graph.adj[k];
       if (cap[nb] == global_levels)
         continue;
       cap[nb] = global_levels;
-      damaged.push_back({"cluster " + std::to_string(nb),
-                         "suspect: its block passes its 8-bit check, but cluster " +
-                             std::to_string(c) + " next to it failed to decode",
-                         global_levels});
+      damaged.push_back(damaged_cluster(nb,
+                                        "suspect: its block passes its 8-bit check, but "
+                                        "cluster " +
+                                            std::to_string(c) + " next to it failed to decode",
+                                        global_levels));
     }
   }
   return true;
@@ -138,8 +143,8 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   size_t hsize = s.global.size();
   for (size_t want; (want = header_size(s.global.data(), hsize)) > hsize;) {
     if (want > file_size)
-      throw Error("truncated .pomar file: the header alone needs " + std::to_string(want) +
-                  " bytes");
+      throw Error(Error::Kind::TruncatedFile, "truncated .pomar file: the header alone needs " +
+                                                  std::to_string(want) + " bytes");
     s.global.resize(want);
     s.source->read(hsize, want - hsize, s.global.data() + hsize);
     hsize = want;
@@ -211,25 +216,24 @@ uint32_t SelectiveDecoder::clusters_decoded() const {
 
 // ---------------------------------------------------------------- requests
 
-namespace {
-int check_level(int level, int finest) {
+void check_level_exists(int level, int finest) {
   if (level < 0 || level > finest)
-    throw Error("level " + std::to_string(level) + " does not exist: the file has levels 0.." +
-                std::to_string(finest));
-  return level;
+    throw Error(Error::Kind::Usage, "level " + std::to_string(level) +
+                                        " does not exist: the file has levels 0.." +
+                                        std::to_string(finest));
 }
-} // namespace
 
 void SelectiveDecoder::want_cluster(uint32_t cluster, int level) {
-  check_level(level, s_->finest);
+  check_level_exists(level, s_->finest);
   if (cluster >= s_->clusters.size())
-    throw Error("cluster " + std::to_string(cluster) + " does not exist: the file has " +
-                std::to_string(s_->clusters.size()) + " clusters");
+    throw Error(Error::Kind::Usage, "cluster " + std::to_string(cluster) +
+                                        " does not exist: the file has " +
+                                        std::to_string(s_->clusters.size()) + " clusters");
   s_->wanted[cluster] = std::max(s_->wanted[cluster], level);
 }
 
 void SelectiveDecoder::want_all(int level) {
-  check_level(level, s_->finest);
+  check_level_exists(level, s_->finest);
   if (!s_->clustered()) {
     s_->uniform_level = std::max(s_->uniform_level, level);
     return;
@@ -239,12 +243,13 @@ void SelectiveDecoder::want_all(int level) {
 }
 
 void SelectiveDecoder::want_vertices(const std::vector<uint32_t> &vertices, int level) {
-  check_level(level, s_->finest);
+  check_level_exists(level, s_->finest);
   if (!s_->clustered())
     return;
   for (uint32_t v : vertices) {
     if (v >= s_->mesh.vertex_count())
-      throw Error("vertex " + std::to_string(v) + " is not in the decoded mesh");
+      throw Error(Error::Kind::Usage,
+                  "vertex " + std::to_string(v) + " is not in the decoded mesh");
     int &w = s_->wanted[s_->mesh.cluster_of(v)];
     w = std::max(w, level);
   }
@@ -254,7 +259,7 @@ void SelectiveDecoder::want_faces(const std::vector<uint32_t> &faces, int level)
   std::vector<uint32_t> vertices;
   for (uint32_t f : faces) {
     if (f >= s_->mesh.ct.face_count())
-      throw Error("face " + std::to_string(f) + " is not in the decoded mesh");
+      throw Error(Error::Kind::Usage, "face " + std::to_string(f) + " is not in the decoded mesh");
     vertices.insert(vertices.end(), &s_->mesh.ct.V[3 * f], &s_->mesh.ct.V[3 * f] + 3);
   }
   want_vertices(vertices, level);
@@ -264,13 +269,10 @@ namespace {
 template <class Inside>
 std::vector<uint32_t> vertices_where(const LevelMesh &m, const Quantizer &g, Inside inside) {
   std::vector<uint32_t> out;
-  for (uint32_t v = 0; v < m.vertex_count(); ++v) {
-    const float p[3] = {g.dequantize(0, uint32_t(m.q[3 * v])),
-                        g.dequantize(1, uint32_t(m.q[3 * v + 1])),
-                        g.dequantize(2, uint32_t(m.q[3 * v + 2]))};
-    if (inside(p))
+  const std::vector<float> p = dequantize(g, m.q);
+  for (uint32_t v = 0; v < m.vertex_count(); ++v)
+    if (inside(&p[3 * v]))
       out.push_back(v);
-  }
   return out;
 }
 } // namespace
@@ -308,10 +310,11 @@ void SelectiveDecoder::clear_wanted() {
 
 void SelectiveDecoder::set_wanted(const std::vector<int> &levels) {
   if (levels.size() != s_->clusters.size())
-    throw Error("set_wanted: " + std::to_string(levels.size()) + " levels for " +
-                std::to_string(s_->clusters.size()) + " clusters");
+    throw Error(Error::Kind::Usage, "set_wanted: " + std::to_string(levels.size()) +
+                                        " levels for " + std::to_string(s_->clusters.size()) +
+                                        " clusters");
   for (int l : levels)
-    check_level(l, s_->finest);
+    check_level_exists(l, s_->finest);
   s_->wanted = levels;
 }
 
@@ -408,8 +411,8 @@ void SelectiveDecoder::State::check_cluster_data() {
   if (checksum(blocks) == h.cluster_checksum)
     return;
   if (!skip_damaged)
-    throw Error(kUnlocatedDamage);
-  damaged.push_back({"cluster data", kUnlocatedDamage, -1});
+    throw Error(Error::Kind::DamagedFile, kUnlocatedDamage);
+  damaged.push_back(unlocated_damage(kUnlocatedDamage));
 }
 
 Mesh SelectiveDecoder::mesh() const { return to_mesh(s_->mesh, s_->layout.header.grid); }

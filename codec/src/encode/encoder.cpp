@@ -31,8 +31,9 @@ std::vector<float> compact_vertices(const Mesh &mesh, std::vector<uint32_t> &tri
   triangles = mesh.triangles;
   for (uint32_t &i : triangles) {
     if (i >= nv)
-      throw Error("a triangle refers to vertex " + std::to_string(i) + " but the mesh has only " +
-                  std::to_string(nv) + " vertices");
+      throw Error(Error::Kind::InvalidMesh, "a triangle refers to vertex " + std::to_string(i) +
+                                                " but the mesh has only " + std::to_string(nv) +
+                                                " vertices");
     if (remap[i] == kNone) {
       remap[i] = 0; // mark used; numbered below in input order
     }
@@ -52,24 +53,26 @@ std::vector<float> compact_vertices(const Mesh &mesh, std::vector<uint32_t> &tri
 
 void check_input(const Mesh &mesh, const EncodeOptions &options) {
   if (options.bits < 4 || options.bits > 24)
-    throw Error("quantization bits must be between 4 and 24 (got " + std::to_string(options.bits) +
-                ")");
+    throw Error(Error::Kind::Usage, "quantization bits must be between 4 and 24 (got " +
+                                        std::to_string(options.bits) + ")");
   if (mesh.positions.size() % 3 || mesh.triangles.size() % 3)
-    throw Error("position and triangle arrays must hold multiples of 3 values");
+    throw Error(Error::Kind::InvalidMesh,
+                "position and triangle arrays must hold multiples of 3 values");
   if (mesh.triangle_count() == 0)
-    throw Error("the mesh contains no triangles");
+    throw Error(Error::Kind::InvalidMesh, "the mesh contains no triangles");
   for (size_t i = 0; i < mesh.positions.size(); ++i)
     if (!std::isfinite(mesh.positions[i]))
-      throw Error("vertex " + std::to_string(i / 3) + " has a non-finite coordinate");
+      throw Error(Error::Kind::InvalidMesh,
+                  "vertex " + std::to_string(i / 3) + " has a non-finite coordinate");
 }
 
 /// The input ready for decimation: referenced vertices only, quantized, renumbered for
 /// memory locality, connectivity built and validated.
 struct PreparedInput {
   Quantizer grid;
-  std::vector<int32_t> q;             // quantized xyz, prepared numbering
+  std::vector<int32_t> q; // quantized xyz, prepared numbering
   CornerTable ct;
-  std::vector<uint32_t> to_input;     // prepared vertex -> the caller's vertex
+  std::vector<uint32_t> to_input; // prepared vertex -> the caller's vertex
   uint32_t vertices = 0, faces = 0;
 };
 
@@ -193,7 +196,8 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
   if (global < rb.levels())
     clustered = encode_clustered_levels(rb, global, header, options.progress);
   if (rb.mesh.vertex_count() != nv || rb.mesh.ct.face_count() != nf)
-    throw Error("internal encoder error: the refined mesh does not match the input");
+    throw Error(Error::Kind::Internal,
+                "internal encoder error: the refined mesh does not match the input");
 
   std::vector<Section> sections;
   if (hook) { // the lossless stage's record, in the decoder's numbering

@@ -101,7 +101,7 @@ public:
   SymbolBits bits; // ideal code lengths per symbol kind
 
   [[noreturn]] void corrupt(const char *what) {
-    throw Error(std::string("internal encoder error: ") + what);
+    throw Error(Error::Kind::Internal, std::string("internal encoder error: ") + what);
   }
 
 private:

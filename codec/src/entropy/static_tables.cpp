@@ -273,7 +273,9 @@ std::vector<Models> read_tables(const uint8_t *data, size_t size, size_t levels)
   RangeDecoder rc(data, size);
   TableModels t;
   History history;
-  auto bad = [] { throw Error("damaged .pomar file: invalid static model tables"); };
+  auto bad = [] {
+    throw Error(Error::Kind::DamagedFile, "damaged .pomar file: invalid static model tables");
+  };
   for (Models &m : models) {
     size_t slot = 0;
     for_each_model(

@@ -47,4 +47,11 @@ std::vector<int32_t> quantize(const Quantizer &g, const float *p, size_t n) {
   return q;
 }
 
+std::vector<float> dequantize(const Quantizer &g, const std::vector<int32_t> &q) {
+  std::vector<float> p(q.size());
+  for (size_t i = 0; i < q.size(); ++i)
+    p[i] = g.dequantize(static_cast<int>(i % 3), static_cast<uint32_t>(q[i]));
+  return p;
+}
+
 } // namespace pomar

@@ -10,8 +10,16 @@
 
 namespace pomar::io {
 
+[[noreturn]] void fail(Error::Kind kind, const std::string &path, const std::string &what) {
+  throw Error(kind, path + ": " + what).with_path(path);
+}
+
 [[noreturn]] void fail(const std::string &path, const std::string &what) {
-  throw Error(path + ": " + what);
+  fail(Error::Kind::InvalidMesh, path, what);
+}
+
+[[noreturn]] void fail_io(const std::string &path, const std::string &what) {
+  fail(Error::Kind::Io, path, what);
 }
 
 void run_size_check(const SizeCheck &check, const std::string &path, uint64_t vertices,
@@ -21,7 +29,7 @@ void run_size_check(const SizeCheck &check, const std::string &path, uint64_t ve
   try {
     check(vertices, faces);
   } catch (const Error &e) {
-    fail(path, e.what());
+    fail(e.kind(), path, e.what());
   }
 }
 
@@ -128,15 +136,15 @@ void add_ignored_from_mask(int mask, std::vector<std::string> &out) {
 uint64_t check_regular_file(const std::string &path) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0)
-    fail(path, "cannot open: " + errno_text(errno));
+    fail_io(path, "cannot open: " + errno_text(errno));
   FdGuard guard(fd);
   struct stat st;
   if (::fstat(fd, &st) != 0)
-    fail(path, "cannot stat: " + errno_text(errno));
+    fail_io(path, "cannot stat: " + errno_text(errno));
   if (S_ISDIR(st.st_mode))
-    fail(path, "is a directory");
+    fail_io(path, "is a directory");
   if (!S_ISREG(st.st_mode))
-    fail(path, "not a regular file");
+    fail_io(path, "not a regular file");
   return static_cast<uint64_t>(st.st_size);
 }
 
@@ -211,9 +219,9 @@ void append_vertices(std::string &out, const Mesh &mesh, const char *prefix) {
 void check_written_size(const std::string &file, uint64_t expected, const std::string &target) {
   struct stat st;
   if (::stat(file.c_str(), &st) != 0)
-    fail(target, "cannot stat temporary file: " + errno_text(errno));
+    fail_io(target, "cannot stat temporary file: " + errno_text(errno));
   if (static_cast<uint64_t>(st.st_size) != expected)
-    fail(target, "short write (" + num(uint64_t(st.st_size)) + " of " + num(expected) +
+    fail_io(target, "short write (" + num(uint64_t(st.st_size)) + " of " + num(expected) +
                      " bytes; disk full?)");
 }
 

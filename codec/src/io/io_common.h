@@ -38,9 +38,13 @@ namespace pomar::io {
 
 // ---- Errors, names, numbers (io_common.cpp) ----
 
-/// Throws pomar::Error("<path>: <what>"): every error message starts with the path of the
-/// file concerned.
+/// Throws pomar::Error("<path>: <what>") of `kind` naming `path`: every error message
+/// starts with the path of the file concerned.
+[[noreturn]] void fail(Error::Kind kind, const std::string &path, const std::string &what);
+/// fail() for a file whose content cannot be used (Error::Kind::InvalidMesh).
 [[noreturn]] void fail(const std::string &path, const std::string &what);
+/// fail() for a file that cannot be opened, read or written (Error::Kind::Io).
+[[noreturn]] void fail_io(const std::string &path, const std::string &what);
 /// Runs the caller's size check (if any), prefixing its error with the path.
 void run_size_check(const SizeCheck &check, const std::string &path, uint64_t vertices,
                     uint64_t faces);
@@ -93,7 +97,7 @@ public:
     size_ = check_regular_file(path);
     fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
     if (fd_ < 0)
-      fail(path, "cannot open: " + errno_text(errno));
+      fail_io(path, "cannot open: " + errno_text(errno));
     buf_.resize(1 << 16);
   }
   ~FileReader() { ::close(fd_); }
@@ -133,7 +137,7 @@ public:
       begin_ += static_cast<size_t>(n);
     } else {
       if (::lseek(fd_, static_cast<off_t>(pos_ + n), SEEK_SET) < 0)
-        fail(path_, "cannot seek: " + errno_text(errno));
+        fail_io(path_, "cannot seek: " + errno_text(errno));
       begin_ = end_ = 0;
     }
     pos_ += n;
@@ -171,7 +175,7 @@ private:
       if (r < 0 && errno == EINTR)
         continue;
       if (r < 0)
-        fail(path_, "cannot read: " + errno_text(errno));
+        fail_io(path_, "cannot read: " + errno_text(errno));
       begin_ = 0, end_ = static_cast<size_t>(r);
       return r > 0;
     }
@@ -194,7 +198,7 @@ public:
     dir_ = slash == std::string::npos ? "." : target.substr(0, slash + 1);
     const std::string base = slash == std::string::npos ? target : target.substr(slash + 1);
     if (base.empty())
-      fail(target, "not a file name");
+      fail_io(target, "not a file name");
     const std::string prefix = slash == std::string::npos ? "" : dir_;
     path_ = prefix + "." + base + ".tmp." + num(static_cast<uint64_t>(::getpid())) + "." +
             num(counter++);
@@ -216,7 +220,7 @@ public:
     if (sync)
       sync_file();
     if (::rename(path_.c_str(), target_.c_str()) != 0)
-      fail(target_, "cannot rename temporary file into place: " + errno_text(errno));
+      fail_io(target_, "cannot rename temporary file into place: " + errno_text(errno));
     committed_ = true;
     unregister_temporary(slot_);
     slot_ = -1;
@@ -231,10 +235,10 @@ private:
   void sync_file() {
     const int fd = ::open(path_.c_str(), O_RDONLY | O_CLOEXEC);
     if (fd < 0)
-      fail(target_, "cannot reopen temporary file: " + errno_text(errno));
+      fail_io(target_, "cannot reopen temporary file: " + errno_text(errno));
     FdGuard guard(fd);
     if (::fsync(fd) != 0)
-      fail(target_, "fsync failed: " + errno_text(errno));
+      fail_io(target_, "fsync failed: " + errno_text(errno));
   }
 
   std::string target_, dir_, path_;
@@ -294,7 +298,7 @@ auto guarded(const std::string &path, F &&call) -> decltype(call()) {
   } catch (const Error &) {
     throw;
   } catch (const std::bad_alloc &) {
-    fail(path, "out of memory while reading");
+    fail(Error::Kind::MemoryLimit, path, "out of memory while reading");
   } catch (const std::exception &e) {
     fail(path, std::string("read failed: ") + e.what());
   }

@@ -18,7 +18,7 @@ class OffLines {
 public:
   explicit OffLines(const std::string &path) : in_(path) {
     if (!in_)
-      fail(path, "cannot open: " + errno_text(errno));
+      fail_io(path, "cannot open: " + errno_text(errno));
   }
   bool failed() const { return in_.fail(); }
 

@@ -547,8 +547,9 @@ void save_ply_binary(const std::string &path, const Mesh &mesh) {
   errno = 0;
   const int err = Exporter::Save(m, tmp.path().c_str(), true);
   if (err != 0)
-    fail(path, "cannot write: " + vcg_message<Exporter>(err, vcg::tri::io::PlyInfo::E_MAXPLYINFOERRORS) +
-                   errno_suffix());
+    fail_io(path, "cannot write: " +
+                      vcg_message<Exporter>(err, vcg::tri::io::PlyInfo::E_MAXPLYINFOERRORS) +
+                      errno_suffix());
   check_written_size(tmp.path(), ply_header_size(tmp.path(), path) + 12 * nv + 13 * nf, path);
   tmp.commit(true);
 }

@@ -60,7 +60,6 @@ uint64_t get_u(RangeDecoder &rc, UintModel &m) {
   return v;
 }
 
-
 /// Position groups: group[v] numbers the distinct positions of `mesh` (exact float bits).
 std::vector<uint32_t> position_groups(const Mesh &mesh) {
   const uint32_t n = static_cast<uint32_t>(mesh.vertex_count());
@@ -130,7 +129,7 @@ struct RecordModels {
 };
 
 [[noreturn]] void damaged(const std::string &what) {
-  throw Error("damaged .pomar file: lossless record: " + what);
+  throw Error(Error::Kind::DamagedFile, "damaged .pomar file: lossless record: " + what);
 }
 
 /// Upper bound for a count read from a body of `size` bytes (an adaptive model can make a
@@ -171,7 +170,6 @@ LosslessCounts read_counts(const uint8_t *data, size_t size, RangeDecoder &rc, R
     damaged("counts are larger than the record can hold");
   return n;
 }
-
 
 /// A value in [0, total) as equally likely: up to 2^16 values in one step, else the high
 /// part (up to 2^16 values) then the low bits raw.
@@ -265,8 +263,7 @@ struct Neighbours {
 /// unused output vertex after prev (symbol 1), then prev's unused neighbours (2, 3, ...);
 /// symbol 0 is "none of them" (then the rank among all unused vertices follows).
 template <class Visit>
-void order_candidates(const Neighbours &nb, const UnusedSet &unused, uint32_t prev,
-                      Visit visit) {
+void order_candidates(const Neighbours &nb, const UnusedSet &unused, uint32_t prev, Visit visit) {
   uint32_t symbol = 1;
   const uint32_t r = unused.rank(prev + 1);
   uint32_t following = r < unused.left() ? unused.nth(r) : kNone;
@@ -300,9 +297,8 @@ std::vector<uint32_t> canonical_face_order(const std::vector<uint32_t> &t) {
   std::vector<uint32_t> order(nf);
   for (uint32_t f = 0; f < nf; ++f)
     order[f] = f;
-  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
-    return key[a] != key[b] ? key[a] < key[b] : a < b;
-  });
+  std::sort(order.begin(), order.end(),
+            [&](uint32_t a, uint32_t b) { return key[a] != key[b] ? key[a] < key[b] : a < b; });
   return order;
 }
 
@@ -333,7 +329,8 @@ std::vector<uint8_t> write_lossless_record(const LosslessRecord &r, const Mesh &
       if (next < r.copies.size() && r.copies[next].first == v) {
         const uint32_t i = cand.index_of(v, r.copies[next].second);
         if (i == Candidates::kNoVertex)
-          throw Error("internal lossless error: a vertex copy is not at its original's position");
+          throw Error(Error::Kind::Internal,
+                      "internal lossless error: a vertex copy is not at its original's position");
         put_u(rc, m.copy_gap, position - last);
         if (k > 1)
           put_u(rc, m.copy_index, i);
@@ -345,7 +342,7 @@ std::vector<uint8_t> write_lossless_record(const LosslessRecord &r, const Mesh &
       ++position;
     }
     if (next != r.copies.size())
-      throw Error("internal lossless error: vertex copies out of order");
+      throw Error(Error::Kind::Internal, "internal lossless error: vertex copies out of order");
   }
   uint64_t last = 0;
   for (uint32_t f : r.flipped) {
@@ -381,7 +378,8 @@ std::vector<uint8_t> write_lossless_record(const LosslessRecord &r, const Mesh &
     const Mesh mesh = apply_lossless_record(decoded, without, Quantizer());
     const uint32_t n = static_cast<uint32_t>(mesh.vertex_count());
     if (r.order.size() != n)
-      throw Error("internal lossless error: the vertex order does not fit the mesh");
+      throw Error(Error::Kind::Internal,
+                  "internal lossless error: the vertex order does not fit the mesh");
     std::vector<uint32_t> output_of(n);
     for (uint32_t o = 0; o < n; ++o)
       output_of[r.order[o]] = o;

@@ -75,7 +75,7 @@ LosslessRecord read_lossless_record(const uint8_t *data, size_t size, const Mesh
 /// D with the record undone: the input mesh (positions on the grid). `source` (optional)
 /// receives for each vertex of the result the vertex of D it comes from (kNone: a vertex no
 /// face of D uses).
-Mesh apply_lossless_record(const Mesh &decoded, const LosslessRecord &record,
-                           const Quantizer &grid, std::vector<uint32_t> *source = nullptr);
+Mesh apply_lossless_record(const Mesh &decoded, const LosslessRecord &record, const Quantizer &grid,
+                           std::vector<uint32_t> *source = nullptr);
 
 } // namespace pomar

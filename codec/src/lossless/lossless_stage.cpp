@@ -176,7 +176,8 @@ LosslessRecord build_lossless_record(const Mesh &input, const Mesh &cut, const R
     const Key key = rotated(t);
     auto it = std::lower_bound(kept_keys.begin(), kept_keys.end(), std::make_pair(key, 0u));
     if (it == kept_keys.end() || it->first != key)
-      throw Error("internal lossless error: a removed face is neither degenerate nor a duplicate");
+      throw Error(Error::Kind::Internal,
+                  "internal lossless error: a removed face is neither degenerate nor a duplicate");
     ++extra_copies[rank[it->second]];
   }
   for (uint32_t i = 0; i < nf; ++i)
@@ -209,8 +210,9 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
   RepairMap map;
   const RepairReport repair = make_manifold(cut, &map); // checks the indices
   if (cut.triangle_count() == 0)
-    throw Error("the mesh has no valid triangle: all " + std::to_string(mesh.triangle_count()) +
-                " faces repeat a vertex");
+    throw Error(Error::Kind::InvalidMesh, "the mesh has no valid triangle: all " +
+                                              std::to_string(mesh.triangle_count()) +
+                                              " faces repeat a vertex");
 
   LosslessHook hook;
   hook.grid = make_quantizer(mesh.positions.data(), nv, options.bits);

@@ -55,8 +55,8 @@ public:
   /// Refine one cluster by one clustered level; `next_local` is the cluster's counter of
   /// created vertices (LevelMesh::local), advanced by the splits.
   template <class Codec, class Check = NoCheck>
-  void cluster_level(LevelMesh &mesh, Codec &codec, const ClusterLevel &where,
-                     uint32_t &next_local, const Check &check = {}) {
+  void cluster_level(LevelMesh &mesh, Codec &codec, const ClusterLevel &where, uint32_t &next_local,
+                     const Check &check = {}) {
     const LevelView view{where.level, where.older_than};
     traverse_and_check(mesh, where.level, check, [&] {
       traverse_cluster(mesh, codec, scratch_, where.cluster, view, splits_);
