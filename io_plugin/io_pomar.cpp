@@ -261,9 +261,15 @@ bool PomarIOPlugin::open(const QString &format, const QString &fileName, MeshMod
     } else {
       decoder.want_all(level);
       decoder.update(progress.function());
-      mesh = decoder.mesh();
-      cluster = decoder.vertex_cluster();
-      vertexLevel = decoder.vertex_level();
+      // At the finest level, intact: exactly what was saved (a lossless record undone);
+      // coarser levels show the coded, cut mesh.
+      std::vector<uint32_t> source;
+      mesh = decoder.exact_mesh(&source);
+      const std::vector<uint32_t> clusters = decoder.vertex_cluster(), levels = decoder.vertex_level();
+      for (uint32_t s : source) {
+        cluster.push_back(s < clusters.size() ? clusters[s] : UINT32_MAX);
+        vertexLevel.push_back(s < levels.size() ? levels[s] : UINT32_MAX);
+      }
       damaged = decoder.damaged();
     }
     if (!damaged.empty()) {
@@ -317,10 +323,12 @@ void PomarIOPlugin::initSaveParameter(const QString &format, MeshModel & /*m*/,
                         "is always exact). Off: quality and custom floats on 16 bits over their "
                         "range, texture coordinates on 12 bits."));
   par.addParam(RichBool("Repair", false, "Repair (cut into a manifold mesh)",
-                        "Opt-in: save a non-manifold or inconsistently oriented mesh by cutting it "
-                        "(faces repeating a vertex and exact duplicates removed, faces flipped, "
-                        "non-manifold vertices split into copies at the same position). Every "
-                        "change is reported as a warning; the layer itself is not modified."));
+                        "Opt-in: save the mesh cut into a manifold one instead of the mesh as it "
+                        "is (faces repeating a vertex and exact duplicates removed, faces "
+                        "flipped, non-manifold vertices split into copies at the same position). "
+                        "Without it any mesh is saved exactly: the cut is stored in the file and "
+                        "undone on open. Every change is reported as a warning; the layer itself "
+                        "is not modified."));
 }
 
 bool PomarIOPlugin::save(const QString &format, const QString &fileName, MeshModel &m,
@@ -349,35 +357,32 @@ bool PomarIOPlugin::save(const QString &format, const QString &fileName, MeshMod
   QStringList dropped = notKept(m, attributes);
   std::vector<uint8_t> bytes;
   QString repaired; // what the Repair option changed, "" if off or nothing
+  QString stored;   // what the file keeps beyond the coded mesh (any mesh saves exactly)
   try {
     progress.report(0);
-    size_t unreferenced = 0;
-    // Skips deleted elements; takes the attributes the save mask asks for; the layer's own
-    // colours when Show Clusters / Show Levels painted it.
+    // Skips deleted elements, keeps unreferenced vertices (the file stores them), takes the
+    // attributes the save mask asks for; the layer's own colours when Show Clusters / Show
+    // Levels painted it.
     pomar::meshlab::swapSavedColours(m.cm);
     pomar::Mesh mesh;
     try {
-      mesh = pomar::from_vcg(m.cm, &unreferenced, attributes);
+      mesh = pomar::from_vcg(m.cm, nullptr, attributes, true);
     } catch (...) {
       pomar::meshlab::swapSavedColours(m.cm);
       throw;
     }
     pomar::meshlab::swapSavedColours(m.cm);
-    if (unreferenced > 0)
-      dropped << QString("%1 unreferenced vertices").arg(unreferenced);
     if (repair) {
       const pomar::RepairReport report = pomar::make_manifold(mesh);
       if (report.changed())
         repaired = QString::fromStdString(report.summary()).replace('\n', "; ");
     }
-    try {
-      bytes = pomar::encode(mesh, options);
-    } catch (const pomar::Error &e) {
-      if (repair || !pomar::repair_would_change(mesh))
-        throw;
-      throw pomar::Error(e.kind(), std::string(e.what()) +
-                                       " (the Repair save option cuts it into a manifold mesh)");
-    }
+    pomar::EncodeReport report;
+    bytes = pomar::encode(mesh, options, &report);
+    stored = QString::fromStdString(report.lossless.summary());
+    if (report.unreferenced_vertices > 0 && !report.lossless.unreferenced_vertices)
+      dropped << QString("%1 vertices no face uses (their attributes cannot be stored yet)")
+                     .arg(report.unreferenced_vertices);
   } catch (const std::exception &e) { // pomar::Error (invalid mesh or options), std::bad_alloc
     return fail(pomar::meshlab::errorText(e, "cannot save " + path));
   }
@@ -399,6 +404,9 @@ bool PomarIOPlugin::save(const QString &format, const QString &fileName, MeshMod
     pomar::meshlab::warn(
         *this, "",
         QString("%1: repaired before saving: %2").arg(QFileInfo(path).fileName(), repaired));
+  if (!stored.isEmpty())
+    Log("pomar: %s: stored for an exact decode: %s", qUtf8Printable(QFileInfo(path).fileName()),
+        qUtf8Printable(stored));
   if (!dropped.isEmpty())
     pomar::meshlab::warn(
         *this, "",

@@ -54,9 +54,9 @@ void setLayerAttributes(MeshType &m, const std::vector<uint32_t> &cluster,
   auto levelOf = Alloc::template GetPerVertexAttribute<float>(m, kLevelAttribute);
   const bool haveClusters = cluster.size() == m.vert.size();
   const bool haveLevels = level.size() == m.vert.size();
-  for (size_t v = 0; v < m.vert.size(); ++v) {
-    clusterOf[v] = haveClusters ? float(cluster[v]) : -1.0f;
-    levelOf[v] = haveLevels ? float(level[v]) : -1.0f;
+  for (size_t v = 0; v < m.vert.size(); ++v) { // -1: none (UINT32_MAX: a vertex no face uses)
+    clusterOf[v] = haveClusters && cluster[v] != UINT32_MAX ? float(cluster[v]) : -1.0f;
+    levelOf[v] = haveLevels && level[v] != UINT32_MAX ? float(level[v]) : -1.0f;
   }
   Alloc::template GetPerMeshAttribute<std::string>(m, kSourceAttribute)() = source;
   Alloc::template GetPerMeshAttribute<int>(m, kSkipDamagedAttribute)() = skipDamaged ? 1 : 0;

@@ -122,6 +122,18 @@ bool skipsDamage(CMeshO &m) {
 /// The per-vertex cluster and level attributes of a layer as integers; false (with `why`)
 /// if they are missing or hold values that are not cluster ids / levels of this file.
 /// `clusters` = 0 for a pure progressive file (no cluster ids needed).
+/// used[v]: a live face uses vertex v.
+std::vector<char> usedVertices(const CMeshO &m) {
+  std::vector<char> used(m.vert.size(), 0);
+  const CVertexO *first = m.vert.empty() ? nullptr : &m.vert[0];
+  for (const CFaceO &f : m.face)
+    if (!f.IsD())
+      for (int k = 0; k < 3; ++k)
+        if (f.cV(k) >= first && f.cV(k) < first + m.vert.size())
+          used[size_t(f.cV(k) - first)] = 1;
+  return used;
+}
+
 bool layerClustersAndLevels(CMeshO &m, uint32_t clusters, int finest, std::vector<int> &cluster,
                             std::vector<int> &level, QString &why) {
   auto ch = vcg::tri::Allocator<CMeshO>::FindPerVertexAttribute<float>(m, kClusterAttr);
@@ -133,10 +145,15 @@ bool layerClustersAndLevels(CMeshO &m, uint32_t clusters, int finest, std::vecto
   }
   cluster.assign(m.vert.size(), -1);
   level.assign(m.vert.size(), -1);
+  // A vertex no face uses (kept by a lossless file, shown only at full resolution) has
+  // neither: it is left at -1 and ignored.
+  const std::vector<char> used = usedVertices(m);
   for (size_t v = 0; v < m.vert.size(); ++v) {
     if (m.vert[v].IsD())
       continue;
     const float c = ch[v], l = lh[v];
+    if (!used[v] && c == -1.0f && l == -1.0f)
+      continue;
     if (clusters > 0) {
       if (!(c >= 0 && c < float(clusters) && c == std::floor(c))) {
         why = QString("vertex %1 has no cluster (pomar_cluster = %2): the layer was opened below "
@@ -290,7 +307,7 @@ bool syncToLayer(PomarFilterPlugin::Session &s, CMeshO &m, ProgressRelay &progre
   if (s.clustered) {
     std::vector<int> wanted(s.clusters, s.base);
     for (size_t v = 0; v < m.vert.size(); ++v)
-      if (!m.vert[v].IsD())
+      if (!m.vert[v].IsD() && cluster[v] >= 0)
         wanted[size_t(cluster[v])] = std::max(wanted[size_t(cluster[v])], level[v]);
     s.decoder->set_wanted(wanted);
   } else {
@@ -304,7 +321,7 @@ bool syncToLayer(PomarFilterPlugin::Session &s, CMeshO &m, ProgressRelay &progre
   s.pristine = false;
   s.haveSignature = false;
   s.decoder->update(progress.range(0, 50));
-  s.signature = signatureOf(s.decoder->mesh());
+  s.signature = signatureOf(s.decoder->exact_mesh());
   s.haveSignature = true;
   how = QString("decoder state rebuilt from the layer's attributes in %1 ms")
             .arg(msSince(t0), 0, 'f', 1);
@@ -329,13 +346,22 @@ void keepOwnColours(CMeshO &m) {
     saved[v] = m.vert[v].C();
 }
 
-/// Replaces the layer's content by the decoder's current mesh, with the pomar attributes;
-/// selects the vertices of the clusters marked in `select` (if given) and the faces whose
-/// three vertices are selected.
+/// Replaces the layer's content by the decoder's current mesh (every cluster at the finest
+/// level: exactly what was saved, a lossless record undone; otherwise the coded, cut mesh),
+/// with the pomar attributes (-1 for a vertex no face uses); selects the vertices of the
+/// clusters marked in `select` (if given) and the faces whose three vertices are selected.
 void replaceMesh(PomarFilterPlugin::Session &s, MeshModel &mm, const std::vector<char> *select) {
-  const pomar::Mesh mesh = s.decoder->mesh();
+  std::vector<uint32_t> from; // vertex of the decoder's mesh() each vertex comes from
+  const pomar::Mesh mesh = s.decoder->exact_mesh(&from);
   const std::vector<uint32_t> cluster = s.decoder->vertex_cluster();
   const std::vector<uint32_t> level = s.decoder->vertex_level();
+  // The attributes of each vertex of `mesh` (UINT32_MAX: a vertex no face uses).
+  std::vector<uint32_t> clusterOf(mesh.vertex_count(), UINT32_MAX), levelOf = clusterOf;
+  for (size_t v = 0; v < mesh.vertex_count(); ++v)
+    if (from[v] < level.size()) {
+      clusterOf[v] = s.clustered ? cluster[from[v]] : UINT32_MAX;
+      levelOf[v] = level[from[v]];
+    }
   CMeshO &m = mm.cm;
   // The decoded attributes of these vertices go with them (colour, normals, quality,
   // texture coordinates, named floats); texture coordinates are optional in CMeshO.
@@ -349,14 +375,14 @@ void replaceMesh(PomarFilterPlugin::Session &s, MeshModel &mm, const std::vector
   const bool ownNormals = written & vcg::tri::io::Mask::IOM_VERTNORMAL;
   if (ownColour)
     mm.updateDataMask(MeshModel::MM_VERTCOLOR);
-  pomar::meshlab::setLayerAttributes(m, s.clustered ? cluster : std::vector<uint32_t>(), level,
+  pomar::meshlab::setLayerAttributes(m, s.clustered ? clusterOf : std::vector<uint32_t>(), levelOf,
                                      s.path, s.skipDamaged);
   for (size_t v = 0; v < mesh.vertex_count(); ++v) {
     if (!ownColour)
       m.vert[v].C() = vcg::Color4b(vcg::Color4b::White);
     if (!ownQuality)
       m.vert[v].Q() = 0;
-    if (select != nullptr && s.clustered && (*select)[cluster[v]])
+    if (select != nullptr && s.clustered && clusterOf[v] != UINT32_MAX && (*select)[clusterOf[v]])
       m.vert[v].SetS();
   }
   const bool faceColor = vcg::tri::HasPerFaceColor(m);
@@ -649,7 +675,7 @@ bool PomarFilterPlugin::refineOrCoarsen(bool refine, MeshModel &mm, Session &s, 
   size_t vertices = 0;
   if (faces == 0)
     for (size_t v = 0; v < m.vert.size(); ++v)
-      if (!m.vert[v].IsD() && m.vert[v].IsS()) {
+      if (!m.vert[v].IsD() && m.vert[v].IsS() && cluster[v] >= 0) {
         ++vertices;
         chosen[size_t(cluster[v])] = 1;
       }
@@ -749,8 +775,9 @@ bool PomarFilterPlugin::showClusters(MeshModel &mm) {
   if (!vcg::tri::Allocator<CMeshO>::IsValidHandle(m, ch))
     return fail("the layer has no per-vertex pomar_cluster attribute");
   std::set<int> seen;
+  const std::vector<char> used = usedVertices(m);
   for (size_t v = 0; v < m.vert.size(); ++v) {
-    if (m.vert[v].IsD())
+    if (m.vert[v].IsD() || (!used[v] && ch[v] == -1.0f)) // a vertex no face uses: no cluster
       continue;
     const float c = ch[v];
     if (!(c >= 0 && c == std::floor(c) && c < 16777216.0f))
@@ -761,11 +788,16 @@ bool PomarFilterPlugin::showClusters(MeshModel &mm) {
   }
   mm.updateDataMask(MeshModel::MM_VERTCOLOR);
   keepOwnColours(m);
-  for (size_t v = 0; v < m.vert.size(); ++v)
-    if (!m.vert[v].IsD()) {
-      m.vert[v].C() = clusterColor(uint32_t(ch[v]));
-      seen.insert(int(ch[v]));
+  for (size_t v = 0; v < m.vert.size(); ++v) {
+    if (m.vert[v].IsD())
+      continue;
+    if (ch[v] < 0) { // a vertex no face uses
+      m.vert[v].C() = vcg::Color4b(vcg::Color4b::Gray);
+      continue;
     }
+    m.vert[v].C() = clusterColor(uint32_t(ch[v]));
+    seen.insert(int(ch[v]));
+  }
   Log("POMAR: coloured %zu clusters", seen.size());
   return true;
 }
@@ -789,7 +821,7 @@ bool PomarFilterPlugin::showLevels(MeshModel &mm, Session *s) {
     for (int l : levels)
       ++histogram[size_t(l)];
     for (size_t v = 0; v < m.vert.size(); ++v)
-      if (!m.vert[v].IsD())
+      if (!m.vert[v].IsD() && cluster[v] >= 0) // (not a vertex no face uses)
         m.vert[v].C() = levelColor(double(levels[size_t(cluster[v])] - s->base) / span);
   } else {
     int uniform = 0;

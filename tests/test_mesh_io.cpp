@@ -276,15 +276,19 @@ TEST_F(MeshIoTest, ObjAttributesRoundTrip) {
   LoadReport r;
   const Mesh back = load_mesh(path("attr.obj"), &r);
   EXPECT_TRUE(r.ignored_attributes.empty());
-  EXPECT_EQ(r.unreferenced_vertices, 1u); // vertex 4 and its attributes are dropped
-  EXPECT_EQ(back.positions, std::vector<float>(m.positions.begin(), m.positions.end() - 3));
+  EXPECT_EQ(r.unreferenced_vertices, 1u); // vertex 4: kept (the codec stores such vertices)
+  EXPECT_EQ(back.positions, m.positions);
   for (const VertexAttribute &a : m.attributes) {
     const VertexAttribute *b = back.find(a.kind);
     ASSERT_NE(b, nullptr) << a.name;
-    EXPECT_EQ(b->colour, std::vector<uint8_t>(a.colour.begin(),
-                                              a.colour.end() - (a.colour.empty() ? 0 : 3)));
-    EXPECT_EQ(b->values, std::vector<float>(a.values.begin(),
-                                            a.values.end() - (a.values.empty() ? 0 : a.components)));
+    ASSERT_EQ(b->vertex_count(), 5u) << a.name;
+    // Colours are per vertex in OBJ ("v x y z r g b"): all come back. Normals and texture
+    // coordinates are per corner: vertex 4, which no face uses, has none (zeros).
+    EXPECT_EQ(b->colour, a.colour);
+    const size_t four = 4 * size_t(a.components);
+    if (!a.values.empty())
+      EXPECT_EQ(std::vector<float>(b->values.begin(), b->values.begin() + four),
+                std::vector<float>(a.values.begin(), a.values.begin() + four));
   }
 }
 
@@ -430,15 +434,15 @@ TEST_F(MeshIoTest, PlySixteenBitColourIsNotKeptAndSaysSo) {
   EXPECT_EQ(m.attributes[0].values, (std::vector<float>{1, 2, 3}));
 }
 
-TEST_F(MeshIoTest, PlyUnreferencedVerticesAreDroppedAndCounted) {
+TEST_F(MeshIoTest, PlyUnreferencedVerticesAreKeptAndCounted) {
   const std::string file = write("unref.ply", "ply\nformat ascii 1.0\nelement vertex 5\n"
                                               "property float x\nproperty float y\nproperty float z\n"
                                               "element face 1\nproperty list uchar int vertex_indices\n"
                                               "end_header\n0 0 0\n9 9 9\n1 0 0\n8 8 8\n0 1 0\n3 4 0 2\n");
   LoadReport r;
   const Mesh m = pomar::load_mesh(file, &r);
-  EXPECT_EQ(m.positions, (std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0}));
-  EXPECT_EQ(m.triangles, (std::vector<uint32_t>{2, 0, 1}));
+  EXPECT_EQ(m.positions, (std::vector<float>{0, 0, 0, 9, 9, 9, 1, 0, 0, 8, 8, 8, 0, 1, 0}));
+  EXPECT_EQ(m.triangles, (std::vector<uint32_t>{4, 0, 2}));
   EXPECT_EQ(r.unreferenced_vertices, 2u);
   EXPECT_EQ(r.file_vertices, 5u);
 }
@@ -446,10 +450,11 @@ TEST_F(MeshIoTest, PlyUnreferencedVerticesAreDroppedAndCounted) {
 TEST_F(MeshIoTest, UnreferencedVerticesInObjAndOff) {
   LoadReport r;
   const Mesh obj = pomar::load_mesh(write("u.obj", "v 9 9 9\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 2 3 4\n"), &r);
-  EXPECT_EQ(obj.triangles, (std::vector<uint32_t>{0, 1, 2}));
+  EXPECT_EQ(obj.triangles, (std::vector<uint32_t>{1, 2, 3}));
+  EXPECT_EQ(obj.vertex_count(), 4u);
   EXPECT_EQ(r.unreferenced_vertices, 1u);
   const Mesh off = pomar::load_mesh(write("u.off", "OFF\n4 1 0\n0 0 0\n1 0 0\n9 9 9\n0 1 0\n3 0 1 3\n"), &r);
-  EXPECT_EQ(off.positions, (std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0}));
+  EXPECT_EQ(off.positions, (std::vector<float>{0, 0, 0, 1, 0, 0, 9, 9, 9, 0, 1, 0}));
   EXPECT_EQ(r.unreferenced_vertices, 1u);
 }
 

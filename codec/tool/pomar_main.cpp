@@ -1,5 +1,6 @@
 // pomar: command-line front end of the codec.
-//   pomar encode IN OUT.pomar [--bits N] [--progressive] [--repair] [--max-memory SIZE]
+//   pomar encode IN OUT.pomar [--bits N] [--progressive] [--strict | --repair] [--keep-order]
+//                [--max-memory SIZE]
 //   pomar decode IN.pomar OUT [--level L] [--cluster/--sphere/--box ...] [--skip-damaged]
 //                [--max-memory SIZE]
 //   pomar info IN.pomar [--json | --check]
@@ -9,6 +10,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -47,7 +49,9 @@ pomar::Progress terminal_progress(bool quiet) {
   };
 }
 
-constexpr const char *kRepairHint = " (pomar encode --repair cuts it into a manifold mesh)";
+constexpr const char *kRepairHint =
+    " (without --strict pomar stores the cut and gives the mesh back exactly; --repair cuts it "
+    "for good)";
 
 /// Runs make_manifold() on `mesh` and prints what it changed on stderr, one line per kind
 /// of change; "nothing to repair" only when not quiet. Returns the seconds it took.
@@ -78,7 +82,7 @@ struct EncodeArgs {
   int bits = 12;
   uint32_t clusters = 0;
   double cluster_ratio = 0.01;
-  bool progressive = false, quiet = false, repair = false;
+  bool progressive = false, quiet = false, repair = false, strict = false, keep_order = false;
   std::string max_memory = "auto";
   pomar::AttributeOptions attributes;
   std::string drop;
@@ -161,13 +165,15 @@ int run_encode(const EncodeArgs &a) {
   opt.memory_limit = memory_limit;
   opt.attributes = a.attributes;
   opt.attributes.keep = parse_drop(a.drop);
+  opt.strict = a.strict;
+  opt.keep_order = a.keep_order;
   pomar::EncodeReport r;
   const auto t1 = Clock::now();
   std::vector<uint8_t> file;
   try {
     file = pomar::encode(mesh, opt, &r);
   } catch (const pomar::Error &e) {
-    if (!a.repair && pomar::repair_would_change(mesh))
+    if (a.strict && pomar::repair_would_change(mesh))
       throw pomar::Error(e.kind(), e.what() + std::string(kRepairHint));
     throw;
   }
@@ -176,9 +182,13 @@ int run_encode(const EncodeArgs &a) {
   if (a.quiet)
     return 0;
   const pomar::FileInfo &i = r.info;
-  std::printf("%s: %u vertices, %u faces", a.in.c_str(), i.vertices, i.faces);
+  if (r.lossless.stored) // the one line saying what the file keeps beyond the coded mesh
+    std::fprintf(stderr, "pomar: stored for an exact decode: %s\n", r.lossless.summary().c_str());
+  std::printf("%s: %zu vertices, %zu faces", a.in.c_str(), mesh.vertex_count(),
+              mesh.triangle_count());
   if (r.unreferenced_vertices)
-    std::printf(" (%zu unreferenced vertices dropped)", r.unreferenced_vertices);
+    std::printf(" (%zu unreferenced vertices %s)", r.unreferenced_vertices,
+                r.lossless.unreferenced_vertices ? "kept" : "dropped");
   if (load.welded_vertices)
     std::printf(" (%zu duplicate STL corners welded)", load.welded_vertices);
   std::printf("\n%s: %zu bytes, %.2f bits/vertex (connectivity %.2f, geometry %.2f), %d-bit "
@@ -186,6 +196,11 @@ int run_encode(const EncodeArgs &a) {
               a.out.c_str(), file.size(), bpv(file.size(), i.vertices),
               bpv(i.connectivity_bytes, i.vertices), bpv(i.geometry_bytes, i.vertices), i.bits,
               i.levels.size(), i.base_vertices);
+  if (r.lossless.stored)
+    std::printf("lossless record: %lu bytes = %.3f bits/vertex (the coded mesh has %u vertices "
+                "and %u faces)\n",
+                static_cast<unsigned long>(i.lossless_bytes), bpv(i.lossless_bytes, i.vertices),
+                i.vertices, i.faces);
   if (i.clustered())
     std::printf("random access: %u clusters from level %u (global part %lu bytes, cluster "
                 "blocks %lu bytes)\n",
@@ -352,7 +367,7 @@ int run_selective_decode(const DecodeArgs &a) {
   } catch (const pomar::Error &e) {
     rethrow_with_hint(e);
   }
-  const pomar::Mesh mesh = d.mesh();
+  const pomar::Mesh mesh = d.exact_mesh(); // every region at its finest: the input exactly
   const double t_decode = since(t0);
   pomar::save_mesh(a.out, mesh, !a.ascii);
   if (a.stats || !a.quiet) {
@@ -431,6 +446,10 @@ nlohmann::json info_json(const pomar::FileInfo &i) {
   j["tables_bytes"] = i.tables_bytes;
   j["index_bytes"] = i.index_bytes;
   j["cluster_bytes"] = i.cluster_bytes;
+  j["lossless_bytes"] = i.lossless_bytes;
+  j["lossless_bits_per_vertex"] = bpv(i.lossless_bytes, i.vertices);
+  j["input_vertices"] = i.input_vertices;
+  j["input_faces"] = i.input_faces;
   j["cluster_block_bytes"] = i.cluster_block_bytes;
   nlohmann::json sections = nlohmann::json::array();
   for (const pomar::FileInfo::Section &sec : i.sections)
@@ -525,6 +544,11 @@ int run_info(const std::string &in, bool json) {
     std::printf("  section %s: %lu bytes = %.2f bits/vertex%s\n", sec.name.c_str(),
                 static_cast<unsigned long>(sec.bytes), bpv(sec.bytes, i.vertices),
                 sec.required ? " (required)" : "");
+  if (i.lossless_bytes)
+    std::printf("  lossless record (section LSLS): a full decode gives back the input's %lu "
+                "vertices and %lu faces exactly (levels and regions show the coded, cut mesh)\n",
+                static_cast<unsigned long>(i.input_vertices),
+                static_cast<unsigned long>(i.input_faces));
   std::printf("  level  vertices     faces  conn.bytes  geom.bytes\n");
   std::printf("  %5d %9u %9u  %10lu  (base mesh)\n", 0, i.base_vertices, i.base_faces,
               static_cast<unsigned long>(i.base_bytes));
@@ -643,15 +667,29 @@ bool verify_attributes(const pomar::Mesh &ref, const pomar::Mesh &out, const pom
   return ok;
 }
 
+/// The vertex positions of `m`, sorted: equal for meshes with the same vertices.
+std::vector<Point> point_multiset(const pomar::Mesh &m) {
+  std::vector<Point> out(m.vertex_count());
+  for (size_t v = 0; v < out.size(); ++v)
+    out[v] = {m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]};
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 int run_verify(const std::string &original, const std::string &file, const std::string &decoded,
                bool repair, const std::string &drop) {
   pomar::Mesh ref = pomar::load_mesh(original);
   // With --repair the reference is the repaired original: what `encode --repair` encoded.
   if (repair)
     repair_and_report(ref, true);
-  const bool could_repair = !repair && pomar::repair_would_change(ref);
   const std::vector<uint8_t> data = pomar::read_file(file);
   const pomar::FileInfo info = pomar::inspect(data.data(), data.size());
+  // A file without a lossless record (encode --strict, or older) has no unreferenced vertex.
+  // With attributes, unreferenced vertices are not stored either (their attributes are not yet).
+  const size_t dropped = info.lossless_bytes == 0 || !info.attributes.empty()
+                             ? pomar::drop_unreferenced_vertices(ref)
+                             : 0;
+  const bool could_repair = !repair && info.lossless_bytes == 0 && pomar::repair_would_change(ref);
   const pomar::Mesh out =
       decoded.empty() ? pomar::decode(data.data(), data.size()) : pomar::load_mesh(decoded);
   // Snap the original onto the file's grid, as the encoder did.
@@ -659,12 +697,21 @@ int run_verify(const std::string &original, const std::string &file, const std::
     const int axis = static_cast<int>(i % 3);
     ref.positions[i] = info.grid.dequantize(axis, info.grid.quantize(axis, ref.positions[i]));
   }
-  const bool same = triangle_multiset(ref) == triangle_multiset(out);
+  // STL stores triangles only (no vertex shared or unused): the triangles are compared.
+  std::string ext = decoded.size() >= 4 ? decoded.substr(decoded.size() - 4) : "";
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  const bool triangles_only = ext == ".stl";
+  const bool same = triangle_multiset(ref) == triangle_multiset(out) &&
+                    (triangles_only || (ref.vertex_count() == out.vertex_count() &&
+                                        point_multiset(ref) == point_multiset(out)));
   const std::string what = decoded.empty() ? file : decoded;
   const bool attributes_ok = !same || verify_attributes(ref, out, info, parse_drop(drop));
   if (!same) {
-    std::fprintf(stderr, "pomar: MISMATCH: %s differs from %s on the %d-bit grid%s\n", what.c_str(),
-                 original.c_str(), info.bits,
+    std::fprintf(stderr,
+                 "pomar: MISMATCH: %s differs from %s on the %d-bit grid (%zu vertices and %zu "
+                 "faces against %zu and %zu)%s\n",
+                 what.c_str(), original.c_str(), info.bits, out.vertex_count(),
+                 out.triangle_count(), ref.vertex_count(), ref.triangle_count(),
                  could_repair
                      ? " (the original needs a repair to be encoded: if it was encoded with "
                        "--repair, verify with --repair)"
@@ -676,10 +723,19 @@ int run_verify(const std::string &original, const std::string &file, const std::
                  what.c_str(), original.c_str());
     return 3;
   }
-  std::printf("OK: %s matches %s%s: the same %zu oriented triangles, every vertex on its %d-bit "
-              "grid position%s\n",
-              what.c_str(), original.c_str(), repair ? " after repair" : "", out.triangle_count(),
-              info.bits, info.attributes.empty() ? "" : ", attributes within their bounds");
+  std::printf("OK: %s matches %s%s: the same %zu vertices and %zu oriented triangles, every vertex "
+              "on its %d-bit grid position",
+              what.c_str(), original.c_str(), repair ? " after repair" : "", out.vertex_count(),
+              out.triangle_count(), info.bits);
+  if (dropped)
+    std::printf(" (%zu unreferenced vertices of the original are not in the file: encoded with "
+                "--strict)",
+                dropped);
+  if (triangles_only)
+    std::printf(" (STL keeps triangles only: vertices not compared)");
+  if (!info.attributes.empty())
+    std::printf(", attributes within their bounds");
+  std::printf("\n");
   return 0;
 }
 
@@ -694,8 +750,9 @@ int main(int argc, char **argv) {
       "  pomar decode bunny.pomar coarse.ply --level 10\n"
       "  pomar decode bunny.pomar ear.ply --sphere -0.06,0.16,0.0,0.02 --stats\n"
       "  pomar verify bunny.ply bunny.pomar          # lossless check\n"
-      "  pomar encode messy.stl messy.pomar --repair # cut a non-manifold mesh first\n"
-      "  pomar verify messy.stl messy.pomar --repair # lossless w.r.t. the repaired mesh\n"};
+      "  pomar encode messy.stl messy.pomar          # any mesh: the cut is stored, exact decode\n"
+      "  pomar encode messy.stl fixed.pomar --repair # keep the cut (manifold) mesh instead\n"
+      "  pomar verify messy.stl fixed.pomar --repair # lossless w.r.t. the repaired mesh\n"};
   app.require_subcommand(1);
   // Ctrl-C or kill during a write: no temporary file left, the old output untouched.
   pomar::remove_temporary_files_on_signals();
@@ -706,7 +763,10 @@ int main(int argc, char **argv) {
   auto *enc =
       app.add_subcommand("encode", "Compress a mesh (PLY, OBJ, OFF, STL) into a .pomar file");
   enc->add_option("input", ea.in,
-                  "Input mesh: manifold, consistently oriented triangles (or use --repair)")
+                  "Input mesh, any triangles: a non-manifold or inconsistently oriented mesh, "
+                  "duplicate faces, faces repeating a vertex and unreferenced vertices are coded "
+                  "as a manifold cut plus a record that a full decode undoes (one line on stderr "
+                  "says what was stored)")
       ->required();
   enc->add_option("output", ea.out, "Output .pomar file (written atomically)")->required();
   enc->add_option("-b,--bits", ea.bits,
@@ -728,7 +788,16 @@ int main(int argc, char **argv) {
                 "a manifold one (remove faces repeating a vertex and exact duplicate faces, "
                 "reorient faces, cut edges of more than two faces or that cannot be oriented, "
                 "split vertices joining several fans into copies at the same position) and print "
-                "every change on stderr. Positions are never moved; verify with --repair");
+                "every change on stderr. Positions are never moved; the file holds the repaired "
+                "mesh (verify with --repair)");
+  enc->add_flag("--strict", ea.strict,
+                "Refuse a mesh that needs cutting (non-manifold, inconsistently oriented, "
+                "duplicate or degenerate faces) and drop unreferenced vertices: for pipelines "
+                "that want clean input (the file is then format version 1 or 3)");
+  enc->add_flag("--keep-order", ea.keep_order,
+                "Also store the input's vertex numbering (a full decode gives the vertices back "
+                "in the input order, e.g. for per-vertex data kept elsewhere); costs a few bits "
+                "per vertex (pomar info shows it as the lossless record)");
   enc->add_flag("-q,--quiet", ea.quiet,
                 "Print nothing on success (what --repair changed is still printed)");
   enc->add_option("--drop", ea.drop,

@@ -144,6 +144,10 @@ py::dict info_dict(const pomar::FileInfo &i) {
     sections.append(entry);
   }
   d["sections"] = sections;
+  d["lossless_bytes"] = i.lossless_bytes;
+  d["lossless_bits_per_vertex"] = bpv(i.lossless_bytes);
+  d["input_vertices"] = i.input_vertices;
+  d["input_faces"] = i.input_faces;
   d["header_bytes"] = i.header_bytes;
   d["base_bytes"] = i.base_bytes;
   d["total_bytes"] = i.total_bytes;

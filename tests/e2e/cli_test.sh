@@ -220,32 +220,92 @@ expect_dir_only "$WORK/level9999"
 
 # ---- non-manifold input ----------------------------------------------------------------------------
 
-section "non-manifold input is refused without creating the output"
+section "non-manifold input is encoded by default, one line says what was stored, verify is exact"
 mkdir "$WORK/nm"
 run encode "$NONMANIFOLD" "$WORK/nm/out.pomar"
+expect_rc 0
+expect_file "$WORK/nm/out.pomar"
+expect_contains "$ERR" "pomar: stored for an exact decode: non-manifold: 2 vertices and 1 edge stored as cuts (" "stderr"
+[ "$(printf '%s\n' "$ERR" | grep -c .)" -eq 1 ] || fail "expected exactly one line on stderr, got: $ERR"
+pass
+expect_contains "$OUT" "lossless record:" "stdout"
+run verify "$NONMANIFOLD" "$WORK/nm/out.pomar"
+expect_rc 0
+expect_contains "$OUT" "the same 6 vertices and 8 oriented triangles" "stdout"
+run info "$WORK/nm/out.pomar"
+expect_rc 0
+expect_contains "$OUT" ".pomar version 4" "stdout"
+expect_contains "$OUT" "a full decode gives back the input's 6 vertices and 8 faces exactly" "stdout"
+run info --json "$WORK/nm/out.pomar"
+expect_rc 0
+[ "$(json_get "$WORK/.out" "d['input_vertices']")" = 6 ] || fail "info --json: input_vertices is not 6"
+pass
+run decode "$WORK/nm/out.pomar" "$WORK/nm/out.off"
+expect_rc 0
+run verify "$NONMANIFOLD" "$WORK/nm/out.pomar" "$WORK/nm/out.off"
+expect_rc 0
+
+section "--strict: non-manifold input is refused without creating the output"
+run encode "$NONMANIFOLD" "$WORK/nm/strict.pomar" --strict
 expect_rc 1
 expect_one_line_error
 expect_contains "$ERR" "non-manifold" "stderr"
-expect_no_file "$WORK/nm/out.pomar"
-expect_dir_only "$WORK/nm"
+expect_no_file "$WORK/nm/strict.pomar"
 
-section "non-manifold input leaves a pre-existing output file byte-identical"
+section "--strict: a refused input leaves a pre-existing output file byte-identical"
 printf 'precious bytes that must survive a failed encode\n' >"$WORK/nm/existing.pomar"
 sum_before="$(sha256sum <"$WORK/nm/existing.pomar")"
-run encode "$NONMANIFOLD" "$WORK/nm/existing.pomar"
+run encode "$NONMANIFOLD" "$WORK/nm/existing.pomar" --strict
 expect_rc 1
 expect_contains "$ERR" "non-manifold" "stderr"
 sum_after="$(sha256sum <"$WORK/nm/existing.pomar")"
 [ "$sum_before" = "$sum_after" ] || fail "the pre-existing output file was modified by a failed encode"
 pass
-expect_dir_only "$WORK/nm" existing.pomar
+expect_dir_only "$WORK/nm" existing.pomar out.off out.pomar
 
-section "the refusal of a non-manifold input hints at --repair"
-run encode "$NONMANIFOLD" "$WORK/nm/hint.pomar"
+section "the --strict refusal hints at the default and at --repair"
+run encode "$NONMANIFOLD" "$WORK/nm/hint.pomar" --strict
 expect_rc 1
 expect_one_line_error
-expect_contains "$ERR" "(pomar encode --repair cuts it into a manifold mesh)" "stderr"
+expect_contains "$ERR" "without --strict pomar stores the cut" "stderr"
+expect_contains "$ERR" "--repair cuts it for good" "stderr"
 expect_no_file "$WORK/nm/hint.pomar"
+
+section "a clean mesh: the same bytes with and without --strict"
+run encode "$BUNNY" "$WORK/nm/bunny_strict.pomar" --strict
+expect_rc 0
+expect_contains "$OUT" "(1113 unreferenced vertices dropped)" "stdout"
+run decode "$WORK/nm/bunny_strict.pomar" "$WORK/nm/clean.ply" --ascii
+expect_rc 0
+run encode "$WORK/nm/clean.ply" "$WORK/nm/clean.pomar"
+expect_rc 0
+[ -z "$ERR" ] || fail "a clean mesh printed on stderr: $ERR"
+pass
+run encode "$WORK/nm/clean.ply" "$WORK/nm/clean_strict.pomar" --strict
+cmp -s "$WORK/nm/clean.pomar" "$WORK/nm/clean_strict.pomar" || fail "a clean mesh encodes differently with --strict"
+pass
+
+section "--keep-order stores the vertex numbering"
+run encode "$WORK/nm/clean.ply" "$WORK/nm/bunny_order.pomar" --keep-order
+expect_rc 0
+expect_contains "$ERR" "the vertex order kept" "stderr"
+run verify "$WORK/nm/clean.ply" "$WORK/nm/bunny_order.pomar"
+expect_rc 0
+run decode "$WORK/nm/bunny_order.pomar" "$WORK/nm/bunny_order.ply" --ascii
+expect_rc 0
+python3 - "$WORK/nm/clean.ply" "$WORK/nm/bunny_order.ply" <<'PY' || fail "--keep-order: the decoded vertex order differs from the input's"
+import sys
+def first_vertex_lines(path, n):
+    # ASCII PLY files written by pomar: compare the first n vertices.
+    with open(path, 'rb') as f:
+        data = f.read()
+    head, _, body = data.partition(b'end_header\n')
+    return [tuple(round(float(x), 2) for x in l.split()[:3]) for l in body.split(b'\n')[:n]]
+a, b = first_vertex_lines(sys.argv[1], 200), first_vertex_lines(sys.argv[2], 200)
+bad = sum(1 for p, q in zip(a, b) if max(abs(x - y) for x, y in zip(p, q)) > 0.001)
+sys.exit(1 if bad else 0)
+PY
+pass
 
 section "encode --repair cuts the non-manifold input and reports every change"
 mkdir "$WORK/repair"
@@ -262,7 +322,7 @@ expect_dir_only "$WORK/repair" out.pomar
 section "verify --repair accepts the repaired file"
 run verify "$NONMANIFOLD" "$WORK/repair/out.pomar" --repair
 expect_rc 0
-expect_contains "$OUT" "after repair: the same 8 oriented triangles" "stdout"
+expect_contains "$OUT" "after repair: the same 8 vertices and 8 oriented triangles" "stdout"
 
 section "encode --repair on a manifold mesh changes nothing and says so"
 run encode "$BUNNY" "$WORK/repair/bunny.pomar" --repair
@@ -271,7 +331,7 @@ expect_contains "$ERR" "pomar: repair: nothing to repair" "stderr"
 cmp -s "$WORK/repair/bunny.pomar" "$WORK/bunny.pomar" || fail "encode --repair of a manifold mesh differs from a plain encode"
 pass
 
-section "a flipped face: refused with the hint, repaired, and plain verify points to --repair"
+section "a flipped face: stored by default, refused with --strict, repaired, and plain verify of the repaired file points to --repair"
 python3 - "$NONMANIFOLD" "$WORK/repair/flipped.off" <<'PY'
 import sys
 # The first tetrahedron of the sample (vertices 0-3, faces 0-3) with face 1 reversed.
@@ -282,10 +342,15 @@ faces[1] = [faces[1][0], faces[1][1], faces[1][3], faces[1][2]]
 with open(sys.argv[2], "w") as f:
     f.write("OFF\n4 4 0\n" + "".join(verts) + "".join(" ".join(t) + "\n" for t in faces))
 PY
-run encode "$WORK/repair/flipped.off" "$WORK/repair/flipped.pomar"
+run encode "$WORK/repair/flipped.off" "$WORK/repair/flipped.pomar" --strict
 expect_rc 1
 expect_contains "$ERR" "inconsistently oriented" "stderr"
-expect_contains "$ERR" "(pomar encode --repair cuts it into a manifold mesh)" "stderr"
+expect_contains "$ERR" "--repair cuts it for good" "stderr"
+run encode "$WORK/repair/flipped.off" "$WORK/repair/flipped_exact.pomar"
+expect_rc 0
+expect_contains "$ERR" "1 flipped face kept" "stderr"
+run verify "$WORK/repair/flipped.off" "$WORK/repair/flipped_exact.pomar"
+expect_rc 0
 run encode "$WORK/repair/flipped.off" "$WORK/repair/flipped.pomar" --repair --quiet
 expect_rc 0
 expect_contains "$ERR" "pomar: repair: flipped 1 face to orient the mesh consistently (e.g. face 1)" "stderr"
@@ -648,7 +713,7 @@ help_mentions() { # help_mentions SUBCOMMAND OPTION...
   local opt
   for opt in "$@"; do expect_contains "$OUT" "$opt" "pomar $sub --help"; done
 }
-help_mentions encode --bits --progressive --clusters --cluster-ratio --repair --quiet --max-memory 512M input output \
+help_mentions encode --bits --progressive --clusters --cluster-ratio --repair --strict --keep-order --quiet --max-memory 512M input output \
   --drop --normal-bits --scalar-bits --texcoord-bits --exact-attributes
 help_mentions decode --level --cluster --sphere --box --stats --ascii --quiet --skip-damaged --max-memory input output \
   --no-attributes

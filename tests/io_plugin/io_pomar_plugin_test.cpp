@@ -460,10 +460,13 @@ TEST_F(PomarPluginTest, SaveAndOpenKeepAttributes) {
 
 TEST_F(PomarPluginTest, FailedSaveWritesNothing) {
   const QStringList before = dirEntries();
-  MeshModel *mm = layer(pomar::gen::nonmanifold_edge());
+  pomar::Mesh degenerate = pomar::gen::tetrahedron(); // nothing but faces repeating a vertex
+  degenerate.triangles = {0, 0, 1, 2, 3, 3};
+  MeshModel *mm = layer(degenerate);
   EXPECT_FALSE(save(*mm, path("bad.pomar")));
-  EXPECT_TRUE(plugin()->errorMsg().contains("non-manifold")) << plugin()->errorMsg().toStdString();
-  EXPECT_TRUE(g_warnings.join("\n").contains("non-manifold"));
+  EXPECT_TRUE(plugin()->errorMsg().contains("no valid triangle"))
+      << plugin()->errorMsg().toStdString();
+  EXPECT_TRUE(g_warnings.join("\n").contains("no valid triangle"));
   EXPECT_EQ(dirEntries(), before);
 
   // An existing destination is left untouched.
@@ -484,13 +487,24 @@ TEST_F(PomarPluginTest, FailedSaveWritesNothing) {
   EXPECT_EQ(dirEntries(), before);
 }
 
+TEST_F(PomarPluginTest, AnyMeshSavesExactlyAndOpensAsItWas) {
+  pomar::Mesh messy = pomar::gen::nonmanifold_edge(); // three faces on edge (0, 1)
+  messy.triangles.insert(messy.triangles.end(), {0, 1, 2, 0, 1, 2, 3, 3, 4}); // + duplicate, degenerate
+  messy.positions.insert(messy.positions.end(), {7.f, 7.f, 7.f}); // + an unreferenced vertex
+  MeshModel *mm = layer(messy);
+  ASSERT_TRUE(save(*mm, path("messy.pomar"))) << plugin()->errorMsg().toStdString();
+  const std::vector<uint8_t> bytes = readBytes(path("messy.pomar"));
+  const pomar::Mesh out = pomar::decode(bytes.data(), bytes.size());
+  EXPECT_EQ(out.vertex_count(), messy.vertex_count());
+  EXPECT_EQ(out.triangle_count(), messy.triangle_count());
+  ASSERT_TRUE(openAt(path("messy.pomar"), -1));
+  EXPECT_EQ(mm_->cm.vn, int(messy.vertex_count()));
+  EXPECT_EQ(mm_->cm.fn, int(messy.triangle_count()));
+  QFile::remove(path("messy.pomar"));
+}
+
 TEST_F(PomarPluginTest, RepairOptionSavesANonManifoldMeshAndSaysWhatChanged) {
-  // Without the option: refused, and the message points at the option.
   MeshModel *mm = layer(pomar::gen::nonmanifold_edge()); // three faces on edge (0, 1)
-  EXPECT_FALSE(save(*mm, path("book.pomar")));
-  EXPECT_TRUE(
-      plugin()->errorMsg().contains("(the Repair save option cuts it into a manifold mesh)"))
-      << plugin()->errorMsg().toStdString();
 
   // With it: saved, one warning naming every change, the layer left as it was.
   g_warnings.clear();

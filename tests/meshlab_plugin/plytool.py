@@ -7,9 +7,10 @@ them).
 
   plytool.py count MESH.ply                      -> "<vertices> <faces>"
   plytool.py contains RESULT.ply FULL.ply AXIS MIN
-        every vertex of FULL with coordinate AXIS (x|y|z) > MIN is a vertex of RESULT
+        every vertex of FULL with coordinate AXIS (x|y|z) > MIN that a face uses is a vertex
+        of RESULT (a region decode shows the coded mesh: no vertex that no face uses)
   plytool.py colors MESH.ply                     -> "<distinct colours> <blue> <red>" (vertices
-        whose colour is pure blue (0,0,255) / pure red (255,0,0))
+        whose colour is pure blue (0,0,255) / pure red (255,0,0)), over the vertices faces use
 """
 import struct
 import sys
@@ -95,6 +96,14 @@ def positions(mesh):
     return [(v['x'], v['y'], v['z']) for v in mesh.get('vertex', [])]
 
 
+def used_vertices(mesh):
+    """The vertices a face uses (a lossless file keeps the others, with no cluster)."""
+    used = set()
+    for f in mesh.get('face', []):
+        used.update(next(v for v in f.values() if isinstance(v, (list, tuple))))
+    return used
+
+
 def main(argv):
     cmd = argv[1]
     if cmd == 'count':
@@ -105,14 +114,17 @@ def main(argv):
         result = set(positions(read_ply(argv[2])))
         axis = 'xyz'.index(argv[4])
         lo = float(argv[5])
-        wanted = [p for p in positions(read_ply(argv[3])) if p[axis] > lo]
+        full = read_ply(argv[3])
+        used = used_vertices(full)
+        wanted = [p for i, p in enumerate(positions(full)) if i in used and p[axis] > lo]
         missing = [p for p in wanted if p not in result]
         print(f'{len(wanted)} vertices with {argv[4]} > {lo}; {len(missing)} missing')
         for p in missing[:5]:
             print('  missing', p)
         return 1 if missing or not wanted else 0
     if cmd == 'colors':
-        verts = read_ply(argv[2]).get('vertex', [])
+        mesh = read_ply(argv[2])
+        verts = [mesh['vertex'][i] for i in sorted(used_vertices(mesh))]
         if not verts or 'red' not in verts[0]:
             print('no per-vertex colours')
             return 1

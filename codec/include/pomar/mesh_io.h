@@ -31,7 +31,7 @@ struct LoadReport {
   std::string format;               ///< "ply", "obj", "off" or "stl"
   size_t file_vertices = 0;         ///< vertices stored in the file (STL: 3 per facet)
   size_t file_faces = 0;            ///< faces/polygons in the file (PLY tristrips: triangles)
-  size_t unreferenced_vertices = 0; ///< dropped because no face uses them
+  size_t unreferenced_vertices = 0; ///< vertices no face uses (kept: pomar::encode stores them)
   size_t welded_vertices = 0;       ///< STL only: corners merged with an identical position
   size_t polygons_triangulated = 0; ///< faces with more than 3 vertices, split into triangles
   /// Data present in the file that is not kept, e.g. "normals", "colors",
@@ -52,8 +52,8 @@ using SizeCheck = std::function<void(uint64_t vertices, uint64_t faces)>;
 
 /// Read a triangle mesh. Polygons are split into triangles (PLY/OBJ: fan from the first
 /// vertex; OFF: vcglib's rule, which picks the better diagonal of a quad), STL corners with
-/// exactly equal positions are welded, unreferenced vertices are dropped. Vertex and face
-/// order of the file is kept otherwise. `*report` is reset first. Throws pomar::Error if
+/// exactly equal positions are welded, vertices no face uses are kept. Vertex and face
+/// order of the file is kept. `*report` is reset first. Throws pomar::Error if
 /// the file is missing, unreadable, malformed, has a NaN/Inf coordinate or contains no
 /// triangles, and for files vcglib would misread (see codec/src/io/io_common.h), and when
 /// `size_check` throws.

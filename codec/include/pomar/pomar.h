@@ -126,6 +126,31 @@ struct EncodeOptions {
   /// Which attributes are stored and how precisely (default: all, normals within 0.33°,
   /// scalars on 16 bits, texture coordinates on 12 bits over their ranges).
   AttributeOptions attributes;
+  /// Refuse meshes the codec must cut to code (non-manifold, inconsistently oriented,
+  /// duplicate or degenerate faces) and drop unreferenced vertices, as before format
+  /// version 4. Off: such meshes are cut and the cut is stored (LosslessReport).
+  bool strict = false;
+  /// Store the input vertex numbering too (messy and clean meshes alike: the file is then
+  /// version 4): a full decode gives the vertices back in the input order.
+  bool keep_order = false;
+};
+
+/// What the codec stored to give a mesh back exactly although it had to cut it (the
+/// lossless record, format version 4). All zero for a clean mesh.
+struct LosslessReport {
+  bool stored = false;              ///< the file carries a lossless record
+  size_t vertex_copies = 0;         ///< decoded vertices that are one input vertex (cuts)
+  size_t vertices_split = 0;        ///< input vertices cut into several
+  size_t edges_cut = 0;             ///< non-manifold or non-orientable edges cut
+  size_t faces_flipped = 0;         ///< faces reversed to orient the coded mesh
+  size_t duplicate_faces = 0;       ///< exact duplicates kept in the record
+  size_t degenerate_faces = 0;      ///< faces repeating a vertex kept in the record
+  size_t unreferenced_vertices = 0; ///< vertices no coded face uses, kept in the record
+  bool keep_order = false;          ///< the input vertex numbering is stored
+  uint64_t bytes = 0;               ///< size of the record (the LSLS section body)
+  /// "non-manifold: 421 vertices and 12 edges stored as cuts; 3 duplicate faces kept; ...",
+  /// "" if nothing was stored.
+  std::string summary() const;
 };
 
 /// One refinement level of a file: the mesh it produces and what it costs.
@@ -185,6 +210,11 @@ struct FileInfo {
   std::vector<AttributeInfo> attributes;
   std::vector<std::string> texture_files;
   uint64_t attribute_bytes = 0; ///< the whole ATTR section
+  /// Version 4: bytes of the lossless record (0 = none): undone by a full decode.
+  uint64_t lossless_bytes = 0;
+  /// What a full decode gives (the input's counts): vertices/faces above are those of the
+  /// coded mesh, which differ when the file carries a lossless record (filled by inspect()).
+  uint64_t input_vertices = 0, input_faces = 0;
   /// Version 4: what the file carries in sections of its global part, with their sizes.
   struct Section {
     std::string name;      ///< four ASCII characters, e.g. "LSLS"
@@ -209,18 +239,29 @@ struct SymbolBits {
 struct EncodeReport {
   FileInfo info;
   size_t input_vertices = 0;
-  size_t unreferenced_vertices = 0; ///< dropped: no triangle uses them
+  /// No triangle uses them: dropped with `strict`, else kept in the lossless record.
+  size_t unreferenced_vertices = 0;
   double quantize_seconds = 0, decimate_seconds = 0, encode_seconds = 0;
   /// Ideal code length per symbol kind of the global levels (adaptive models).
   SymbolBits symbol_bits;
   /// decoded vertex i (in a full decode) is input vertex decoded_to_input[i].
   std::vector<uint32_t> decoded_to_input;
+  LosslessReport lossless; ///< what was stored to undo the cut
 };
 
-/// Encode a manifold, consistently oriented triangle mesh. Throws pomar::Error on invalid
-/// input (non-manifold, inconsistent orientation, repeated vertex in a face, NaN, empty...).
+/// Encode a triangle mesh. The codec codes manifold, consistently oriented meshes: any other
+/// mesh is first cut into one (make_manifold, pomar/repair.h) and what the cut changed is
+/// stored (format version 4), so that a full decode gives back exactly the input: its
+/// vertex count, its oriented faces as a multiset (duplicates and faces repeating a vertex
+/// included), every vertex on its grid position (vertex order too with keep_order).
+/// Throws pomar::Error on a NaN or an index out of range, a mesh with no valid triangle,
+/// and, with `strict`, on any mesh that needs cutting.
 std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options = {},
                             EncodeReport *report = nullptr);
+
+/// Drops the vertices no triangle uses (the others keep their order, triangles are
+/// renumbered; indices out of range are left as they are); returns how many were dropped.
+size_t drop_unreferenced_vertices(Mesh &mesh);
 
 /// Read the header, base mesh and level table of a .pomar image (checks their checksums).
 FileInfo inspect(const uint8_t *data, size_t size);

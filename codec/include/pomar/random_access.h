@@ -131,7 +131,17 @@ public:
   // ----- the current mesh -----
   /// Positions, triangles and the attributes of exactly these vertices (the same values a
   /// full decode gives them).
+  /// The decoded mesh as coded: a file that carries a lossless record (format version 4)
+  /// codes its input cut into a manifold, oriented mesh, and every region shows that cut
+  /// mesh (non-manifold vertices and edges as separate copies, flipped faces as coded,
+  /// duplicates, faces repeating a vertex and unreferenced vertices absent).
   Mesh mesh() const;
+  /// mesh() with the lossless record undone once every cluster is at finest_level() and no
+  /// block was skipped: then exactly the encoded input (as pomar::decode gives it);
+  /// otherwise the same as mesh(). `source` (optional) receives for each of its vertices
+  /// the vertex of mesh() it comes from (UINT32_MAX for a vertex no coded face uses), e.g.
+  /// to carry vertex_cluster() and vertex_level() over.
+  Mesh exact_mesh(std::vector<uint32_t> *source = nullptr) const;
   /// Per vertex of mesh(): its cluster and the level that created it.
   std::vector<uint32_t> vertex_cluster() const;
   std::vector<uint32_t> vertex_level() const;

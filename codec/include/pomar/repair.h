@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "pomar/pomar.h"
 
@@ -53,6 +54,16 @@ struct RepairReport {
   std::string summary() const;
 };
 
+/// How the faces and vertices of the cut mesh relate to the input (make_manifold's `map`).
+struct RepairMap {
+  /// Cut-mesh vertex nv + i (nv = input vertex count) is a copy of input vertex copy_of[i].
+  std::vector<uint32_t> copy_of;
+  /// Cut-mesh face f is input face face_origin[f], its vertex order reversed if flipped[f]
+  /// (then its corners 1 and 2 are swapped). Input faces not listed were removed.
+  std::vector<uint32_t> face_origin;
+  std::vector<uint8_t> flipped;
+};
+
 /// Cut `mesh` into a manifold, consistently oriented mesh that pomar::encode() accepts:
 ///  1. remove faces repeating a vertex and exact duplicate faces (see RepairReport);
 ///  2. orient each connected piece consistently, flipping as few faces as the traversal
@@ -67,7 +78,9 @@ struct RepairReport {
 /// distinct vertices are valid and kept); unreferenced vertices are left alone (the encoder drops
 /// them). A mesh that needs nothing is left bit for bit unchanged. Throws pomar::Error if a face
 /// refers to a vertex index >= the vertex count.
-RepairReport make_manifold(Mesh &mesh);
+/// `map` (optional) receives how the result relates to the input (filled even when nothing
+/// changed).
+RepairReport make_manifold(Mesh &mesh, RepairMap *map = nullptr);
 
 /// True if make_manifold() would change `mesh` (run on a copy; false if it throws): when an
 /// encode fails, whether the repair is worth suggesting.

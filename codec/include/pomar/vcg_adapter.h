@@ -132,14 +132,16 @@ void take_attributes(const MeshType &m, const std::vector<uint32_t> &remap, int 
 /// Convert a vcglib triangle mesh to a pomar::Mesh.
 ///
 /// Deleted vertices and faces (IsD()) are skipped. Vertices that no live face references
-/// are dropped and counted into `*unreferenced` (if given). The remaining vertices keep
-/// their relative order and are renumbered compactly; faces keep their order.
+/// are counted into `*unreferenced` (if given) and dropped, or kept with
+/// `keep_unreferenced` (pomar::encode stores them). The remaining vertices keep their
+/// relative order and are renumbered compactly; faces keep their order.
 /// Per-vertex attributes are taken as `attribute_mask` says (see kVcgCustomScalars; 0 =
 /// positions and triangles only), when the mesh type has them (vcg::tri::HasPerVertex*).
 /// Throws pomar::Error if a live face references a deleted vertex or a vertex outside
 /// m.vert, or if a face is not a triangle.
 template <class MeshType>
-Mesh from_vcg(const MeshType &m, size_t *unreferenced = nullptr, int attribute_mask = 0) {
+Mesh from_vcg(const MeshType &m, size_t *unreferenced = nullptr, int attribute_mask = 0,
+              bool keep_unreferenced = false) {
   constexpr uint32_t kUnused = UINT32_MAX;
   std::vector<uint32_t> remap(m.vert.size(), kUnused);
   size_t live_faces = 0;
@@ -173,7 +175,8 @@ Mesh from_vcg(const MeshType &m, size_t *unreferenced = nullptr, int attribute_m
       continue;
     if (remap[v] == kUnused) {
       ++dropped;
-      continue;
+      if (!keep_unreferenced)
+        continue;
     }
     if (next == kUnused)
       throw Error(Error::Kind::InvalidMesh, "vcg mesh: too many vertices for 32-bit indices");

@@ -10,6 +10,7 @@
 #include "decode/decoder_codec.h"
 #include "entropy/models.h"
 #include "format/file_format.h"
+#include "lossless/lossless_stage.h"
 #include "pomar/limits.h"
 #include "pomar/random_access.h"
 
@@ -19,6 +20,7 @@ FileInfo inspect(const uint8_t *data, size_t size) {
   const FileLayout layout = read_layout(data, size);
   read_base_mesh(data, layout); // checks the base block too
   FileInfo info = file_info(layout, size);
+  lossless_info(data, layout, info);
   if (layout.header.clustered()) {
     check_block(data + layout.tables_offset, layout.header.tables_bytes,
                 layout.header.tables_checksum, "static model tables");
@@ -93,6 +95,11 @@ Mesh decode(const uint8_t *data, size_t size, int level, const Progress &progres
   return decode(data, size, options);
 }
 
+/// What a skip_damaged decode says when the lossless record is damaged.
+const char *const kCutMeshKept =
+    " (the mesh is the coded one: cut into a manifold, oriented mesh, without its duplicate and "
+    "degenerate faces and unreferenced vertices)";
+
 Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, DecodeReport *report) {
   DecodeReport scratch_report;
   DecodeReport &r = report ? *report : scratch_report;
@@ -131,7 +138,14 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
       r.level = std::max(r.level, l);
       r.clusters_below_request += l < static_cast<int>(target);
     }
-    return d.mesh();
+    try {
+      return d.exact_mesh(); // the full mesh, intact: as it was input
+    } catch (const Error &e) {
+      if (!options.skip_damaged)
+        throw;
+      r.damaged.push_back({"lossless record", std::string(e.what()) + kCutMeshKept, -1});
+      return d.mesh();
+    }
   }
   LevelMesh lm = base_level_mesh(data, layout);
   Models models;
@@ -144,10 +158,19 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
   r.level = static_cast<int>(decode_global_levels(data, layout, 0, std::min(target, global), lm,
                                                   models, options.progress,
                                                   options.skip_damaged ? &r.damaged : nullptr));
-  Mesh out = to_mesh(lm, h.grid);
+  Mesh mesh = to_mesh(lm, h.grid);
   if (attributes)
-    attach_attributes(*attributes, lm, options.attributes, out);
-  return out;
+    attach_attributes(*attributes, lm, options.attributes, mesh);
+  if (r.level == static_cast<int>(levels)) {
+    try {
+      undo_cut(data, layout, mesh); // the full mesh: as it was input (attributes follow)
+    } catch (const Error &e) {
+      if (!options.skip_damaged)
+        throw;
+      r.damaged.push_back({"lossless record", std::string(e.what()) + kCutMeshKept, -1});
+    }
+  }
+  return mesh;
 }
 
 } // namespace pomar

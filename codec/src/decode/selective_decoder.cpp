@@ -13,6 +13,7 @@
 #include "entropy/static_tables.h"
 #include "format/file_format.h"
 #include "geometry/quantize.h"
+#include "lossless/lossless_stage.h"
 #include "pomar/limits.h"
 #include "pomar/random_access.h"
 #include "refine/level_step.h"
@@ -433,6 +434,23 @@ Mesh SelectiveDecoder::mesh() const {
   if (s.attributes)
     attach_attributes(*s.attributes, s.mesh, s.attribute_mask, out);
   return out;
+}
+
+Mesh SelectiveDecoder::exact_mesh(std::vector<uint32_t> *source) const {
+  Mesh m = mesh();
+  const bool complete =
+      s_->damaged.empty() &&
+      (s_->clustered() ? std::all_of(s_->levels.begin(), s_->levels.end(),
+                                     [&](int l) { return l == s_->finest; })
+                       : s_->uniform_level == s_->finest);
+  if (complete) {
+    undo_cut(s_->global.data(), s_->layout, m, source); // the record lies in the global part
+  } else if (source) {
+    source->resize(m.vertex_count());
+    for (uint32_t v = 0; v < source->size(); ++v)
+      (*source)[v] = v;
+  }
+  return m;
 }
 
 std::vector<uint32_t> SelectiveDecoder::vertex_cluster() const {

@@ -13,6 +13,7 @@
 #include "entropy/models.h"
 #include "format/file_format.h"
 #include "geometry/quantize.h"
+#include "lossless/lossless_stage.h"
 #include "mesh/reorder.h"
 #include "pomar/limits.h"
 
@@ -76,7 +77,8 @@ struct PreparedInput {
   uint32_t vertices = 0, faces = 0;
 };
 
-PreparedInput prepare_input(const Mesh &mesh, const EncodeOptions &options) {
+PreparedInput prepare_input(const Mesh &mesh, const EncodeOptions &options,
+                            const LosslessHook *hook) {
   check_input(mesh, options);
   validate_attributes(mesh, !options.attributes.exact, options.attributes.keep);
   // The caller already holds the input mesh: an automatic check counts only the rest.
@@ -90,7 +92,7 @@ PreparedInput prepare_input(const Mesh &mesh, const EncodeOptions &options) {
   const uint32_t nf = static_cast<uint32_t>(triangles.size() / 3);
   in.vertices = nv;
   in.faces = nf;
-  in.grid = make_quantizer(positions.data(), nv, options.bits);
+  in.grid = hook ? hook->grid : make_quantizer(positions.data(), nv, options.bits);
   in.q = quantize(in.grid, positions.data(), nv);
   // Renumber for memory locality, then build (and validate) the connectivity. An invalid
   // mesh is validated again in the caller's numbering so that the message names its indices.
@@ -167,9 +169,14 @@ std::vector<std::vector<uint8_t>> encode_global_levels(Rebuild &rb, size_t globa
 
 } // namespace
 
-std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, EncodeReport *report) {
+void check_encode_input(const Mesh &mesh, const EncodeOptions &options) {
+  check_input(mesh, options);
+}
+
+std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &options,
+                                     EncodeReport *report, const LosslessHook *hook) {
   auto t0 = std::chrono::steady_clock::now();
-  PreparedInput in = prepare_input(mesh, options);
+  PreparedInput in = prepare_input(mesh, options, hook);
   const uint32_t nv = in.vertices, nf = in.faces;
   const double t_quantize = seconds_since(t0);
 
@@ -222,6 +229,13 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
       attributes.estimated_bytes[i] = static_cast<uint64_t>(attr_bits / 8.0 + 0.5);
     }
     sections.push_back({kAttributeSectionTag, 0, write_attributes(attributes)}); // optional
+  }
+  if (hook) { // the lossless stage's record, in the decoder's numbering
+    std::vector<uint32_t> decoded_to_cut(nv);
+    for (uint32_t i = 0; i < nv; ++i)
+      decoded_to_cut[i] = in.to_input[rb.dec_to_input[i]];
+    // Required: a reader that ignored it would give the cut mesh for the input.
+    sections.push_back({kLosslessTag, kSectionRequired, hook->record(decoded_to_cut)});
   }
   std::vector<uint8_t> file = write_file(header, pack_base_mesh(base, in.grid.bits), blocks,
                                          clustered.tables, clustered.blocks, sections);

@@ -232,6 +232,17 @@ int RangeDecoder::decode_bit(BitModel &m) {
   return bit;
 }
 
+uint32_t RangeDecoder::decode_uniform(uint32_t total) {
+  const uint32_t r = range_ / total;
+  uint32_t v = code_ / r;
+  if (v >= total)
+    v = total - 1; // only reachable on corrupt data
+  code_ -= r * v;
+  range_ = r;
+  normalize();
+  return v;
+}
+
 uint32_t RangeDecoder::decode_bypass(int nbits) {
   uint32_t v = 0;
   for (int i = 0; i < nbits; ++i) {

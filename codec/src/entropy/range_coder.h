@@ -69,6 +69,8 @@ public:
   void encode(FrequencyModel &m, int symbol);
   void encode_bit(BitModel &m, int bit);
   void encode_bypass(uint32_t value, int nbits); // nbits <= 24, equiprobable bits
+  /// value in [0, total), all equally likely; total <= 2^16.
+  void encode_uniform(uint32_t value, uint32_t total) { encode(value, 1, total); }
   /// Write the final bytes (as few as disambiguate the stream: 1 to 4); the stream is
   /// complete after this.
   void finish();
@@ -103,6 +105,7 @@ public:
   int decode(FrequencyModel &m);
   int decode_bit(BitModel &m);
   uint32_t decode_bypass(int nbits);
+  uint32_t decode_uniform(uint32_t total); ///< mirror of RangeEncoder::encode_uniform
   /// True when the decoder has asked for more bytes than the stream holds by more than
   /// the final flush can explain: the stream is truncated or corrupt.
   bool overrun() const { return overrun_ > 8; }

@@ -552,7 +552,7 @@ const uint8_t *section_body(const uint8_t *data, const FileLayout &L, size_t i) 
 
 const std::vector<uint32_t> &known_sections() {
   // The sections this build's decoders honour (issues 12 and 13 add theirs here).
-  static const std::vector<uint32_t> known = {section_tag("ATTR")};
+  static const std::vector<uint32_t> known = {section_tag("ATTR"), kLosslessTag};
   return known;
 }
 
@@ -640,7 +640,11 @@ FileInfo file_info(const FileLayout &L, uint64_t file_size) {
     info.sections.push_back({name, e.bytes, (e.flags & kSectionRequired) != 0});
     if (e.tag == section_tag("ATTR"))
       info.attribute_bytes += e.bytes;
+    if (e.tag == kLosslessTag)
+      info.lossless_bytes += e.bytes;
   }
+  info.input_vertices = h.vertices; // inspect() reads a lossless record's counts
+  info.input_faces = h.faces;
   return info;
 }
 

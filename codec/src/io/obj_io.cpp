@@ -7,6 +7,7 @@
 
 #include <tiny_obj_loader.h>
 
+#include <algorithm>
 #include <climits>
 #include <istream>
 #include <streambuf>
@@ -136,40 +137,12 @@ std::vector<uint32_t> fan_triangles(const std::vector<tinyobj::shape_t> &shapes,
   return tris;
 }
 
-/// Drops vertices no triangle uses (keeping the order of the others); returns how many.
-size_t drop_unreferenced(Mesh &mesh) {
-  constexpr uint32_t kUnused = UINT32_MAX;
-  std::vector<uint32_t> remap(mesh.vertex_count(), kUnused);
+/// Vertices no triangle uses (they are kept).
+size_t count_unreferenced(const Mesh &mesh) {
+  std::vector<uint8_t> used(mesh.vertex_count(), 0);
   for (uint32_t t : mesh.triangles)
-    remap[t] = 0;
-  std::vector<float> kept;
-  uint32_t next = 0;
-  for (size_t v = 0; v < remap.size(); ++v) {
-    if (remap[v] == kUnused)
-      continue;
-    remap[v] = next++;
-    kept.insert(kept.end(), mesh.positions.begin() + 3 * v, mesh.positions.begin() + 3 * v + 3);
-  }
-  for (auto &t : mesh.triangles)
-    t = remap[t];
-  const size_t dropped = mesh.vertex_count() - next;
-  for (VertexAttribute &a : mesh.attributes) { // the attributes of the kept vertices
-    const size_t n = a.components;
-    auto compact = [&](auto &values) {
-      size_t out = 0;
-      for (size_t v = 0; v < remap.size(); ++v)
-        if (remap[v] != kUnused)
-          for (size_t k = 0; k < n; ++k)
-            values[out++] = values[v * n + k];
-      values.resize(out);
-    };
-    if (a.kind == AttributeKind::Colour)
-      compact(a.colour);
-    else
-      compact(a.values);
-  }
-  mesh.positions.swap(kept);
-  return dropped;
+    used[t] = 1;
+  return static_cast<size_t>(std::count(used.begin(), used.end(), uint8_t(0)));
 }
 
 /// Per-vertex normals or texture coordinates from OBJ's per-corner indices (`which`: the
@@ -285,7 +258,7 @@ Mesh load_obj(const std::string &path, LoadReport &report, const SizeCheck &chec
   report.file_vertices = scan.vertices;
   report.file_faces = scan.faces;
   report.polygons_triangulated = scan.polygons;
-  report.unreferenced_vertices = drop_unreferenced(mesh);
+  report.unreferenced_vertices = count_unreferenced(mesh);
   if (scan.materials) add_unique(report.ignored_attributes, "materials");
   return mesh;
 }

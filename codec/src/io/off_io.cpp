@@ -194,7 +194,7 @@ Mesh load_off(const std::string &path, LoadReport &report, const SizeCheck &chec
   report.file_vertices = layout.vertices;
   report.file_faces = layout.faces;
   report.polygons_triangulated = layout.polygons;
-  return from_vcg(m, &report.unreferenced_vertices, kept);
+  return from_vcg(m, &report.unreferenced_vertices, kept, true); // unreferenced vertices kept
 }
 
 std::string off_text(const Mesh &mesh) {

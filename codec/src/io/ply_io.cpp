@@ -708,7 +708,8 @@ Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &chec
     if (a.vertex_count() != m.vert.size())
       fail(path, "PLY vertex attribute '" + a.name + "' was not read for every vertex");
   const int attribute_mask = put_attributes(plan.attributes, texture_files, m);
-  Mesh mesh = from_vcg(m, &report.unreferenced_vertices, attribute_mask);
+  // Unreferenced vertices kept (the file stores them).
+  Mesh mesh = from_vcg(m, &report.unreferenced_vertices, attribute_mask, true);
   mesh.texture_files = texture_files; // also without per-vertex texture coordinates
   return mesh;
 }

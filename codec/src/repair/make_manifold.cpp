@@ -197,9 +197,9 @@ std::vector<uint32_t> find_mates(const std::vector<uint32_t> &t, size_t nv, Repa
 /// directions, by BFS over each connected piece (the first face reached decides; a cycle
 /// that disagrees, as in a Moebius strip, is cut later by cut_nonorientable()). A piece where more
 /// than half the faces would flip is flipped back: the fewest changes. Applies the flips to `t`
-/// (and renumbers `mate` to follow the corners).
-void orient(std::vector<uint32_t> &t, std::vector<uint32_t> &mate,
-            const std::vector<uint32_t> &origin, RepairReport &r) {
+/// (and renumbers `mate` to follow the corners). Returns the flip of each face.
+std::vector<uint8_t> orient(std::vector<uint32_t> &t, std::vector<uint32_t> &mate,
+                            const std::vector<uint32_t> &origin, RepairReport &r) {
   const uint32_t nf = static_cast<uint32_t>(t.size() / 3);
   std::vector<uint8_t> flip(nf, 0), seen(nf, 0);
   std::vector<uint32_t> piece; // faces of the current piece, in BFS order
@@ -242,6 +242,7 @@ void orient(std::vector<uint32_t> &t, std::vector<uint32_t> &mate,
     if (r.faces_flipped++ == 0)
       r.flipped_example = origin[f];
   }
+  return flip;
 }
 
 /// After orient(): a gluable edge stays glued iff its two faces now use it in opposite
@@ -351,7 +352,7 @@ std::string RepairReport::summary() const {
 
 // ------------------------------------------------------------------ make_manifold
 
-RepairReport make_manifold(Mesh &mesh) {
+RepairReport make_manifold(Mesh &mesh, RepairMap *map) {
   RepairReport r;
   const size_t nv = mesh.vertex_count();
   if (mesh.positions.size() % 3 != 0 || mesh.triangles.size() % 3 != 0)
@@ -371,7 +372,7 @@ RepairReport make_manifold(Mesh &mesh) {
   std::vector<uint32_t> t = mesh.triangles, origin;
   remove_bad_faces(t, nv, origin, r);
   std::vector<uint32_t> mate = find_mates(t, nv, r);
-  orient(t, mate, origin, r);
+  std::vector<uint8_t> flipped = orient(t, mate, origin, r);
   cut_nonorientable(t, mate, r);
 
   std::vector<uint32_t> copy_of;
@@ -391,6 +392,11 @@ RepairReport make_manifold(Mesh &mesh) {
     }
   }
 
+  if (map) {
+    map->copy_of = copy_of;
+    map->face_origin = std::move(origin);
+    map->flipped = std::move(flipped);
+  }
   if (!r.changed())
     return r; // bit for bit unchanged
   mesh.triangles = std::move(split);

@@ -1,0 +1,639 @@
+// The lossless record's coding (layout: docs/format.md, "LSLS section").
+//
+// One flags byte, then one range-coded stream: the six counts, then each part in the
+// order the decoder meets it. Index lists are coded as gaps (a run of neighbouring flipped
+// faces costs almost nothing), numbers as a magnitude class (adaptive) plus the bits below
+// the leading one (the first of them adaptive, the others raw).
+#include "lossless/lossless_record.h"
+
+#include <algorithm>
+#include <cstring>
+#include <string>
+
+#include "entropy/models.h"
+#include "entropy/range_coder.h"
+#include "mesh/corner_table.h"
+
+namespace pomar {
+
+namespace {
+
+constexpr uint8_t kHasOrder = 1;
+constexpr int kUintClasses = 34; // bit lengths 0..33
+
+/// An unsigned number as its bit length (adaptive) and the bits below the leading one.
+struct UintModel {
+  FrequencyModel classes{kUintClasses};
+  BitModel top[kUintClasses];
+};
+
+void put_u(RangeEncoder &rc, UintModel &m, uint64_t v) {
+  const int n = bit_length(v);
+  rc.encode(m.classes, n);
+  if (n < 2)
+    return;
+  int rest = n - 1;
+  rc.encode_bit(m.top[n], static_cast<int>((v >> (rest - 1)) & 1));
+  --rest;
+  const uint64_t low = v & ((uint64_t(1) << rest) - 1);
+  if (rest > 24) {
+    rc.encode_bypass(static_cast<uint32_t>(low >> 24), rest - 24);
+    rc.encode_bypass(static_cast<uint32_t>(low & 0xFFFFFF), 24);
+  } else if (rest > 0) {
+    rc.encode_bypass(static_cast<uint32_t>(low), rest);
+  }
+}
+
+uint64_t get_u(RangeDecoder &rc, UintModel &m) {
+  const int n = rc.decode(m.classes);
+  if (n < 2)
+    return static_cast<uint64_t>(n);
+  int rest = n - 1;
+  uint64_t v = 2 | static_cast<uint64_t>(rc.decode_bit(m.top[n]));
+  --rest;
+  if (rest > 24) {
+    v = (v << (rest - 24)) | rc.decode_bypass(rest - 24);
+    v = (v << 24) | rc.decode_bypass(24);
+  } else if (rest > 0) {
+    v = (v << rest) | rc.decode_bypass(rest);
+  }
+  return v;
+}
+
+/// Position groups: group[v] numbers the distinct positions of `mesh` (exact float bits).
+std::vector<uint32_t> position_groups(const Mesh &mesh) {
+  const uint32_t n = static_cast<uint32_t>(mesh.vertex_count());
+  std::vector<uint32_t> order(n), group(n);
+  for (uint32_t v = 0; v < n; ++v)
+    order[v] = v;
+  auto key = [&](uint32_t v) {
+    uint32_t k[3];
+    std::memcpy(k, &mesh.positions[3 * size_t(v)], sizeof k);
+    return std::array<uint32_t, 3>{k[0], k[1], k[2]};
+  };
+  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+    const auto ka = key(a), kb = key(b);
+    return ka != kb ? ka < kb : a < b;
+  });
+  uint32_t g = 0;
+  for (uint32_t i = 0; i < n; ++i) {
+    if (i > 0 && key(order[i]) != key(order[i - 1]))
+      ++g;
+    group[order[i]] = g;
+  }
+  return group;
+}
+
+/// The representatives met so far per position group (decoded vertices that are not
+/// copies), in decoding order: the candidates of a copy.
+struct Candidates {
+  std::vector<uint32_t> group, head, tail, count, next;
+  explicit Candidates(const Mesh &mesh) : group(position_groups(mesh)) {
+    const size_t n = group.size();
+    head.assign(n, kNoVertex);
+    tail.assign(n, kNoVertex);
+    count.assign(n, 0);
+    next.assign(n, kNoVertex);
+  }
+  static constexpr uint32_t kNoVertex = 0xFFFFFFFFu;
+  void add(uint32_t v) {
+    const uint32_t g = group[v];
+    if (tail[g] == kNoVertex)
+      head[g] = v;
+    else
+      next[tail[g]] = v;
+    tail[g] = v;
+    ++count[g];
+  }
+  uint32_t of(uint32_t v) const { return count[group[v]]; }
+  uint32_t nth(uint32_t v, uint32_t k) const {
+    uint32_t c = head[group[v]];
+    while (k--)
+      c = next[c];
+    return c;
+  }
+  uint32_t index_of(uint32_t v, uint32_t rep) const {
+    uint32_t k = 0;
+    for (uint32_t c = head[group[v]]; c != kNoVertex; c = next[c], ++k)
+      if (c == rep)
+        return k;
+    return kNoVertex;
+  }
+};
+
+/// All the adaptive models of a record.
+struct RecordModels {
+  UintModel counts, copy_gap, copy_index, flip_gap, dup_gap, dup_count, degen_gap, degen_b,
+      extra[3], order_symbol;
+  BitModel degen_single, extra_sign[3]; // sorted extra vertices: x rarely goes down
+};
+
+[[noreturn]] void damaged(const std::string &what) {
+  throw Error(Error::Kind::DamagedFile, "damaged .pomar file: lossless record: " + what);
+}
+
+/// Upper bound for a count read from a body of `size` bytes (an adaptive model can make a
+/// symbol cost very little, but not nothing): refuses absurd counts before allocating.
+uint64_t count_bound(size_t size) { return 16384 * uint64_t(size) + 1024; }
+
+LosslessCounts counts_of(const LosslessRecord &r) {
+  LosslessCounts n;
+  n.copies = r.copies.size();
+  n.flipped = r.flipped.size();
+  n.duplicated = r.duplicates.size();
+  for (const auto &d : r.duplicates)
+    n.duplicate_faces += d.second;
+  n.degenerate = r.degenerate.size();
+  n.extra = r.extra_q.size() / 3;
+  n.order = !r.order.empty();
+  return n;
+}
+
+/// The flags byte and the counts; leaves `rc` and `m` ready for the parts.
+LosslessCounts read_counts(const uint8_t *data, size_t size, RangeDecoder &rc, RecordModels &m) {
+  if (size < 1)
+    damaged("empty");
+  if (data[0] & ~kHasOrder)
+    damaged("unknown flags " + std::to_string(data[0]));
+  rc.reset(data + 1, size - 1);
+  LosslessCounts n;
+  n.order = (data[0] & kHasOrder) != 0;
+  n.copies = get_u(rc, m.counts);
+  n.flipped = get_u(rc, m.counts);
+  n.duplicated = get_u(rc, m.counts);
+  n.duplicate_faces = get_u(rc, m.counts);
+  n.degenerate = get_u(rc, m.counts);
+  n.extra = get_u(rc, m.counts);
+  const uint64_t bound = count_bound(size);
+  if (n.copies > 0xFFFFFFFFu || n.flipped > 0xFFFFFFFFu || n.duplicated > n.duplicate_faces ||
+      n.duplicate_faces > bound || n.degenerate > bound || n.extra > bound)
+    damaged("counts are larger than the record can hold");
+  return n;
+}
+
+/// A value in [0, total) as equally likely: up to 2^16 values in one step, else the high
+/// part (up to 2^16 values) then the low bits raw.
+void put_uniform(RangeEncoder &rc, uint32_t v, uint32_t total) {
+  const int shift = std::max(0, bit_length(total - 1) - 16);
+  rc.encode_uniform(v >> shift, ((total - 1) >> shift) + 1);
+  if (shift)
+    rc.encode_bypass(v & ((1u << shift) - 1), shift);
+}
+
+uint32_t get_uniform(RangeDecoder &rc, uint32_t total) {
+  const int shift = std::max(0, bit_length(total - 1) - 16);
+  uint32_t v = rc.decode_uniform(((total - 1) >> shift) + 1) << shift;
+  if (shift)
+    v |= rc.decode_bypass(shift);
+  return v;
+}
+
+/// Which of 0..n-1 are still unused, with rank queries (Fenwick tree of counts).
+class UnusedSet {
+public:
+  explicit UnusedSet(uint32_t n) : tree_(n + 1, 0), left_(n) {
+    for (uint32_t i = 1; i <= n; ++i) {
+      tree_[i] += 1;
+      const uint32_t j = i + (i & (0u - i));
+      if (j <= n)
+        tree_[j] += tree_[i];
+    }
+  }
+  uint32_t left() const { return left_; }
+  /// Unused items below v.
+  uint32_t rank(uint32_t v) const {
+    uint32_t s = 0;
+    for (; v > 0; v -= v & (0u - v))
+      s += tree_[v];
+    return s;
+  }
+  /// The unused item of rank k (k < left()).
+  uint32_t nth(uint32_t k) const {
+    uint32_t pos = 0;
+    for (uint32_t step = highest(); step; step >>= 1)
+      if (pos + step < tree_.size() && tree_[pos + step] <= k) {
+        pos += step;
+        k -= tree_[pos];
+      }
+    return pos;
+  }
+  bool used(uint32_t v) const { return rank(v + 1) == rank(v); }
+  void take(uint32_t v) {
+    for (uint32_t i = v + 1; i < tree_.size(); i += i & (0u - i))
+      --tree_[i];
+    --left_;
+  }
+
+private:
+  uint32_t highest() const {
+    uint32_t h = 1;
+    while (2 * h < tree_.size())
+      h *= 2;
+    return h;
+  }
+  std::vector<uint32_t> tree_;
+  uint32_t left_;
+};
+
+/// Vertex neighbours of a triangle list over n vertices: list[start[v] .. end[v]), sorted.
+struct Neighbours {
+  std::vector<uint32_t> start, end, list;
+  Neighbours(const std::vector<uint32_t> &t, uint32_t n) : start(n + 1, 0), end(n) {
+    for (size_t c = 0; c < t.size(); ++c)
+      start[t[c] + 1] += 2;
+    for (uint32_t v = 0; v < n; ++v)
+      start[v + 1] += start[v];
+    list.resize(start[n]);
+    std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+    for (size_t f = 0; f < t.size() / 3; ++f)
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t v = t[3 * f + k];
+        list[fill[v]++] = t[3 * f + (k + 1) % 3];
+        list[fill[v]++] = t[3 * f + (k + 2) % 3];
+      }
+    for (uint32_t v = 0; v < n; ++v) {
+      auto b = list.begin() + start[v], e = list.begin() + start[v + 1];
+      std::sort(b, e);
+      end[v] = start[v] + static_cast<uint32_t>(std::unique(b, e) - b);
+    }
+  }
+};
+
+/// Candidates for the output vertex of the next input vertex, after `prev`'s: the next
+/// unused output vertex after prev (symbol 1), then prev's unused neighbours (2, 3, ...);
+/// symbol 0 is "none of them" (then the rank among all unused vertices follows).
+template <class Visit>
+void order_candidates(const Neighbours &nb, const UnusedSet &unused, uint32_t prev, Visit visit) {
+  uint32_t symbol = 1;
+  const uint32_t r = unused.rank(prev + 1);
+  uint32_t following = r < unused.left() ? unused.nth(r) : kNone;
+  if (following != kNone && visit(following, symbol++))
+    return;
+  for (uint32_t i = nb.start[prev]; i < nb.end[prev]; ++i) {
+    const uint32_t w = nb.list[i];
+    if (w == following || unused.used(w))
+      continue;
+    if (visit(w, symbol++))
+      return;
+  }
+}
+
+} // namespace
+
+LosslessCounts read_lossless_counts(const uint8_t *data, size_t size) {
+  RangeDecoder rc;
+  RecordModels m;
+  return read_counts(data, size, rc, m);
+}
+
+std::vector<uint32_t> canonical_face_order(const std::vector<uint32_t> &t) {
+  const uint32_t nf = static_cast<uint32_t>(t.size() / 3);
+  std::vector<std::array<uint32_t, 3>> key(nf);
+  for (uint32_t f = 0; f < nf; ++f) {
+    const uint32_t *v = &t[3 * size_t(f)];
+    const int k = v[0] < v[1] ? (v[0] < v[2] ? 0 : 2) : (v[1] < v[2] ? 1 : 2);
+    key[f] = {v[k], v[(k + 1) % 3], v[(k + 2) % 3]};
+  }
+  std::vector<uint32_t> order(nf);
+  for (uint32_t f = 0; f < nf; ++f)
+    order[f] = f;
+  std::sort(order.begin(), order.end(),
+            [&](uint32_t a, uint32_t b) { return key[a] != key[b] ? key[a] < key[b] : a < b; });
+  return order;
+}
+
+std::vector<uint8_t> write_lossless_record(const LosslessRecord &r, const Mesh &decoded) {
+  std::vector<uint8_t> out;
+  out.push_back(r.order.empty() ? 0 : kHasOrder);
+  RangeEncoder rc(&out);
+  RecordModels m;
+  const LosslessCounts n = counts_of(r);
+  put_u(rc, m.counts, n.copies);
+  put_u(rc, m.counts, n.flipped);
+  put_u(rc, m.counts, n.duplicated);
+  put_u(rc, m.counts, n.duplicate_faces);
+  put_u(rc, m.counts, n.degenerate);
+  put_u(rc, m.counts, n.extra);
+
+  // Copies: a gap over the vertices whose position repeats a representative's, then which
+  // representative (only when there are several).
+  if (!r.copies.empty()) {
+    Candidates cand(decoded);
+    size_t next = 0, position = 0, last = 0;
+    for (uint32_t v = 0; v < decoded.vertex_count(); ++v) {
+      const uint32_t k = cand.of(v);
+      if (k == 0) {
+        cand.add(v);
+        continue;
+      }
+      if (next < r.copies.size() && r.copies[next].first == v) {
+        const uint32_t i = cand.index_of(v, r.copies[next].second);
+        if (i == Candidates::kNoVertex)
+          throw Error(Error::Kind::Internal,
+                      "internal lossless error: a vertex copy is not at its original's position");
+        put_u(rc, m.copy_gap, position - last);
+        if (k > 1)
+          put_u(rc, m.copy_index, i);
+        last = position + 1;
+        ++next;
+      } else {
+        cand.add(v);
+      }
+      ++position;
+    }
+    if (next != r.copies.size())
+      throw Error(Error::Kind::Internal, "internal lossless error: vertex copies out of order");
+  }
+  uint64_t last = 0;
+  for (uint32_t f : r.flipped) {
+    put_u(rc, m.flip_gap, f - last);
+    last = uint64_t(f) + 1;
+  }
+  last = 0;
+  for (const auto &d : r.duplicates) {
+    put_u(rc, m.dup_gap, d.first - last);
+    put_u(rc, m.dup_count, d.second - 1);
+    last = uint64_t(d.first) + 1;
+  }
+  last = 0;
+  for (const auto &d : r.degenerate) {
+    put_u(rc, m.degen_gap, d[0] - last);
+    last = d[0];
+    rc.encode_bit(m.degen_single, d[0] == d[1]);
+    if (d[0] != d[1])
+      put_u(rc, m.degen_b, d[1]);
+  }
+  int32_t prev[3] = {0, 0, 0};
+  for (size_t i = 0; i < r.extra_q.size(); ++i) {
+    const int k = static_cast<int>(i % 3);
+    const int64_t d = int64_t(r.extra_q[i]) - prev[k];
+    put_u(rc, m.extra[k], static_cast<uint64_t>(d < 0 ? -d : d));
+    if (d != 0)
+      rc.encode_bit(m.extra_sign[k], d < 0);
+    prev[k] = r.extra_q[i];
+  }
+  if (!r.order.empty()) {
+    LosslessRecord without = r;
+    without.order.clear();
+    const Mesh mesh = apply_lossless_record(decoded, without, Quantizer());
+    const uint32_t n = static_cast<uint32_t>(mesh.vertex_count());
+    if (r.order.size() != n)
+      throw Error(Error::Kind::Internal,
+                  "internal lossless error: the vertex order does not fit the mesh");
+    std::vector<uint32_t> output_of(n);
+    for (uint32_t o = 0; o < n; ++o)
+      output_of[r.order[o]] = o;
+    const Neighbours nb(mesh.triangles, n);
+    UnusedSet unused(n);
+    for (uint32_t i = 0, prev = 0; i < n; ++i) {
+      const uint32_t o = output_of[i];
+      uint32_t symbol = 0;
+      if (i > 0) {
+        order_candidates(nb, unused, prev, [&](uint32_t w, uint32_t s) {
+          if (w != o)
+            return false;
+          symbol = s;
+          return true;
+        });
+        put_u(rc, m.order_symbol, symbol);
+      }
+      if (symbol == 0)
+        put_uniform(rc, unused.rank(o), unused.left());
+      unused.take(o);
+      prev = o;
+    }
+  }
+  rc.finish();
+  return out;
+}
+
+LosslessRecord read_lossless_record(const uint8_t *data, size_t size, const Mesh &decoded,
+                                    int bits) {
+  RangeDecoder rc;
+  RecordModels m;
+  const LosslessCounts n = read_counts(data, size, rc, m);
+  const uint64_t nv = decoded.vertex_count(), nf = decoded.triangle_count();
+  const uint64_t copies = n.copies, flipped = n.flipped, duplicates = n.duplicated,
+                 degenerate = n.degenerate, extra = n.extra;
+  if (copies >= std::max<uint64_t>(nv, 1) || flipped > nf || duplicates > nf)
+    damaged("counts do not fit the decoded mesh");
+  if (n.vertices(nv) > 0xFFFFFFFEu || n.faces(nf) > 0xFFFFFFFEu)
+    damaged("counts are larger than the record can hold");
+  LosslessRecord r;
+  if (copies) {
+    Candidates cand(decoded);
+    r.copies.reserve(copies);
+    uint64_t gap = get_u(rc, m.copy_gap);
+    for (uint32_t v = 0; v < nv; ++v) {
+      const uint32_t k = cand.of(v);
+      if (k == 0 || r.copies.size() == copies) {
+        cand.add(v);
+        continue;
+      }
+      if (gap > 0) {
+        --gap;
+        cand.add(v);
+        continue;
+      }
+      const uint64_t i = k > 1 ? get_u(rc, m.copy_index) : 0;
+      if (i >= k)
+        damaged("vertex " + std::to_string(v) + " is a copy of a vertex that does not exist");
+      r.copies.push_back({v, cand.nth(v, static_cast<uint32_t>(i))});
+      if (r.copies.size() < copies)
+        gap = get_u(rc, m.copy_gap);
+    }
+    if (r.copies.size() != copies)
+      damaged("vertex copies past the last decoded vertex");
+  }
+  uint64_t at = 0;
+  r.flipped.reserve(flipped);
+  for (uint64_t i = 0; i < flipped; ++i) {
+    at += get_u(rc, m.flip_gap);
+    if (at >= nf)
+      damaged("flipped face past the last face");
+    r.flipped.push_back(static_cast<uint32_t>(at++));
+  }
+  at = 0;
+  r.duplicates.reserve(duplicates);
+  uint64_t copies_of_faces = 0;
+  for (uint64_t i = 0; i < duplicates; ++i) {
+    at += get_u(rc, m.dup_gap);
+    const uint64_t k = get_u(rc, m.dup_count) + 1;
+    copies_of_faces += k;
+    if (at >= nf)
+      damaged("duplicated face past the last face");
+    if (copies_of_faces > n.duplicate_faces)
+      damaged("more duplicate faces than counted");
+    r.duplicates.push_back({static_cast<uint32_t>(at++), static_cast<uint32_t>(k)});
+  }
+  if (copies_of_faces != n.duplicate_faces)
+    damaged("fewer duplicate faces than counted");
+  const uint64_t out_vertices = nv - copies + extra;
+  at = 0;
+  r.degenerate.reserve(degenerate);
+  for (uint64_t i = 0; i < degenerate; ++i) {
+    at += get_u(rc, m.degen_gap);
+    const uint64_t b = rc.decode_bit(m.degen_single) ? at : get_u(rc, m.degen_b);
+    if (at >= out_vertices || b >= out_vertices)
+      damaged("degenerate face uses a vertex past the last one");
+    r.degenerate.push_back({static_cast<uint32_t>(at), static_cast<uint32_t>(b)});
+  }
+  const int64_t top = (int64_t(1) << bits) - 1;
+  int64_t prev[3] = {0, 0, 0};
+  r.extra_q.reserve(3 * extra);
+  for (uint64_t i = 0; i < 3 * extra; ++i) {
+    const int k = static_cast<int>(i % 3);
+    int64_t d = static_cast<int64_t>(get_u(rc, m.extra[k]));
+    if (d != 0 && rc.decode_bit(m.extra_sign[k]))
+      d = -d;
+    const int64_t q = prev[k] + d;
+    if (q < 0 || q > top)
+      damaged("vertex position off the grid");
+    r.extra_q.push_back(static_cast<int32_t>(q));
+    prev[k] = q;
+  }
+  if (data[0] & kHasOrder) {
+    const Mesh mesh = apply_lossless_record(decoded, r, Quantizer());
+    const uint32_t n = static_cast<uint32_t>(mesh.vertex_count());
+    const Neighbours nb(mesh.triangles, n);
+    UnusedSet unused(n);
+    r.order.resize(n);
+    for (uint32_t i = 0, prev = 0; i < n; ++i) {
+      const uint64_t symbol = i > 0 ? get_u(rc, m.order_symbol) : 0;
+      uint32_t o = kNone;
+      if (symbol == 0) {
+        const uint32_t k = get_uniform(rc, unused.left());
+        if (k >= unused.left())
+          damaged("vertex order: rank past the last vertex");
+        o = unused.nth(k);
+      } else {
+        order_candidates(nb, unused, prev, [&](uint32_t w, uint32_t s) {
+          if (s != symbol)
+            return false;
+          o = w;
+          return true;
+        });
+        if (o == kNone)
+          damaged("vertex order: input vertex " + std::to_string(i) + " has no output vertex");
+      }
+      r.order[o] = i;
+      unused.take(o);
+      prev = o;
+    }
+  }
+  if (rc.overrun())
+    damaged("the data ends too early");
+  return r;
+}
+
+Mesh apply_lossless_record(const Mesh &decoded, const LosslessRecord &r, const Quantizer &grid,
+                           std::vector<uint32_t> *source) {
+  const uint32_t nv = static_cast<uint32_t>(decoded.vertex_count());
+  std::vector<uint32_t> out_of(nv, kNone);
+  Mesh out;
+  const size_t extra = r.extra_q.size() / 3;
+  out.positions.reserve(3 * (nv - r.copies.size() + extra));
+  size_t next_copy = 0;
+  uint32_t next = 0;
+  for (uint32_t v = 0; v < nv; ++v) {
+    if (next_copy < r.copies.size() && r.copies[next_copy].first == v) {
+      out_of[v] = out_of[r.copies[next_copy++].second];
+      continue;
+    }
+    out_of[v] = next++;
+    out.positions.insert(out.positions.end(), &decoded.positions[3 * size_t(v)],
+                         &decoded.positions[3 * size_t(v)] + 3);
+  }
+  for (size_t i = 0; i < r.extra_q.size(); ++i)
+    out.positions.push_back(grid.dequantize(static_cast<int>(i % 3), uint32_t(r.extra_q[i])));
+
+  const std::vector<uint32_t> order = canonical_face_order(decoded.triangles);
+  size_t faces = order.size() + r.degenerate.size();
+  for (const auto &d : r.duplicates)
+    faces += d.second;
+  out.triangles.reserve(3 * faces);
+  size_t flip = 0, dup = 0;
+  for (uint32_t i = 0; i < order.size(); ++i) {
+    const uint32_t *t = &decoded.triangles[3 * size_t(order[i])];
+    uint32_t f[3] = {out_of[t[0]], out_of[t[1]], out_of[t[2]]};
+    if (flip < r.flipped.size() && r.flipped[flip] == i) {
+      std::swap(f[1], f[2]);
+      ++flip;
+    }
+    uint32_t n = 1;
+    if (dup < r.duplicates.size() && r.duplicates[dup].first == i)
+      n += r.duplicates[dup++].second;
+    for (uint32_t k = 0; k < n; ++k)
+      out.triangles.insert(out.triangles.end(), f, f + 3);
+  }
+  for (const auto &d : r.degenerate) {
+    const uint32_t f[3] = {d[0], d[0], d[1]};
+    out.triangles.insert(out.triangles.end(), f, f + 3);
+  }
+
+  // Attributes: an output vertex has those of the decoded vertex it comes from (its copies
+  // carry the same values: the cut copies attributes). The encoder stores no unreferenced
+  // vertex for a mesh with attributes (lossless_stage.cpp), so a record that has both is
+  // damaged.
+  out.texture_files = decoded.texture_files;
+  if (!decoded.attributes.empty() && extra != 0)
+    damaged("unreferenced vertices in a mesh with attributes");
+  for (const VertexAttribute &a : decoded.attributes) {
+    VertexAttribute b = a;
+    const size_t n = a.components;
+    auto keep_representatives = [&](auto &values) {
+      size_t at = 0;
+      for (uint32_t v = 0, c = 0; v < nv; ++v) {
+        if (c < r.copies.size() && r.copies[c].first == v) {
+          ++c;
+          continue;
+        }
+        for (size_t k = 0; k < n; ++k)
+          values[at++] = values[v * n + k];
+      }
+      values.resize(at);
+    };
+    if (a.kind == AttributeKind::Colour)
+      keep_representatives(b.colour);
+    else
+      keep_representatives(b.values);
+    out.attributes.push_back(std::move(b));
+  }
+
+  if (!r.order.empty()) {
+    // Output vertex o is input vertex order[o]: renumber.
+    if (r.order.size() != out.vertex_count())
+      damaged("the vertex order does not fit the mesh");
+    std::vector<float> p(out.positions.size());
+    for (size_t o = 0; o < r.order.size(); ++o)
+      std::copy(&out.positions[3 * o], &out.positions[3 * o] + 3, &p[3 * size_t(r.order[o])]);
+    out.positions.swap(p);
+    for (uint32_t &v : out.triangles)
+      v = r.order[v];
+    for (VertexAttribute &a : out.attributes) {
+      const size_t n = a.components;
+      auto permute = [&](auto &values) {
+        auto moved = values;
+        for (size_t o = 0; o < r.order.size(); ++o)
+          for (size_t k = 0; k < n; ++k)
+            moved[size_t(r.order[o]) * n + k] = values[o * n + k];
+        values.swap(moved);
+      };
+      if (a.kind == AttributeKind::Colour)
+        permute(a.colour);
+      else
+        permute(a.values);
+    }
+  }
+  if (source) {
+    source->assign(out.vertex_count(), kNone);
+    for (uint32_t v = 0; v < nv; ++v) {
+      const uint32_t o = r.order.empty() ? out_of[v] : r.order[out_of[v]];
+      if ((*source)[o] == kNone)
+        (*source)[o] = v;
+    }
+  }
+  return out;
+}
+
+} // namespace pomar

@@ -1,0 +1,55 @@
+// The lossless stage: the codec's first stage on encode (cut the mesh into a manifold,
+// oriented one, remember what changed) and its last on a full decode (undo the cut).
+// docs/architecture.md, "The lossless stage".
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "lossless/lossless_record.h"
+#include "pomar/pomar.h"
+#include "pomar/repair.h"
+
+namespace pomar {
+
+struct FileLayout;
+
+/// What the lossless stage asks of the manifold encoder (encode_manifold).
+struct LosslessHook {
+  /// The grid to use instead of the bounding box of the coded vertices (it also covers the
+  /// vertices no coded face uses).
+  Quantizer grid;
+  /// Called once the decoder's numbering is known (decoded vertex i is vertex
+  /// decoded_to_cut[i] of the mesh given to encode_manifold); returns the LSLS body.
+  std::function<std::vector<uint8_t>(const std::vector<uint32_t> &decoded_to_cut)> record;
+};
+
+/// The codec proper (codec/src/encode/encoder.cpp): a manifold, oriented mesh; unreferenced
+/// vertices are dropped. With a hook, the file is version 4 and carries the record.
+std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &options,
+                                     EncodeReport *report, const LosslessHook *hook);
+
+/// The manifold encoder's checks of the input that do not depend on its topology (bits,
+/// array sizes, no triangle, NaN/Inf); throws pomar::Error.
+void check_encode_input(const Mesh &mesh, const EncodeOptions &options);
+
+/// The record for `input` cut into `cut` by make_manifold (with `map`), when a full decode
+/// numbers cut vertex decoded_to_cut[i] as i. `decoded` receives that full decode (D) and
+/// `output_to_input` what input vertex each vertex of the decoded output is.
+LosslessRecord build_lossless_record(const Mesh &input, const Mesh &cut, const RepairMap &map,
+                                     const std::vector<uint32_t> &decoded_to_cut,
+                                     const Quantizer &grid, bool keep_order, Mesh &decoded,
+                                     std::vector<uint32_t> &output_to_input);
+
+/// inspect(): the input's counts from a lossless record's counts, if the file has one (its
+/// checksum is checked).
+void lossless_info(const uint8_t *data, const FileLayout &layout, FileInfo &info);
+
+/// A full decode's last stage: if the file carries a lossless record, undo the cut on the
+/// decoded mesh (`data` holds the whole file).
+/// `source` (optional): see apply_lossless_record (the identity when there is no record).
+void undo_cut(const uint8_t *data, const FileLayout &layout, Mesh &decoded,
+              std::vector<uint32_t> *source = nullptr);
+
+} // namespace pomar
