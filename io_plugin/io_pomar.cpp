@@ -380,9 +380,6 @@ bool PomarIOPlugin::save(const QString &format, const QString &fileName, MeshMod
     pomar::EncodeReport report;
     bytes = pomar::encode(mesh, options, &report);
     stored = QString::fromStdString(report.lossless.summary());
-    if (report.unreferenced_vertices > 0 && !report.lossless.unreferenced_vertices)
-      dropped << QString("%1 vertices no face uses (their attributes cannot be stored yet)")
-                     .arg(report.unreferenced_vertices);
   } catch (const std::exception &e) { // pomar::Error (invalid mesh or options), std::bad_alloc
     return fail(pomar::meshlab::errorText(e, "cannot save " + path));
   }

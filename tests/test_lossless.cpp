@@ -361,3 +361,62 @@ TEST(Lossless, RecordReaderRejectsGarbage) {
 
 } // namespace
 } // namespace pomar
+
+namespace pomar {
+namespace {
+
+// Attributes ride through the lossless stage: cut copies carry their vertex's values, and
+// vertices no face uses (which the levels never code) get theirs back bit for bit from the
+// record; with keep_order too.
+TEST(Lossless, AttributesOfEveryVertexComeBackWithTheMessyMesh) {
+  Mesh m = messy_sphere(2);
+  const size_t nv = m.vertex_count();
+  VertexAttribute colour, normal, quality;
+  colour.kind = AttributeKind::Colour;
+  colour.name = "colour";
+  colour.components = 4;
+  normal.kind = AttributeKind::Normal;
+  normal.name = "normal";
+  normal.components = 3;
+  quality.kind = AttributeKind::Scalar;
+  quality.name = "quality";
+  for (size_t v = 0; v < nv; ++v) {
+    for (int k = 0; k < 4; ++k)
+      colour.colour.push_back(static_cast<uint8_t>(v * 37 + k * 91));
+    const float x = m.positions[3 * v], y = m.positions[3 * v + 1], z = m.positions[3 * v + 2];
+    const float len = std::sqrt(x * x + y * y + z * z);
+    normal.values.insert(normal.values.end(), {x / len, y / len, z / len});
+    quality.values.push_back(0.001f * float(v) - 0.25f);
+  }
+  m.attributes = {colour, normal, quality};
+  for (bool keep_order : {false, true}) {
+    EncodeOptions o;
+    o.keep_order = keep_order;
+    const EncodeReport r = expect_exact(m, o);
+    ASSERT_GT(r.lossless.unreferenced_vertices, 0u);
+    EncodeReport again;
+    const std::vector<uint8_t> file = encode(m, o, &again);
+    const Mesh out = decode(file.data(), file.size());
+    ASSERT_EQ(out.vertex_count(), nv);
+    const VertexAttribute *c = out.find(AttributeKind::Colour);
+    const VertexAttribute *n = out.find(AttributeKind::Normal);
+    const VertexAttribute *q = out.find(AttributeKind::Scalar, "quality");
+    ASSERT_TRUE(c && n && q);
+    ASSERT_EQ(c->vertex_count(), nv);
+    ASSERT_EQ(n->vertex_count(), nv);
+    ASSERT_EQ(q->vertex_count(), nv);
+    for (size_t i = 0; i < nv; ++i) {
+      const uint32_t v = again.decoded_to_input[i];
+      for (int k = 0; k < 4; ++k)
+        EXPECT_EQ(c->colour[4 * i + k], colour.colour[4 * v + k]) << "vertex " << v;
+      double dot = 0;
+      for (int k = 0; k < 3; ++k)
+        dot += double(n->values[3 * i + k]) * normal.values[3 * v + k];
+      EXPECT_GT(dot, std::cos(n->bound * M_PI / 180.0) - 1e-6) << "vertex " << v;
+      EXPECT_NEAR(q->values[i], quality.values[v], q->bound + 1e-7) << "vertex " << v;
+    }
+  }
+}
+
+} // namespace
+} // namespace pomar

@@ -685,10 +685,7 @@ int run_verify(const std::string &original, const std::string &file, const std::
   const std::vector<uint8_t> data = pomar::read_file(file);
   const pomar::FileInfo info = pomar::inspect(data.data(), data.size());
   // A file without a lossless record (encode --strict, or older) has no unreferenced vertex.
-  // With attributes, unreferenced vertices are not stored either (their attributes are not yet).
-  const size_t dropped = info.lossless_bytes == 0 || !info.attributes.empty()
-                             ? pomar::drop_unreferenced_vertices(ref)
-                             : 0;
+  const size_t dropped = info.lossless_bytes == 0 ? pomar::drop_unreferenced_vertices(ref) : 0;
   const bool could_repair = !repair && info.lossless_bytes == 0 && pomar::repair_would_change(ref);
   const pomar::Mesh out =
       decoded.empty() ? pomar::decode(data.data(), data.size()) : pomar::load_mesh(decoded);

@@ -19,6 +19,7 @@ namespace pomar {
 namespace {
 
 constexpr uint8_t kHasOrder = 1;
+constexpr uint8_t kHasAttributes = 2; // the extra vertices' attributes end the stream
 constexpr int kUintClasses = 34; // bit lengths 0..33
 
 /// An unsigned number as its bit length (adaptive) and the bits below the leading one.
@@ -153,7 +154,7 @@ LosslessCounts counts_of(const LosslessRecord &r) {
 LosslessCounts read_counts(const uint8_t *data, size_t size, RangeDecoder &rc, RecordModels &m) {
   if (size < 1)
     damaged("empty");
-  if (data[0] & ~kHasOrder)
+  if (data[0] & ~(kHasOrder | kHasAttributes))
     damaged("unknown flags " + std::to_string(data[0]));
   rc.reset(data + 1, size - 1);
   LosslessCounts n;
@@ -302,9 +303,80 @@ std::vector<uint32_t> canonical_face_order(const std::vector<uint32_t> &t) {
   return order;
 }
 
+/// The extra vertices' attributes, raw: a count, then per attribute its kind, components
+/// and name, then its values (colour bytes as 8 bits, floats as their 32 bits, high half
+/// first), all as equiprobable bits.
+void write_extra_attributes(RangeEncoder &rc, const std::vector<VertexAttribute> &attributes) {
+  if (attributes.empty())
+    return;
+  rc.encode_bypass(static_cast<uint32_t>(attributes.size()), 8);
+  for (const VertexAttribute &a : attributes) {
+    rc.encode_bypass(static_cast<uint32_t>(a.kind), 8);
+    rc.encode_bypass(a.components, 8);
+    rc.encode_bypass(static_cast<uint32_t>(a.name.size()), 8);
+    for (char c : a.name)
+      rc.encode_bypass(static_cast<uint8_t>(c), 8);
+  }
+  for (const VertexAttribute &a : attributes) {
+    for (uint8_t c : a.colour)
+      rc.encode_bypass(c, 8);
+    for (float f : a.values) {
+      uint32_t bits;
+      std::memcpy(&bits, &f, 4);
+      rc.encode_bypass(bits >> 16, 16);
+      rc.encode_bypass(bits & 0xFFFF, 16);
+    }
+  }
+}
+
+std::vector<VertexAttribute> read_extra_attributes(RangeDecoder &rc, uint64_t extra,
+                                                   size_t size) {
+  const uint32_t count = rc.decode_bypass(8);
+  if (count == 0)
+    damaged("attribute flag without attributes");
+  std::vector<VertexAttribute> out(count);
+  for (VertexAttribute &a : out) {
+    const uint32_t kind = rc.decode_bypass(8);
+    if (kind < 1 || kind > 4)
+      damaged("unknown attribute kind " + std::to_string(kind));
+    a.kind = static_cast<AttributeKind>(kind);
+    a.components = rc.decode_bypass(8);
+    if (a.components < 1 || a.components > 4)
+      damaged("attribute with " + std::to_string(a.components) + " components");
+    const uint32_t length = rc.decode_bypass(8);
+    if (length == 0)
+      damaged("attribute without a name");
+    for (uint32_t i = 0; i < length; ++i)
+      a.name += static_cast<char>(rc.decode_bypass(8));
+  }
+  for (VertexAttribute &a : out) {
+    // Every value takes at least a byte of the record: refuse counts the data cannot hold
+    // before allocating for them.
+    const uint64_t values = extra * a.components;
+    if (values > size)
+      damaged("more attribute values than the record holds");
+    if (a.kind == AttributeKind::Colour) {
+      a.colour.resize(values);
+      for (uint8_t &c : a.colour)
+        c = static_cast<uint8_t>(rc.decode_bypass(8));
+    } else {
+      a.values.resize(values);
+      for (float &f : a.values) {
+        const uint32_t high = rc.decode_bypass(16);
+        const uint32_t bits = (high << 16) | rc.decode_bypass(16);
+        std::memcpy(&f, &bits, 4);
+      }
+    }
+    if (rc.overrun())
+      damaged("the attributes of unreferenced vertices end too early");
+  }
+  return out;
+}
+
 std::vector<uint8_t> write_lossless_record(const LosslessRecord &r, const Mesh &decoded) {
   std::vector<uint8_t> out;
-  out.push_back(r.order.empty() ? 0 : kHasOrder);
+  out.push_back(uint8_t((r.order.empty() ? 0 : kHasOrder) |
+                        (r.extra_attributes.empty() ? 0 : kHasAttributes)));
   RangeEncoder rc(&out);
   RecordModels m;
   const LosslessCounts n = counts_of(r);
@@ -403,6 +475,7 @@ std::vector<uint8_t> write_lossless_record(const LosslessRecord &r, const Mesh &
       prev = o;
     }
   }
+  write_extra_attributes(rc, r.extra_attributes);
   rc.finish();
   return out;
 }
@@ -493,7 +566,12 @@ LosslessRecord read_lossless_record(const uint8_t *data, size_t size, const Mesh
     prev[k] = q;
   }
   if (data[0] & kHasOrder) {
-    const Mesh mesh = apply_lossless_record(decoded, r, Quantizer());
+    // The order is coded against the output's faces: its shape only (the attributes of the
+    // extra vertices come after the order).
+    Mesh shape;
+    shape.positions = decoded.positions;
+    shape.triangles = decoded.triangles;
+    const Mesh mesh = apply_lossless_record(shape, r, Quantizer());
     const uint32_t n = static_cast<uint32_t>(mesh.vertex_count());
     const Neighbours nb(mesh.triangles, n);
     UnusedSet unused(n);
@@ -521,6 +599,8 @@ LosslessRecord read_lossless_record(const uint8_t *data, size_t size, const Mesh
       prev = o;
     }
   }
+  if (data[0] & kHasAttributes)
+    r.extra_attributes = read_extra_attributes(rc, extra, size);
   if (rc.overrun())
     damaged("the data ends too early");
   return r;
@@ -572,14 +652,22 @@ Mesh apply_lossless_record(const Mesh &decoded, const LosslessRecord &r, const Q
   }
 
   // Attributes: an output vertex has those of the decoded vertex it comes from (its copies
-  // carry the same values: the cut copies attributes). The encoder stores no unreferenced
-  // vertex for a mesh with attributes (lossless_stage.cpp), so a record that has both is
-  // damaged.
+  // carry the same values: the cut copies attributes); the extra vertices, those the record
+  // stores (bit for bit).
   out.texture_files = decoded.texture_files;
-  if (!decoded.attributes.empty() && extra != 0)
-    damaged("unreferenced vertices in a mesh with attributes");
   for (const VertexAttribute &a : decoded.attributes) {
     VertexAttribute b = a;
+    // The extra vertices' values of this attribute (none: a record without attributes,
+    // e.g. written for a mesh that had none).
+    const VertexAttribute *x = nullptr;
+    for (const VertexAttribute &e : r.extra_attributes)
+      if (e.kind == a.kind && e.name == a.name && e.components == a.components)
+        x = &e;
+    if (extra != 0 && (x == nullptr || x->vertex_count() != extra))
+      damaged("no " + std::string(kind_name(a.kind)) + " '" + a.name +
+              "' for the vertices no face uses");
+    if (a.vertex_count() != nv)
+      damaged("attribute '" + a.name + "' does not fit the decoded mesh");
     const size_t n = a.components;
     auto keep_representatives = [&](auto &values) {
       size_t at = 0;
@@ -597,6 +685,10 @@ Mesh apply_lossless_record(const Mesh &decoded, const LosslessRecord &r, const Q
       keep_representatives(b.colour);
     else
       keep_representatives(b.values);
+    if (x != nullptr && extra != 0) {
+      b.colour.insert(b.colour.end(), x->colour.begin(), x->colour.end());
+      b.values.insert(b.values.end(), x->values.begin(), x->values.end());
+    }
     out.attributes.push_back(std::move(b));
   }
 

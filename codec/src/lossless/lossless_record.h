@@ -41,7 +41,10 @@ struct LosslessRecord {
   std::vector<int32_t> extra_q;
   /// Empty, or for each output vertex the input vertex it is (a permutation).
   std::vector<uint32_t> order;
-  // Attributes of the extra vertices (issue 12) will follow the positions here.
+  /// The attributes of the extra vertices (their values in extra order, kind, name and
+  /// components as the input's), stored bit for bit: no face uses these vertices, so the
+  /// levels never code them.
+  std::vector<VertexAttribute> extra_attributes;
 
   bool empty() const {
     return copies.empty() && flipped.empty() && duplicates.empty() && degenerate.empty() &&

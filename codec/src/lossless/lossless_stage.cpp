@@ -57,6 +57,26 @@ bool valid_topology(const Mesh &mesh) {
   return true;
 }
 
+/// The levels code only vertices a face uses; the record keeps the others' attributes bit
+/// for bit. So that the attribute checks of the coded mesh do not refuse values the levels
+/// never see (an OBJ vertex without a normal, a NaN), such vertices get a neutral value in
+/// the copy that is coded.
+void usable_attributes_for_unused_vertices(Mesh &cut) {
+  const size_t nv = cut.vertex_count();
+  std::vector<uint8_t> used(nv, 0);
+  for (uint32_t v : cut.triangles)
+    used[v] = 1;
+  for (VertexAttribute &a : cut.attributes) {
+    if (a.kind == AttributeKind::Colour || a.values.size() != nv * a.components)
+      continue;
+    for (size_t v = 0; v < nv; ++v)
+      if (!used[v])
+        for (uint32_t k = 0; k < a.components; ++k)
+          a.values[v * a.components + k] =
+              a.kind == AttributeKind::Normal && k == 2 ? 1.0f : 0.0f;
+  }
+}
+
 std::string plural(size_t n, const char *one, const char *many) {
   return std::to_string(n) + " " + (n == 1 ? one : many);
 }
@@ -138,6 +158,23 @@ LosslessRecord build_lossless_record(const Mesh &input, const Mesh &cut, const R
     output_to_input.push_back(v);
     r.extra_q.insert(r.extra_q.end(), q.begin(), q.end());
   }
+  // Their attributes, as the input has them (the levels never code these vertices).
+  if (!extra.empty())
+    for (const VertexAttribute &a : input.attributes) {
+      VertexAttribute x;
+      x.kind = a.kind;
+      x.name = a.name;
+      x.components = a.components;
+      const size_t n = a.components;
+      for (const auto &e : extra) {
+        const size_t v = e.second;
+        if (a.kind == AttributeKind::Colour)
+          x.colour.insert(x.colour.end(), &a.colour[v * n], &a.colour[v * n] + n);
+        else
+          x.values.insert(x.values.end(), &a.values[v * n], &a.values[v * n] + n);
+      }
+      r.extra_attributes.push_back(std::move(x));
+    }
 
   // Faces of D, and where each cut face comes in D's canonical order.
   const uint32_t nf = static_cast<uint32_t>(cut.triangle_count());
@@ -189,43 +226,10 @@ LosslessRecord build_lossless_record(const Mesh &input, const Mesh &cut, const R
   return r;
 }
 
-std::vector<uint8_t> encode(const Mesh &input_mesh, const EncodeOptions &options,
-                            EncodeReport *report) {
+std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, EncodeReport *report) {
   if (options.strict)
-    return encode_manifold(input_mesh, options, report, nullptr);
-  // Attributes of vertices no face uses are not stored yet (the lossless record keeps their
-  // positions only): with attributes, such vertices are dropped as before format version 4,
-  // and the report counts them (the CLI says "dropped").
-  Mesh compacted;
-  size_t dropped_with_attributes = 0;
-  if (!input_mesh.attributes.empty() && !all_vertices_used(input_mesh)) {
-    if (options.keep_order)
-      throw Error(Error::Kind::Usage,
-                  "keep_order (--keep-order) needs every vertex of a mesh with attributes to be "
-                  "used by a face: attributes of unreferenced vertices are not stored yet");
-    compacted = input_mesh;
-    dropped_with_attributes = drop_unreferenced_vertices(compacted);
-  }
-  const Mesh &mesh = dropped_with_attributes ? compacted : input_mesh;
-  if (dropped_with_attributes && report) {
-    // Whatever path codes it, the report names the input's unreferenced vertices dropped
-    // and maps decoded vertices to the caller's numbering.
-    std::vector<uint8_t> file = encode(mesh, options, report);
-    std::vector<uint32_t> compact_to_input;
-    std::vector<uint8_t> used(input_mesh.vertex_count(), 0);
-    for (uint32_t v : input_mesh.triangles)
-      used[v] = 1;
-    for (uint32_t v = 0; v < used.size(); ++v)
-      if (used[v])
-        compact_to_input.push_back(v);
-    for (uint32_t &v : report->decoded_to_input)
-      v = compact_to_input[v];
-    report->input_vertices = input_mesh.vertex_count();
-    report->unreferenced_vertices = dropped_with_attributes;
-    return file;
-  }
-  if (dropped_with_attributes)
-    return encode(mesh, options, report);
+    return encode_manifold(mesh, options, report, nullptr);
+
   if (!options.keep_order && all_vertices_used(mesh)) {
     // Most meshes are clean: code them as they are (the file is then byte for byte what
     // strict gives). The manifold encoder checks the topology early (its corner table);
@@ -243,6 +247,7 @@ std::vector<uint8_t> encode(const Mesh &input_mesh, const EncodeOptions &options
   Mesh cut = mesh;
   RepairMap map;
   const RepairReport repair = make_manifold(cut, &map); // checks the indices
+  usable_attributes_for_unused_vertices(cut);
   if (cut.triangle_count() == 0)
     throw Error(Error::Kind::InvalidMesh, "the mesh has no valid triangle: all " +
                                               std::to_string(mesh.triangle_count()) +
