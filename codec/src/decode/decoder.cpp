@@ -1,6 +1,7 @@
 // pomar::decode (a global level target decodes the global levels here; a clustered target
 // goes through the SelectiveDecoder), pomar::inspect, pomar::check_blocks,
 // pomar::describe_damage.
+#include <algorithm>
 #include <memory>
 #include <string>
 
@@ -130,6 +131,9 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
     return d.mesh();
   }
   LevelMesh lm = base_level_mesh(data, layout);
+  const size_t reach = std::min(target, global);
+  if (reach > 0)
+    lm.reserve(h.levels[reach - 1].vertices, h.levels[reach - 1].faces, size);
   Models models;
   r.level = static_cast<int>(decode_global_levels(data, layout, 0, std::min(target, global), lm,
                                                   models, options.progress,
