@@ -87,6 +87,7 @@ struct EncodeArgs {
   double cluster_ratio = 0.01;
   bool progressive = false, quiet = false, repair = false;
   std::string max_memory = "auto";
+  unsigned threads = 0;
 };
 
 int run_encode(const EncodeArgs &a) {
@@ -110,6 +111,7 @@ int run_encode(const EncodeArgs &a) {
   opt.clusters = a.clusters;
   opt.cluster_ratio = a.cluster_ratio;
   opt.progressive = a.progressive;
+  opt.threads = a.threads;
   opt.progress = terminal_progress(a.quiet);
   opt.memory_limit = memory_limit;
   pomar::EncodeReport r;
@@ -540,6 +542,10 @@ int main(int argc, char **argv) {
       ->capture_default_str();
   enc->add_flag("--progressive", ea.progressive,
                 "Pure progressive mode: global levels only, no random access (a little smaller)");
+  enc->add_option("--threads", ea.threads,
+                  "Threads for decimation (0 = every core this process may use); the output is the "
+                  "same for any number")
+      ->capture_default_str();
   enc->add_flag("--repair", ea.repair,
                 "Opt-in: first cut a non-manifold, inconsistently oriented or degenerate mesh into "
                 "a manifold one (remove faces repeating a vertex and exact duplicate faces, "
