@@ -34,7 +34,9 @@ if grep -Eq '^(\.\.\. )?io_pomar(:| |$)' <<<"$targets"; then
   cmake --build "$BUILD" --target io_pomar filter_pomar
   SUDO=()
   if [ "$(id -u)" -ne 0 ] && command -v sudo >/dev/null 2>&1; then SUDO=(sudo); fi
-  "${SUDO[@]}" cmake --install "$BUILD" --prefix /usr
+  # The tool and the plugins only (CMake's default component): the "library" and "python"
+  # components (cmake/PomarInstall.cmake, python/) are not built by this script.
+  "${SUDO[@]}" cmake --install "$BUILD" --prefix /usr --component Unspecified
 else
   echo
   echo "demo: no io_pomar target in $BUILD (MeshLab plugin not configured): skipping the plugin build, the install into /usr and the meshlabserver step"

@@ -24,7 +24,9 @@ PACKAGES=(
   libcli11-dev nlohmann-json3-dev libtinyobjloader-dev libxxhash-dev zlib1g-dev
   draco libdraco-dev
   time python3 clang
+  pybind11-dev python3-dev python3-numpy python3-pytest   # the Python module (python/) and its tests
   imagemagick x11-utils xdotool        # scripts/gui_screenshot.sh (GUI checks under Xvfb)
+  emscripten nodejs chromium           # web/: the WebAssembly decoder and its browser test
 )
 
 log() { printf 'setup: %s\n' "$*"; }

@@ -3,7 +3,8 @@
 # This is the project's test command (also run by .ci/run). Works from any directory.
 #
 # Release optimisation but with assertions enabled (no -DNDEBUG), so assert()s in the codec and in
-# vcglib are checked while the tests run; then the same suite again under ASan + UBSan (build-asan/),
+# vcglib are checked while the tests run; then the web tests (web/test/run.sh: the WebAssembly decoder
+# against the native one, the viewer in headless Chromium); then the same suite again under ASan + UBSan (build-asan/),
 # then a timed libFuzzer run of each fuzz target (build-fuzz/; POMAR_TEST_FUZZ_SECONDS, default 20,
 # 0 skips). Takes about 6 minutes from scratch on 2 cores (tests/fuzz/README.md has the breakdown).
 set -euo pipefail
@@ -26,6 +27,15 @@ cmake --build "$BUILD" -j "$JOBS"
 
 echo "test: running ctest"
 ctest --test-dir "$BUILD" --output-on-failure -j "$JOBS"
+
+# ---- web: the WebAssembly decoder and the viewer in headless Chromium -----------------------------
+# web/test/run.sh builds the decoder with emscripten (build-web-test/), checks WASM decode = native
+# decode bit for bit and that damaged inputs give messages (Node.js), then runs the viewer page in
+# headless Chromium. About 1-2 minutes on 2 cores; each part is skipped with a message when
+# emscripten, node or chromium is missing. POMAR_TEST_WEB=0 skips it.
+if [ "${POMAR_TEST_WEB:-1}" != 0 ]; then
+  JOBS="$JOBS" bash web/test/run.sh "$REPO/build-web-test" "$REPO/$BUILD/codec/pomar"
+fi
 
 # ---- ASan/UBSan pass -------------------------------------------------------------------------------
 # The same suite again, built with -fsanitize=address,undefined (POMAR_SANITIZE) in build-asan/.

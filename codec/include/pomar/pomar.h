@@ -3,7 +3,24 @@
 // This is the core API on flat arrays (positions + 32-bit triangle indices). It has no
 // dependency on vcglib; `pomar/vcg_adapter.h` converts from/to vcglib meshes and
 // `pomar/mesh_io.h` reads and writes PLY/OBJ/OFF/STL files.
+//
+// Installed as a CMake package (`find_package(pomar CONFIG)`: pomar::core for this header,
+// random_access.h, repair.h and limits.h; pomar::io adds mesh_io.h) and for pkg-config
+// (`pomar`). vcg_adapter.h is header-only and uses the program's own vcglib.
+//
+// Threads: the library has no global mutable state. Every free function (encode, decode,
+// inspect, check_blocks, make_manifold, load_mesh, save_mesh, ...) may be called from
+// several threads at once, on different or on the same (unmodified) inputs. An object
+// (SelectiveDecoder, FileSource, MemorySource) is used by one thread at a time; distinct
+// objects are independent. Callbacks (Progress, SizeCheck) run on the calling thread,
+// before the function returns. Nothing starts threads of its own.
+//
+// Ownership: functions take inputs by const reference or as (pointer, size) and do not
+// keep them after returning (exception: MemorySource, see random_access.h); results are
+// returned by value and belong to the caller.
 #pragma once
+
+#include "pomar/version.h"
 
 #include <cstddef>
 #include <cstdint>
@@ -13,6 +30,10 @@
 #include <vector>
 
 namespace pomar {
+
+/// The version of the library the program runs with, "MAJOR.MINOR.PATCH" (compare with
+/// the POMAR_VERSION_* macros of pomar/version.h, the headers it was compiled with).
+const char *version();
 
 /// Every failure of the library is reported as a pomar::Error whose what() is one line
 /// naming the problem (and, for invalid meshes, where: counts and one example).

@@ -7,6 +7,12 @@
 //   d.update();                                   // completes the level map, decodes
 //   pomar::Mesh m = d.mesh();                     // + d.vertex_cluster(), d.vertex_level()
 //   d.want_cluster(17, d.finest_level());  d.update();   // delta refinement
+//
+// Threads and ownership: a SelectiveDecoder owns its ByteSource and calls it only from
+// inside its own member functions; use each decoder (and each source) from one thread at a
+// time (several decoders on several threads are independent, also on the same file).
+// The const members (info, levels, mesh, ...) read state only and may be called
+// concurrently with each other, not with update() or a want_*() call.
 #pragma once
 
 #include <cstdint>
@@ -30,6 +36,8 @@ public:
   virtual void read(uint64_t offset, size_t n, uint8_t *out) = 0;
 };
 
+/// Bytes in memory. Does not copy them: `data` must stay valid and unchanged for the
+/// source's lifetime (and so for the lifetime of a SelectiveDecoder that owns it).
 class MemorySource : public ByteSource {
 public:
   MemorySource(const uint8_t *data, size_t size) : data_(data), size_(size) {}
@@ -41,6 +49,8 @@ private:
   size_t size_;
 };
 
+/// A file, opened by the constructor (throws pomar::Error naming the path) and read with
+/// fseek/fread; the file should not change while it is open.
 class FileSource : public ByteSource {
 public:
   explicit FileSource(const std::string &path);

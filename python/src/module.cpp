@@ -1,0 +1,112 @@
+// pomar._pomar: the library's functions on numpy arrays and bytes. The user-facing API
+// (pomar.Mesh, keyword arguments, files by extension) is python/pomar/__init__.py.
+#include "convert.h"
+#include "errors.h"
+#include "selective.h"
+
+#include <pomar/mesh_io.h>
+#include <pomar/pomar.h>
+
+#include <string>
+
+namespace py = pybind11;
+using namespace pomar_python;
+
+namespace {
+
+py::bytes encode(const py::handle &vertices, const py::handle &faces, int bits, uint32_t clusters,
+                 double cluster_ratio, bool progressive, const py::handle &max_memory) {
+  if (bits < 4 || bits > 24)
+    throw py::value_error("bits must be between 4 and 24, not " + std::to_string(bits));
+  pomar::Mesh mesh = mesh_from_arrays(vertices, faces);
+  pomar::EncodeOptions options;
+  options.bits = bits;
+  options.clusters = clusters;
+  options.cluster_ratio = cluster_ratio;
+  options.progressive = progressive;
+  options.memory_limit = memory_limit(max_memory);
+  std::vector<uint8_t> file;
+  {
+    py::gil_scoped_release unlocked;
+    file = call_library("invalid_mesh", [&] { return pomar::encode(mesh, options); });
+  }
+  return py::bytes(reinterpret_cast<const char *>(file.data()), file.size());
+}
+
+py::tuple decode(const py::handle &data, const py::handle &level, const py::handle &max_memory) {
+  const ReadBuffer buffer(data, "decode()");
+  pomar::DecodeOptions options;
+  options.memory_limit = memory_limit(max_memory);
+  if (!level.is_none()) {
+    const pomar::FileInfo i =
+        call_library("damaged_file", [&] { return pomar::inspect(buffer.data(), buffer.size()); });
+    options.level = checked_level(level, static_cast<int>(i.levels.size()), -1);
+  }
+  pomar::Mesh mesh;
+  {
+    py::gil_scoped_release unlocked;
+    mesh = call_library("damaged_file",
+                        [&] { return pomar::decode(buffer.data(), buffer.size(), options); });
+  }
+  return arrays_from_mesh(std::move(mesh));
+}
+
+py::dict info(const py::handle &data) {
+  const ReadBuffer buffer(data, "info()");
+  pomar::FileInfo i;
+  {
+    py::gil_scoped_release unlocked;
+    i = call_library("damaged_file", [&] { return pomar::inspect(buffer.data(), buffer.size()); });
+  }
+  return info_dict(i);
+}
+
+py::tuple read_mesh(const std::string &path) {
+  pomar::LoadReport report;
+  pomar::Mesh mesh;
+  {
+    py::gil_scoped_release unlocked;
+    mesh = call_library("io", [&] { return pomar::load_mesh(path, &report); });
+  }
+  py::dict r;
+  r["format"] = report.format;
+  r["file_vertices"] = report.file_vertices;
+  r["file_faces"] = report.file_faces;
+  r["unreferenced_vertices"] = report.unreferenced_vertices;
+  r["welded_vertices"] = report.welded_vertices;
+  r["polygons_triangulated"] = report.polygons_triangulated;
+  r["ignored_attributes"] = py::cast(report.ignored_attributes);
+  py::tuple arrays = arrays_from_mesh(std::move(mesh));
+  return py::make_tuple(arrays[0], arrays[1], r);
+}
+
+void write_mesh(const std::string &path, const py::handle &vertices, const py::handle &faces,
+                bool binary) {
+  const pomar::Mesh mesh = mesh_from_arrays(vertices, faces);
+  py::gil_scoped_release unlocked;
+  call_library("io", [&] { pomar::save_mesh(path, mesh, binary); });
+}
+
+void write_bytes(const std::string &path, const py::handle &data) {
+  const ReadBuffer buffer(data, "write_bytes()");
+  py::gil_scoped_release unlocked;
+  call_library("io", [&] { pomar::write_file_atomic(path, buffer.data(), buffer.size()); });
+}
+
+} // namespace
+
+PYBIND11_MODULE(_pomar, m) {
+  m.doc() = "pomar's library on numpy arrays (use the pomar package, not this module)";
+  register_errors(m);
+  m.attr("__version__") = pomar::version();
+  m.def("encode", &encode, py::arg("vertices"), py::arg("faces"), py::arg("bits"),
+        py::arg("clusters"), py::arg("cluster_ratio"), py::arg("progressive"),
+        py::arg("memory_limit"));
+  m.def("decode", &decode, py::arg("data"), py::arg("level"), py::arg("memory_limit"));
+  m.def("info", &info, py::arg("data"));
+  m.def("read_mesh", &read_mesh, py::arg("path"));
+  m.def("write_mesh", &write_mesh, py::arg("path"), py::arg("vertices"), py::arg("faces"),
+        py::arg("binary"));
+  m.def("write_bytes", &write_bytes, py::arg("path"), py::arg("data"));
+  register_selective_decoder(m);
+}

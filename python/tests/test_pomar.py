@@ -1,0 +1,337 @@
+"""The Python module: round trips on numpy arrays, levels, info, files, selective decoding,
+errors for bad input, the GIL released, no growth in memory under repeated calls."""
+import gc
+import json
+import os
+import subprocess
+import sys
+import threading
+
+import numpy as np
+import pytest
+
+import pomar
+
+SAMPLES = os.environ.get("POMAR_SAMPLES", os.path.join(os.path.dirname(__file__), "../../samples"))
+BUNNY = os.path.join(SAMPLES, "bunny.ply")
+
+
+def torus(rings=40, sides=24, big=1.0, small=0.3):
+    """A closed manifold torus: float32 (rings*sides, 3), uint32 (2*rings*sides, 3)."""
+    u = np.linspace(0, 2 * np.pi, rings, endpoint=False)[:, None]
+    v = np.linspace(0, 2 * np.pi, sides, endpoint=False)[None, :]
+    x = (big + small * np.cos(v)) * np.cos(u)
+    y = (big + small * np.cos(v)) * np.sin(u)
+    z = small * np.sin(v) * np.ones_like(u)
+    vertices = np.stack([x, y, z], axis=-1).reshape(-1, 3).astype(np.float32)
+    i, j = np.meshgrid(np.arange(rings), np.arange(sides), indexing="ij")
+    a = i * sides + j
+    b = ((i + 1) % rings) * sides + j
+    c = ((i + 1) % rings) * sides + (j + 1) % sides
+    d = i * sides + (j + 1) % sides
+    faces = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3),
+                            np.stack([a, c, d], -1).reshape(-1, 3)]).astype(np.uint32)
+    return vertices, faces
+
+
+def sorted_triangles(vertices, faces):
+    """Triangles as sorted rows of corner positions (rotated to start at the smallest
+    corner, orientation kept): comparable whatever the vertex numbering."""
+    corners = vertices[faces]  # (m, 3, 3)
+    keys = [tuple(map(tuple, tri)) for tri in corners]
+    out = []
+    for k in keys:
+        r = k.index(min(k))
+        out.append(k[r:] + k[:r])
+    return sorted(out)
+
+
+@pytest.fixture(scope="module")
+def bunny():
+    return pomar.read(BUNNY)
+
+
+def test_version():
+    assert pomar.__version__.count(".") == 2
+
+
+def test_round_trip_arrays_lossless_on_the_grid():
+    vertices, faces = torus()
+    data = pomar.encode(vertices, faces, bits=16)
+    assert isinstance(data, bytes)
+    mesh = pomar.decode(data)
+    assert mesh.vertices.dtype == np.float32 and mesh.vertices.shape == vertices.shape
+    assert mesh.faces.dtype == np.uint32 and mesh.faces.shape == faces.shape
+    step = 2.6 / (2**16 - 1)  # the grid spans the bounding cube (extent 2.6)
+    # Same triangles: re-encode the decoded mesh and get it back bit for bit.
+    again = pomar.decode(pomar.encode(mesh, bits=16))
+    assert sorted_triangles(again.vertices, again.faces) == sorted_triangles(mesh.vertices, mesh.faces)
+    # Positions within half a grid step of the input (decoded_to_input is unknown here:
+    # compare each decoded vertex with its nearest input vertex).
+    d = np.abs(mesh.vertices[:, None, :] - vertices[None, :, :]).max(-1).min(-1)
+    assert d.max() <= 0.5 * step * 1.01
+
+
+def test_levels_and_info(bunny):
+    data = pomar.encode(bunny)
+    info = pomar.info(data)
+    assert info["vertices"] == len(bunny.vertices) and info["faces"] == len(bunny.faces)
+    assert info["level_count"] == len(info["levels"]) - 1
+    base = pomar.decode(data, level=0)
+    assert len(base.vertices) == info["base_vertices"]
+    counts = [len(pomar.decode(data, level=l).vertices) for l in (0, 3, info["level_count"])]
+    assert counts == sorted(counts) and counts[-1] == info["vertices"]
+    assert len(pomar.decode(data, level=5).faces) == info["levels"][5]["faces"]
+    # bytearray and memoryview work as well as bytes.
+    assert len(pomar.decode(bytearray(data), 2).faces) == len(pomar.decode(memoryview(data), 2).faces)
+
+
+@pytest.mark.skipif(not os.path.exists(os.environ.get("POMAR_TOOL", "")), reason="pomar tool not built")
+def test_info_matches_the_tool(tmp_path, bunny):
+    path = tmp_path / "bunny.pomar"
+    pomar.write(path, bunny)
+    out = subprocess.run([os.environ["POMAR_TOOL"], "info", str(path), "--json"],
+                         check=True, capture_output=True, text=True).stdout
+    tool = json.loads(out)
+    mine = pomar.info(path.read_bytes())
+    assert mine.keys() == tool.keys()
+    for key in tool:
+        if isinstance(tool[key], float):
+            assert mine[key] == pytest.approx(tool[key]), key
+        elif key in ("bbox_min", "grid_max"):
+            assert mine[key] == pytest.approx(tool[key]), key
+        else:
+            assert mine[key] == tool[key], key
+
+
+def test_files(tmp_path, bunny):
+    for name in ("b.ply", "b.obj", "b.off", "b.stl"):
+        pomar.write(tmp_path / name, bunny)
+        back = pomar.read(tmp_path / name)
+        assert len(back.faces) == len(bunny.faces), name
+    pomar.write(tmp_path / "a.ply", bunny, binary=False)
+    assert np.array_equal(pomar.read(tmp_path / "a.ply").vertices, bunny.vertices)
+    pomar.write(str(tmp_path / "b.pomar"), bunny, bits=14)
+    assert pomar.info((tmp_path / "b.pomar").read_bytes())["bits"] == 14
+    assert len(pomar.read(tmp_path / "b.pomar", level=0).vertices) < len(bunny.vertices)
+    assert len(pomar.read(tmp_path / "b.pomar").vertices) == len(bunny.vertices)
+    with pytest.raises(TypeError, match="pomar files only"):
+        pomar.write(tmp_path / "c.ply", bunny, bits=14)
+
+
+def test_selective_decoder(tmp_path, bunny):
+    data = pomar.encode(bunny)
+    path = tmp_path / "bunny.pomar"
+    path.write_bytes(data)
+    for source in (path, str(path), data):
+        d = pomar.SelectiveDecoder(source)
+        info = d.info
+        assert d.cluster_count == info["clusters"] > 1
+        base = d.mesh()
+        assert len(base.vertices) > 0
+        d.want_cluster(0)
+        d.update()
+        one = d.mesh()
+        assert len(one.vertices) > len(base.vertices)
+        assert d.blocks_read >= 1 and d.bytes_read < info["total_bytes"]
+        assert d.levels[0] == d.finest_level
+        assert d.vertex_cluster().shape == (len(one.vertices),)
+        assert d.vertex_level().max() == d.finest_level
+        lo = np.array(info["bbox_min"], np.float32)
+        d.want_box(lo, lo + 0.1, level=d.base_clustered_level + 1)
+        d.want_sphere(tuple(lo), 0.05)
+        d.update()
+        d.want_all()
+        d.update()
+        full = d.mesh()
+        assert len(full.vertices) == info["vertices"] and d.damaged == []
+        assert d.bytes_read == info["total_bytes"]
+
+
+def test_bad_arrays_raise_clear_errors():
+    vertices, faces = torus()
+    with pytest.raises(TypeError, match=r"vertices must have dtype float32, not float64.*astype"):
+        pomar.encode(vertices.astype(np.float64), faces)
+    with pytest.raises(TypeError, match=r"faces must have dtype uint32, not int64"):
+        pomar.encode(vertices, faces.astype(np.int64))
+    with pytest.raises(ValueError, match=r"vertices must have shape \(n, 3\), not \(960, 2\)"):
+        pomar.encode(vertices[:, :2].copy(), faces)
+    with pytest.raises(ValueError, match="not C-contiguous"):
+        pomar.encode(np.asfortranarray(vertices), faces)
+    with pytest.raises(ValueError, match="not C-contiguous"):
+        pomar.encode(vertices, faces[::2])
+    with pytest.raises(TypeError, match="numpy array"):
+        pomar.encode(vertices.tolist(), faces)
+    bad = faces.copy()
+    bad[3, 1] = len(vertices)  # a face referring to a vertex that does not exist
+    with pytest.raises(pomar.Error) as e:
+        pomar.encode(vertices, bad)
+    assert e.value.kind == "invalid_mesh" and str(len(vertices)) in str(e.value)
+    nan = vertices.copy()
+    nan[7, 2] = np.nan
+    with pytest.raises(pomar.Error) as e:
+        pomar.encode(nan, faces)
+    assert e.value.kind == "invalid_mesh"
+    with pytest.raises(ValueError, match="bits must be between 4 and 24, not 40"):
+        pomar.encode(vertices, faces, bits=40)
+    data = pomar.encode(vertices, faces)
+    levels = pomar.info(data)["level_count"]
+    for level in (-1, levels + 1):
+        with pytest.raises(ValueError, match=rf"level {level} does not exist: the file has levels 0..{levels}"):
+            pomar.decode(data, level)
+    d = pomar.SelectiveDecoder(data)
+    with pytest.raises(ValueError, match=rf"cluster {d.cluster_count} does not exist"):
+        d.want_cluster(d.cluster_count)
+    with pytest.raises(ValueError, match="level 99 does not exist"):
+        d.want_all(99)
+    with pytest.raises(TypeError, match="center must be 3 numbers"):
+        d.want_sphere((1, 2), 0.1)
+
+
+def test_damaged_and_wrong_data_raise_clear_errors(tmp_path):
+    vertices, faces = torus()
+    data = bytearray(pomar.encode(vertices, faces))
+    data[len(data) // 2] ^= 0x40
+    with pytest.raises(pomar.Error) as e:
+        pomar.decode(bytes(data))
+    assert e.value.kind == "damaged_file"
+    with pytest.raises(pomar.Error) as e:
+        pomar.info(b"not a pomar file")
+    assert e.value.kind == "damaged_file"
+    with pytest.raises(pomar.Error):
+        pomar.decode(bytes(data[:100]))
+    with pytest.raises(TypeError, match="not a path"):
+        pomar.decode("bunny.pomar")
+    with pytest.raises(TypeError, match="bytes-like"):
+        pomar.decode(12)
+    with pytest.raises(pomar.Error) as e:
+        pomar.read(tmp_path / "missing.ply")
+    assert e.value.kind == "io" and "missing.ply" in str(e.value)
+    with pytest.raises(pomar.Error) as e:
+        pomar.SelectiveDecoder(tmp_path / "missing.pomar")
+    with pytest.raises(pomar.Error) as e:
+        pomar.encode(vertices, faces, memory_limit=1000)
+    assert e.value.kind == "memory_limit"
+    with pytest.raises(pomar.Error) as e:
+        pomar.encode(vertices, faces, memory_limit="lots")
+    assert e.value.kind == "usage"
+
+
+def test_gil_released_during_encode_and_decode():
+    """Another Python thread runs while encode/decode work. With a 0.5 s switch interval a
+    thread holding the GIL keeps it through a call shorter than that (these take a few
+    ms), so the counter could not move during the call if the GIL were held."""
+    vertices, faces = torus(100, 50)
+    ticks = 0
+    stop = threading.Event()
+
+    def count():
+        nonlocal ticks
+        while not stop.is_set():
+            ticks += 1
+
+    moved = []
+
+    def work():
+        before = ticks
+        data = pomar.encode(vertices, faces)
+        middle = ticks
+        pomar.decode(data)
+        moved.extend([middle - before, ticks - middle])
+
+    interval = sys.getswitchinterval()
+    sys.setswitchinterval(0.5)
+    try:
+        counter = threading.Thread(target=count)
+        counter.start()
+        worker = threading.Thread(target=work)
+        worker.start()
+        worker.join()
+        stop.set()
+        counter.join()
+    finally:
+        sys.setswitchinterval(interval)
+    assert len(moved) == 2 and moved[0] > 0 and moved[1] > 0, moved
+
+
+def test_threads_share_one_decoder(bunny):
+    data = pomar.encode(bunny)
+    d = pomar.SelectiveDecoder(data)
+    errors = []
+
+    def work(c):
+        try:
+            d.want_cluster(c)
+            d.update()
+            d.mesh()
+        except Exception as e:  # noqa: BLE001
+            errors.append(e)
+
+    threads = [threading.Thread(target=work, args=(c,)) for c in range(8)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert not errors
+
+
+def rss_bytes():
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+
+
+def test_no_growth_under_repeated_calls(bunny):
+    data = pomar.encode(bunny)
+    for _ in range(5):  # warm up the allocator
+        pomar.decode(data)
+    gc.collect()
+    before = rss_bytes()
+    for _ in range(25):
+        mesh = pomar.decode(data)
+        pomar.info(data)
+        pomar.SelectiveDecoder(data).mesh()
+        try:
+            pomar.decode(data[:200])
+        except pomar.Error:
+            pass
+    del mesh
+    gc.collect()
+    # One decoded bunny is about 0.8 MB; leaking it on every call would add ~20 MB.
+    assert rss_bytes() - before < 8 * 2**20
+
+
+def test_trimesh_example(monkeypatch):
+    """examples/trimesh_convert.py (quoted in the README), when trimesh is installed."""
+    pytest.importorskip("trimesh")
+    import runpy
+    repo = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
+    monkeypatch.chdir(repo)
+    result = runpy.run_path("examples/trimesh_convert.py")
+    assert len(result["back"].faces) == len(result["mesh"].faces)
+
+
+def test_selective_requests_by_vertices_and_faces(bunny):
+    d = pomar.SelectiveDecoder(pomar.encode(bunny))
+    base = d.mesh()
+    d.want_vertices(np.arange(0, len(base.vertices), 50, dtype=np.uint32))
+    d.want_faces([0, 1, 2], level=d.base_clustered_level + 1)
+    d.update()
+    assert (d.levels > d.base_clustered_level).sum() >= 2
+    d.clear_wanted()
+    d.update()
+    assert len(d.mesh().vertices) == len(base.vertices)
+
+
+def test_selective_decoder_around_damage(bunny):
+    data = bytearray(pomar.encode(bunny))
+    data[len(data) - 100] ^= 0x5A  # inside the last cluster blocks
+    strict = pomar.SelectiveDecoder(bytes(data))
+    strict.want_all()
+    with pytest.raises(pomar.Error) as e:
+        strict.update()
+    assert e.value.kind == "damaged_file" and "cluster" in str(e.value)
+    lenient = pomar.SelectiveDecoder(bytes(data), skip_damaged=True)
+    lenient.want_all()
+    lenient.update()
+    assert lenient.damaged and lenient.damaged[0]["block"].startswith("cluster")
+    assert len(lenient.mesh().vertices) < lenient.info["vertices"]

@@ -1,0 +1,142 @@
+// The WebAssembly decoder's C ABI (web/src/pomar_web.cpp) as a small synchronous class.
+// Used by the Web Worker (pomar_worker.js) and by the Node tests; knows nothing about the
+// network: bytes come in as Uint8Arrays, meshes go out as typed arrays (copies).
+import createPomarDecoder from './dist/pomar_decoder.mjs';
+
+let modulePromise = null;
+/** The WebAssembly module, instantiated once (`options`: emscripten's, e.g. wasmBinary). */
+export function loadModule(options = {}) {
+  if (!modulePromise) modulePromise = createPomarDecoder(options);
+  return modulePromise;
+}
+
+export class PomarError extends Error {}
+
+function lastError(M) {
+  return M.UTF8ToString(M._pw_last_error());
+}
+
+/** Copy `bytes` into the WebAssembly heap for the duration of `f(ptr)`. */
+function withBytes(M, bytes, f) {
+  const ptr = M._malloc(Math.max(1, bytes.length));
+  if (!ptr) throw new PomarError('out of memory: cannot copy ' + bytes.length + ' bytes');
+  try {
+    M.HEAPU8.set(bytes, ptr);
+    return f(ptr);
+  } finally {
+    M._free(ptr);
+  }
+}
+
+/** How many leading bytes of a file of `fileSize` bytes Decoder.open needs, knowing its first
+ *  bytes `prefix`: grows (header size, then global part) until it is <= prefix.length. */
+export function globalBytes(M, prefix, fileSize) {
+  const n = withBytes(M, prefix, (p) => M._pw_global_bytes(p, prefix.length, fileSize));
+  if (n < 0) throw new PomarError(lastError(M));
+  return n;
+}
+
+export class Decoder {
+  /** Decode the base clustered mesh from the file's first bytes (>= globalBytes).
+   *  `tolerant`: skip damaged or missing cluster blocks (and read every block whole);
+   *  otherwise read blocks only as far as the wanted levels need, and fail on damage. */
+  constructor(M, prefix, fileSize, tolerant = true) {
+    this.M = M;
+    this.tolerant = tolerant;
+    this.h = withBytes(M, prefix, (p) => M._pw_open(p, prefix.length, fileSize, tolerant ? 1 : 0));
+    if (!this.h) throw new PomarError(lastError(M));
+    this.refreshInfo();
+    const n = this.info.clusters;
+    this.blockOffset = new Float64Array(n);
+    this.blockSize = new Float64Array(n);
+    for (let c = 0; c < n; ++c) {
+      this.blockOffset[c] = M._pw_block_offset(this.h, c);
+      this.blockSize[c] = M._pw_block_size(this.h, c);
+    }
+  }
+
+  refreshInfo() {
+    const M = this.M;
+    const n = M._pw_info_size(this.h);
+    const d = new Float64Array(M.HEAPF64.buffer, M._pw_info(this.h), n).slice();
+    const levels = [];
+    for (let i = 18; i + 1 < n; i += 2) levels.push({ vertices: d[i], faces: d[i + 1] });
+    this.info = {
+      clusters: d[0], baseLevel: d[1], finestLevel: d[2], vertices: d[3], faces: d[4],
+      fileBytes: d[5], globalBytes: d[6], bboxMin: [d[7], d[8], d[9]], bboxMax: [d[10], d[11], d[12]],
+      version: d[13], decoderBytesRead: d[14], blocksRead: d[15], baseVertices: d[16], baseFaces: d[17], levels,
+    };
+    return this.info;
+  }
+
+  close() {
+    if (this.h) this.M._pw_close(this.h);
+    this.h = 0;
+  }
+
+  /** Call f(ptr) with `levels` (one per cluster; progressive files: [level]) in the heap. */
+  withLevels(levels, f) {
+    const M = this.M;
+    const n = Math.max(1, levels.length);
+    const ptr = M._malloc(4 * n);
+    try {
+      M.HEAP32.set(Int32Array.from(levels), ptr >> 2);
+      return f(ptr);
+    } finally {
+      M._free(ptr);
+    }
+  }
+
+  /** The level map update(wanted) would decode (the level map rule applied). */
+  complete(wanted) {
+    const M = this.M;
+    if (this.withLevels(wanted, (p) => M._pw_complete(this.h, p)) < 0)
+      throw new PomarError(lastError(M));
+    return new Int32Array(M.HEAP32.buffer, M._pw_levels(this.h), this.info.clusters).slice();
+  }
+
+  /** Hand over the first bytes of cluster c's block (all of it, or what its levels need). */
+  putBlock(c, bytes) {
+    const M = this.M;
+    if (withBytes(M, bytes, (p) => M._pw_put_block(this.h, c, p, bytes.length)) < 0)
+      throw new PomarError(lastError(M));
+  }
+
+  /** Decode to the completed level map of `wanted`; returns the level of every cluster.
+   *  Throws a PomarError; its `missingCluster` is the cluster whose block lacked bytes (-1 if
+   *  that was not the problem; then coarsen everything to the base level before retrying). */
+  update(wanted) {
+    const M = this.M;
+    if (this.withLevels(wanted, (p) => M._pw_update(this.h, p)) < 0) {
+      const e = new PomarError(lastError(M));
+      e.missingCluster = M._pw_missing_cluster(this.h);
+      throw e;
+    }
+    this.refreshInfo();
+    return new Int32Array(M.HEAP32.buffer, M._pw_levels(this.h), this.info.clusters).slice();
+  }
+
+  /** Damaged blocks skipped so far: { count, text } (text: one line per block). */
+  damaged() {
+    const M = this.M;
+    return { count: M._pw_damaged_count(this.h), text: M.UTF8ToString(M._pw_damaged(this.h)) };
+  }
+
+  /** The current mesh as typed arrays (copies, transferable), plus per-cluster bounds:
+   *  8 floats per cluster (bbox min, max, longest edge, face count). */
+  mesh() {
+    const M = this.M;
+    if (M._pw_extract(this.h) < 0) throw new PomarError(lastError(M));
+    const nv = M._pw_vertex_count(this.h);
+    const nt = M._pw_triangle_count(this.h);
+    const f32 = (ptr, n) => new Float32Array(M.HEAPF32.buffer, ptr, n).slice();
+    const u32 = (ptr, n) => new Uint32Array(M.HEAPU32.buffer, ptr, n).slice();
+    return {
+      positions: f32(M._pw_positions(this.h), 3 * nv),
+      triangles: u32(M._pw_triangles(this.h), 3 * nt),
+      vertexCluster: u32(M._pw_vertex_cluster(this.h), nv),
+      vertexLevel: u32(M._pw_vertex_level(this.h), nv),
+      clusterBounds: f32(M._pw_cluster_bounds(this.h), 8 * Math.max(1, this.info.clusters)),
+    };
+  }
+}

@@ -1,0 +1,75 @@
+// The Web Worker behind pomar.js: one PomarStream (pomar_stream.js) over a RangeFile; posts
+// meshes (transferred typed arrays) and messages back.
+//
+// in:  {type:'open', source (URL or File), options}, {type:'want', id, levels}, {type:'close'}
+// out: {type:'opened'|'mesh', id, info, mesh, levels, stats}, {type:'warning', message},
+//      {type:'error', id, message}
+import { loadModule } from './pomar_core.js';
+import { PomarStream } from './pomar_stream.js';
+import { RangeFile } from './range_fetch.js';
+
+let stream = null;
+let damagedReported = 0;
+let warningsReported = 0;
+let busy = false;
+let pending = null; // the latest want not yet served (older ones are superseded)
+
+function post(type, id, extra) {
+  const mesh = stream.decoder.mesh();
+  const transfer = [mesh.positions.buffer, mesh.triangles.buffer, mesh.vertexCluster.buffer,
+    mesh.vertexLevel.buffer, mesh.clusterBounds.buffer];
+  const stats = { ...stream.stats(), vertices: mesh.positions.length / 3, triangles: mesh.triangles.length / 3, ...extra };
+  self.postMessage({ type, id, info: stream.info, mesh, levels: stream.levels, stats }, transfer);
+}
+
+function report() {
+  for (; warningsReported < stream.warnings.length; ++warningsReported)
+    self.postMessage({ type: 'warning', message: stream.warnings[warningsReported] });
+  const d = stream.decoder.damaged();
+  if (d.count > damagedReported) {
+    damagedReported = d.count;
+    self.postMessage({ type: 'warning', message: `damaged blocks skipped (as --skip-damaged does):\n${d.text}` });
+  }
+}
+
+async function serve() {
+  busy = true;
+  while (pending) {
+    const { id, levels } = pending;
+    pending = null;
+    try {
+      const t0 = performance.now();
+      await stream.want(levels);
+      report();
+      post('mesh', id, { decodeMs: performance.now() - t0 });
+    } catch (e) {
+      self.postMessage({ type: 'error', id, message: e.message || String(e) });
+    }
+  }
+  busy = false;
+}
+
+self.onmessage = async (event) => {
+  const msg = event.data;
+  if (msg.type === 'open') {
+    try {
+      const t0 = performance.now();
+      const M = await loadModule();
+      stream = await new PomarStream(M, new RangeFile(msg.source, msg.options), msg.options).open();
+      post('opened', 0, { decodeMs: performance.now() - t0 });
+    } catch (e) {
+      self.postMessage({ type: 'error', id: 0, fatal: true, message: e.message || String(e) });
+    }
+  } else if (msg.type === 'want') {
+    if (!stream) {
+      self.postMessage({ type: 'error', id: msg.id, message: 'no file is open' });
+      return;
+    }
+    pending = { id: msg.id, levels: msg.levels };
+    if (!busy) serve();
+  } else if (msg.type === 'close') {
+    if (stream) stream.close();
+    stream = null;
+    self.close();
+  }
+};

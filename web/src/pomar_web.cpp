@@ -1,0 +1,355 @@
+// The C ABI of the WebAssembly decoder (web/pomar_core.js wraps it): a SelectiveDecoder
+// whose bytes arrive over the network. The JavaScript side (web/pomar_stream.js) fetches
+// the global part, completes the wanted level map (pw_complete), fetches what the blocks
+// of the raised clusters need with range requests, hands it over (pw_put_block) and
+// decodes (pw_update). Every pomar::Error (and any
+// other exception, e.g. out of memory) becomes a return code and a message
+// (pw_last_error); nothing traps.
+#include <emscripten/emscripten.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "format/file_format.h"
+#include "pomar/pomar.h"
+#include "pomar/random_access.h"
+
+namespace {
+
+std::string g_error;
+
+/// WebAssembly has at most 4 GiB of memory: a file whose base clustered mesh needs more than
+/// this is refused with a message before anything large is allocated.
+constexpr uint64_t kMemoryLimit = uint64_t(1) << 31;
+
+/// The bytes of the file the page has fetched: the global part, and a prefix of each cluster
+/// block (the whole block, or as much as the levels wanted of it need; see pomar_stream.js).
+/// A read of bytes not handed over throws and records where (pw_missing_cluster): the page
+/// fetches them and decodes again.
+class StagedSource : public pomar::ByteSource {
+public:
+  StagedSource(std::vector<uint8_t> prefix, uint64_t size)
+      : prefix_(std::move(prefix)), size_(size) {}
+  uint64_t size() const override { return size_; }
+  void read(uint64_t offset, size_t n, uint8_t *out) override {
+    if (offset > size_ || n > size_ - offset)
+      throw pomar::Error("truncated .pomar file: it ends at byte " + std::to_string(size_) +
+                         ", byte " + std::to_string(offset + n) + " is needed");
+    if (offset + n <= prefix_.size()) {
+      if (n)
+        std::memcpy(out, prefix_.data() + offset, n);
+      return;
+    }
+    auto it = staged_.upper_bound(offset);
+    if (it != staged_.begin()) {
+      --it;
+      if (offset + n <= it->first + it->second.size()) {
+        std::memcpy(out, it->second.data() + (offset - it->first), n);
+        return;
+      }
+    }
+    missing_ = offset;
+    throw pomar::Error("bytes " + std::to_string(offset) + ".." + std::to_string(offset + n) +
+                       " were not fetched");
+  }
+  /// The first `bytes` of the block at `offset` (replacing a shorter prefix).
+  void stage(uint64_t offset, std::vector<uint8_t> bytes) { staged_[offset] = std::move(bytes); }
+  uint64_t missing() const { return missing_; }
+  void clear_missing() { missing_ = UINT64_MAX; }
+
+private:
+  std::vector<uint8_t> prefix_;
+  uint64_t size_;
+  std::map<uint64_t, std::vector<uint8_t>> staged_;
+  uint64_t missing_ = UINT64_MAX;
+};
+
+struct Handle {
+  StagedSource *source = nullptr; // owned by the decoder
+  std::unique_ptr<pomar::SelectiveDecoder> decoder;
+  pomar::ClusterIndex index;
+  std::vector<uint32_t> adj_start, adj; // the cluster graph (edges of the base clustered mesh)
+  // Results kept alive for JavaScript to copy out of the heap.
+  pomar::Mesh mesh;
+  std::vector<uint32_t> vertex_cluster, vertex_level;
+  std::vector<float> bounds;
+  std::vector<int32_t> levels;
+  std::vector<double> info;
+  std::string text;
+};
+
+template <class F> int guarded(F &&f) {
+  try {
+    return f();
+  } catch (const std::bad_alloc &) {
+    g_error = "out of memory (WebAssembly has at most 2 GiB here)";
+  } catch (const std::exception &e) {
+    g_error = e.what();
+  }
+  return -1;
+}
+
+void cluster_graph(const pomar::Mesh &base, uint32_t n, std::vector<uint32_t> &start,
+                   std::vector<uint32_t> &adj) {
+  std::vector<std::vector<uint32_t>> nb(n);
+  for (size_t f = 0; f < base.triangle_count(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t a = base.triangles[3 * f + k], b = base.triangles[3 * f + (k + 1) % 3];
+      nb[a].push_back(b);
+      nb[b].push_back(a);
+    }
+  start.assign(n + 1, 0);
+  adj.clear();
+  for (uint32_t c = 0; c < n; ++c) {
+    std::sort(nb[c].begin(), nb[c].end());
+    nb[c].erase(std::unique(nb[c].begin(), nb[c].end()), nb[c].end());
+    adj.insert(adj.end(), nb[c].begin(), nb[c].end());
+    start[c + 1] = static_cast<uint32_t>(adj.size());
+  }
+}
+
+std::vector<int> to_levels(const Handle &h, const int32_t *wanted) {
+  return std::vector<int>(wanted, wanted + h.decoder->cluster_count());
+}
+
+} // namespace
+
+extern "C" {
+
+EMSCRIPTEN_KEEPALIVE const char *pw_last_error() { return g_error.c_str(); }
+
+/// How many leading bytes of the file open needs: the header's size while `n` is too short
+/// to tell more, then the whole global part (header, base mesh, global levels, model
+/// tables, cluster index). -1 on a damaged header (pw_last_error).
+EMSCRIPTEN_KEEPALIVE double pw_global_bytes(const uint8_t *data, size_t n, double file_size) {
+  double out = -1;
+  guarded([&] {
+    const uint64_t size = static_cast<uint64_t>(file_size);
+    if (n < pomar::kFixedHeaderBytes && n < size) {
+      out = double(std::min<uint64_t>(size, pomar::kFixedHeaderBytes));
+      return 0;
+    }
+    const size_t hsize = pomar::header_size(data, n);
+    if (hsize > size)
+      throw pomar::Error("truncated .pomar file: the header alone needs " + std::to_string(hsize) +
+                         " bytes, the file has " + std::to_string(size));
+    if (n < hsize) {
+      out = double(hsize);
+      return 0;
+    }
+    const pomar::FileLayout layout = pomar::read_layout(data, hsize, size, true);
+    out = double(std::min<uint64_t>(layout.global_bytes, size));
+    return 0;
+  });
+  return out;
+}
+
+/// Decode the base clustered mesh from the file's first `n` bytes (at least
+/// pw_global_bytes) of `file_size`. `tolerant`: damaged or missing cluster blocks are
+/// skipped (SelectiveOptions::skip_damaged; every block is then read whole, to verify its
+/// check before decoding it); otherwise blocks are read only as far as the wanted levels
+/// need and any damage fails pw_update. Returns a handle, 0 on error (pw_last_error).
+EMSCRIPTEN_KEEPALIVE Handle *pw_open(const uint8_t *data, size_t n, double file_size,
+                                     int tolerant) {
+  Handle *out = nullptr;
+  guarded([&] {
+    auto h = std::make_unique<Handle>();
+    const uint64_t size = static_cast<uint64_t>(file_size);
+    auto source = std::make_unique<StagedSource>(std::vector<uint8_t>(data, data + n), size);
+    h->source = source.get();
+    pomar::SelectiveOptions options;
+    options.skip_damaged = tolerant != 0; // damaged blocks are skipped and listed (pw_damaged)
+    options.memory_limit = kMemoryLimit;
+    h->decoder = std::make_unique<pomar::SelectiveDecoder>(std::move(source), options);
+    const uint32_t clusters = h->decoder->cluster_count();
+    if (clusters) {
+      const size_t hsize = pomar::header_size(data, n);
+      const pomar::FileLayout layout = pomar::read_layout(data, hsize, size, true);
+      h->index = pomar::read_cluster_index(data + layout.index_offset, layout);
+      cluster_graph(h->decoder->mesh(), clusters, h->adj_start, h->adj);
+    }
+    out = h.release();
+    return 0;
+  });
+  return out;
+}
+
+EMSCRIPTEN_KEEPALIVE void pw_close(Handle *h) { delete h; }
+
+/// Facts as doubles: [clusters, base clustered level, finest level, vertices, faces,
+/// file bytes, global bytes, bbox min xyz, bbox max xyz, version, bytes read by the decoder,
+/// blocks read, base mesh vertices, faces, then per level 1..finest: vertices, faces].
+EMSCRIPTEN_KEEPALIVE const double *pw_info(Handle *h) {
+  const pomar::FileInfo &i = h->decoder->info();
+  h->info = {double(h->decoder->cluster_count()),
+             double(h->decoder->base_clustered_level()),
+             double(h->decoder->finest_level()),
+             double(i.vertices),
+             double(i.faces),
+             double(i.total_bytes),
+             double(i.global_bytes),
+             i.bbox_min[0],
+             i.bbox_min[1],
+             i.bbox_min[2],
+             i.bbox_max[0],
+             i.bbox_max[1],
+             i.bbox_max[2],
+             double(i.version),
+             double(h->decoder->bytes_read()),
+             double(h->decoder->blocks_read()),
+             double(i.base_vertices),
+             double(i.base_faces)};
+  for (const pomar::LevelInfo &l : i.levels) {
+    h->info.push_back(l.vertices);
+    h->info.push_back(l.faces);
+  }
+  return h->info.data();
+}
+EMSCRIPTEN_KEEPALIVE int pw_info_size(Handle *h) { return int(pw_info(h) ? h->info.size() : 0); }
+
+/// Where cluster c's block is in the file (offset; its size: pw_block_size).
+EMSCRIPTEN_KEEPALIVE double pw_block_offset(Handle *h, uint32_t c) {
+  return c < h->index.offset.size() ? double(h->index.offset[c]) : -1;
+}
+EMSCRIPTEN_KEEPALIVE double pw_block_size(Handle *h, uint32_t c) {
+  return c < h->index.size.size() ? double(h->index.size[c]) : -1;
+}
+
+/// The completed level map for `wanted` (pw_levels_out), without decoding.
+EMSCRIPTEN_KEEPALIVE int pw_complete(Handle *h, const int32_t *wanted) {
+  return guarded([&] {
+    const std::vector<int> target = pomar::complete_level_map(
+        to_levels(*h, wanted), h->adj_start, h->adj, h->decoder->base_clustered_level());
+    h->levels.assign(target.begin(), target.end());
+    return 0;
+  });
+}
+
+/// Hand over the first `n` bytes of cluster c's block (all of it, or the prefix its wanted
+/// levels need; replaces a shorter prefix handed over before).
+EMSCRIPTEN_KEEPALIVE int pw_put_block(Handle *h, uint32_t c, const uint8_t *data, size_t n) {
+  return guarded([&] {
+    if (c >= h->index.offset.size())
+      throw pomar::Error("cluster " + std::to_string(c) + " does not exist");
+    h->source->stage(h->index.offset[c], std::vector<uint8_t>(data, data + n));
+    return 0;
+  });
+}
+
+/// After pw_update failed: the cluster whose block lacked bytes (-1: the failure was not a
+/// missing byte). The mesh is intact but that cluster's stream is not: coarsen everything
+/// to the base clustered level (pw_update) before decoding again.
+EMSCRIPTEN_KEEPALIVE int pw_missing_cluster(Handle *h) {
+  const uint64_t at = h->source->missing();
+  if (at == UINT64_MAX)
+    return -1;
+  for (uint32_t c = 0; c < h->index.offset.size(); ++c)
+    if (at >= h->index.offset[c] && at < h->index.offset[c] + h->index.size[c])
+      return int(c);
+  return -1;
+}
+
+/// Bring the mesh to the level map completed from `wanted` (clustered files) or to level
+/// wanted[0] everywhere (progressive files). Tolerant decoders skip damaged or missing
+/// blocks (pw_damaged). Returns 0, or -1 on error (pw_last_error, pw_missing_cluster).
+EMSCRIPTEN_KEEPALIVE int pw_update(Handle *h, const int32_t *wanted) {
+  h->source->clear_missing();
+  return guarded([&] {
+    if (h->decoder->cluster_count() == 0) {
+      h->decoder->clear_wanted();
+      h->decoder->want_all(wanted[0]);
+    } else {
+      h->decoder->set_wanted(to_levels(*h, wanted));
+    }
+    h->decoder->update();
+    h->levels.assign(h->decoder->levels().begin(), h->decoder->levels().end());
+    return 0;
+  });
+}
+
+/// The level of every cluster after pw_update (or the map of pw_complete).
+EMSCRIPTEN_KEEPALIVE const int32_t *pw_levels(Handle *h) { return h->levels.data(); }
+
+/// Damaged blocks skipped so far, one line each ("" when none).
+EMSCRIPTEN_KEEPALIVE const char *pw_damaged(Handle *h) {
+  h->text = h->decoder->damaged().empty() ? "" : pomar::describe_damage(h->decoder->damaged());
+  return h->text.c_str();
+}
+EMSCRIPTEN_KEEPALIVE int pw_damaged_count(Handle *h) { return int(h->decoder->damaged().size()); }
+
+/// Extract the current mesh; then pw_positions (3 floats per vertex), pw_triangles (3
+/// indices per face), pw_vertex_cluster, pw_vertex_level point at it until the next call.
+EMSCRIPTEN_KEEPALIVE int pw_extract(Handle *h) {
+  return guarded([&] {
+    h->mesh = h->decoder->mesh();
+    h->vertex_cluster = h->decoder->vertex_cluster();
+    h->vertex_level = h->decoder->vertex_level();
+    return 0;
+  });
+}
+EMSCRIPTEN_KEEPALIVE int pw_vertex_count(Handle *h) { return int(h->mesh.vertex_count()); }
+EMSCRIPTEN_KEEPALIVE int pw_triangle_count(Handle *h) { return int(h->mesh.triangle_count()); }
+EMSCRIPTEN_KEEPALIVE const float *pw_positions(Handle *h) { return h->mesh.positions.data(); }
+EMSCRIPTEN_KEEPALIVE const uint32_t *pw_triangles(Handle *h) { return h->mesh.triangles.data(); }
+EMSCRIPTEN_KEEPALIVE const uint32_t *pw_vertex_cluster(Handle *h) {
+  return h->vertex_cluster.data();
+}
+EMSCRIPTEN_KEEPALIVE const uint32_t *pw_vertex_level(Handle *h) { return h->vertex_level.data(); }
+
+/// Per cluster of the extracted mesh, 8 floats: bounding box min xyz, max xyz, the longest
+/// edge between two of its vertices (or, if it has none, touching it: the screen-space
+/// error proxy, see web/view_refine.js), and its face count (faces are counted in the
+/// cluster of their first vertex).
+EMSCRIPTEN_KEEPALIVE const float *pw_cluster_bounds(Handle *h) {
+  const uint32_t n = std::max<uint32_t>(1, h->decoder->cluster_count());
+  h->bounds.assign(size_t(n) * 8, 0.f);
+  for (uint32_t c = 0; c < n; ++c)
+    for (int k = 0; k < 3; ++k) {
+      h->bounds[8 * c + k] = 3.4e38f;
+      h->bounds[8 * c + 3 + k] = -3.4e38f;
+    }
+  const std::vector<float> &p = h->mesh.positions;
+  auto cluster = [&](uint32_t v) { return h->vertex_cluster.empty() ? 0u : h->vertex_cluster[v]; };
+  for (uint32_t v = 0; v < h->mesh.vertex_count(); ++v) {
+    float *b = &h->bounds[8 * size_t(cluster(v))];
+    for (int k = 0; k < 3; ++k) {
+      b[k] = std::min(b[k], p[3 * v + k]);
+      b[3 + k] = std::max(b[3 + k], p[3 * v + k]);
+    }
+  }
+  // Edges inside a cluster measure it; a cluster with none (a single vertex, as at the base
+  // clustered level) takes the edges around it. Edges across a border do not count where
+  // a cluster has inner edges: they belong to the coarser neighbour as much as to it.
+  const std::vector<uint32_t> &t = h->mesh.triangles;
+  std::vector<float> around(n, 0.f);
+  for (size_t f = 0; f < h->mesh.triangle_count(); ++f) {
+    h->bounds[8 * size_t(cluster(t[3 * f])) + 7] += 1;
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t a = t[3 * f + k], b = t[3 * f + (k + 1) % 3];
+      double d2 = 0;
+      for (int j = 0; j < 3; ++j) {
+        const double d = double(p[3 * a + j]) - p[3 * b + j];
+        d2 += d * d;
+      }
+      const float len = float(std::sqrt(d2));
+      if (cluster(a) == cluster(b)) {
+        float &e = h->bounds[8 * size_t(cluster(a)) + 6];
+        e = std::max(e, len);
+      } else {
+        around[cluster(a)] = std::max(around[cluster(a)], len);
+        around[cluster(b)] = std::max(around[cluster(b)], len);
+      }
+    }
+  }
+  for (uint32_t c = 0; c < n; ++c)
+    if (h->bounds[8 * size_t(c) + 6] == 0)
+      h->bounds[8 * size_t(c) + 6] = around[c];
+  return h->bounds.data();
+}
+
+} // extern "C"

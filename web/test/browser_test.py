@@ -1,0 +1,180 @@
+#!/usr/bin/env python3
+"""The web viewer in a real headless browser.
+
+    python3 web/test/browser_test.py FILE.pomar [--images DIR] [--chromium PATH]
+
+Serves the repository's web/ folder and copies of FILE (intact, truncated in the global
+part, truncated in the cluster blocks, one cluster block damaged, and through a path that
+ignores Range) with web/serve.py on 127.0.0.1, opens web/index.html?test=1 in headless
+Chromium (WebGL2 on SwiftShader through ANGLE: --use-gl=swiftshader makes this Chromium's GPU
+process fail to start and, now and then, WebGL contexts get lost) and checks what web/test/page_test.js reports: the base
+mesh is drawn at once, a close-up refines and fetches a fraction of the file, zooming out
+coarsens, a full-resolution view fetches every byte of the file exactly once (checked in
+the server's log), and 404 / no Range support / truncated / damaged files show a message
+in the page. --images DIR keeps the screenshots (base, overview, closeup, zoomout, full).
+Exit status 0 = pass, 1 = a check failed, 77 = Chromium or the WebAssembly build missing.
+"""
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+WEB = os.path.dirname(HERE)
+sys.path.insert(0, WEB)
+import serve  # noqa: E402
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    ap.add_argument('pomar', help='a clustered .pomar file')
+    ap.add_argument('--images', help='copy the screenshots into this directory (prefix web_)')
+    ap.add_argument('--chromium', default=shutil.which('chromium') or shutil.which('chromium-browser'))
+    ap.add_argument('--timeout', type=float, default=240)
+    ap.add_argument('--target', type=float, default=3, help='target screen-space error in pixels')
+    ap.add_argument('--closeup', type=float, default=0.3, help='close-up distance / model size')
+    ap.add_argument('--max-gap', type=int, default=4096, help='pomar.js maxGap for the session (bytes)')
+    args = ap.parse_args()
+    if not args.chromium:
+        print('browser_test: SKIP: chromium not installed')
+        return 77
+    if not os.path.exists(os.path.join(WEB, 'dist', 'pomar_decoder.wasm')):
+        print('browser_test: SKIP: web/dist/pomar_decoder.wasm not built (bash web/build.sh)')
+        return 77
+
+    failures = []
+
+    def check(ok, what):
+        print(('ok   ' if ok else 'FAIL ') + what)
+        if not ok:
+            failures.append(what)
+
+    work = tempfile.mkdtemp(prefix='pomar-browser-')
+    proc = None
+    server = None
+    try:
+        root = os.path.join(work, 'root')
+        data = os.path.join(root, 'data')
+        os.makedirs(data)
+        os.symlink(WEB, os.path.join(root, 'web'))
+        with open(args.pomar, 'rb') as f:
+            blob = f.read()
+        with open(os.path.join(data, 'model.pomar'), 'wb') as f:
+            f.write(blob)
+        # The global part's size, from the header, as `pomar info` reports it: found by
+        # the page; here only cuts are needed: inside the header, inside the blocks.
+        with open(os.path.join(data, 'truncated_global.pomar'), 'wb') as f:
+            f.write(blob[:200])
+        with open(os.path.join(data, 'truncated_blocks.pomar'), 'wb') as f:
+            f.write(blob[:len(blob) * 3 // 4])
+        damaged = bytearray(blob)
+        damaged[len(blob) - 40] ^= 0x5A  # inside the last cluster blocks
+        with open(os.path.join(data, 'damaged_blocks.pomar'), 'wb') as f:
+            f.write(bytes(damaged))
+        reports = os.path.join(work, 'reports')
+        os.makedirs(reports)
+        server = serve.make_server(root, 0, test=True, report_dir=reports)
+        threading.Thread(target=server.serve_forever, daemon=True).start()
+        base = f'http://127.0.0.1:{server.server_address[1]}'
+        url = (f'{base}/web/index.html?test=1&file=/data/model.pomar&maxGap={args.max_gap}'
+               f'&target={args.target}&closeup={args.closeup}&missing=/data/missing.pomar'
+               '&noRange=/no-range/data/model.pomar&truncatedGlobal=/data/truncated_global.pomar'
+               '&truncatedBlocks=/data/truncated_blocks.pomar&damagedBlocks=/data/damaged_blocks.pomar')
+        profile = os.path.join(work, 'profile')
+        cmd = [args.chromium, '--headless=new', '--no-sandbox', '--use-angle=swiftshader',
+               '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist', '--no-first-run',
+               '--no-default-browser-check', '--disable-extensions', '--window-size=800,600',
+               f'--user-data-dir={profile}', '--enable-logging=stderr', '--v=0', url]
+        browser_log = open(os.path.join(work, 'chromium.log'), 'wb')
+        proc = subprocess.Popen(cmd, stdout=browser_log, stderr=subprocess.STDOUT)
+        result_path = os.path.join(reports, 'result.json')
+        deadline = time.time() + args.timeout
+        while not os.path.exists(result_path) and time.time() < deadline and proc.poll() is None:
+            time.sleep(0.25)
+        if not os.path.exists(result_path):
+            print('browser_test: FAIL: the page reported nothing ' +
+                  ('(Chromium exited)' if proc.poll() is not None else f'in {args.timeout:.0f} s'))
+            with open(os.path.join(work, 'chromium.log'), 'rb') as f:
+                lines = f.read().decode('utf-8', 'replace').splitlines()
+            keep = [x for x in lines if 'CONSOLE' in x or 'Uncaught' in x]
+            print('\n'.join('  chromium: ' + x for x in keep[-30:]))
+            shutil.rmtree(work, ignore_errors=True)
+            return 1
+        with open(result_path) as f:
+            r = json.load(f)
+        if os.environ.get('POMAR_BROWSER_TEST_VERBOSE'):
+            print('\n'.join('  page: ' + x for x in r.get('log', [])))
+        log = server.log
+    finally:
+        if proc is not None:
+            proc.terminate()
+            try:
+                proc.wait(10)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+        if server is not None:
+            server.shutdown()
+
+    try:
+        check(r.get('ok'), 'the scripted session ran to the end' + ('' if r.get('ok') else ': ' + str(r.get('exception'))))
+        if not r.get('ok'):
+            return 1
+        size = r['info']['fileBytes']
+        b, ov, cu, zo, full = r['base'], r['overview'], r['closeup'], r['zoomout'], r['full']
+        print(f"file {size} bytes, global part {r['info']['globalBytes']}, {r['info']['clusters']} clusters, "
+              f"levels {r['info']['baseLevel']}..{r['info']['finestLevel']}; first frame {r['firstFrameMs']:.0f} ms")
+        for name, s in (('base', b), ('close-up', cu), ('overview', ov), ('zoomed out', zo), ('full', full)):
+            print(f"  {name:10s} {s['triangles']:7d} triangles, levels {s['minLevel']}..{s['maxLevel']}, "
+                  f"{s['bytesFetched']:7d} bytes fetched ({100 * s['bytesFetched'] / size:.1f}%) in {s['requests']} requests, "
+                  f"{100 * (s['covered'] or 0):.1f}% of the pixels drawn")
+        check(b['requests'] <= 2 and b['bytesFetched'] < size, 'open reads the global part in one or two requests')
+        check(b['covered'] > 0.02, 'the base clustered mesh is drawn')
+        check(b['maxLevel'] == r['info']['baseLevel'], 'open decodes the base clustered mesh only')
+        check(cu['maxLevel'] == r['info']['finestLevel'] and cu['minLevel'] < cu['maxLevel'],
+              'the close-up refines the region in view to the finest level, not everything')
+        check(cu['covered'] > 0.3, 'the close-up fills the view')
+        print(f"  close-up: fetched {cu['bytesFetched']} bytes ({100 * cu['bytesFetched'] / size:.1f}%), "
+              f"of which {cu['bytesForCloseup']} after the base mesh")
+        check(ov['triangles'] > b['triangles'] and ov['covered'] > 0.02, 'the overview refines')
+        check(zo['triangles'] < ov['triangles'] / 2 and zo['maxLevel'] <= ov['maxLevel'], 'zooming out coarsens')
+        check(r['interactive']['triangles'] > zo['triangles'] and r['interactive']['covered'] > 0.02,
+              "the viewer's own refinement loop refines the overview again")
+        check(full['triangles'] > cu['triangles'] and full['minLevel'] == r['info']['finestLevel'], 'full resolution everywhere')
+        check(full['bytesFetched'] == size, f"full resolution fetched {full['bytesFetched']} bytes of {size}")
+        check(full['maxInFlightSeen'] <= 4, 'at most 4 requests in flight')
+        if args.max_gap >= 1024:
+            check(full['requests'] < r['info']['clusters'] / 4,
+                  f"{full['requests']} requests for {r['info']['clusters']} blocks (coalesced)")
+        # The server's view: the intact file's bytes, each served once.
+        served = sorted((e['start'], e['start'] + e['bytes']) for e in log
+                        if e['path'] == '/data/model.pomar' and e['status'] == 206)
+        overlap = any(a[1] > b_[0] for a, b_ in zip(served, served[1:]))
+        total = sum(e - s for s, e in served)
+        check(total == size and not overlap, f'the server sent {total} bytes of {size} in {len(served)} ranges, none twice')
+        e = r['errors']
+        check('404' in e['missing']['error'], 'a missing file shows the HTTP status: ' + e['missing']['error'])
+        check('Range' in e['noRange']['error'], 'a server without Range support is named: ' + e['noRange']['error'])
+        check('truncated' in e['truncatedGlobal']['error'], 'a file cut in its global part: ' + e['truncatedGlobal']['error'])
+        check(not e['truncatedBlocks']['error'] and 'truncated' in e['truncatedBlocks']['warning'],
+              'a file cut in its cluster blocks decodes around them: ' + e['truncatedBlocks']['warning'].splitlines()[0]
+              if e['truncatedBlocks']['warning'] else 'a file cut in its cluster blocks: no warning')
+        check(not e['damagedBlocks']['error'] and 'damaged' in e['damagedBlocks']['warning'],
+              'a damaged cluster block is skipped with a warning')
+        if args.images:
+            os.makedirs(args.images, exist_ok=True)
+            for name in ('base', 'closeup', 'closeup_levels', 'overview', 'overview_levels', 'zoomout', 'full'):
+                shutil.copy(os.path.join(reports, name + '.png'), os.path.join(args.images, f'web_{name}.png'))
+            print(f'screenshots: {args.images}/web_*.png')
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    print('browser_test: ' + ('PASS' if not failures else f'{len(failures)} checks FAILED'))
+    return 1 if failures else 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,148 @@
+// The scripted browser test, run by viewer.js with ?test=1 (web/test/browser_test.py starts
+// the server and headless Chromium, then checks what this posts to /report/).
+// ?file=URL of an intact file; &missing=, &truncatedGlobal=, &truncatedBlocks=,
+// &damagedBlocks=, &noRange= URLs of the error cases.
+const params = new URLSearchParams(location.search);
+const targetPixels = Number(params.get('target') || 3);
+const closeup = Number(params.get('closeup') || 0.3);
+const $ = (id) => document.getElementById(id);
+const log = [];
+function note(...args) {
+  const line = args.join(' ');
+  log.push(line);
+  console.log('page_test: ' + line);
+}
+
+async function post(name, body) {
+  await fetch('/report/' + name, { method: 'POST', body });
+}
+async function screenshot(name, v) {
+  v.frame();
+  const blob = await new Promise((resolve) => document.getElementById('view').toBlob(resolve, 'image/png'));
+  await post(name + '.png', blob);
+  // Fraction of pixels that are not the background: the mesh is drawn.
+  const gl = document.getElementById('view').getContext('webgl2');
+  if (gl.isContextLost()) {
+    note('the WebGL context is lost');
+    return -1;
+  }
+  const w = gl.drawingBufferWidth;
+  const h = gl.drawingBufferHeight;
+  const px = new Uint8Array(4 * w * h);
+  gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, px);
+  let covered = 0;
+  for (let i = 0; i < px.length; i += 4) {
+    if (Math.abs(px[i] - 32) + Math.abs(px[i + 1] - 36) + Math.abs(px[i + 2] - 42) > 12) ++covered;
+  }
+  return covered / (w * h);
+}
+function within(ms, promise, what) {
+  let timer;
+  const timeout = new Promise((_, reject) => { timer = setTimeout(() => reject(new Error(`${what}: no answer in ${ms} ms`)), ms); });
+  return Promise.race([promise, timeout]).finally(() => clearTimeout(timer));
+}
+function snapshot(model, covered, extra = {}) {
+  const s = model.stats;
+  return { bytesFetched: s.bytesFetched, fileBytes: s.fileBytes, requests: s.requests, triangles: s.triangles,
+    vertices: s.vertices, minLevel: Math.min(...model.levels), maxLevel: Math.max(...model.levels),
+    maxInFlightSeen: s.maxInFlightSeen, damaged: s.damaged, covered, heldBytes: s.heldBytes, blocksHeld: s.blocksHeld, ...extra };
+}
+/** Refinement steps for the current camera until the model is stable for it. */
+async function settle(v, what) {
+  let steps = 0;
+  for (; steps < 64; ++steps) {
+    const r = await within(30000, v.model().wantView(v.view(), { targetPixels }), what);
+    if (!r.changed) break;
+  }
+  v.frame();
+  return steps;
+}
+
+export async function run(v) {
+  const result = { ok: false, log };
+  try {
+    $('refine').checked = false; // the test drives refinement itself (but see below)
+    const t0 = performance.now();
+    const fetchOptions = params.has('maxGap') ? { maxGap: Number(params.get('maxGap')) } : {};
+    const model = await within(30000, v.openSource(params.get('file'), fetchOptions), 'open');
+    result.firstFrameMs = performance.now() - t0;
+    result.info = { clusters: model.info.clusters, baseLevel: model.info.baseLevel, finestLevel: model.info.finestLevel,
+      fileBytes: model.info.fileBytes, globalBytes: model.info.globalBytes };
+    result.base = snapshot(model, await screenshot('base', v));
+    note('base clustered mesh', JSON.stringify(result.base));
+
+    // Close-up: the surface point facing the camera, seen from `closeup` x the model's size.
+    const center = v.camera.target.slice();
+    const eye = v.view().eye;
+    const p = model.mesh.positions;
+    let best = 0;
+    let bestDot = -Infinity;
+    const dir = [0, 1, 2].map((k) => eye[k] - v.camera.target[k]);
+    for (let i = 0; i < p.length / 3; ++i) {
+      const d = (p[3 * i] - v.camera.target[0]) * dir[0] + (p[3 * i + 1] - v.camera.target[1]) * dir[1] +
+        (p[3 * i + 2] - v.camera.target[2]) * dir[2];
+      if (d > bestDot) { bestDot = d; best = i; }
+    }
+    v.camera.target = [p[3 * best], p[3 * best + 1], p[3 * best + 2]];
+    v.camera.distance = closeup * v.camera.extent;
+    const before = model.stats.bytesFetched;
+    result.closeupSteps = await settle(v, 'close-up');
+    result.closeup = snapshot(model, await screenshot('closeup', v), { bytesForCloseup: model.stats.bytesFetched - before });
+    $('colour').value = '2'; // the same view coloured by level
+    await screenshot('closeup_levels', v);
+    $('colour').value = '0';
+    note('close-up', JSON.stringify(result.closeup));
+
+    // The whole model on screen: refine until the projected error is under the target.
+    v.camera.target = center;
+    v.camera.distance = 1.6 * v.camera.extent;
+    result.overviewSteps = await settle(v, 'overview');
+    result.overview = snapshot(model, await screenshot('overview', v));
+    $('colour').value = '2';
+    await screenshot('overview_levels', v);
+    $('colour').value = '0';
+    note('overview', JSON.stringify(result.overview));
+
+    // Zoom out: what shrinks to a few pixels coarsens.
+    v.camera.distance = 30 * v.camera.extent;
+    result.zoomoutSteps = await settle(v, 'zoom out');
+    result.zoomout = snapshot(model, await screenshot('zoomout', v));
+    note('zoomed out', JSON.stringify(result.zoomout));
+
+    // The viewer's own loop (what orbiting and zooming run): back to the overview.
+    $('refine').checked = true;
+    v.camera.distance = 1.6 * v.camera.extent;
+    await within(60000, v.refineLoop(), 'the viewer refinement loop');
+    $('refine').checked = false;
+    result.interactive = snapshot(model, await screenshot('interactive', v));
+    note('viewer loop', JSON.stringify(result.interactive));
+
+    // Full resolution everywhere: every block, each fetched once.
+    v.camera.distance = 1.6 * v.camera.extent;
+    await within(30000, model.want({ all: model.info.finestLevel }), 'full resolution');
+    result.full = snapshot(model, await screenshot('full', v));
+    note('full resolution', JSON.stringify(result.full));
+
+    // Error cases: each must show a message in the page, never hang.
+    result.errors = {};
+    for (const key of ['missing', 'noRange', 'truncatedGlobal', 'truncatedBlocks', 'damagedBlocks']) {
+      const url = params.get(key);
+      if (!url) continue;
+      v.showError('');
+      $('warning').textContent = '';
+      try {
+        const m = await within(20000, v.openSource(url), key);
+        if (m.info.clusters) await within(20000, m.want({ all: m.info.finestLevel }), key);
+      } catch (e) {
+        v.showError(e.message);
+      }
+      result.errors[key] = { error: $('error').textContent, warning: $('warning').textContent };
+      note(key, JSON.stringify(result.errors[key]));
+    }
+    result.ok = true;
+  } catch (e) {
+    result.exception = String(e && e.stack ? e.stack : e);
+    note('exception', result.exception);
+  }
+  await post('result.json', JSON.stringify(result));
+}

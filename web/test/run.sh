@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# The web tests (called by scripts/test.sh):  bash web/test/run.sh BUILD_DIR POMAR_TOOL
+#  1. builds the WebAssembly decoder (web/build.sh, in BUILD_DIR);
+#  2. encodes samples/bunny.ply three ways with the native tool and checks that the WASM
+#     decoder decodes them bit for bit like the native one, and that damaged/truncated
+#     copies give messages (web/test/wasm_decode_test.mjs, Node.js);
+#  3. runs the viewer in headless Chromium (web/test/browser_test.py).
+# (Plus web/test/unit_test.mjs: request coalescing and the choice of levels for a view.)
+# Each step is skipped with a message when emscripten, Node.js or Chromium is missing.
+set -euo pipefail
+REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+BUILD="$1"
+TOOL="$2"
+if ! command -v emcmake >/dev/null 2>&1 || ! command -v node >/dev/null 2>&1; then
+  echo "web tests: SKIPPED: emscripten or node not installed (scripts/setup.sh installs them)"
+  exit 0
+fi
+echo "web tests: building the WebAssembly decoder in $BUILD"
+bash "$REPO/web/build.sh" "$BUILD"
+samples="$BUILD/samples"
+mkdir -p "$samples"
+"$TOOL" encode "$REPO/samples/bunny.ply" "$samples/bunny.pomar" -q
+"$TOOL" encode "$REPO/samples/bunny.ply" "$samples/bunny_c5.pomar" --cluster-ratio 0.05 -q
+"$TOOL" encode "$REPO/samples/bunny.ply" "$samples/bunny_progressive.pomar" --progressive -q
+node "$REPO/web/test/unit_test.mjs"
+echo "web tests: WASM decode = native decode (node web/test/wasm_decode_test.mjs)"
+node "$REPO/web/test/wasm_decode_test.mjs" "$TOOL" "$samples/bunny.pomar" "$samples/bunny_c5.pomar" \
+  "$samples/bunny_progressive.pomar"
+if ! command -v chromium >/dev/null 2>&1; then
+  echo "web tests: browser test SKIPPED: chromium not installed"
+  exit 0
+fi
+echo "web tests: the viewer in headless Chromium (web/test/browser_test.py)"
+status=0
+python3 "$REPO/web/test/browser_test.py" "$samples/bunny_c5.pomar" || status=$?
+if [ "$status" = 77 ]; then
+  echo "web tests: browser test SKIPPED"
+elif [ "$status" != 0 ]; then
+  exit "$status"
+fi
+echo "web tests: passed"

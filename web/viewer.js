@@ -1,0 +1,286 @@
+// The pomar web viewer: WebGL2, orbit camera, view-dependent refinement through pomar.js.
+// URL parameters: ?file=URL opens a file; &test=1 runs the scripted browser test
+// (web/test/browser_test.py) and reports to the test server.
+import { open } from './pomar.js';
+
+const $ = (id) => document.getElementById(id);
+const canvas = $('view');
+const gl = canvas.getContext('webgl2', { antialias: true, preserveDrawingBuffer: true });
+const params = new URLSearchParams(location.search);
+
+// ------------------------------------------------------------------ small matrix helpers
+function perspective(fovY, aspect, near, far) {
+  const f = 1 / Math.tan(fovY / 2);
+  const nf = 1 / (near - far);
+  return [f / aspect, 0, 0, 0, 0, f, 0, 0, 0, 0, (far + near) * nf, -1, 0, 0, 2 * far * near * nf, 0];
+}
+function lookAt(eye, target, up) {
+  const sub = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+  const norm = (a) => { const l = Math.hypot(...a) || 1; return a.map((x) => x / l); };
+  const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+  const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+  const z = norm(sub(eye, target));
+  const x = norm(cross(up, z));
+  const y = cross(z, x);
+  return [x[0], y[0], z[0], 0, x[1], y[1], z[1], 0, x[2], y[2], z[2], 0, -dot(x, eye), -dot(y, eye), -dot(z, eye), 1];
+}
+function multiply(a, b) {
+  const out = new Array(16).fill(0);
+  for (let c = 0; c < 4; ++c)
+    for (let r = 0; r < 4; ++r)
+      for (let k = 0; k < 4; ++k) out[4 * c + r] += a[4 * k + r] * b[4 * c + k];
+  return out;
+}
+
+// ------------------------------------------------------------------ renderer
+const VS = `#version 300 es
+layout(location=0) in vec3 position;
+layout(location=1) in uint cluster;
+layout(location=2) in uint level;
+uniform mat4 viewProj;
+uniform int colourMode;
+uniform float finest;
+uniform float base;
+out vec3 vPosition;
+flat out vec3 vColour;
+vec3 hue(float h) { return clamp(abs(mod(h * 6.0 + vec3(0, 4, 2), 6.0) - 3.0) - 1.0, 0.0, 1.0); }
+void main() {
+  vPosition = position;
+  if (colourMode == 1) vColour = 0.35 + 0.65 * hue(fract(float(cluster) * 0.61803));
+  else if (colourMode == 2) vColour = 0.3 + 0.7 * hue(0.66 * (1.0 - (float(level) - base) / max(1.0, finest - base)));
+  else vColour = vec3(0.82, 0.80, 0.76);
+  gl_Position = viewProj * vec4(position, 1.0);
+}`;
+const FS = `#version 300 es
+precision highp float;
+in vec3 vPosition;
+flat in vec3 vColour;
+uniform vec3 eye;
+out vec4 colour;
+void main() {
+  vec3 n = normalize(cross(dFdx(vPosition), dFdy(vPosition)));
+  vec3 l = normalize(eye - vPosition);
+  float d = abs(dot(n, l));
+  colour = vec4(vColour * (0.25 + 0.75 * d), 1.0);
+}`;
+
+function compile(type, source) {
+  const s = gl.createShader(type);
+  gl.shaderSource(s, source);
+  gl.compileShader(s);
+  if (!gl.getShaderParameter(s, gl.COMPILE_STATUS)) throw new Error(gl.getShaderInfoLog(s));
+  return s;
+}
+let program = null;
+let vao = null;
+const buffers = {};
+let indexCount = 0;
+function initGL() {
+  program = gl.createProgram();
+  gl.attachShader(program, compile(gl.VERTEX_SHADER, VS));
+  gl.attachShader(program, compile(gl.FRAGMENT_SHADER, FS));
+  gl.linkProgram(program);
+  if (!gl.getProgramParameter(program, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(program));
+  vao = gl.createVertexArray();
+  gl.bindVertexArray(vao);
+  for (const name of ['position', 'cluster', 'level', 'index']) buffers[name] = gl.createBuffer();
+  gl.bindBuffer(gl.ARRAY_BUFFER, buffers.position);
+  gl.enableVertexAttribArray(0);
+  gl.vertexAttribPointer(0, 3, gl.FLOAT, false, 0, 0);
+  gl.bindBuffer(gl.ARRAY_BUFFER, buffers.cluster);
+  gl.enableVertexAttribArray(1);
+  gl.vertexAttribIPointer(1, 1, gl.UNSIGNED_INT, 0, 0);
+  gl.bindBuffer(gl.ARRAY_BUFFER, buffers.level);
+  gl.enableVertexAttribArray(2);
+  gl.vertexAttribIPointer(2, 1, gl.UNSIGNED_INT, 0, 0);
+  gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, buffers.index);
+  gl.enable(gl.DEPTH_TEST);
+}
+function upload(mesh, model) {
+  gl.bindVertexArray(vao);
+  gl.bindBuffer(gl.ARRAY_BUFFER, buffers.position);
+  gl.bufferData(gl.ARRAY_BUFFER, mesh.positions, gl.DYNAMIC_DRAW);
+  gl.bindBuffer(gl.ARRAY_BUFFER, buffers.cluster);
+  gl.bufferData(gl.ARRAY_BUFFER, mesh.vertexCluster, gl.DYNAMIC_DRAW);
+  // Colour by level: the level of the vertex's cluster (the level map), not the level
+  // that created the vertex (which mixes all levels up to it in every region).
+  const levels = model ? model.levels : null;
+  const level = new Uint32Array(mesh.vertexCluster.length);
+  for (let v = 0; v < level.length; ++v) level[v] = levels && levels.length ? levels[mesh.vertexCluster[v]] : mesh.vertexLevel[v];
+  gl.bindBuffer(gl.ARRAY_BUFFER, buffers.level);
+  gl.bufferData(gl.ARRAY_BUFFER, level, gl.DYNAMIC_DRAW);
+  gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, buffers.index);
+  gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, mesh.triangles, gl.DYNAMIC_DRAW);
+  indexCount = mesh.triangles.length;
+}
+
+// ------------------------------------------------------------------ camera
+const camera = { target: [0, 0, 0], distance: 1, yaw: 0.6, pitch: 0.3, fovY: Math.PI / 4, extent: 1 };
+let cameraVersion = 0;
+function view() {
+  const dpr = window.devicePixelRatio || 1;
+  const w = Math.max(1, Math.round(canvas.clientWidth * dpr));
+  const h = Math.max(1, Math.round(canvas.clientHeight * dpr));
+  if (canvas.width !== w || canvas.height !== h) {
+    canvas.width = w;
+    canvas.height = h;
+  }
+  const c = camera;
+  const eye = [c.target[0] + c.distance * Math.cos(c.pitch) * Math.sin(c.yaw),
+    c.target[1] + c.distance * Math.sin(c.pitch),
+    c.target[2] + c.distance * Math.cos(c.pitch) * Math.cos(c.yaw)];
+  const near = Math.max(c.distance * 0.01, c.extent * 1e-4);
+  const far = c.distance + 4 * c.extent;
+  const viewProj = multiply(perspective(c.fovY, w / h, near, far), lookAt(eye, c.target, [0, 1, 0]));
+  return { eye, viewProj, fovY: c.fovY, height: h, near };
+}
+function frame(model) {
+  if (!program) return;
+  const v = view();
+  gl.viewport(0, 0, canvas.width, canvas.height);
+  gl.clearColor(0.125, 0.14, 0.165, 1);
+  gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
+  if (!indexCount) return;
+  gl.useProgram(program);
+  gl.uniformMatrix4fv(gl.getUniformLocation(program, 'viewProj'), false, v.viewProj);
+  gl.uniform3fv(gl.getUniformLocation(program, 'eye'), v.eye);
+  gl.uniform1i(gl.getUniformLocation(program, 'colourMode'), Number($('colour').value));
+  gl.uniform1f(gl.getUniformLocation(program, 'finest'), model ? model.info.finestLevel : 1);
+  gl.uniform1f(gl.getUniformLocation(program, 'base'), model ? model.info.baseLevel : 0);
+  gl.bindVertexArray(vao);
+  gl.drawElements(gl.TRIANGLES, indexCount, gl.UNSIGNED_INT, 0);
+}
+
+// ------------------------------------------------------------------ the model
+let model = null;
+let refining = false;
+function showStats() {
+  if (!model) return;
+  const s = model.stats;
+  const lv = model.levels.length ? [Math.min(...model.levels), Math.max(...model.levels)] : [0, 0];
+  const kb = (b) => (b / 1024).toFixed(1) + ' KiB';
+  $('stats').textContent =
+    `fetched ${kb(s.bytesFetched)} of ${kb(s.fileBytes)} (${(100 * s.bytesFetched / s.fileBytes).toFixed(1)}%) in ${s.requests} requests\n` +
+    `${s.triangles} triangles, ${s.vertices} vertices, levels ${lv[0]}..${lv[1]} of ${model.info.finestLevel} ` +
+    `(base clustered ${model.info.baseLevel}), ${model.info.clusters} clusters\n` +
+    `blocks held ${s.blocksHeld} (${kb(s.heldBytes)}), damaged ${s.damaged}, last decode ${(s.decodeMs || 0).toFixed(0)} ms`;
+}
+function onMesh(mesh, m = model) {
+  upload(mesh, m);
+  frame(model);
+  showStats();
+}
+function showError(message) {
+  $('error').textContent = message ? 'error: ' + message : '';
+}
+
+/** Refine/coarsen for the current view until the model is stable for it. */
+async function refineLoop() {
+  if (refining || !model || !$('refine').checked) return;
+  refining = true;
+  try {
+    for (let step = 0; step < 64; ++step) {
+      const version = cameraVersion;
+      const r = await model.wantView(view(), { targetPixels: Number($('target').value) || 3 });
+      if (!r.changed && version === cameraVersion) break;
+    }
+  } catch (e) {
+    showError(e.message);
+  } finally {
+    refining = false;
+  }
+}
+
+async function openSource(source, extraOptions = {}) {
+  showError('');
+  $('warning').textContent = '';
+  if (model) model.close();
+  model = null;
+  indexCount = 0;
+  frame(null);
+  const m = await open(source, {
+    ...extraOptions,
+    onMesh: (mesh, m) => onMesh(mesh, m),
+    onWarning: (message) => { $('warning').textContent = 'warning: ' + message; },
+  });
+  model = m;
+  // The header's box is the quantization cube; frame the base mesh's own box instead.
+  const p = m.mesh.positions;
+  const lo = [Infinity, Infinity, Infinity];
+  const hi = [-Infinity, -Infinity, -Infinity];
+  for (let i = 0; i < p.length; ++i) {
+    lo[i % 3] = Math.min(lo[i % 3], p[i]);
+    hi[i % 3] = Math.max(hi[i % 3], p[i]);
+  }
+  camera.target = [0, 1, 2].map((k) => (lo[k] + hi[k]) / 2);
+  camera.extent = Math.max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+  camera.distance = 1.6 * camera.extent;
+  ++cameraVersion;
+  onMesh(m.mesh, m);
+  if (m.info.clusters === 0) await m.want({ all: m.info.finestLevel }); // progressive: no regions
+  return m;
+}
+
+// ------------------------------------------------------------------ interaction
+function moved() {
+  ++cameraVersion;
+  frame(model);
+  refineLoop();
+}
+const pointers = new Map();
+canvas.addEventListener('pointerdown', (e) => { canvas.setPointerCapture(e.pointerId); pointers.set(e.pointerId, [e.clientX, e.clientY]); });
+canvas.addEventListener('pointerup', (e) => pointers.delete(e.pointerId));
+canvas.addEventListener('pointercancel', (e) => pointers.delete(e.pointerId));
+canvas.addEventListener('pointermove', (e) => {
+  if (!pointers.has(e.pointerId)) return;
+  const [x, y] = pointers.get(e.pointerId);
+  if (pointers.size === 2) { // pinch: zoom by the change of the distance between fingers
+    const other = [...pointers.entries()].find(([id]) => id !== e.pointerId)[1];
+    const before = Math.hypot(x - other[0], y - other[1]);
+    const after = Math.hypot(e.clientX - other[0], e.clientY - other[1]);
+    if (before > 0 && after > 0) camera.distance *= before / after;
+  } else {
+    camera.yaw -= (e.clientX - x) * 0.01;
+    camera.pitch = Math.max(-1.5, Math.min(1.5, camera.pitch + (e.clientY - y) * 0.01));
+  }
+  pointers.set(e.pointerId, [e.clientX, e.clientY]);
+  moved();
+});
+canvas.addEventListener('wheel', (e) => {
+  e.preventDefault();
+  camera.distance *= Math.exp(e.deltaY * 0.001);
+  moved();
+}, { passive: false });
+window.addEventListener('resize', moved);
+$('colour').addEventListener('change', () => frame(model));
+$('target').addEventListener('change', moved);
+$('refine').addEventListener('change', moved);
+$('open').addEventListener('submit', (e) => {
+  e.preventDefault();
+  const url = $('url').value.trim();
+  if (url) openSource(url).then(() => refineLoop(), (err) => showError(err.message));
+});
+window.addEventListener('dragover', (e) => { e.preventDefault(); $('drop').style.display = 'block'; });
+window.addEventListener('dragleave', () => { $('drop').style.display = 'none'; });
+window.addEventListener('drop', (e) => {
+  e.preventDefault();
+  $('drop').style.display = 'none';
+  const f = e.dataTransfer.files[0];
+  if (f) openSource(f).then(() => refineLoop(), (err) => showError(err.message));
+});
+
+// ------------------------------------------------------------------ start
+try {
+  if (!gl) throw new Error('this browser has no WebGL2');
+  initGL();
+  frame(null);
+  if (params.get('test')) {
+    import('./test/page_test.js').then((t) => t.run({ openSource, camera, moved, view, frame: () => frame(model),
+      model: () => model, showError, refineLoop }));
+  } else if (params.get('file')) {
+    $('url').value = params.get('file');
+    openSource(params.get('file')).then(() => refineLoop(), (err) => showError(err.message));
+  }
+} catch (e) {
+  showError(e.message);
+}
