@@ -138,7 +138,7 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
   r.level = static_cast<int>(decode_global_levels(data, layout, 0, std::min(target, global), lm,
                                                   models, options.progress,
                                                   options.skip_damaged ? &r.damaged : nullptr));
-  return to_mesh(lm, h.grid);
+  return to_mesh(std::move(lm), h.grid);
 }
 
 } // namespace pomar

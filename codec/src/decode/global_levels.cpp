@@ -9,12 +9,30 @@
 
 namespace pomar {
 
+namespace {
+/// Quantizer::dequantize for every coordinate, the step computed once.
+std::vector<float> dequantize_all(const std::vector<int32_t> &q, const Quantizer &grid) {
+  std::vector<float> out(q.size());
+  const double step = grid.step();
+  const double origin[3] = {grid.origin[0], grid.origin[1], grid.origin[2]};
+  for (size_t i = 0; i + 2 < q.size(); i += 3)
+    for (int k = 0; k < 3; ++k)
+      out[i + k] = static_cast<float>(origin[k] + double(static_cast<uint32_t>(q[i + k])) * step);
+  return out;
+}
+} // namespace
+
 Mesh to_mesh(const LevelMesh &lm, const Quantizer &grid) {
   Mesh out;
-  out.positions.resize(lm.q.size());
-  for (size_t i = 0; i < lm.q.size(); ++i)
-    out.positions[i] = grid.dequantize(static_cast<int>(i % 3), static_cast<uint32_t>(lm.q[i]));
+  out.positions = dequantize_all(lm.q, grid);
   out.triangles = lm.ct.V;
+  return out;
+}
+
+Mesh to_mesh(LevelMesh &&lm, const Quantizer &grid) {
+  Mesh out;
+  out.positions = dequantize_all(lm.q, grid);
+  out.triangles = std::move(lm.ct.V);
   return out;
 }
 
