@@ -8,10 +8,9 @@ include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
 set(POMAR_CMAKE_DIR "${CMAKE_INSTALL_LIBDIR}/cmake/pomar")
-set(_pomar_headers limits.h mesh_io.h pomar.h random_access.h repair.h vcg_adapter.h version.h)
-list(TRANSFORM _pomar_headers PREPEND "${PROJECT_SOURCE_DIR}/codec/include/pomar/")
-install(FILES ${_pomar_headers} DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}/pomar"
-        COMPONENT library)
+# Every header of codec/include/pomar is public (internals live in codec/src).
+install(DIRECTORY "${PROJECT_SOURCE_DIR}/codec/include/pomar" DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}"
+        COMPONENT library FILES_MATCHING PATTERN "*.h")
 
 # Shared libraries: libpomar_core.so.0.1 -> libpomar_core.so.0.1.0. Before 1.0 a minor
 # version may change the ABI, so the SONAME carries MAJOR.MINOR.

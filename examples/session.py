@@ -1,4 +1,3 @@
-import numpy as np
 import pomar
 
 mesh = pomar.read("samples/bunny.ply")           # .ply .obj .off .stl .pomar

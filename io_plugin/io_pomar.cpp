@@ -26,14 +26,6 @@ namespace {
 const char *const kFormatName = "POMAR progressive mesh";
 const char *const kExtension = "pomar";
 
-/// "<verb> <path>: <what>", or just `what` when the codec's message names the file already.
-QString describe(const char *verb, const QString &path, const char *what) {
-  const QString text = QString::fromStdString(what);
-  if (text.contains(path))
-    return text;
-  return QString("%1 %2: %3").arg(verb, path, text);
-}
-
 bool isPomar(const QString &format) {
   return format.compare(QLatin1String(kExtension), Qt::CaseInsensitive) == 0;
 }
@@ -49,7 +41,6 @@ bool hasOwnVertexNormals(const CMeshO &m) {
   using P = vcg::Point3f;
   std::vector<P> acc(m.vert.size(), P(0, 0, 0));
   std::vector<char> used(m.vert.size(), 0);
-  const CVertexO *first = m.vert.empty() ? nullptr : &m.vert[0];
   for (const CFaceO &f : m.face) {
     if (f.IsD())
       continue;
@@ -62,7 +53,7 @@ bool hasOwnVertexNormals(const CMeshO &m) {
     const P e0 = (p1 - p0).Normalize(), e1 = (p2 - p1).Normalize(), e2 = (p0 - p2).Normalize();
     const float w[3] = {vcg::AngleN(e0, -e2), vcg::AngleN(-e0, e1), vcg::AngleN(-e1, e2)};
     for (int k = 0; k < 3; ++k) {
-      const size_t v = size_t(f.cV(k) - first);
+      const size_t v = pomar::vertex_position(m, f.cV(k));
       if (v >= acc.size() || !std::isfinite(w[k]))
         continue;
       acc[v] += n * w[k];
@@ -83,8 +74,30 @@ bool hasOwnVertexNormals(const CMeshO &m) {
   return count > 0 && differ * 100 > count;
 }
 
-/// What the mesh carries that a .pomar file does not keep (positions and triangles only).
-QStringList notKept(MeshModel &mm) {
+/// The per-vertex data a .pomar file keeps (vcg::tri::io::Mask bits).
+constexpr int kKeptMask = vcg::tri::io::Mask::IOM_VERTCOLOR | vcg::tri::io::Mask::IOM_VERTNORMAL |
+                          vcg::tri::io::Mask::IOM_VERTQUALITY |
+                          vcg::tri::io::Mask::IOM_VERTTEXCOORD;
+
+/// What the layer has of the kept per-vertex data (MeshModel's data mask), as from_vcg's mask.
+int layerAttributes(MeshModel &mm) {
+  using M = vcg::tri::io::Mask;
+  int mask = pomar::kVcgCustomScalars;
+  if (mm.hasDataMask(MeshModel::MM_VERTCOLOR))
+    mask |= M::IOM_VERTCOLOR;
+  if (mm.hasDataMask(MeshModel::MM_VERTNORMAL))
+    mask |= M::IOM_VERTNORMAL;
+  if (mm.hasDataMask(MeshModel::MM_VERTQUALITY))
+    mask |= M::IOM_VERTQUALITY;
+  if (mm.hasDataMask(MeshModel::MM_VERTTEXCOORD))
+    mask |= M::IOM_VERTTEXCOORD;
+  return mask;
+}
+
+/// What the mesh carries that the saved .pomar file does not keep: everything but positions,
+/// triangles, named per-vertex float attributes and the per-vertex data in `saveMask`.
+QStringList notKept(MeshModel &mm, int saveMask) {
+  using M = vcg::tri::io::Mask;
   const CMeshO &m = mm.cm;
   QStringList out;
   auto anyVertex = [&](auto pred) {
@@ -99,16 +112,17 @@ QStringList notKept(MeshModel &mm) {
         return true;
     return false;
   };
-  if (mm.hasDataMask(MeshModel::MM_VERTCOLOR) &&
+  if (mm.hasDataMask(MeshModel::MM_VERTCOLOR) && !(saveMask & M::IOM_VERTCOLOR) &&
       anyVertex([](const CVertexO &v) { return v.cC() != vcg::Color4b(vcg::Color4b::White); }))
-    out << "per-vertex colors";
-  if (mm.hasDataMask(MeshModel::MM_VERTNORMAL) && hasOwnVertexNormals(m))
-    out << "per-vertex normals";
-  if (mm.hasDataMask(MeshModel::MM_VERTQUALITY) &&
+    out << "per-vertex colors (tick Color in the save dialog / meshlabserver -m vc)";
+  if (mm.hasDataMask(MeshModel::MM_VERTNORMAL) && !(saveMask & M::IOM_VERTNORMAL) &&
+      hasOwnVertexNormals(m))
+    out << "per-vertex normals (tick Normal / -m vn)";
+  if (mm.hasDataMask(MeshModel::MM_VERTQUALITY) && !(saveMask & M::IOM_VERTQUALITY) &&
       anyVertex([](const CVertexO &v) { return v.cQ() != 0; }))
-    out << "per-vertex quality";
-  if (mm.hasDataMask(MeshModel::MM_VERTTEXCOORD))
-    out << "per-vertex texture coordinates";
+    out << "per-vertex quality (tick Quality / -m vq)";
+  if (mm.hasDataMask(MeshModel::MM_VERTTEXCOORD) && !(saveMask & M::IOM_VERTTEXCOORD))
+    out << "per-vertex texture coordinates (tick TexCoord / -m vt)";
   if (mm.hasDataMask(MeshModel::MM_VERTRADIUS))
     out << "per-vertex radius";
   if (mm.hasDataMask(MeshModel::MM_FACECOLOR) &&
@@ -125,7 +139,8 @@ QStringList notKept(MeshModel &mm) {
     out << "per-wedge colors";
   if (mm.hasDataMask(MeshModel::MM_POLYGONAL))
     out << "polygons (faux edges; saved as triangles)";
-  if (!m.textures.empty())
+  if (!m.textures.empty() &&
+      !(mm.hasDataMask(MeshModel::MM_VERTTEXCOORD) && (saveMask & M::IOM_VERTTEXCOORD)))
     out << QString("%1 texture(s)").arg(m.textures.size());
   if (m.en > 0)
     out << QString("%1 edge(s)").arg(m.en);
@@ -137,7 +152,9 @@ QStringList notKept(MeshModel &mm) {
       if (!a._name.empty() && !pomar::meshlab::isPomarAttribute(a._name))
         custom << QString::fromStdString(a._name);
   };
-  addNames(m.vert_attr);
+  for (const auto &a : m.vert_attr) // named float attributes are kept
+    if (!a._name.empty() && !pomar::meshlab::isPomarAttribute(a._name) && a._type != typeid(float))
+      custom << QString::fromStdString(a._name);
   addNames(m.face_attr);
   addNames(m.edge_attr);
   addNames(m.mesh_attr);
@@ -160,8 +177,11 @@ QList<MeshIOInterface::Format> PomarIOPlugin::exportFormats() const {
 
 void PomarIOPlugin::GetExportMaskCapability(QString & /*format*/, int &capability,
                                             int &defaultBits) const {
-  capability = 0; // positions and triangles only: nothing optional to choose
-  defaultBits = 0;
+  // Per-vertex colour, normals, quality and texture coordinates (named per-vertex float
+  // attributes are always kept). Normals are off by default: MeshLab recomputes them from
+  // the geometry; a layer with its own normals gets a warning if they are not ticked.
+  capability = kKeptMask;
+  defaultBits = kKeptMask & ~vcg::tri::io::Mask::IOM_VERTNORMAL;
 }
 
 bool PomarIOPlugin::fail(const QString &text) {
@@ -215,10 +235,7 @@ bool PomarIOPlugin::open(const QString &format, const QString &fileName, MeshMod
       level = decoder.base_clustered_level();
     else if (openAt == OPEN_GLOBAL_LEVEL)
       level = wantedLevel;
-    if (level < 0 || level > decoder.finest_level())
-      throw pomar::Error("level " + std::to_string(level) +
-                         " does not exist: the file has levels 0.." +
-                         std::to_string(decoder.finest_level()));
+    pomar::check_level_exists(level, decoder.finest_level());
 
     pomar::Mesh mesh;
     std::vector<uint32_t> cluster, vertexLevel;
@@ -226,11 +243,13 @@ bool PomarIOPlugin::open(const QString &format, const QString &fileName, MeshMod
     if (info.clustered() && level < decoder.base_clustered_level()) {
       // Below the base clustered mesh only the plain decoder goes; it knows no vertex levels.
       QFile file(path);
-      if (!file.open(QIODevice::ReadOnly))
-        throw pomar::Error("cannot read " + native + ": " + file.errorString().toStdString());
-      const QByteArray bytes = file.readAll();
-      if (file.error() != QFileDevice::NoError)
-        throw pomar::Error("cannot read " + native + ": " + file.errorString().toStdString());
+      QByteArray bytes;
+      if (file.open(QIODevice::ReadOnly))
+        bytes = file.readAll();
+      if (!file.isOpen() || file.error() != QFileDevice::NoError)
+        throw pomar::Error(pomar::Error::Kind::Io,
+                           "cannot read " + native + ": " + file.errorString().toStdString())
+            .with_path(native);
       pomar::DecodeOptions options;
       options.level = level;
       options.skip_damaged = skipDamaged;
@@ -253,36 +272,25 @@ bool PomarIOPlugin::open(const QString &format, const QString &fileName, MeshMod
                                   .arg(path)
                                   .arg(damaged.size())
                                   .arg(QString::fromStdString(pomar::describe_damage(damaged)));
-      Log(GLLogStream::WARNING, qUtf8Printable(warning));
-      qWarning("pomar: %s", qUtf8Printable(warning)); // Log() is a no-op in meshlabserver
+      pomar::meshlab::warn(*this, "", warning);
     }
 
-    pomar::to_vcg(mesh, m.cm); // also clears m's attributes
-    auto clusterOf = vcg::tri::Allocator<CMeshO>::GetPerVertexAttribute<float>(
-        m.cm, pomar::meshlab::kClusterAttribute);
-    auto levelOf = vcg::tri::Allocator<CMeshO>::GetPerVertexAttribute<float>(
-        m.cm, pomar::meshlab::kLevelAttribute);
-    const bool haveClusters = info.clustered() && cluster.size() == mesh.vertex_count();
-    const bool haveLevels = vertexLevel.size() == mesh.vertex_count();
-    for (size_t v = 0; v < mesh.vertex_count(); ++v) {
-      clusterOf[v] = haveClusters ? float(cluster[v]) : -1.0f;
-      levelOf[v] = haveLevels ? float(vertexLevel[v]) : -1.0f;
-    }
-    auto source = vcg::tri::Allocator<CMeshO>::GetPerMeshAttribute<std::string>(
-        m.cm, pomar::meshlab::kSourceAttribute);
-    source() = native;
-    auto skip = vcg::tri::Allocator<CMeshO>::GetPerMeshAttribute<int>(
-        m.cm, pomar::meshlab::kSkipDamagedAttribute);
-    skip() = skipDamaged ? 1 : 0;
+    if (mesh.find(pomar::AttributeKind::TexCoord))
+      m.updateDataMask(MeshModel::MM_VERTTEXCOORD); // optional in CMeshO: enable first
+    // Also clears m's attributes; the mask tells MeshLab what to show (colours, ...).
+    mask = pomar::to_vcg(mesh, m.cm) & kKeptMask;
+    if (!info.clustered())
+      cluster.clear(); // a progressive file's vertices have no cluster
+    pomar::meshlab::setLayerAttributes(m.cm, cluster, vertexLevel, native, skipDamaged);
 
-    progress.report(100);
+    progress.done();
     Log("pomar: opened %s at level %d of %d (%s): %zu vertices, %zu faces", qUtf8Printable(path),
         level, decoder.finest_level(), info.clustered() ? "clustered file" : "progressive file",
         mesh.vertex_count(), mesh.triangle_count());
     return true;
   } catch (const std::exception &e) { // pomar::Error, or std::bad_alloc
     m.cm.Clear();
-    return fail(describe("cannot open", path, e.what()));
+    return fail(pomar::meshlab::errorText(e, "cannot open " + path));
   }
 }
 
@@ -301,6 +309,13 @@ void PomarIOPlugin::initSaveParameter(const QString &format, MeshModel & /*m*/,
                          "progressive file)."));
   par.addParam(RichBool("Progressive", defaults.progressive, "Pure progressive",
                         "Global levels only, no clusters: no random access."));
+  par.addParam(RichInt("NormalBits", defaults.attributes.normal_bits, "Normal bits",
+                       "Bits per octahedral coordinate of per-vertex normals (4..16): at most "
+                       "0.332 degrees of error at 9, half as much per extra bit."));
+  par.addParam(RichBool("ExactAttributes", false, "Exact attributes",
+                        "Store normals, quality and other per-vertex floats bit for bit (colour "
+                        "is always exact). Off: quality and custom floats on 16 bits over their "
+                        "range, texture coordinates on 12 bits."));
   par.addParam(RichBool("Repair", false, "Repair (cut into a manifold mesh)",
                         "Opt-in: save a non-manifold or inconsistently oriented mesh by cutting it "
                         "(faces repeating a vertex and exact duplicates removed, faces flipped, "
@@ -309,7 +324,7 @@ void PomarIOPlugin::initSaveParameter(const QString &format, MeshModel & /*m*/,
 }
 
 bool PomarIOPlugin::save(const QString &format, const QString &fileName, MeshModel &m,
-                         const int /*mask*/, const RichParameterList &par, vcg::CallBackPos *cb,
+                         const int mask, const RichParameterList &par, vcg::CallBackPos *cb,
                          QWidget *) {
   if (!isPomar(format))
     return fail(QString("unknown format \"%1\"").arg(format));
@@ -322,17 +337,32 @@ bool PomarIOPlugin::save(const QString &format, const QString &fileName, MeshMod
     options.cluster_ratio = par.getFloat("ClusterRatio");
   if (par.hasParameter("Progressive"))
     options.progressive = par.getBool("Progressive");
+  if (par.hasParameter("NormalBits"))
+    options.attributes.normal_bits = par.getInt("NormalBits");
+  options.attributes.exact = par.hasParameter("ExactAttributes") && par.getBool("ExactAttributes");
   const bool repair = par.hasParameter("Repair") && par.getBool("Repair");
+  // The save mask (dialog ticks, meshlabserver -m) limited to what the layer has.
+  const int attributes = layerAttributes(m) & (mask | pomar::kVcgCustomScalars);
 
   ProgressRelay progress(cb, "Encoding pomar");
   options.progress = progress.function();
-  QStringList dropped = notKept(m);
+  QStringList dropped = notKept(m, attributes);
   std::vector<uint8_t> bytes;
   QString repaired; // what the Repair option changed, "" if off or nothing
   try {
     progress.report(0);
     size_t unreferenced = 0;
-    pomar::Mesh mesh = pomar::from_vcg(m.cm, &unreferenced); // skips deleted elements
+    // Skips deleted elements; takes the attributes the save mask asks for; the layer's own
+    // colours when Show Clusters / Show Levels painted it.
+    pomar::meshlab::swapSavedColours(m.cm);
+    pomar::Mesh mesh;
+    try {
+      mesh = pomar::from_vcg(m.cm, &unreferenced, attributes);
+    } catch (...) {
+      pomar::meshlab::swapSavedColours(m.cm);
+      throw;
+    }
+    pomar::meshlab::swapSavedColours(m.cm);
     if (unreferenced > 0)
       dropped << QString("%1 unreferenced vertices").arg(unreferenced);
     if (repair) {
@@ -343,14 +373,13 @@ bool PomarIOPlugin::save(const QString &format, const QString &fileName, MeshMod
     try {
       bytes = pomar::encode(mesh, options);
     } catch (const pomar::Error &e) {
-      pomar::Mesh copy = mesh;
-      if (repair || !pomar::make_manifold(copy).changed())
+      if (repair || !pomar::repair_would_change(mesh))
         throw;
-      throw pomar::Error(std::string(e.what()) +
-                         " (the Repair save option cuts it into a manifold mesh)");
+      throw pomar::Error(e.kind(), std::string(e.what()) +
+                                       " (the Repair save option cuts it into a manifold mesh)");
     }
   } catch (const std::exception &e) { // pomar::Error (invalid mesh or options), std::bad_alloc
-    return fail(describe("cannot save", path, e.what()));
+    return fail(pomar::meshlab::errorText(e, "cannot save " + path));
   }
 
   // Atomic replacement: a temporary file next to the destination, renamed over it on commit.
@@ -364,21 +393,18 @@ bool PomarIOPlugin::save(const QString &format, const QString &fileName, MeshMod
     file.cancelWriting();
     return fail(QString("cannot save %1: %2").arg(path, why));
   }
-  progress.report(100);
+  progress.done();
 
-  if (!repaired.isEmpty()) {
-    const QString warning =
-        QString("%1: repaired before saving: %2").arg(QFileInfo(path).fileName(), repaired);
-    Log(GLLogStream::WARNING, qUtf8Printable(warning));
-    qWarning("pomar: %s", qUtf8Printable(warning)); // Log() is a no-op in meshlabserver
-  }
-  if (!dropped.isEmpty()) {
-    const QString warning =
-        QString("%1: the .pomar format keeps only positions and triangles; not saved: %2")
-            .arg(QFileInfo(path).fileName(), dropped.join("; "));
-    Log(GLLogStream::WARNING, qUtf8Printable(warning));
-    qWarning("pomar: %s", qUtf8Printable(warning)); // Log() is a no-op in meshlabserver
-  }
+  if (!repaired.isEmpty())
+    pomar::meshlab::warn(
+        *this, "",
+        QString("%1: repaired before saving: %2").arg(QFileInfo(path).fileName(), repaired));
+  if (!dropped.isEmpty())
+    pomar::meshlab::warn(
+        *this, "",
+        QString("%1: not saved (a .pomar file keeps positions, triangles and per-vertex "
+                "colour, normals, quality, texture coordinates and float attributes): %2")
+            .arg(QFileInfo(path).fileName(), dropped.join("; ")));
   Log("pomar: saved %s: %zu bytes", qUtf8Printable(path), bytes.size());
   return true;
 }

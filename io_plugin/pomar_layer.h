@@ -1,15 +1,25 @@
 // What the two MeshLab plugins share about a layer opened from a .pomar file: the names of
-// the attributes the IO plugin writes and the filter plugin reads, and the relay of the
-// codec's progress to MeshLab's callback.
+// the attributes the IO plugin writes and the filter plugin reads (and writing them), the
+// relay of the codec's progress to MeshLab's callback, warnings, and error messages.
 #pragma once
 
 #include <pomar/pomar.h>
 
+#include <common/interfaces.h>
+#include <vcg/complex/allocate.h>
+#include <common/ml_mesh_type.h>
 #include <vcg/complex/complex.h>
+
+#include <QString>
+#include <QtGlobal>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <exception>
 #include <string>
+#include <vector>
+#include <utility>
 
 namespace pomar::meshlab {
 
@@ -19,14 +29,69 @@ constexpr const char *kSourceAttribute = "pomar_source";   ///< per mesh, absolu
 /// per mesh, int: 1 if the layer was opened with "Skip damaged blocks" (the filters then
 /// decode around damaged blocks too)
 constexpr const char *kSkipDamagedAttribute = "pomar_skip_damaged";
+/// per vertex, vcg::Color4b: the layer's own colours while "Show Clusters" / "Show Levels"
+/// paint the vertices; "Show Original Colours" puts them back, saving uses them.
+constexpr const char *kSavedColourAttribute = "pomar_saved_colour";
 
 /// The attributes above: a .pomar file re-creates them, saving does not lose them.
 inline bool isPomarAttribute(const std::string &name) {
-  for (const char *own :
-       {kClusterAttribute, kLevelAttribute, kSourceAttribute, kSkipDamagedAttribute})
+  for (const char *own : {kClusterAttribute, kLevelAttribute, kSourceAttribute,
+                          kSkipDamagedAttribute, kSavedColourAttribute})
     if (name == own)
       return true;
   return false;
+}
+
+/// Writes the attributes of a layer decoded from `source`: per vertex its cluster and the
+/// level that created it (-1 where unknown: `cluster` / `level` not one per vertex, as for a
+/// pure progressive file's clusters), per mesh the source file and the damage policy.
+template <class MeshType>
+void setLayerAttributes(MeshType &m, const std::vector<uint32_t> &cluster,
+                        const std::vector<uint32_t> &level, const std::string &source,
+                        bool skipDamaged) {
+  using Alloc = vcg::tri::Allocator<MeshType>;
+  auto clusterOf = Alloc::template GetPerVertexAttribute<float>(m, kClusterAttribute);
+  auto levelOf = Alloc::template GetPerVertexAttribute<float>(m, kLevelAttribute);
+  const bool haveClusters = cluster.size() == m.vert.size();
+  const bool haveLevels = level.size() == m.vert.size();
+  for (size_t v = 0; v < m.vert.size(); ++v) {
+    clusterOf[v] = haveClusters ? float(cluster[v]) : -1.0f;
+    levelOf[v] = haveLevels ? float(level[v]) : -1.0f;
+  }
+  Alloc::template GetPerMeshAttribute<std::string>(m, kSourceAttribute)() = source;
+  Alloc::template GetPerMeshAttribute<int>(m, kSkipDamagedAttribute)() = skipDamaged ? 1 : 0;
+}
+
+/// A warning in MeshLab's log (with `logPrefix`) and on stderr ("pomar: "): Log() is a
+/// no-op in meshlabserver.
+inline void warn(MeshLabInterface &plugin, const char *logPrefix, const QString &text) {
+  plugin.Log(GLLogStream::WARNING, qUtf8Printable(logPrefix + text));
+  qWarning("pomar: %s", qUtf8Printable(text));
+}
+
+/// The message of a failure while working on a file: the codec's message as it is when it
+/// names the file already (pomar::Error::path()), else "<context>: <message>".
+inline QString errorText(const std::exception &e, const QString &context) {
+  const QString what = QString::fromStdString(e.what());
+  const auto *error = dynamic_cast<const pomar::Error *>(&e);
+  if (error != nullptr && !error->path().empty())
+    return what;
+  return QString("%1: %2").arg(context, what);
+}
+
+/// The layer's own colours saved by Show Clusters / Show Levels (invalid handle if none).
+inline CMeshO::PerVertexAttributeHandle<vcg::Color4b> savedColours(CMeshO &m) {
+  return vcg::tri::Allocator<CMeshO>::FindPerVertexAttribute<vcg::Color4b>(m,
+                                                                            kSavedColourAttribute);
+}
+
+/// Swap the vertex colours with the saved ones (no-op without saved colours).
+inline void swapSavedColours(CMeshO &m) {
+  auto saved = savedColours(m);
+  if (!vcg::tri::Allocator<CMeshO>::IsValidHandle(m, saved))
+    return;
+  for (size_t v = 0; v < m.vert.size(); ++v)
+    std::swap(m.vert[v].C(), saved[v]);
 }
 
 /// Forwards progress to MeshLab's callback at most every 10% (meshlabserver prints the
@@ -50,11 +115,23 @@ public:
     };
   }
   Progress function() { return range(0, 100); }
+  /// The end: 100% with an empty label, which clears the label from MeshLab's status bar
+  /// (it would keep showing it). The destructor calls it if nobody did.
+  void done() {
+    if (cb_ != nullptr && !done_) {
+      done_ = true;
+      (*cb_)(100, "");
+    }
+  }
+  ~ProgressRelay() { done(); }
+  ProgressRelay(const ProgressRelay &) = delete;
+  ProgressRelay &operator=(const ProgressRelay &) = delete;
 
 private:
   vcg::CallBackPos *cb_;
   const char *label_;
   int last_ = -100;
+  bool done_ = false;
 };
 
 } // namespace pomar::meshlab

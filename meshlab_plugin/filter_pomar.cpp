@@ -90,15 +90,13 @@ Signature signatureOf(const CMeshO &m) {
     for (int a = 0; a < 3; ++a)
       h.add(float(m.vert[v].cP()[a]));
   }
-  const CVertexO *first = m.vert.empty() ? nullptr : &m.vert[0];
   for (const CFaceO &f : m.face) {
     if (f.IsD())
       continue;
     ++fn;
     for (int k = 0; k < f.VN(); ++k) {
-      const CVertexO *v = f.cV(k);
-      const bool inside = first != nullptr && v >= first && v < first + m.vert.size();
-      h.add(inside ? index[size_t(v - first)] : kNone);
+      const size_t v = pomar::vertex_position(m, f.cV(k));
+      h.add(v < index.size() ? index[v] : kNone);
     }
   }
   return {vn, fn, h.value()};
@@ -255,9 +253,7 @@ PomarFilterPlugin::Session *PomarFilterPlugin::session(const std::string &path, 
     try {
       s->open();
     } catch (const std::exception &e) { // pomar::Error, std::bad_alloc
-      const QString what = QString::fromStdString(e.what());
-      error = what.contains(fi.filePath()) ? what
-                                           : QString("cannot read %1: %2").arg(fi.filePath(), what);
+      error = pomar::meshlab::errorText(e, "cannot read " + fi.filePath());
       return nullptr;
     }
     while (sessions_.size() >= kMaxSessions) {
@@ -322,6 +318,17 @@ bool syncToLayer(PomarFilterPlugin::Session &s, CMeshO &m, ProgressRelay &progre
   return true;
 }
 
+/// Before Show Clusters / Show Levels paint the vertices: keep the layer's own colours aside
+/// (once: painting twice keeps the first, the user's).
+void keepOwnColours(CMeshO &m) {
+  if (vcg::tri::Allocator<CMeshO>::IsValidHandle(m, pomar::meshlab::savedColours(m)))
+    return;
+  auto saved = vcg::tri::Allocator<CMeshO>::AddPerVertexAttribute<vcg::Color4b>(
+      m, pomar::meshlab::kSavedColourAttribute);
+  for (size_t v = 0; v < m.vert.size(); ++v)
+    saved[v] = m.vert[v].C();
+}
+
 /// Replaces the layer's content by the decoder's current mesh, with the pomar attributes;
 /// selects the vertices of the clusters marked in `select` (if given) and the faces whose
 /// three vertices are selected.
@@ -330,23 +337,28 @@ void replaceMesh(PomarFilterPlugin::Session &s, MeshModel &mm, const std::vector
   const std::vector<uint32_t> cluster = s.decoder->vertex_cluster();
   const std::vector<uint32_t> level = s.decoder->vertex_level();
   CMeshO &m = mm.cm;
-  pomar::to_vcg(mesh, m); // Clear() + ClearAttributes(), then the new vertices and faces
-
-  auto clusterOf = vcg::tri::Allocator<CMeshO>::GetPerVertexAttribute<float>(m, kClusterAttr);
-  auto levelOf = vcg::tri::Allocator<CMeshO>::GetPerVertexAttribute<float>(m, kLevelAttr);
+  // The decoded attributes of these vertices go with them (colour, normals, quality,
+  // texture coordinates, named floats); texture coordinates are optional in CMeshO.
+  if (mesh.find(pomar::AttributeKind::TexCoord))
+    mm.updateDataMask(MeshModel::MM_VERTTEXCOORD);
+  // Clear() + ClearAttributes() (saved colours of Show Clusters included), then the new
+  // vertices and faces with their attributes.
+  const int written = pomar::to_vcg(mesh, m);
+  const bool ownColour = written & vcg::tri::io::Mask::IOM_VERTCOLOR;
+  const bool ownQuality = written & vcg::tri::io::Mask::IOM_VERTQUALITY;
+  const bool ownNormals = written & vcg::tri::io::Mask::IOM_VERTNORMAL;
+  if (ownColour)
+    mm.updateDataMask(MeshModel::MM_VERTCOLOR);
+  pomar::meshlab::setLayerAttributes(m, s.clustered ? cluster : std::vector<uint32_t>(), level,
+                                     s.path, s.skipDamaged);
   for (size_t v = 0; v < mesh.vertex_count(); ++v) {
-    clusterOf[v] = s.clustered ? float(cluster[v]) : -1.0f;
-    levelOf[v] = float(level[v]);
-    m.vert[v].C() = vcg::Color4b(vcg::Color4b::White);
-    m.vert[v].Q() = 0;
+    if (!ownColour)
+      m.vert[v].C() = vcg::Color4b(vcg::Color4b::White);
+    if (!ownQuality)
+      m.vert[v].Q() = 0;
     if (select != nullptr && s.clustered && (*select)[cluster[v]])
       m.vert[v].SetS();
   }
-  auto source = vcg::tri::Allocator<CMeshO>::GetPerMeshAttribute<std::string>(m, kSourceAttr);
-  source() = s.path;
-  auto skip = vcg::tri::Allocator<CMeshO>::GetPerMeshAttribute<int>(
-      m, pomar::meshlab::kSkipDamagedAttribute);
-  skip() = s.skipDamaged ? 1 : 0;
   const bool faceColor = vcg::tri::HasPerFaceColor(m);
   for (CFaceO &f : m.face) {
     if (faceColor)
@@ -356,7 +368,13 @@ void replaceMesh(PomarFilterPlugin::Session &s, MeshModel &mm, const std::vector
   }
   m.svn = int(vcg::tri::UpdateSelection<CMeshO>::VertexCount(m));
   m.sfn = int(vcg::tri::UpdateSelection<CMeshO>::FaceCount(m));
-  mm.UpdateBoxAndNormals();
+  if (ownNormals) { // the file's normals, not recomputed ones
+    vcg::tri::UpdateBounding<CMeshO>::Box(m);
+    if (m.fn > 0)
+      vcg::tri::UpdateNormal<CMeshO>::PerFaceNormalized(m);
+  } else {
+    mm.UpdateBoxAndNormals();
+  }
   s.signature = signatureOf(mesh);
   s.haveSignature = true;
 }
@@ -367,7 +385,7 @@ void replaceMesh(PomarFilterPlugin::Session &s, MeshModel &mm, const std::vector
 
 PomarFilterPlugin::PomarFilterPlugin() {
   typeList << FP_REFINE_SELECTED << FP_COARSEN_SELECTED << FP_SET_LEVEL << FP_SHOW_CLUSTERS
-           << FP_SHOW_LEVELS;
+           << FP_SHOW_LEVELS << FP_SHOW_ORIGINAL_COLOURS;
   for (FilterIDType id : types())
     actionList << new QAction(filterName(id), this);
 }
@@ -388,6 +406,8 @@ QString PomarFilterPlugin::filterName(FilterIDType filter) const {
     return "POMAR: Show Clusters";
   case FP_SHOW_LEVELS:
     return "POMAR: Show Levels";
+  case FP_SHOW_ORIGINAL_COLOURS:
+    return "POMAR: Show Original Colours";
   }
   return "Unknown POMAR filter";
 }
@@ -419,11 +439,19 @@ QString PomarFilterPlugin::filterInfo(FilterIDType filter) const {
            "below the base clustered level give the base clustered mesh)." +
            common;
   case FP_SHOW_CLUSTERS:
-    return "Colours every vertex by its random-access cluster (a fixed colour per cluster id)." +
+    return "Colours every vertex by its random-access cluster (a fixed colour per cluster id). "
+           "The layer's own colours are kept aside: <i>Show Original Colours</i> puts them "
+           "back, saving as .pomar saves them, and refining or coarsening restores the file's "
+           "colours." +
            common;
   case FP_SHOW_LEVELS:
     return "Colours every vertex by the level of its cluster in the current level map: blue = "
-           "the base clustered level (coarse) to red = the finest level (full resolution)." +
+           "the base clustered level (coarse) to red = the finest level (full resolution). "
+           "The layer's own colours are kept aside as for <i>Show Clusters</i>." +
+           common;
+  case FP_SHOW_ORIGINAL_COLOURS:
+    return "Puts back the vertex colours the layer had before <i>Show Clusters</i> or "
+           "<i>Show Levels</i> (nothing to do if neither was applied since the last refine)." +
            common;
   }
   return QString();
@@ -438,6 +466,7 @@ MeshFilterInterface::FilterClass PomarFilterPlugin::getClass(QAction *a) {
     return Remeshing;
   case FP_SHOW_CLUSTERS:
   case FP_SHOW_LEVELS:
+  case FP_SHOW_ORIGINAL_COLOURS:
     return VertexColoring;
   }
   return Remeshing; // never Generic: MeshLab refuses to load a plugin with a Generic filter
@@ -451,6 +480,7 @@ int PomarFilterPlugin::getRequirements(QAction *a) {
   switch (ID(a)) {
   case FP_SHOW_CLUSTERS:
   case FP_SHOW_LEVELS:
+  case FP_SHOW_ORIGINAL_COLOURS:
     return MeshModel::MM_VERTCOLOR;
   default:
     return MeshModel::MM_NONE;
@@ -471,6 +501,7 @@ int PomarFilterPlugin::postCondition(QAction *a) const {
   switch (ID(a)) {
   case FP_SHOW_CLUSTERS:
   case FP_SHOW_LEVELS:
+  case FP_SHOW_ORIGINAL_COLOURS:
     return MeshModel::MM_VERTCOLOR;
   default: // the mesh is replaced (includes the selection flags)
     return MeshModel::MM_GEOMETRY_AND_TOPOLOGY_CHANGE;
@@ -519,8 +550,7 @@ void PomarFilterPlugin::initParameterSet(QAction *a, MeshModel &m, RichParameter
 
 bool PomarFilterPlugin::fail(const QString &text) {
   errorMessage = text;
-  Log(GLLogStream::WARNING, qUtf8Printable("POMAR: " + text));
-  qWarning("pomar: %s", qUtf8Printable(text));
+  pomar::meshlab::warn(*this, "POMAR: ", text);
   return false;
 }
 
@@ -540,6 +570,8 @@ bool PomarFilterPlugin::applyFilter(QAction *a, MeshDocument &md, const RichPara
   const int id = ID(a);
   if (id == FP_SHOW_CLUSTERS)
     return showClusters(*mm);
+  if (id == FP_SHOW_ORIGINAL_COLOURS)
+    return showOriginalColours(*mm);
 
   QString error;
   Session *s = session(path, skipsDamage(mm->cm), error);
@@ -568,9 +600,7 @@ bool PomarFilterPlugin::applyFilter(QAction *a, MeshDocument &md, const RichPara
     // The decoder may be half way through an update: forget it. The layer is unchanged
     // (it is replaced only after a successful update).
     sessions_.erase(path);
-    const QString what = QString::fromStdString(e.what());
-    const QString file = QFile::decodeName(path.c_str());
-    return fail(what.contains(file) ? what : QString("%1: %2").arg(file, what));
+    return fail(pomar::meshlab::errorText(e, QFile::decodeName(path.c_str())));
   }
 }
 
@@ -586,8 +616,7 @@ void PomarFilterPlugin::warnAboutNewDamage(Session &s) {
           .arg(damaged.size() - s.damageReported)
           .arg(QString::fromStdString(pomar::describe_damage(damaged, s.damageReported)));
   s.damageReported = damaged.size();
-  Log(GLLogStream::WARNING, qUtf8Printable("POMAR: " + text));
-  qWarning("pomar: %s", qUtf8Printable(text)); // Log() is a no-op in meshlabserver
+  pomar::meshlab::warn(*this, "POMAR: ", text);
 }
 
 bool PomarFilterPlugin::refineOrCoarsen(bool refine, MeshModel &mm, Session &s, int requested,
@@ -607,16 +636,14 @@ bool PomarFilterPlugin::refineOrCoarsen(bool refine, MeshModel &mm, Session &s, 
   // The clusters of the selected faces (or, with no face selected, of the selected vertices).
   std::vector<char> chosen(s.clusters, 0);
   size_t faces = 0;
-  const CVertexO *first = m.vert.empty() ? nullptr : &m.vert[0];
   for (const CFaceO &f : m.face) {
     if (f.IsD() || !f.IsS())
       continue;
     ++faces;
     for (int k = 0; k < f.VN(); ++k) {
-      const CVertexO *v = f.cV(k);
-      if (first != nullptr && v >= first && v < first + m.vert.size() &&
-          cluster[size_t(v - first)] >= 0)
-        chosen[size_t(cluster[size_t(v - first)])] = 1;
+      const size_t v = pomar::vertex_position(m, f.cV(k));
+      if (v < cluster.size() && cluster[v] >= 0)
+        chosen[size_t(cluster[v])] = 1;
     }
   }
   size_t vertices = 0;
@@ -664,7 +691,7 @@ bool PomarFilterPlugin::refineOrCoarsen(bool refine, MeshModel &mm, Session &s, 
     reached += chosen[c] && after[c] == target;
   }
   replaceMesh(s, mm, &chosen);
-  progress.report(100);
+  progress.done();
 
   const double ms = msSince(t0);
   Log("POMAR: %s %zu clusters in %.1f ms (to level %d, from %zu selected %s; %s; decode %.1f "
@@ -705,7 +732,7 @@ bool PomarFilterPlugin::setLevel(MeshModel &mm, Session &s, int requested, vcg::
   d.update(progress.range(0, 95));
   const double decodeMs = msSince(t0);
   replaceMesh(s, mm, nullptr);
-  progress.report(100);
+  progress.done();
   Log("POMAR: set level of detail %d%s in %.1f ms (decode %.1f ms): %d vertices, %d faces; read "
       "%.1f KB more of the file",
       level,
@@ -733,6 +760,7 @@ bool PomarFilterPlugin::showClusters(MeshModel &mm) {
                       .arg(double(c)));
   }
   mm.updateDataMask(MeshModel::MM_VERTCOLOR);
+  keepOwnColours(m);
   for (size_t v = 0; v < m.vert.size(); ++v)
     if (!m.vert[v].IsD()) {
       m.vert[v].C() = clusterColor(uint32_t(ch[v]));
@@ -753,6 +781,7 @@ bool PomarFilterPlugin::showLevels(MeshModel &mm, Session *s) {
   if (!syncToLayer(*s, m, progress, how, why))
     return fail(QString("cannot show the levels: %1").arg(why));
   mm.updateDataMask(MeshModel::MM_VERTCOLOR);
+  keepOwnColours(m);
   const int span = std::max(1, s->finest - s->base);
   std::vector<size_t> histogram(size_t(s->finest + 1), 0);
   if (s->clustered) {
@@ -779,6 +808,20 @@ bool PomarFilterPlugin::showLevels(MeshModel &mm, Session *s) {
   Log("POMAR: levels shown (blue = level %d, red = level %d) in %.1f ms; %s %s; %s", s->base,
       s->finest, msSince(t0), s->clustered ? "clusters per level:" : "pure progressive file,",
       qUtf8Printable(parts.join(", ")), qUtf8Printable(how));
+  return true;
+}
+
+bool PomarFilterPlugin::showOriginalColours(MeshModel &mm) {
+  CMeshO &m = mm.cm;
+  auto saved = pomar::meshlab::savedColours(m);
+  if (!vcg::tri::Allocator<CMeshO>::IsValidHandle(m, saved)) {
+    Log("POMAR: the layer shows its own colours already");
+    return true;
+  }
+  for (size_t v = 0; v < m.vert.size(); ++v)
+    m.vert[v].C() = saved[v];
+  vcg::tri::Allocator<CMeshO>::DeletePerVertexAttribute(m, saved);
+  Log("POMAR: original colours restored");
   return true;
 }
 

@@ -42,6 +42,7 @@ public:
     FP_SET_LEVEL,
     FP_SHOW_CLUSTERS,
     FP_SHOW_LEVELS,
+    FP_SHOW_ORIGINAL_COLOURS,
   };
 
   PomarFilterPlugin();
@@ -75,6 +76,7 @@ private:
   bool setLevel(MeshModel &mm, Session &s, int level, vcg::CallBackPos *cb);
   bool showClusters(MeshModel &mm);
   bool showLevels(MeshModel &mm, Session *s);
+  bool showOriginalColours(MeshModel &mm);
   /// errorMessage = text, also logged (meshlabserver prints the log, not errorMessage).
   bool fail(const QString &text);
 

@@ -264,7 +264,7 @@ TEST(MemoryCheck, DecodeAndSelectiveDecoderRefuseAfterTheHeader) {
   // A level above the global ones goes through the selective decoder: still the full check.
   EXPECT_THROW(decode(file.data(), file.size(), int(info.levels.size()), {}, full - 1), Error);
   const std::string msg = error_of([&] {
-    SelectiveDecoder d(std::make_unique<MemorySource>(file.data(), file.size()), {false, 1024});
+    SelectiveDecoder d(std::make_unique<MemorySource>(file.data(), file.size()), {false, 1024, {}});
   });
   const LevelInfo &base_clustered = info.levels[info.global_levels - 1];
   EXPECT_NE(msg.find("not enough memory to decode " + std::to_string(base_clustered.vertices) +
@@ -272,7 +272,7 @@ TEST(MemoryCheck, DecodeAndSelectiveDecoderRefuseAfterTheHeader) {
             std::string::npos)
       << msg;
   SelectiveDecoder d(std::make_unique<MemorySource>(file.data(), file.size()),
-                     {false, kNoMemoryLimit});
+                     {false, kNoMemoryLimit, {}});
   EXPECT_EQ(d.cluster_count(), info.clusters);
 }
 

@@ -29,6 +29,8 @@ namespace {
 
 using pomar::LoadReport;
 using pomar::Mesh;
+using pomar::AttributeKind;
+using pomar::VertexAttribute;
 
 // ------------------------------------------------------------------------------------
 // Helpers
@@ -230,7 +232,7 @@ TEST_F(MeshIoTest, ObjQuadIsFanTriangulated) {
   EXPECT_EQ(r.file_faces, 1u);
 }
 
-TEST_F(MeshIoTest, ObjRelativeIndicesSlashesGroupsAndIgnoredAttributes) {
+TEST_F(MeshIoTest, ObjRelativeIndicesSlashesGroupsAndAttributes) {
   const std::string file = write("rel.obj", "mtllib x.mtl\r\no a\r\nv 0 0 0 1 0 0\r\nv 1 0 0 1 0 0\r\n"
                                             "v 0 1 0 1 0 0\r\nvn 0 0 1\r\nvt 0 0\r\n"
                                             "g first\r\nusemtl red\r\nf -3/1/1 -2/1/1 -1/1/1\r\n"
@@ -238,10 +240,52 @@ TEST_F(MeshIoTest, ObjRelativeIndicesSlashesGroupsAndIgnoredAttributes) {
   LoadReport r;
   const Mesh m = pomar::load_mesh(file, &r);
   EXPECT_EQ(m.triangles, (std::vector<uint32_t>{0, 1, 2, 1, 3, 2}));
-  for (const char *a : {"normals", "texture coordinates", "colors", "materials"})
-    EXPECT_NE(std::find(r.ignored_attributes.begin(), r.ignored_attributes.end(), a),
-              r.ignored_attributes.end())
-        << a;
+  // Vertex colours and the one normal every corner uses are kept; the texture coordinate
+  // is missing on the second face's corners, and materials are not kept.
+  EXPECT_EQ(r.ignored_attributes,
+            (std::vector<std::string>{"texture coordinates (not given for every corner)",
+                                      "materials"}));
+  ASSERT_EQ(m.attributes.size(), 2u);
+  EXPECT_EQ(m.find(AttributeKind::Colour)->colour,
+            (std::vector<uint8_t>{255, 0, 0, 255, 0, 0, 255, 0, 0, 255, 0, 0}));
+  EXPECT_EQ(m.find(AttributeKind::Normal)->values,
+            (std::vector<float>{0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}));
+}
+
+TEST_F(MeshIoTest, ObjAttributesRoundTrip) {
+  Mesh m;
+  m.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0.5f, 9, 9, 9};
+  m.triangles = {0, 1, 2, 1, 3, 2};
+  VertexAttribute c;
+  c.kind = AttributeKind::Colour;
+  c.name = "colour";
+  c.components = 3;
+  c.colour = {1, 2, 3, 250, 251, 252, 9, 8, 7, 128, 0, 255, 5, 5, 5};
+  VertexAttribute n;
+  n.kind = AttributeKind::Normal;
+  n.name = "normal";
+  n.components = 3;
+  n.values = {0, 0, 1, 0.6f, 0, 0.8f, -1, 0, 0, 0.1f, 0.2f, 0.3f, 1, 1, 1};
+  VertexAttribute uv;
+  uv.kind = AttributeKind::TexCoord;
+  uv.name = "texcoord";
+  uv.components = 2;
+  uv.values = {0, 0, 1, 0, 0, 1, 0.333333343f, 0.7f, 5, 5};
+  m.attributes = {c, n, uv};
+  save_mesh(path("attr.obj"), m);
+  LoadReport r;
+  const Mesh back = load_mesh(path("attr.obj"), &r);
+  EXPECT_TRUE(r.ignored_attributes.empty());
+  EXPECT_EQ(r.unreferenced_vertices, 1u); // vertex 4 and its attributes are dropped
+  EXPECT_EQ(back.positions, std::vector<float>(m.positions.begin(), m.positions.end() - 3));
+  for (const VertexAttribute &a : m.attributes) {
+    const VertexAttribute *b = back.find(a.kind);
+    ASSERT_NE(b, nullptr) << a.name;
+    EXPECT_EQ(b->colour, std::vector<uint8_t>(a.colour.begin(),
+                                              a.colour.end() - (a.colour.empty() ? 0 : 3)));
+    EXPECT_EQ(b->values, std::vector<float>(a.values.begin(),
+                                            a.values.end() - (a.values.empty() ? 0 : a.components)));
+  }
 }
 
 TEST_F(MeshIoTest, ObjBadFacesAreErrors) {
@@ -291,7 +335,7 @@ TEST_F(MeshIoTest, PlyTristripsBadIndexIsError) {
   EXPECT_NE(load_error(file).find("references vertex 7"), std::string::npos);
 }
 
-TEST_F(MeshIoTest, PlyPolygonsAndIgnoredAttributes) {
+TEST_F(MeshIoTest, PlyPolygonsKeptVertexAttributesAndIgnoredFaceAttributes) {
   const std::string file = write("quad.ply", "ply\nformat ascii 1.0\nelement vertex 5\n"
                                              "property float x\nproperty float y\nproperty float z\n"
                                              "property float nx\nproperty float ny\nproperty float nz\n"
@@ -306,10 +350,84 @@ TEST_F(MeshIoTest, PlyPolygonsAndIgnoredAttributes) {
   EXPECT_EQ(m.triangles, (std::vector<uint32_t>{0, 1, 2, 0, 2, 3, 1, 4, 2}));
   EXPECT_EQ(r.polygons_triangulated, 1u);
   EXPECT_EQ(r.file_faces, 2u);
-  for (const char *a : {"normals", "colors", "quality"})
-    EXPECT_NE(std::find(r.ignored_attributes.begin(), r.ignored_attributes.end(), a),
-              r.ignored_attributes.end())
-        << a;
+  // Vertex normals and colours are kept; the face quality is not.
+  EXPECT_EQ(r.ignored_attributes, (std::vector<std::string>{"quality"}));
+  ASSERT_EQ(m.attributes.size(), 2u);
+  const VertexAttribute *c = m.find(AttributeKind::Colour);
+  ASSERT_NE(c, nullptr);
+  EXPECT_EQ(c->components, 3u);
+  EXPECT_EQ(c->colour,
+            (std::vector<uint8_t>{255, 0, 0, 255, 0, 0, 255, 0, 0, 255, 0, 0, 255, 0, 0}));
+  const VertexAttribute *n = m.find(AttributeKind::Normal);
+  ASSERT_NE(n, nullptr);
+  EXPECT_EQ(n->values.size(), 15u);
+}
+
+/// A PLY file with every kind of vertex attribute, written and read back in both
+/// encodings: bit-identical values, names and texture files.
+TEST_F(MeshIoTest, PlyAttributesRoundTrip) {
+  Mesh m;
+  m.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0.5f};
+  m.triangles = {0, 1, 2, 1, 3, 2};
+  VertexAttribute c;
+  c.kind = AttributeKind::Colour;
+  c.name = "colour";
+  c.components = 4;
+  c.colour = {1, 2, 3, 4, 250, 251, 252, 0, 9, 8, 7, 6, 128, 0, 255, 255};
+  VertexAttribute n;
+  n.kind = AttributeKind::Normal;
+  n.name = "normal";
+  n.components = 3;
+  n.values = {0, 0, 1, 0.6f, 0, 0.8f, -1, 0, 0, 0.1f, 0.2f, 0.3f};
+  VertexAttribute q;
+  q.kind = AttributeKind::Scalar;
+  q.name = "quality";
+  q.values = {0.1f, 1e-30f, -3, 7};
+  VertexAttribute conf = q;
+  conf.name = "confidence";
+  conf.values = {1, 0.5f, 0.25f, 0.125f};
+  VertexAttribute uv;
+  uv.kind = AttributeKind::TexCoord;
+  uv.name = "texcoord";
+  uv.components = 2;
+  uv.values = {0, 0, 1, 0, 0, 1, 0.333333343f, 0.7f};
+  m.attributes = {c, n, q, conf, uv};
+  m.texture_files = {"skin.png", "a b.jpg"};
+  for (bool binary : {true, false}) {
+    const std::string file = path(binary ? "attr_bin.ply" : "attr_ascii.ply");
+    save_mesh(file, m, binary);
+    LoadReport r;
+    const Mesh back = load_mesh(file, &r);
+    EXPECT_TRUE(r.ignored_attributes.empty());
+    EXPECT_EQ(back.positions, m.positions);
+    EXPECT_EQ(back.triangles, m.triangles);
+    EXPECT_EQ(back.texture_files, m.texture_files);
+    ASSERT_EQ(back.attributes.size(), m.attributes.size());
+    for (const VertexAttribute &a : m.attributes) {
+      const VertexAttribute *b = back.find(a.kind, a.name);
+      ASSERT_NE(b, nullptr) << a.name;
+      EXPECT_EQ(b->components, a.components) << a.name;
+      EXPECT_EQ(b->colour, a.colour) << a.name;
+      EXPECT_EQ(b->values, a.values) << a.name;
+    }
+  }
+}
+
+TEST_F(MeshIoTest, PlySixteenBitColourIsNotKeptAndSaysSo) {
+  const std::string file = write("c16.ply", "ply\nformat ascii 1.0\nelement vertex 3\n"
+                                            "property float x\nproperty float y\nproperty float z\n"
+                                            "property ushort red\nproperty ushort green\n"
+                                            "property ushort blue\nproperty float intensity\n"
+                                            "element face 1\nproperty list uchar int vertex_indices\n"
+                                            "end_header\n0 0 0 65535 0 0 1\n1 0 0 0 65535 0 2\n"
+                                            "0 1 0 0 0 65535 3\n3 0 1 2\n");
+  LoadReport r;
+  const Mesh m = load_mesh(file, &r);
+  EXPECT_EQ(r.ignored_attributes,
+            (std::vector<std::string>{"colors (16-bit channels: pomar keeps 8-bit colour)"}));
+  ASSERT_EQ(m.attributes.size(), 1u);
+  EXPECT_EQ(m.attributes[0].name, "intensity");
+  EXPECT_EQ(m.attributes[0].values, (std::vector<float>{1, 2, 3}));
 }
 
 TEST_F(MeshIoTest, PlyUnreferencedVerticesAreDroppedAndCounted) {
@@ -461,11 +579,21 @@ TEST_F(MeshIoTest, OffWithNormalsColorsAndTexCoords) {
   const Mesh m = pomar::load_mesh(write("n.off", "NOFF\n3 1 0\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n"
                                                  "3 0 1 2\n"), &r);
   EXPECT_EQ(m.triangles, (std::vector<uint32_t>{0, 1, 2}));
-  EXPECT_EQ(r.ignored_attributes, (std::vector<std::string>{"normals"}));
+  EXPECT_TRUE(r.ignored_attributes.empty()); // per-vertex normals are kept
+  ASSERT_NE(m.find(AttributeKind::Normal), nullptr);
+  EXPECT_EQ(m.find(AttributeKind::Normal)->values,
+            (std::vector<float>{0, 0, 1, 0, 0, 1, 0, 0, 1}));
   const Mesh c = pomar::load_mesh(write("c.off", "STCOFF 3 1 0\n0 0 0 255 0 0 255 0.5 0.5\n"
                                                  "1 0 0 255 0 0 255 1 0\n0 1 0 9 9 9 9 0 1\n"
                                                  "3 0 1 2 255 0 0\n"), &r);
   EXPECT_EQ(c.positions, (std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0}));
+  // Vertex colours (RGBA: an alpha is not 255) are kept; the face colour and the texture
+  // coordinates (which vcglib's importer does not store) are not.
+  EXPECT_EQ(r.ignored_attributes, (std::vector<std::string>{"colors", "texture coordinates"}));
+  ASSERT_NE(c.find(AttributeKind::Colour), nullptr);
+  EXPECT_EQ(c.find(AttributeKind::Colour)->colour,
+            (std::vector<uint8_t>{255, 0, 0, 255, 255, 0, 0, 255, 9, 9, 9, 9}));
+  EXPECT_EQ(c.find(AttributeKind::TexCoord), nullptr);
 }
 
 TEST_F(MeshIoTest, OffTruncatedFaceListIsError) {

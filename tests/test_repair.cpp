@@ -80,8 +80,8 @@ TEST(Repair, AlreadyManifoldMeshesAreUnchangedBitForBit) {
   }
 }
 
-TEST(Repair, BowtieVertexIsSplitIntoTwo) {
-  // Two fans of two triangles each around vertex 0, touching only there.
+/// Two fans of two triangles each around vertex 0, touching only there.
+Mesh bowtie() {
   Mesh m;
   add_vertex(m, 0, 0, 0);
   add_vertex(m, 1, 0, 0);
@@ -94,6 +94,11 @@ TEST(Repair, BowtieVertexIsSplitIntoTwo) {
   add_face(m, 0, 2, 3);
   add_face(m, 0, 4, 5);
   add_face(m, 0, 5, 6);
+  return m;
+}
+
+TEST(Repair, BowtieVertexIsSplitIntoTwo) {
+  Mesh m = bowtie();
   const Mesh input = m;
   const RepairReport r = make_manifold(m);
   EXPECT_EQ(counts(r), (std::vector<size_t>{0, 0, 0, 0, 0, 1, 1}));
@@ -107,6 +112,27 @@ TEST(Repair, BowtieVertexIsSplitIntoTwo) {
   EXPECT_EQ(m.triangles[9], 7u);
   EXPECT_EQ(unoriented(m), unoriented(input));
   expect_valid_and_lossless(m);
+}
+
+TEST(Repair, CopiesCarryTheAttributesOfTheirVertex) {
+  Mesh m = bowtie();
+  VertexAttribute c;
+  c.kind = AttributeKind::Colour;
+  c.name = "colour";
+  c.components = 3;
+  for (uint8_t v = 0; v < 7; ++v)
+    c.colour.insert(c.colour.end(), {v, uint8_t(v + 10), uint8_t(v + 20)});
+  VertexAttribute q;
+  q.kind = AttributeKind::Scalar;
+  q.name = "quality";
+  q.values = {0.5f, 1, 2, 3, 4, 5, 6};
+  m.attributes = {c, q};
+  make_manifold(m);
+  ASSERT_EQ(m.vertex_count(), 8u);
+  EXPECT_NO_THROW(validate_attributes(m, true));
+  EXPECT_EQ(std::vector<uint8_t>(m.attributes[0].colour.end() - 3, m.attributes[0].colour.end()),
+            (std::vector<uint8_t>{0, 10, 20}));
+  EXPECT_EQ(m.attributes[1].values.back(), 0.5f);
 }
 
 TEST(Repair, TwoTetrahedraOnOneEdgeBecomeTwoTetrahedra) {

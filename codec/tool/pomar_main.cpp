@@ -10,7 +10,10 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <map>
 #include <memory>
 #include <unistd.h>
 
@@ -42,16 +45,6 @@ pomar::Progress terminal_progress(bool quiet) {
       std::fprintf(stderr, "\r%20s\r", "");
     std::fflush(stderr);
   };
-}
-
-/// True if make_manifold() would change `mesh` (a copy): then `--repair` is worth a hint.
-bool repair_would_help(const pomar::Mesh &mesh) {
-  pomar::Mesh copy = mesh;
-  try {
-    return pomar::make_manifold(copy).changed();
-  } catch (const pomar::Error &) {
-    return false;
-  }
 }
 
 constexpr const char *kRepairHint = " (pomar encode --repair cuts it into a manifold mesh)";
@@ -88,7 +81,59 @@ struct EncodeArgs {
   bool progressive = false, quiet = false, repair = false;
   std::string max_memory = "auto";
   unsigned threads = 0;
+  pomar::AttributeOptions attributes;
+  std::string drop;
 };
+
+/// "--drop colour,normals,scalars,texcoords" (also "color", "normal", "scalar", "texcoord",
+/// "uv", "all") as a mask of what is kept.
+pomar::AttributeMask parse_drop(const std::string &list) {
+  pomar::AttributeMask keep;
+  size_t start = 0;
+  while (start <= list.size() && !list.empty()) {
+    const size_t comma = std::min(list.find(',', start), list.size());
+    const std::string w = list.substr(start, comma - start);
+    if (w == "colour" || w == "colours" || w == "color" || w == "colors")
+      keep.colour = false;
+    else if (w == "normal" || w == "normals")
+      keep.normals = false;
+    else if (w == "scalar" || w == "scalars" || w == "quality")
+      keep.scalars = false;
+    else if (w == "texcoord" || w == "texcoords" || w == "uv" || w == "uvs")
+      keep.texcoords = false;
+    else if (w == "all")
+      keep = pomar::AttributeMask::none();
+    else
+      throw pomar::Error("bad --drop '" + list + "': '" + w +
+                         "' is not one of colour, normals, scalars, texcoords, all");
+    start = comma + 1;
+  }
+  return keep;
+}
+
+/// "colour (3 x 8 bits, exact)", "normal (9-bit octahedral, <= 0.332 deg)", ...
+std::string describe_precision(pomar::AttributeKind kind, uint32_t components, int bits,
+                               double bound) {
+  char text[160];
+  if (kind == pomar::AttributeKind::Colour)
+    std::snprintf(text, sizeof text, "%s, 8 bits exact", components == 4 ? "RGBA" : "RGB");
+  else if (bits == 0)
+    std::snprintf(text, sizeof text, "exact floats");
+  else if (kind == pomar::AttributeKind::Normal)
+    std::snprintf(text, sizeof text, "%d-bit octahedral, error <= %.3g deg", bits, bound);
+  else
+    std::snprintf(text, sizeof text, "%d bits over its range, error <= %.3g", bits, bound);
+  return text;
+}
+
+void print_attributes(const pomar::FileInfo &i) {
+  for (const pomar::AttributeInfo &a : i.attributes)
+    std::printf("  attribute %-10s %-8s %.2f bits/vertex (%s)\n", a.name.c_str(),
+                pomar::kind_name(a.kind), bpv(a.bytes, i.vertices),
+                describe_precision(a.kind, a.components, a.bits, a.bound).c_str());
+  for (const std::string &t : i.texture_files)
+    std::printf("  texture file %s\n", t.c_str());
+}
 
 int run_encode(const EncodeArgs &a) {
   const auto t0 = Clock::now();
@@ -101,7 +146,9 @@ int run_encode(const EncodeArgs &a) {
     std::string list;
     for (const auto &s : load.ignored_attributes)
       list += (list.empty() ? "" : ", ") + s;
-    std::fprintf(stderr, "pomar: warning: %s has %s; .pomar keeps positions and triangles only\n",
+    std::fprintf(stderr,
+                 "pomar: warning: %s has %s, not kept (.pomar keeps positions, triangles and "
+                 "per-vertex colour, normals, scalars and texture coordinates)\n",
                  a.in.c_str(), list.c_str());
   }
   const double t_load = since(t0);
@@ -114,14 +161,16 @@ int run_encode(const EncodeArgs &a) {
   opt.threads = a.threads;
   opt.progress = terminal_progress(a.quiet);
   opt.memory_limit = memory_limit;
+  opt.attributes = a.attributes;
+  opt.attributes.keep = parse_drop(a.drop);
   pomar::EncodeReport r;
   const auto t1 = Clock::now();
   std::vector<uint8_t> file;
   try {
     file = pomar::encode(mesh, opt, &r);
   } catch (const pomar::Error &e) {
-    if (!a.repair && repair_would_help(mesh))
-      throw pomar::Error(e.what() + std::string(kRepairHint));
+    if (!a.repair && pomar::repair_would_change(mesh))
+      throw pomar::Error(e.kind(), e.what() + std::string(kRepairHint));
     throw;
   }
   const double t_encode = since(t1);
@@ -146,6 +195,7 @@ int run_encode(const EncodeArgs &a) {
                 static_cast<unsigned long>(i.cluster_bytes));
   else
     std::printf("pure progressive (no random access)\n");
+  print_attributes(i);
   std::printf("time: read %.3f s, ", t_load);
   if (a.repair)
     std::printf("repair %.3f s, ", t_repair);
@@ -161,6 +211,7 @@ struct DecodeArgs {
   int level = -1;
   std::vector<std::string> clusters, spheres, boxes;
   bool ascii = false, quiet = false, stats = false, skip_damaged = false;
+  bool no_attributes = false;
   std::string max_memory = "auto";
   bool selective() const { return !clusters.empty() || !spheres.empty() || !boxes.empty(); }
 };
@@ -179,8 +230,9 @@ std::vector<double> parse_spec(const std::string &spec, size_t count, int finest
       if (used != spec.size() - colon - 1)
         throw std::invalid_argument("level");
     } catch (const std::exception &) {
-      throw pomar::Error(std::string("bad ") + what + " '" + spec +
-                         "': the level after ':' must be an integer");
+      throw pomar::Error(pomar::Error::Kind::Usage,
+                         std::string("bad ") + what + " '" + spec +
+                             "': the level after ':' must be an integer");
     }
   }
   std::vector<double> v;
@@ -195,21 +247,34 @@ std::vector<double> parse_spec(const std::string &spec, size_t count, int finest
       if (used != item.size())
         throw std::invalid_argument("number");
     } catch (const std::exception &) {
-      throw pomar::Error(std::string("bad ") + what + " '" + spec + "': '" + item +
-                         "' is not a number");
+      throw pomar::Error(pomar::Error::Kind::Usage, std::string("bad ") + what + " '" + spec +
+                                                        "': '" + item + "' is not a number");
     }
     if (comma == std::string::npos)
       break;
     pos = comma + 1;
   }
   if (v.size() != count)
-    throw pomar::Error(std::string("bad ") + what + " '" + spec + "': expected " +
-                       std::to_string(count) + " numbers");
+    throw pomar::Error(pomar::Error::Kind::Usage, std::string("bad ") + what + " '" + spec +
+                                                      "': expected " + std::to_string(count) +
+                                                      " numbers");
   return v;
 }
 
-/// Exit status of a decode that skipped damaged blocks (the output is written).
+// Exit statuses (README "Exit codes"). Errors exit 1 whatever their pomar::Error kind
+// (invalid mesh, damaged or truncated file, I/O, memory limit, bad argument): scripts and
+// the end-to-end tests rely on that; only a broken invariant of the codec (a bug) gets its
+// own status. exit_status() is the one place that maps kinds to statuses.
+constexpr int kExitError = 1;
+/// verify: the mesh differs; info --check / decode --skip-damaged: damaged blocks found
+/// (the decode still wrote its output).
+constexpr int kExitMismatch = 3;
 constexpr int kExitDamaged = 3;
+constexpr int kExitInternal = 70; // EX_SOFTWARE
+
+int exit_status(const pomar::Error &e) {
+  return e.kind() == pomar::Error::Kind::Internal ? kExitInternal : kExitError;
+}
 
 /// List skipped blocks on stderr; returns the exit status (0 or kExitDamaged).
 int report_damage(const std::vector<pomar::DamagedBlock> &damaged, const std::string &out) {
@@ -232,16 +297,19 @@ int report_damage(const std::vector<pomar::DamagedBlock> &damaged, const std::st
   return kExitDamaged;
 }
 
-/// A damaged or missing level or cluster block can be skipped; say so in the error.
+/// A damaged or missing level or cluster block (or a truncated file) can be skipped; say
+/// so in the error.
 [[noreturn]] void rethrow_with_hint(const pomar::Error &e) {
-  const std::string m = e.what();
-  const bool block = m.find("level ") != std::string::npos ||
-                     m.find("cluster ") != std::string::npos ||
-                     m.rfind("truncated .pomar file", 0) == 0;
-  if (block && (m.rfind("damaged", 0) == 0 || m.rfind("truncated", 0) == 0))
-    throw pomar::Error(m + " (pomar info --check lists damaged blocks; pomar decode "
-                           "--skip-damaged decodes the rest)");
-  throw e;
+  using Kind = pomar::Error::Kind;
+  const bool skippable =
+      e.kind() == Kind::TruncatedFile || (e.kind() == Kind::DamagedFile && e.in_block());
+  if (!skippable)
+    throw e;
+  pomar::Error hinted(e.kind(), e.what() + std::string(" (pomar info --check lists damaged "
+                                                       "blocks; pomar decode --skip-damaged "
+                                                       "decodes the rest)"));
+  hinted.with_path(e.path()).in_block(e.level(), e.cluster());
+  throw hinted;
 }
 
 int run_selective_decode(const DecodeArgs &a) {
@@ -249,9 +317,12 @@ int run_selective_decode(const DecodeArgs &a) {
   pomar::SelectiveOptions options;
   options.skip_damaged = a.skip_damaged;
   options.memory_limit = pomar::parse_memory_size(a.max_memory);
+  if (a.no_attributes)
+    options.attributes = pomar::AttributeMask::none();
   pomar::SelectiveDecoder d(std::make_unique<pomar::FileSource>(a.in), options);
   if (!d.info().clustered())
-    throw pomar::Error(a.in + " is a pure progressive file (encoded with --progressive): it has "
+    throw pomar::Error(pomar::Error::Kind::Usage,
+                       a.in + " is a pure progressive file (encoded with --progressive): it has "
                               "no clusters to select; use --level");
   const int finest = d.finest_level();
   if (a.level >= 0)
@@ -260,8 +331,9 @@ int run_selective_decode(const DecodeArgs &a) {
     int level;
     const std::vector<double> id = parse_spec(spec, 1, finest, level, "--cluster");
     if (id[0] < 0 || id[0] != double(uint32_t(id[0])))
-      throw pomar::Error("bad --cluster '" + spec +
-                         "': the cluster id must be a non-negative integer");
+      throw pomar::Error(pomar::Error::Kind::Usage,
+                         "bad --cluster '" + spec +
+                             "': the cluster id must be a non-negative integer");
     d.want_cluster(static_cast<uint32_t>(id[0]), level);
   }
   for (const std::string &spec : a.spheres) {
@@ -308,6 +380,8 @@ int run_decode(const DecodeArgs &a) {
   options.skip_damaged = a.skip_damaged;
   options.memory_limit = memory_limit;
   options.progress = terminal_progress(a.quiet);
+  if (a.no_attributes)
+    options.attributes = pomar::AttributeMask::none();
   pomar::DecodeReport report;
   pomar::Mesh mesh;
   try {
@@ -373,6 +447,19 @@ nlohmann::json info_json(const pomar::FileInfo &i) {
   j["bpv"] = bpv(i.total_bytes, i.vertices);
   j["connectivity_bpv"] = bpv(i.connectivity_bytes, i.vertices);
   j["geometry_bpv"] = bpv(i.geometry_bytes, i.vertices);
+  nlohmann::json attributes = nlohmann::json::array();
+  for (const pomar::AttributeInfo &a : i.attributes)
+    attributes.push_back({{"kind", pomar::kind_name(a.kind)},
+                          {"name", a.name},
+                          {"components", a.components},
+                          {"bits", a.bits},
+                          {"exact", a.bits == 0},
+                          {"bound", a.bound},
+                          {"bytes", a.bytes},
+                          {"bpv", bpv(a.bytes, i.vertices)}});
+  j["attributes"] = attributes;
+  j["attribute_bytes"] = i.attribute_bytes;
+  j["texture_files"] = i.texture_files;
   return j;
 }
 
@@ -412,6 +499,16 @@ int run_info(const std::string &in, bool json) {
               static_cast<unsigned long>(i.total_bytes), bpv(i.total_bytes, i.vertices),
               bpv(i.connectivity_bytes, i.vertices), bpv(i.geometry_bytes, i.vertices),
               bpv(i.base_bytes, i.vertices), bpv(i.header_bytes, i.vertices));
+  if (!i.attributes.empty() || !i.texture_files.empty()) {
+    uint64_t coded = 0;
+    for (const pomar::AttributeInfo &a : i.attributes)
+      coded += a.bytes;
+    std::printf("  attributes about %.2f bits/vertex, coded with the positions in the levels and "
+                "cluster blocks (encoder's estimate; ATTR section with the base mesh's: %lu "
+                "bytes):\n",
+                bpv(coded, i.vertices), static_cast<unsigned long>(i.attribute_bytes));
+    print_attributes(i);
+  }
   if (i.clustered()) {
     std::vector<uint32_t> sizes = i.cluster_block_bytes;
     std::sort(sizes.begin(), sizes.end());
@@ -468,13 +565,93 @@ std::vector<Triangle> triangle_multiset(const pomar::Mesh &m) {
   return out;
 }
 
+/// Largest difference between attribute values a (of vertex i) and b (of vertex j):
+/// degrees for normals, absolute otherwise; exact attributes: 0 when bit-identical.
+double attribute_error(const pomar::VertexAttribute &a, size_t i, const pomar::VertexAttribute &b,
+                       size_t j, bool exact) {
+  const uint32_t n = a.components;
+  if (a.kind == pomar::AttributeKind::Colour) {
+    double e = 0;
+    for (uint32_t k = 0; k < n; ++k)
+      e = std::max(e, std::fabs(double(a.colour[i * n + k]) - double(b.colour[j * n + k])));
+    return e;
+  }
+  const float *x = &a.values[i * n], *y = &b.values[j * n];
+  if (exact && std::memcmp(x, y, 4 * n) == 0)
+    return 0;
+  if (a.kind == pomar::AttributeKind::Normal && !exact) {
+    const double cx = double(x[1]) * y[2] - double(x[2]) * y[1];
+    const double cy = double(x[2]) * y[0] - double(x[0]) * y[2];
+    const double cz = double(x[0]) * y[1] - double(x[1]) * y[0];
+    const double dot = double(x[0]) * y[0] + double(x[1]) * y[1] + double(x[2]) * y[2];
+    return std::atan2(std::sqrt(cx * cx + cy * cy + cz * cz), dot) * 180.0 / M_PI;
+  }
+  double e = 0;
+  for (uint32_t k = 0; k < n; ++k) {
+    const double d = std::fabs(double(x[k]) - double(y[k]));
+    e = std::max(e, std::isnan(d) ? HUGE_VAL : d);
+  }
+  return exact && e == 0 ? HUGE_VAL : e; // bit patterns differ (-0 and 0, NaN payloads)
+}
+
+/// verify: every attribute of `ref` the file should keep against `out`, vertices matched by
+/// position (a vertex may share its position with others: the closest of them counts).
+/// Prints one line per attribute; false if one is missing or outside its bound.
+bool verify_attributes(const pomar::Mesh &ref, const pomar::Mesh &out, const pomar::FileInfo &info,
+                       const pomar::AttributeMask &keep) {
+  std::map<Point, std::vector<uint32_t>> at;
+  for (uint32_t v = 0; v < ref.vertex_count(); ++v)
+    at[Point{ref.positions[3 * v], ref.positions[3 * v + 1], ref.positions[3 * v + 2]}].push_back(v);
+  bool ok = true;
+  for (const pomar::VertexAttribute &a : ref.attributes) {
+    if (!keep.keeps(a.kind))
+      continue;
+    const pomar::VertexAttribute *b = out.find(a.kind, a.name);
+    const pomar::AttributeInfo *stored = nullptr;
+    for (const pomar::AttributeInfo &s : info.attributes)
+      if (s.kind == a.kind && s.name == a.name)
+        stored = &s;
+    if (!b || !stored || b->components != a.components) {
+      std::fprintf(stderr, "pomar: MISMATCH: %s attribute '%s' of the original is %s\n",
+                   pomar::kind_name(a.kind), a.name.c_str(),
+                   !stored ? "not in the file (verify --drop if it was dropped on purpose)"
+                           : "missing from the decoded mesh");
+      ok = false;
+      continue;
+    }
+    const bool exact = stored->bits == 0;
+    double worst = 0;
+    for (uint32_t v = 0; v < out.vertex_count(); ++v) {
+      const auto it = at.find(Point{out.positions[3 * v], out.positions[3 * v + 1],
+                                    out.positions[3 * v + 2]});
+      if (it == at.end())
+        continue; // the geometry check reports it
+      double best = HUGE_VAL;
+      for (uint32_t r : it->second)
+        best = std::min(best, attribute_error(a, r, *b, v, exact));
+      worst = std::max(worst, best);
+    }
+    const bool within = exact ? worst == 0 : worst <= stored->bound;
+    ok &= within;
+    std::fprintf(within ? stdout : stderr, "%s  %s '%s': %s, max error %.6g%s\n",
+                 within ? "" : "pomar: MISMATCH:", pomar::kind_name(a.kind), a.name.c_str(),
+                 describe_precision(a.kind, a.components, stored->bits, stored->bound).c_str(),
+                 worst, a.kind == pomar::AttributeKind::Normal && !exact ? " deg" : "");
+  }
+  if (keep.texcoords && ref.texture_files != out.texture_files) {
+    std::fprintf(stderr, "pomar: MISMATCH: texture file names differ\n");
+    ok = false;
+  }
+  return ok;
+}
+
 int run_verify(const std::string &original, const std::string &file, const std::string &decoded,
-               bool repair) {
+               bool repair, const std::string &drop) {
   pomar::Mesh ref = pomar::load_mesh(original);
   // With --repair the reference is the repaired original: what `encode --repair` encoded.
   if (repair)
     repair_and_report(ref, true);
-  const bool could_repair = !repair && repair_would_help(ref);
+  const bool could_repair = !repair && pomar::repair_would_change(ref);
   const std::vector<uint8_t> data = pomar::read_file(file);
   const pomar::FileInfo info = pomar::inspect(data.data(), data.size());
   const pomar::Mesh out =
@@ -486,6 +663,7 @@ int run_verify(const std::string &original, const std::string &file, const std::
   }
   const bool same = triangle_multiset(ref) == triangle_multiset(out);
   const std::string what = decoded.empty() ? file : decoded;
+  const bool attributes_ok = !same || verify_attributes(ref, out, info, parse_drop(drop));
   if (!same) {
     std::fprintf(stderr, "pomar: MISMATCH: %s differs from %s on the %d-bit grid%s\n", what.c_str(),
                  original.c_str(), info.bits,
@@ -493,12 +671,17 @@ int run_verify(const std::string &original, const std::string &file, const std::
                      ? " (the original needs a repair to be encoded: if it was encoded with "
                        "--repair, verify with --repair)"
                      : "");
+    return kExitMismatch;
+  }
+  if (!attributes_ok) {
+    std::fprintf(stderr, "pomar: MISMATCH: %s has the geometry of %s but not its attributes\n",
+                 what.c_str(), original.c_str());
     return 3;
   }
   std::printf("OK: %s matches %s%s: the same %zu oriented triangles, every vertex on its %d-bit "
-              "grid position\n",
+              "grid position%s\n",
               what.c_str(), original.c_str(), repair ? " after repair" : "", out.triangle_count(),
-              info.bits);
+              info.bits, info.attributes.empty() ? "" : ", attributes within their bounds");
   return 0;
 }
 
@@ -519,7 +702,7 @@ int main(int argc, char **argv) {
   // Ctrl-C or kill during a write: no temporary file left, the old output untouched.
   pomar::remove_temporary_files_on_signals();
   app.set_version_flag("--version",
-                       "pomar 0.1.0 (writes .pomar format versions 1 and 3, reads 1 to 3)");
+                       "pomar 0.1.0 (writes .pomar format versions 1, 3 and 4 (attributes), reads 1 to 4)");
 
   EncodeArgs ea;
   auto *enc =
@@ -554,6 +737,28 @@ int main(int argc, char **argv) {
                 "every change on stderr. Positions are never moved; verify with --repair");
   enc->add_flag("-q,--quiet", ea.quiet,
                 "Print nothing on success (what --repair changed is still printed)");
+  enc->add_option("--drop", ea.drop,
+                  "Per-vertex attributes to leave out, comma-separated: colour, normals, "
+                  "scalars (quality and named PLY properties), texcoords (with the texture file "
+                  "names), or all. Default: everything the input has is kept")
+      ->type_name("LIST");
+  enc->add_option("--normal-bits", ea.attributes.normal_bits,
+                  "Bits per octahedral coordinate of normals (4..16); the angle error is at most "
+                  "0.332 deg at 9, halved by each bit (0.67 at 8, 0.166 at 10, 0.0026 at 16)")
+      ->check(CLI::Range(4, 16))
+      ->capture_default_str();
+  enc->add_option("--scalar-bits", ea.attributes.scalar_bits,
+                  "Bits over each scalar's range (1..24): error at most half of range/(2^bits-1)")
+      ->check(CLI::Range(1, 24))
+      ->capture_default_str();
+  enc->add_option("--texcoord-bits", ea.attributes.texcoord_bits,
+                  "Bits over the range of u and of v (1..24): error at most half a step")
+      ->check(CLI::Range(1, 24))
+      ->capture_default_str();
+  enc->add_flag("--exact-attributes", ea.attributes.exact,
+                "Store normals, scalars and texture coordinates bit for bit (NaN, infinities, "
+                "denormals, zero normals included); colour is always exact. Without it a NaN "
+                "or infinite value or a zero-length normal is an error");
   enc->add_option("--max-memory", ea.max_memory,
                   "Refuse (exit 1, no output file) a mesh whose loading and encoding would need "
                   "more than SIZE of memory, checked from the file's header before reading it: "
@@ -596,6 +801,10 @@ int main(int argc, char **argv) {
                 "3 (the output is written). The header, base mesh, tables and index must be "
                 "intact");
   dec->add_flag("-q,--quiet", da.quiet, "Print nothing on success");
+  dec->add_flag("--no-attributes", da.no_attributes,
+                "Write positions and triangles only: leave out colour, normals, scalars and "
+                "texture coordinates (their codes are interleaved with the positions and are "
+                "read anyway)");
   dec->add_option("--max-memory", da.max_memory,
                   "Refuse (exit 1, no output file) a file whose decoding would need more than "
                   "SIZE of memory, checked from its header (with --cluster/--sphere/--box: for "
@@ -615,7 +824,7 @@ int main(int argc, char **argv) {
                 "Check every block's checksum instead (no decoding); exit status 3 lists the "
                 "damaged or missing blocks");
 
-  std::string v_orig, v_file, v_decoded;
+  std::string v_orig, v_file, v_decoded, v_drop;
   bool v_repair = false;
   auto *ver = app.add_subcommand(
       "verify", "Check that a .pomar file (or a mesh decoded from it) is the original, losslessly");
@@ -625,6 +834,9 @@ int main(int argc, char **argv) {
   ver->add_flag("--repair", v_repair,
                 "The file was encoded with encode --repair: compare with the original as repaired "
                 "(the same cut as encode --repair; lossless means equal to that mesh)");
+  ver->add_option("--drop", v_drop,
+                  "The file was encoded with encode --drop LIST: do not expect those attributes")
+      ->type_name("LIST");
 
   try {
     app.parse(argc, argv);
@@ -639,13 +851,13 @@ int main(int argc, char **argv) {
     if (*inf)
       return info_check ? run_check(info_in) : run_info(info_in, info_jsonf);
     if (*ver)
-      return run_verify(v_orig, v_file, v_decoded, v_repair);
+      return run_verify(v_orig, v_file, v_decoded, v_repair, v_drop);
   } catch (const pomar::Error &e) {
     std::fprintf(stderr, "pomar: error: %s\n", e.what());
-    return 1;
+    return exit_status(e);
   } catch (const std::exception &e) {
     std::fprintf(stderr, "pomar: error: %s\n", e.what());
-    return 1;
+    return kExitError;
   }
   return 0;
 }

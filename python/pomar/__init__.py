@@ -26,24 +26,29 @@ class Mesh:
     seen from outside. Per-vertex attributes (issue 12) will be further fields, None when
     a mesh has none."""
 
-    __slots__ = ("vertices", "faces")
+    __slots__ = ("vertices", "faces", "damaged")
 
-    def __init__(self, vertices, faces):
+    def __init__(self, vertices, faces, damaged=()):
         self.vertices = vertices
         self.faces = faces
+        #: blocks a decode with skip_damaged=True decoded around: dicts with "block"
+        #: ("cluster 17", "level 9"), "problem" and "level_kept"; empty when intact.
+        self.damaged = list(damaged)
 
     def __repr__(self):
         return f"pomar.Mesh({len(self.vertices)} vertices, {len(self.faces)} faces)"
 
 
 def encode(vertices, faces=None, *, bits=12, clusters=0, cluster_ratio=0.01,
-           progressive=False, memory_limit=None):
+           progressive=False, memory_limit=None, progress=None):
     """Compress a manifold, consistently oriented triangle mesh into .pomar bytes.
 
     vertices: float32 array (n, 3), faces: uint32 array (m, 3), both C-contiguous; or a
     pomar.Mesh as the only argument. bits: quantization grid, 4..24. The file is random
     access (about cluster_ratio x vertices clusters, or `clusters`) unless progressive=True.
     memory_limit: bytes or "512M" / "auto" / "none" (default: the memory available).
+    progress: None or a callable(fraction, stage) called now and then (Ctrl-C interrupts
+    the call in any case; an exception raised by progress stops it and propagates).
     """
     if isinstance(vertices, Mesh):
         if faces is not None:
@@ -52,13 +57,18 @@ def encode(vertices, faces=None, *, bits=12, clusters=0, cluster_ratio=0.01,
     elif faces is None:
         raise TypeError("encode() needs faces (or a pomar.Mesh)")
     return _pomar.encode(vertices, faces, bits, clusters, cluster_ratio, progressive,
-                         memory_limit)
+                         memory_limit, progress)
 
 
-def decode(data, level=None, *, memory_limit=None):
+def decode(data, level=None, *, skip_damaged=False, memory_limit=None, progress=None):
     """Decode .pomar bytes (bytes, bytearray, memoryview) to a Mesh after `level`
-    refinement levels (0 = base mesh, None = full resolution)."""
-    return Mesh(*_pomar.decode(data, level, memory_limit))
+    refinement levels (0 = base mesh, None = full resolution).
+
+    skip_damaged=True decodes around damaged or missing blocks instead of raising (a
+    damaged global level stops before it, a damaged cluster stays coarse) and lists them
+    in mesh.damaged; damage in the header, base mesh or tables still raises pomar.Error.
+    progress: as for encode()."""
+    return Mesh(*_pomar.decode(data, level, skip_damaged, memory_limit, progress))
 
 
 def read(path, level=None):

@@ -69,6 +69,30 @@ ReadBuffer::ReadBuffer(const py::handle &object, const char *what) {
 
 ReadBuffer::~ReadBuffer() { PyBuffer_Release(&view_); }
 
+pomar::Progress python_progress(const py::handle &callback) {
+  if (!callback.is_none() && !PyCallable_Check(callback.ptr()))
+    throw py::type_error("progress must be a callable(fraction, stage) or None");
+  return [callback](double fraction, const char *stage) {
+    py::gil_scoped_acquire locked;
+    if (PyErr_CheckSignals() != 0)
+      throw py::error_already_set();
+    if (!callback.is_none())
+      callback(fraction, stage);
+  };
+}
+
+py::list damaged_list(const std::vector<pomar::DamagedBlock> &blocks) {
+  py::list out;
+  for (const pomar::DamagedBlock &b : blocks) {
+    py::dict d;
+    d["block"] = b.block;
+    d["problem"] = b.problem;
+    d["level_kept"] = b.level_kept;
+    out.append(d);
+  }
+  return out;
+}
+
 py::dict info_dict(const pomar::FileInfo &i) {
   auto bpv = [&](uint64_t bytes) {
     return i.vertices ? 8.0 * double(bytes) / double(i.vertices) : 0.0;
@@ -126,6 +150,22 @@ py::dict info_dict(const pomar::FileInfo &i) {
   d["bpv"] = bpv(i.total_bytes);
   d["connectivity_bpv"] = bpv(i.connectivity_bytes);
   d["geometry_bpv"] = bpv(i.geometry_bytes);
+  py::list attributes;
+  for (const pomar::AttributeInfo &a : i.attributes) {
+    py::dict entry;
+    entry["kind"] = pomar::kind_name(a.kind);
+    entry["name"] = a.name;
+    entry["components"] = a.components;
+    entry["bits"] = a.bits;
+    entry["exact"] = a.bits == 0;
+    entry["bound"] = a.bound;
+    entry["bytes"] = a.bytes;
+    entry["bpv"] = bpv(a.bytes);
+    attributes.append(entry);
+  }
+  d["attributes"] = attributes;
+  d["attribute_bytes"] = i.attribute_bytes;
+  d["texture_files"] = py::list(py::cast(i.texture_files));
   return d;
 }
 

@@ -50,6 +50,16 @@ private:
   Py_buffer view_;
 };
 
+/// The Progress of an encode/decode running with the GIL released: at every report it
+/// takes the GIL, runs Python's signal handlers (Ctrl-C interrupts a long call with
+/// KeyboardInterrupt) and calls `callback(fraction, stage)` unless it is None. An exception
+/// from either leaves the library call as it is. `callback` must outlive the call (it is
+/// not reference-counted here: copies of the Progress happen without the GIL).
+pomar::Progress python_progress(const py::handle &callback);
+
+/// Skipped blocks as a list of dicts {"block", "problem", "level_kept"}.
+py::list damaged_list(const std::vector<pomar::DamagedBlock> &blocks);
+
 /// FileInfo as the dict `pomar info --json` prints (same keys and values).
 py::dict info_dict(const pomar::FileInfo &info);
 

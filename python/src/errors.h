@@ -1,11 +1,9 @@
-// pomar.Error: the library's errors as one Python exception class with a `kind`.
-//
-// pomar::Error does not carry a kind yet (issue 11 gives it one), so the kind is the
-// usual failure of the operation that raised it: "invalid_mesh" (encode), "damaged_file"
-// (decode, info, SelectiveDecoder), "io" (read, write), "usage" (a memory limit text that
-// does not parse), and "memory_limit" whenever a memory check refused the work. Bad
-// arguments the binding can check itself (dtype, shape, bits, level, cluster) raise
-// TypeError / ValueError before the library is called.
+// pomar.Error: the library's errors as one Python exception class whose `kind` is
+// pomar::Error::kind() as snake_case text ("invalid_mesh", "damaged_file", ...), with the
+// error's `path`, `level` and `cluster` (None when it names none); an error
+// thrown without a kind (Kind::Other) gets the usual failure of the operation that raised
+// it. Bad arguments the binding checks itself (dtype, shape, bits, level, cluster) raise
+// TypeError / ValueError before the library runs.
 #pragma once
 
 #include <pomar/pomar.h>
@@ -20,10 +18,10 @@ namespace pomar_python {
 /// A library error on its way to Python as pomar.Error(message) with .kind.
 struct KindedError {
   std::string kind;
-  std::string message;
+  pomar::Error error; // message, path, level and cluster
 };
 
-/// The kind of `e`, raised by an operation whose usual failure is `operation_kind`.
+/// The Python kind of `e`, raised by an operation whose usual failure is `operation_kind`.
 std::string kind_of(const pomar::Error &e, const char *operation_kind);
 
 /// Runs f(); a pomar::Error leaving it becomes a KindedError.
@@ -31,7 +29,7 @@ template <class F> auto call_library(const char *operation_kind, F &&f) -> declt
   try {
     return f();
   } catch (const pomar::Error &e) {
-    throw KindedError{kind_of(e, operation_kind), e.what()};
+    throw KindedError{kind_of(e, operation_kind), e};
   }
 }
 

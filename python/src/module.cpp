@@ -15,7 +15,8 @@ using namespace pomar_python;
 namespace {
 
 py::bytes encode(const py::handle &vertices, const py::handle &faces, int bits, uint32_t clusters,
-                 double cluster_ratio, bool progressive, const py::handle &max_memory) {
+                 double cluster_ratio, bool progressive, const py::handle &max_memory,
+                 const py::handle &progress) {
   if (bits < 4 || bits > 24)
     throw py::value_error("bits must be between 4 and 24, not " + std::to_string(bits));
   pomar::Mesh mesh = mesh_from_arrays(vertices, faces);
@@ -25,6 +26,7 @@ py::bytes encode(const py::handle &vertices, const py::handle &faces, int bits, 
   options.cluster_ratio = cluster_ratio;
   options.progressive = progressive;
   options.memory_limit = memory_limit(max_memory);
+  options.progress = python_progress(progress);
   std::vector<uint8_t> file;
   {
     py::gil_scoped_release unlocked;
@@ -33,22 +35,28 @@ py::bytes encode(const py::handle &vertices, const py::handle &faces, int bits, 
   return py::bytes(reinterpret_cast<const char *>(file.data()), file.size());
 }
 
-py::tuple decode(const py::handle &data, const py::handle &level, const py::handle &max_memory) {
+py::tuple decode(const py::handle &data, const py::handle &level, bool skip_damaged,
+                 const py::handle &max_memory, const py::handle &progress) {
   const ReadBuffer buffer(data, "decode()");
   pomar::DecodeOptions options;
+  options.skip_damaged = skip_damaged;
   options.memory_limit = memory_limit(max_memory);
+  options.progress = python_progress(progress);
   if (!level.is_none()) {
     const pomar::FileInfo i =
         call_library("damaged_file", [&] { return pomar::inspect(buffer.data(), buffer.size()); });
     options.level = checked_level(level, static_cast<int>(i.levels.size()), -1);
   }
   pomar::Mesh mesh;
+  pomar::DecodeReport report;
   {
     py::gil_scoped_release unlocked;
-    mesh = call_library("damaged_file",
-                        [&] { return pomar::decode(buffer.data(), buffer.size(), options); });
+    mesh = call_library("damaged_file", [&] {
+      return pomar::decode(buffer.data(), buffer.size(), options, &report);
+    });
   }
-  return arrays_from_mesh(std::move(mesh));
+  py::tuple arrays = arrays_from_mesh(std::move(mesh));
+  return py::make_tuple(arrays[0], arrays[1], damaged_list(report.damaged));
 }
 
 py::dict info(const py::handle &data) {
@@ -101,8 +109,9 @@ PYBIND11_MODULE(_pomar, m) {
   m.attr("__version__") = pomar::version();
   m.def("encode", &encode, py::arg("vertices"), py::arg("faces"), py::arg("bits"),
         py::arg("clusters"), py::arg("cluster_ratio"), py::arg("progressive"),
-        py::arg("memory_limit"));
-  m.def("decode", &decode, py::arg("data"), py::arg("level"), py::arg("memory_limit"));
+        py::arg("memory_limit"), py::arg("progress"));
+  m.def("decode", &decode, py::arg("data"), py::arg("level"), py::arg("skip_damaged"),
+        py::arg("memory_limit"), py::arg("progress"));
   m.def("info", &info, py::arg("data"));
   m.def("read_mesh", &read_mesh, py::arg("path"));
   m.def("write_mesh", &write_mesh, py::arg("path"), py::arg("vertices"), py::arg("faces"),

@@ -89,18 +89,6 @@ std::vector<float> point(const py::handle &value, const char *name) {
   return p;
 }
 
-py::list damaged_list(const std::vector<pomar::DamagedBlock> &blocks) {
-  py::list out;
-  for (const pomar::DamagedBlock &b : blocks) {
-    py::dict d;
-    d["block"] = b.block;
-    d["problem"] = b.problem;
-    d["level_kept"] = b.level_kept;
-    out.append(d);
-  }
-  return out;
-}
-
 using D = pomar::SelectiveDecoder;
 
 } // namespace
@@ -169,6 +157,22 @@ void register_selective_decoder(py::module_ &m) {
           },
           py::arg("faces"), py::arg("level") = py::none())
       .def("clear_wanted", [](Decoder &s) { s.locked([](D &d) { d.clear_wanted(); }); })
+      .def(
+          "set_wanted",
+          [](Decoder &s, const std::vector<int> &levels) {
+            const uint32_t count = s.locked([](D &d) { return d.cluster_count(); });
+            if (levels.size() != count)
+              throw py::value_error("set_wanted needs one level per cluster (" +
+                                    std::to_string(count) + "), got " +
+                                    std::to_string(levels.size()));
+            s.locked([&](D &d) { d.set_wanted(levels); });
+          },
+          py::arg("levels"))
+      .def_property_readonly("wanted",
+                             [](Decoder &s) {
+                               std::vector<int> w = s.locked([](D &d) { return d.wanted(); });
+                               return array_from_vector(std::move(w), 0);
+                             })
       .def("update", [](Decoder &s) { s.locked([](D &d) { d.update(); }); })
       .def_property_readonly("levels",
                              [](Decoder &s) {

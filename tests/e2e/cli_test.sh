@@ -541,6 +541,98 @@ for count in 2147483648 2147483647; do
   done
 done
 
+# ---- per-vertex attributes (issue 12) ------------------------------------------------------------------
+
+section "attributes: a coloured, scalar-carrying PLY (generated: the bunny with colour, normals, quality)"
+mkdir -p "$WORK/attr"
+python3 - "$BUNNY" "$WORK/attr/c.ply" "$WORK/attr/nan.ply" <<'PY'
+import math, struct, sys
+data = open(sys.argv[1], 'rb').read()
+end = data.index(b'end_header\n') + len(b'end_header\n')
+head = data[:end].decode()
+nv = int(head.split('element vertex ')[1].split()[0])
+nf = int(head.split('element face ')[1].split()[0])
+pos = struct.unpack_from('<%df' % (3 * nv), data, end)
+faces = data[end + 12 * nv:]
+def write(path, nan):
+    out = ['ply', 'format binary_little_endian 1.0', 'comment TextureFile skin.png',
+           'element vertex %d' % nv] + ['property float %s' % a for a in 'xyz'] + \
+          ['property uchar red', 'property uchar green', 'property uchar blue',
+           'property float nx', 'property float ny', 'property float nz', 'property float quality',
+           'element face %d' % nf, 'property list uchar int vertex_indices', 'end_header']
+    body = bytearray()
+    for v in range(nv):
+        x, y, z = pos[3 * v:3 * v + 3]
+        r = math.sqrt(x * x + y * y + z * z) or 1.0
+        q = float('nan') if nan and v == 7 else 100 * x * y
+        body += struct.pack('<3f3B4f', x, y, z, int(128 + 120 * math.sin(40 * x)),
+                            int(128 + 120 * math.sin(40 * y)), v % 256, x / r, y / r, z / r, q)
+    open(path, 'wb').write(('\n'.join(out) + '\n').encode() + bytes(body) + faces)
+write(sys.argv[2], False)
+write(sys.argv[3], True)
+PY
+run encode "$WORK/attr/c.ply" "$WORK/attr/c.pomar"
+expect_rc 0
+expect_contains "$OUT" "attribute colour" "encode output"
+expect_contains "$OUT" "attribute normal" "encode output"
+expect_contains "$OUT" "attribute quality" "encode output"
+run info --json "$WORK/attr/c.pomar"
+expect_rc 0
+printf '%s' "$OUT" >"$WORK/attr/info.json"
+[ "$(json_get "$WORK/attr/info.json" "d['version']")" = 4 ] || fail "an attribute file is version 4"; pass
+[ "$(json_get "$WORK/attr/info.json" "len(d['attributes'])")" = 3 ] || fail "3 attributes"; pass
+[ "$(json_get "$WORK/attr/info.json" "[a['kind'] for a in d['attributes']]")" = "['colour', 'normal', 'scalar']" ] ||
+  fail "attribute kinds in info --json"; pass
+[ "$(json_get "$WORK/attr/info.json" "d['attributes'][0]['exact']")" = True ] || fail "colour is exact"; pass
+[ "$(json_get "$WORK/attr/info.json" "d['texture_files']")" = "['skin.png']" ] || fail "texture file kept"; pass
+run info "$WORK/attr/c.pomar"
+expect_contains "$OUT" "bits/vertex (RGB, 8 bits exact)" "info text"
+run verify "$WORK/attr/c.ply" "$WORK/attr/c.pomar"
+expect_rc 0
+expect_contains "$OUT" "colour 'colour': RGB, 8 bits exact, max error 0" "verify"
+expect_contains "$OUT" "normal 'normal': 9-bit octahedral" "verify"
+
+section "attributes: decode writes them, --no-attributes leaves them out, verify reads a decoded file"
+run decode "$WORK/attr/c.pomar" "$WORK/attr/back.ply"
+expect_rc 0
+run verify "$WORK/attr/c.ply" "$WORK/attr/c.pomar" "$WORK/attr/back.ply"
+expect_rc 0
+run decode --no-attributes "$WORK/attr/c.pomar" "$WORK/attr/plain.ply"
+expect_rc 0
+grep -q "property uchar red" "$WORK/attr/plain.ply" && fail "--no-attributes wrote colours"; pass
+run verify "$WORK/attr/c.ply" "$WORK/attr/c.pomar" "$WORK/attr/plain.ply"
+expect_rc 3
+expect_contains "$ERR" "missing from the decoded mesh" "verify of a mesh without attributes"
+run decode --level 3 "$WORK/attr/c.pomar" "$WORK/attr/l3.ply"
+expect_rc 0
+grep -q "property uchar red" "$WORK/attr/l3.ply" || fail "an intermediate level has colours"; pass
+
+section "attributes: --drop, --exact-attributes, NaN in quantized mode"
+run encode --drop colour,normals "$WORK/attr/c.ply" "$WORK/attr/d.pomar"
+expect_rc 0
+run verify "$WORK/attr/c.ply" "$WORK/attr/d.pomar"
+expect_rc 3
+expect_contains "$ERR" "not in the file" "verify without --drop"
+run verify --drop colour,normals "$WORK/attr/c.ply" "$WORK/attr/d.pomar"
+expect_rc 0
+run encode --drop colours,bogus "$WORK/attr/c.ply" "$WORK/attr/x.pomar"
+expect_rc 1
+expect_contains "$ERR" "'bogus' is not one of colour, normals, scalars, texcoords, all" "bad --drop"
+run encode "$WORK/attr/nan.ply" "$WORK/attr/nan.pomar"
+expect_rc 1
+expect_contains "$ERR" "scalar attribute 'quality' of vertex 7 is NaN" "NaN in quantized mode"
+expect_no_file "$WORK/attr/nan.pomar"
+run encode --exact-attributes "$WORK/attr/nan.ply" "$WORK/attr/nan.pomar"
+expect_rc 0
+run verify "$WORK/attr/nan.ply" "$WORK/attr/nan.pomar"
+expect_rc 0
+expect_contains "$OUT" "exact floats, max error 0" "exact mode"
+run encode --normal-bits 12 --scalar-bits 8 "$WORK/attr/c.ply" "$WORK/attr/b.pomar"
+expect_rc 0
+run verify "$WORK/attr/c.ply" "$WORK/attr/b.pomar"
+expect_rc 0
+expect_contains "$OUT" "12-bit octahedral" "--normal-bits"
+
 # ---- --help ------------------------------------------------------------------------------------------
 
 section "--help"
@@ -556,10 +648,12 @@ help_mentions() { # help_mentions SUBCOMMAND OPTION...
   local opt
   for opt in "$@"; do expect_contains "$OUT" "$opt" "pomar $sub --help"; done
 }
-help_mentions encode --bits --progressive --clusters --cluster-ratio --repair --quiet --max-memory 512M input output
-help_mentions decode --level --cluster --sphere --box --stats --ascii --quiet --skip-damaged --max-memory input output
+help_mentions encode --bits --progressive --clusters --cluster-ratio --repair --quiet --max-memory 512M input output \
+  --drop --normal-bits --scalar-bits --texcoord-bits --exact-attributes
+help_mentions decode --level --cluster --sphere --box --stats --ascii --quiet --skip-damaged --max-memory input output \
+  --no-attributes
 help_mentions info --json --check input
-help_mentions verify original pomar decoded --repair
+help_mentions verify original pomar decoded --repair --drop
 
 LAST_CMD=""
 printf 'cli_end_to_end: all %d checks passed\n' "$CHECKS"

@@ -5,6 +5,9 @@
 // No X display needed: nothing here touches OpenGL or widgets.
 #include <gtest/gtest.h>
 
+#include <array>
+#include <map>
+
 #include <QCoreApplication>
 #include <QDir>
 #include <QFile>
@@ -131,11 +134,12 @@ protected:
   }
 
   /// Save with the defaults of initSaveParameter, changed by `edit`.
-  template <class Edit> bool save(MeshModel &mm, const QString &fileName, Edit edit) {
+  template <class Edit>
+  bool save(MeshModel &mm, const QString &fileName, Edit edit, int mask = 0) {
     RichParameterList par;
     plugin()->initSaveParameter("pomar", mm, par);
     edit(par);
-    return plugin()->save("pomar", fileName, mm, 0, par);
+    return plugin()->save("pomar", fileName, mm, mask, par);
   }
   bool save(MeshModel &mm, const QString &fileName) {
     return save(mm, fileName, [](RichParameterList &) {});
@@ -176,8 +180,10 @@ TEST_F(PomarPluginTest, FormatsAndCapabilities) {
   QString format = "pomar";
   int capability = -1, defaultBits = -1;
   plugin()->GetExportMaskCapability(format, capability, defaultBits);
-  EXPECT_EQ(capability, 0);
-  EXPECT_EQ(defaultBits, 0);
+  using M = vcg::tri::io::Mask;
+  EXPECT_EQ(capability,
+            M::IOM_VERTCOLOR | M::IOM_VERTNORMAL | M::IOM_VERTQUALITY | M::IOM_VERTTEXCOORD);
+  EXPECT_EQ(defaultBits, M::IOM_VERTCOLOR | M::IOM_VERTQUALITY | M::IOM_VERTTEXCOORD);
 }
 
 TEST_F(PomarPluginTest, ParameterDefaults) {
@@ -375,12 +381,12 @@ TEST_F(PomarPluginTest, SaveWarnsAboutWhatIsNotKept) {
   for (auto &v : mm->cm.vert)
     v.C() = vcg::Color4b::White;
   mm->cm.vert[5].C() = vcg::Color4b::Red;
-  vcg::tri::Allocator<CMeshO>::GetPerVertexAttribute<float>(mm->cm, "my_weight");
-  ASSERT_TRUE(save(*mm, path("w.pomar"))) << plugin()->errorMsg().toStdString();
+  vcg::tri::Allocator<CMeshO>::GetPerVertexAttribute<int>(mm->cm, "my_label");
+  ASSERT_TRUE(save(*mm, path("w.pomar"))) << plugin()->errorMsg().toStdString(); // mask 0
   const QString all = g_warnings.join("\n");
-  EXPECT_TRUE(all.contains("per-vertex colors")) << all.toStdString();
-  EXPECT_TRUE(all.contains("my_weight")) << all.toStdString();
-  EXPECT_FALSE(all.contains("normals")) << all.toStdString(); // MeshLab's own normals
+  EXPECT_TRUE(all.contains("per-vertex colors (tick Color")) << all.toStdString();
+  EXPECT_TRUE(all.contains("my_label")) << all.toStdString(); // not a float: not kept
+  EXPECT_FALSE(all.contains("per-vertex normals")) << all.toStdString(); // MeshLab's own
   EXPECT_EQ(readBytes(path("w.pomar")), *clustered_);         // and the file is the same
 
   // Normals that are not MeshLab's angle-weighted ones are named too.
@@ -390,6 +396,66 @@ TEST_F(PomarPluginTest, SaveWarnsAboutWhatIsNotKept) {
   ASSERT_TRUE(save(*mm, path("w.pomar")));
   EXPECT_TRUE(g_warnings.join("\n").contains("per-vertex normals"));
   QFile::remove(path("w.pomar"));
+}
+
+// Save with the mask of the save dialog / meshlabserver -m, open again: the attributes come
+// back exactly (colour, float attribute) or within their bound (quality), and the open mask
+// tells MeshLab to show the colours.
+TEST_F(PomarPluginTest, SaveAndOpenKeepAttributes) {
+  using M = vcg::tri::io::Mask;
+  MeshModel *mm = layer(*input_);
+  mm->updateDataMask(MeshModel::MM_VERTCOLOR | MeshModel::MM_VERTQUALITY);
+  auto weight = vcg::tri::Allocator<CMeshO>::GetPerVertexAttribute<float>(mm->cm, "my_weight");
+  for (size_t v = 0; v < mm->cm.vert.size(); ++v) {
+    mm->cm.vert[v].C() = vcg::Color4b((v * 7) & 255, (v * 13) & 255, (v * 29) & 255, 255);
+    mm->cm.vert[v].Q() = float(v) * 0.25f;
+    weight[v] = 1.0f / float(v + 1);
+  }
+  ASSERT_TRUE(save(*mm, path("a.pomar"), [](RichParameterList &) {},
+                   M::IOM_VERTCOLOR | M::IOM_VERTQUALITY))
+      << plugin()->errorMsg().toStdString();
+  EXPECT_FALSE(g_warnings.join("\n").contains("colors")) << g_warnings.join("\n").toStdString();
+  const pomar::FileInfo info = infoOf(readBytes(path("a.pomar")));
+  ASSERT_EQ(info.attributes.size(), 3u);
+
+  MeshModel *back = doc_.addNewMesh("", "back", false);
+  int mask = 0;
+  RichParameterList par;
+  plugin()->initPreOpenParameter("pomar", path("a.pomar"), par);
+  ASSERT_TRUE(plugin()->open("pomar", path("a.pomar"), *back, mask, par, nullptr, nullptr))
+      << plugin()->errorMsg().toStdString();
+  EXPECT_TRUE(mask & M::IOM_VERTCOLOR);
+  EXPECT_TRUE(mask & M::IOM_VERTQUALITY);
+  // Match vertices by position on the file's grid (the file renumbers them).
+  std::map<std::array<float, 3>, size_t> at;
+  auto snap = [&](int axis, float x) {
+    return info.grid.dequantize(axis, info.grid.quantize(axis, x));
+  };
+  for (size_t v = 0; v < mm->cm.vert.size(); ++v) {
+    const auto &p = mm->cm.vert[v].P();
+    at[{snap(0, p[0]), snap(1, p[1]), snap(2, p[2])}] = v;
+  }
+  auto backWeight = vcg::tri::Allocator<CMeshO>::FindPerVertexAttribute<float>(back->cm, "my_weight");
+  ASSERT_TRUE(vcg::tri::Allocator<CMeshO>::IsValidHandle(back->cm, backWeight));
+  const double qBound = info.attributes[1].bound;
+  size_t matched = 0;
+  for (size_t v = 0; v < back->cm.vert.size(); ++v) {
+    const auto &p = back->cm.vert[v].P();
+    const auto it = at.find({p[0], p[1], p[2]});
+    ASSERT_NE(it, at.end());
+    ++matched;
+    EXPECT_EQ(back->cm.vert[v].C(), mm->cm.vert[it->second].C());
+    EXPECT_NEAR(back->cm.vert[v].Q(), mm->cm.vert[it->second].Q(), qBound);
+    EXPECT_NEAR(backWeight[v], weight[it->second], info.attributes[2].bound);
+  }
+  EXPECT_GT(matched, 0u);
+
+  // Without the Color tick the colours are not saved, and the warning says how to keep them.
+  g_warnings.clear();
+  ASSERT_TRUE(save(*mm, path("a.pomar"), [](RichParameterList &) {}, M::IOM_VERTQUALITY));
+  EXPECT_TRUE(g_warnings.join("\n").contains("per-vertex colors (tick Color"));
+  EXPECT_EQ(infoOf(readBytes(path("a.pomar"))).attributes.size(), 2u);
+  QFile::remove(path("a.pomar"));
 }
 
 TEST_F(PomarPluginTest, FailedSaveWritesNothing) {

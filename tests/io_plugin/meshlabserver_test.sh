@@ -60,7 +60,8 @@ expect_output "Current Plugins Dir is: $PLUGDIR"
 expect_file "$OUTDIR/bunny.pomar"
 expect_no_output "NOT been saved"
 # bunny.ply has 1113 vertices no face uses: the format drops them and the plugin says so.
-expect_output "not saved: 1113 unreferenced vertices"
+expect_output "not saved (a .pomar file keeps positions, triangles and per-vertex"
+expect_output "1113 unreferenced vertices"
 expect_dir_only bunny.pomar
 
 section "meshlabserver opens bunny.pomar (full resolution) and saves a PLY"
@@ -84,7 +85,7 @@ pomar verify "$BUNNY" "$OUTDIR/prog.pomar" "$OUTDIR/prog_back.ply"
 expect_rc 0
 rm -f "$OUTDIR"/prog*
 
-section "colors and normals are named in the warning"
+section "colors and normals not in the save mask are named in the warning"
 cat >"$OUTDIR/octa.ply" <<'EOF'
 ply
 format ascii 1.0
@@ -120,11 +121,27 @@ EOF
 ml -i octa.ply -o octa.pomar
 expect_rc 0
 expect_file "$OUTDIR/octa.pomar"
-expect_output "keeps only positions and triangles"
-expect_output "per-vertex colors"
-expect_output "per-vertex normals"
+expect_output "per-vertex colors (tick Color in the save dialog / meshlabserver -m vc)"
+expect_output "per-vertex normals (tick Normal / -m vn)"
 pomar verify "$OUTDIR/octa.ply" "$OUTDIR/octa.pomar"
+expect_rc 3 # the file lacks the colours and normals of the original
+expect_output "not in the file"
+pomar verify --drop colour,normals "$OUTDIR/octa.ply" "$OUTDIR/octa.pomar"
 expect_rc 0
+
+section "-m vc vn: colours exact and normals within their bound after save and open"
+ml -i octa.ply -o octa.pomar -m vc vn
+expect_rc 0
+expect_no_output "per-vertex colors"
+expect_no_output "per-vertex normals"
+pomar info "$OUTDIR/octa.pomar"
+expect_output "attribute colour"
+expect_output "attribute normal"
+ml -i octa.pomar -o octa_back.ply -m vc vn
+expect_rc 0
+pomar verify "$OUTDIR/octa.ply" "$OUTDIR/octa.pomar" "$OUTDIR/octa_back.ply"
+expect_rc 0
+expect_output "colour 'colour': RGB, 8 bits exact, max error 0"
 rm -f "$OUTDIR"/octa*
 
 # ---- 2. a non-manifold mesh is refused: no file, an explanation ------------------------------------

@@ -27,6 +27,8 @@
 #include "support/meshlab_layer.h"
 #include <algorithm>
 #include <array>
+#include <cmath>
+#include <iterator>
 #include <cstdio>
 #include <fstream>
 #include <functional>
@@ -44,6 +46,7 @@ const char *const kCoarsen = "POMAR: Coarsen Selected Clusters";
 const char *const kSetLevel = "POMAR: Set Level of Detail";
 const char *const kShowClusters = "POMAR: Show Clusters";
 const char *const kShowLevels = "POMAR: Show Levels";
+const char *const kShowOriginal = "POMAR: Show Original Colours";
 
 // ---------------------------------------------------------------- plugins
 
@@ -103,6 +106,16 @@ protected:
     progressive_ = new std::vector<uint8_t>(pomar::encode(*input_, progressive));
     writeBytes(path("clustered.pomar"), *clustered_);
     writeBytes(path("progressive.pomar"), *progressive_);
+    pomar::Mesh coloured = *input_;
+    pomar::VertexAttribute c;
+    c.kind = pomar::AttributeKind::Colour;
+    c.name = "colour";
+    c.components = 3;
+    for (size_t v = 0; v < coloured.vertex_count(); ++v)
+      for (int k = 0; k < 3; ++k)
+        c.colour.push_back(uint8_t(128 + 127 * std::sin(7.0 * coloured.positions[3 * v + k])));
+    coloured.attributes.push_back(c);
+    writeBytes(path("coloured.pomar"), pomar::encode(coloured));
     info_ = new pomar::FileInfo(pomar::inspect(clustered_->data(), clustered_->size()));
   }
   static void TearDownTestSuite() {
@@ -243,7 +256,8 @@ TEST_F(FilterPomarTest, FiltersAndClasses) {
   QStringList names;
   for (QAction *a : filter()->actions())
     names << a->text();
-  EXPECT_EQ(names, QStringList({kRefine, kCoarsen, kSetLevel, kShowClusters, kShowLevels}));
+  EXPECT_EQ(names, QStringList({kRefine, kCoarsen, kSetLevel, kShowClusters, kShowLevels,
+                                kShowOriginal}));
   for (QAction *a : filter()->actions()) {
     EXPECT_NE(filter()->getClass(a), MeshFilterInterface::Generic) << a->text().toStdString();
     EXPECT_EQ(filter()->filterArity(a), MeshFilterInterface::SINGLE_MESH);
@@ -256,7 +270,7 @@ TEST_F(FilterPomarTest, FiltersAndClasses) {
   EXPECT_TRUE(filter()->getClass(action(kShowLevels)) & MeshFilterInterface::VertexColoring);
   for (const char *f : {kRefine, kCoarsen, kSetLevel})
     EXPECT_EQ(filter()->postCondition(action(f)), int(MeshModel::MM_GEOMETRY_AND_TOPOLOGY_CHANGE));
-  for (const char *f : {kShowClusters, kShowLevels}) {
+  for (const char *f : {kShowClusters, kShowLevels, kShowOriginal}) {
     EXPECT_EQ(filter()->postCondition(action(f)), int(MeshModel::MM_VERTCOLOR));
     EXPECT_EQ(filter()->getRequirements(action(f)), int(MeshModel::MM_VERTCOLOR));
   }
@@ -483,6 +497,44 @@ TEST_F(FilterPomarTest, CoarsenTheWholeMeshGivesTheBaseClusteredMesh) {
 }
 
 // ---------------------------------------------------------------- colours
+
+/// Refining keeps the file's colours on the vertices it decodes; Show Clusters / Show Levels
+/// keep the layer's colours aside and Show Original Colours puts them back.
+TEST_F(FilterPomarTest, AttributesSurviveRefineAndShowFilters) {
+  const std::vector<uint8_t> bytes = [] {
+    std::ifstream in(QFile::encodeName(path("coloured.pomar")).toStdString(), std::ios::binary);
+    return std::vector<uint8_t>(std::istreambuf_iterator<char>(in), {});
+  }();
+  const pomar::Mesh full = pomar::decode(bytes.data(), bytes.size());
+  std::map<std::array<float, 3>, std::array<uint8_t, 3>> colourAt;
+  const pomar::VertexAttribute *c = full.find(pomar::AttributeKind::Colour);
+  ASSERT_NE(c, nullptr);
+  for (size_t v = 0; v < full.vertex_count(); ++v)
+    colourAt[{full.positions[3 * v], full.positions[3 * v + 1], full.positions[3 * v + 2]}] = {
+        c->colour[3 * v], c->colour[3 * v + 1], c->colour[3 * v + 2]};
+  auto expectFileColours = [&](MeshModel &mm) {
+    for (const CVertexO &v : mm.cm.vert) {
+      const auto it = colourAt.find({v.cP()[0], v.cP()[1], v.cP()[2]});
+      ASSERT_NE(it, colourAt.end());
+      ASSERT_EQ(v.cC()[0], it->second[0]);
+      ASSERT_EQ(v.cC()[1], it->second[1]);
+      ASSERT_EQ(v.cC()[2], it->second[2]);
+    }
+  };
+  MeshModel *mm = open("coloured.pomar", 1); // base clustered mesh
+  expectFileColours(*mm);
+  selectFacesOf(*mm, {0, 1, 2});
+  ASSERT_TRUE(refine(info_->levels.size())) << filter()->errorMsg().toStdString();
+  expectFileColours(*mm);
+  ASSERT_TRUE(apply(kShowClusters)) << filter()->errorMsg().toStdString();
+  ASSERT_TRUE(apply(kShowLevels)) << filter()->errorMsg().toStdString();
+  ASSERT_TRUE(apply(kShowOriginal)) << filter()->errorMsg().toStdString();
+  expectFileColours(*mm); // the user's colours, not those of the first Show
+  ASSERT_TRUE(apply(kShowClusters));
+  ASSERT_TRUE(setLevel(-1)); // a refine puts the file's colours on the new mesh
+  expectFileColours(*mm);
+  EXPECT_EQ(mm->cm.vn, int(full.vertex_count()));
+}
 
 TEST_F(FilterPomarTest, ShowClustersAndLevels) {
   MeshModel *mm = open("clustered.pomar");

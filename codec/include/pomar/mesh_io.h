@@ -1,8 +1,12 @@
 // Reading and writing triangle meshes as PLY, OBJ, OFF and STL files.
 //
 // The format is chosen by the file extension (case-insensitive): .ply, .obj, .off, .stl.
-// Only positions and triangles are kept; everything else a file may carry (normals, colors,
-// texture coordinates, ...) is dropped and named in LoadReport::ignored_attributes.
+// Positions, triangles and per-vertex attributes (Mesh::attributes) are kept: PLY vertex
+// colour (8-bit), normals, texture coordinates, every other scalar property by its name and
+// "comment TextureFile" names; OBJ vertex colours (rounded to 8 bits) and the normals and
+// texture coordinates that are per vertex; OFF vertex colours and normals. Everything else a
+// file may carry (face data, per-corner attributes, materials, ...) is dropped and named in
+// LoadReport::ignored_attributes. save_mesh writes the attributes to PLY and OBJ.
 // PLY, OFF and ASCII STL are read through vcglib's importers (so a file loads as it does
 // in MeshLab), binary STL directly, OBJ through tinyobjloader. Every failure throws
 // pomar::Error with a one-line message that starts with the file's path.
@@ -51,8 +55,8 @@ using SizeCheck = std::function<void(uint64_t vertices, uint64_t faces)>;
 /// exactly equal positions are welded, unreferenced vertices are dropped. Vertex and face
 /// order of the file is kept otherwise. `*report` is reset first. Throws pomar::Error if
 /// the file is missing, unreadable, malformed, has a NaN/Inf coordinate or contains no
-/// triangles, and for files vcglib would misread (see codec/src/io/io_common.h), and when `size_check`
-/// throws.
+/// triangles, and for files vcglib would misread (see codec/src/io/io_common.h), and when
+/// `size_check` throws.
 Mesh load_mesh(const std::string &path, LoadReport *report = nullptr,
                const SizeCheck &size_check = {});
 

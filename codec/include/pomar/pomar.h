@@ -29,6 +29,8 @@
 #include <string>
 #include <vector>
 
+#include "pomar/attributes.h"
+
 namespace pomar {
 
 /// The version of the library the program runs with, "MAJOR.MINOR.PATCH" (compare with
@@ -36,20 +38,74 @@ namespace pomar {
 const char *version();
 
 /// Every failure of the library is reported as a pomar::Error whose what() is one line
-/// naming the problem (and, for invalid meshes, where: counts and one example).
+/// naming the problem (and, for invalid meshes, where: counts and one example). kind()
+/// says what sort of failure it is, for callers that react differently (the tool's exit
+/// status, a plugin's message) without reading the text.
 class Error : public std::runtime_error {
 public:
-  using std::runtime_error::runtime_error;
+  enum class Kind {
+    Other,         ///< none of the below (errors thrown by callers with a message only)
+    InvalidMesh,   ///< an input mesh or mesh file that cannot be used: not manifold, NaN,
+                   ///< no triangles, indices out of range, a malformed PLY/OBJ/OFF/STL file
+    DamagedFile,   ///< a .pomar file that fails its checks or is not one at all
+    TruncatedFile, ///< a .pomar file that ends before the data asked for
+    Unsupported,   ///< a .pomar version (or feature) this library cannot read
+    Io,            ///< a file that cannot be opened, read, written or renamed
+    MemoryLimit,   ///< the work would need more memory than allowed (see pomar/limits.h)
+    Usage,         ///< a bad argument: a level or cluster that does not exist, a bad option
+    Internal,      ///< a broken invariant of the codec itself (a bug: please report it)
+  };
+  /// No location: block() is kNoBlock.
+  static constexpr int kNoBlock = -1;
+
+  explicit Error(const std::string &what) : std::runtime_error(what) {}
+  Error(Kind kind, const std::string &what) : std::runtime_error(what), kind_(kind) {}
+  Kind kind() const noexcept { return kind_; }
+
+  /// The file the message names, if any (mesh files; .pomar files read by path).
+  const std::string &path() const noexcept { return path_; }
+  Error &with_path(const std::string &path) {
+    path_ = path;
+    return *this;
+  }
+  /// DamagedFile / TruncatedFile: the level or cluster block the damage is in, which a
+  /// decode with skip_damaged can decode around (kNoBlock: elsewhere, or not known).
+  int level() const noexcept { return level_; }
+  int64_t cluster() const noexcept { return cluster_; }
+  Error &in_block(int level, int64_t cluster = kNoBlock) {
+    level_ = level;
+    cluster_ = cluster;
+    return *this;
+  }
+  bool in_block() const noexcept { return level_ != kNoBlock || cluster_ != kNoBlock; }
+
+private:
+  Kind kind_ = Kind::Other;
+  std::string path_;
+  int level_ = kNoBlock;
+  int64_t cluster_ = kNoBlock;
 };
 
 /// A triangle mesh as flat arrays: x,y,z per vertex and three vertex indices per
-/// triangle, counter-clockwise seen from outside.
+/// triangle, counter-clockwise seen from outside; optionally per-vertex attributes
+/// (pomar/attributes.h) and the texture files the texture coordinates refer to.
 struct Mesh {
   std::vector<float> positions;    // 3 * vertex_count()
   std::vector<uint32_t> triangles; // 3 * triangle_count()
+  std::vector<VertexAttribute> attributes;
+  std::vector<std::string> texture_files; ///< metadata, kept as given
   size_t vertex_count() const { return positions.size() / 3; }
   size_t triangle_count() const { return triangles.size() / 3; }
+  /// The first attribute of this kind (and this name, if given), or nullptr.
+  const VertexAttribute *find(AttributeKind kind, const std::string &name = {}) const;
+  VertexAttribute *find(AttributeKind kind, const std::string &name = {});
 };
+
+/// Throw pomar::Error naming the attribute (and vertex) if an attribute does not fit the
+/// mesh: wrong component count, value count not matching the vertex count, empty or
+/// repeated name; with `quantized`, also NaN/infinite values and zero-length normals.
+/// Attributes whose kind `mask` drops are not checked.
+void validate_attributes(const Mesh &mesh, bool quantized, const AttributeMask &mask = {});
 
 /// Progress callback: fraction in [0,1] and a short stage name ("decimate", "encode", ...).
 using Progress = std::function<void(double fraction, const char *stage)>;
@@ -70,6 +126,9 @@ struct EncodeOptions {
   /// allocations if it would need more (pomar/limits.h). 0 = automatic (the memory
   /// available to the process), UINT64_MAX (kNoMemoryLimit) = do not check.
   uint64_t memory_limit = 0;
+  /// Which attributes are stored and how precisely (default: all, normals within 0.33°,
+  /// scalars on 16 bits, texture coordinates on 12 bits over their ranges).
+  AttributeOptions attributes;
 };
 
 /// One refinement level of a file: the mesh it produces and what it costs.
@@ -89,6 +148,16 @@ struct Quantizer {
   double step() const;
   float dequantize(int axis, uint32_t q) const;
   uint32_t quantize(int axis, float x) const; ///< nearest grid index, clamped to the grid
+};
+
+/// An attribute stored in a file (its ATTR section).
+struct AttributeInfo {
+  AttributeKind kind = AttributeKind::Scalar;
+  std::string name;
+  uint32_t components = 0;
+  int bits = 0;       ///< 0 = exact
+  double bound = 0;   ///< as VertexAttribute::bound
+  uint64_t bytes = 0; ///< its coded residuals
 };
 
 /// What a .pomar file holds (read from its header and level table only).
@@ -115,6 +184,10 @@ struct FileInfo {
   uint64_t global_bytes = 0; ///< header, base mesh, global levels, tables, index
   uint64_t tables_bytes = 0, index_bytes = 0, cluster_bytes = 0;
   std::vector<uint32_t> cluster_block_bytes; ///< filled by inspect()
+  /// Per-vertex attributes (filled by inspect(); empty if the file has none).
+  std::vector<AttributeInfo> attributes;
+  std::vector<std::string> texture_files;
+  uint64_t attribute_bytes = 0; ///< the whole ATTR section
   /// Version 4: what the file carries in sections of its global part, with their sizes.
   struct Section {
     std::string name;      ///< four ASCII characters, e.g. "LSLS"
@@ -162,6 +235,10 @@ FileInfo inspect(const uint8_t *data, size_t size);
 Mesh decode(const uint8_t *data, size_t size, int level = -1, const Progress &progress = {},
             uint64_t memory_limit = 0);
 
+/// Throws pomar::Error (Kind::Usage) "level L does not exist: the file has levels 0..F"
+/// unless 0 <= level <= finest.
+void check_level_exists(int level, int finest);
+
 /// A block of a .pomar file that failed its checks (checksum, structure, or missing from a
 /// truncated file) and was skipped by a decode with `skip_damaged`.
 struct DamagedBlock {
@@ -171,6 +248,8 @@ struct DamagedBlock {
   /// fail their checksum (format version 3) though each passes its own 8-bit check, so the
   /// damaged one cannot be located and skipped; the mesh may be wrong in places.
   int level_kept = 0;
+  int level = -1;       ///< the global level it holds (1-based), -1 for a cluster block
+  int64_t cluster = -1; ///< the cluster whose block it is, -1 for a global level
 };
 
 struct DecodeOptions {
@@ -186,6 +265,9 @@ struct DecodeOptions {
   /// Peak memory allowed, in bytes, checked right after the header (0 = automatic,
   /// UINT64_MAX = do not check; see pomar/limits.h).
   uint64_t memory_limit = 0;
+  /// Which stored attributes the returned mesh carries (AttributeMask::none(): positions
+  /// and triangles only; the codes are interleaved with the positions and decoded anyway).
+  AttributeMask attributes;
 };
 
 struct DecodeReport {

@@ -74,6 +74,9 @@ struct SelectiveOptions {
   /// Bytes the base clustered mesh may need (0 = automatic, UINT64_MAX = do not check; see
   /// pomar/limits.h). Later refinement is not checked: it decodes what is asked for.
   uint64_t memory_limit = 0;
+  /// Which stored attributes mesh() returns (AttributeMask::none(): none). Their codes
+  /// are decoded with the positions, block by block, whatever this says.
+  AttributeMask attributes;
 };
 
 /// Selective, incremental decoder of a .pomar file. Levels are numbered as everywhere
@@ -126,6 +129,8 @@ public:
   const std::vector<DamagedBlock> &damaged() const;
 
   // ----- the current mesh -----
+  /// Positions, triangles and the attributes of exactly these vertices (the same values a
+  /// full decode gives them).
   Mesh mesh() const;
   /// Per vertex of mesh(): its cluster and the level that created it.
   std::vector<uint32_t> vertex_cluster() const;

@@ -69,4 +69,8 @@ struct RepairReport {
 /// refers to a vertex index >= the vertex count.
 RepairReport make_manifold(Mesh &mesh);
 
+/// True if make_manifold() would change `mesh` (run on a copy; false if it throws): when an
+/// encode fails, whether the repair is worth suggesting.
+bool repair_would_change(const Mesh &mesh);
+
 } // namespace pomar

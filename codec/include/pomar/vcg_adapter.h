@@ -12,6 +12,7 @@
 
 #include <vcg/complex/algorithms/update/bounding.h>
 #include <vcg/complex/complex.h>
+#include <wrap/io_trimesh/io_mask.h>
 
 #include <climits>
 #include <cstddef>
@@ -22,18 +23,108 @@
 
 namespace pomar {
 
+/// Position of `v` in m.vert, or m.vert.size() if `v` does not point into m.vert (a face's
+/// vertex pointer -> vertex index).
+template <class MeshType>
+size_t vertex_position(const MeshType &m, const typename MeshType::VertexType *v) {
+  using VertexType = typename MeshType::VertexType;
+  const VertexType *first = m.vert.empty() ? nullptr : &m.vert[0];
+  const std::less<const VertexType *> less;
+  if (v == nullptr || first == nullptr || less(v, first) || !less(v, first + m.vert.size()))
+    return m.vert.size();
+  return static_cast<size_t>(v - first);
+}
+/// from_vcg's attribute mask: vcg::tri::io::Mask bits IOM_VERTCOLOR (colour; RGBA when an
+/// alpha differs from 255), IOM_VERTNORMAL, IOM_VERTQUALITY (a scalar named "quality"),
+/// IOM_VERTTEXCOORD (texcoord + m.textures as texture files), plus kVcgCustomScalars:
+/// every named per-vertex float attribute becomes a scalar of that name.
+constexpr int kVcgCustomScalars = 1 << 30;
+constexpr int kVcgAllAttributes = vcg::tri::io::Mask::IOM_VERTCOLOR |
+                                  vcg::tri::io::Mask::IOM_VERTNORMAL |
+                                  vcg::tri::io::Mask::IOM_VERTQUALITY |
+                                  vcg::tri::io::Mask::IOM_VERTTEXCOORD | kVcgCustomScalars;
+
 namespace vcg_detail {
 
 /// Position of `v` in m.vert, or throws if `v` does not point into m.vert.
 template <class MeshType>
 size_t vertex_index(const MeshType &m, const typename MeshType::VertexType *v, size_t face) {
-  using VertexType = typename MeshType::VertexType;
-  const VertexType *first = m.vert.empty() ? nullptr : &m.vert[0];
-  const std::less<const VertexType *> less;
-  if (v == nullptr || first == nullptr || less(v, first) || !less(v, first + m.vert.size()))
-    throw Error("vcg mesh: face " + std::to_string(face) +
-                " has a vertex pointer outside the vertex array");
-  return static_cast<size_t>(v - first);
+  const size_t i = vertex_position(m, v);
+  if (i == m.vert.size())
+    throw Error(Error::Kind::InvalidMesh, "vcg mesh: face " + std::to_string(face) +
+                                              " has a vertex pointer outside the vertex array");
+  return i;
+}
+
+/// Per-vertex float attributes of m by name (vcglib's user attributes), except pomar's own
+/// ("pomar_*", written by the MeshLab plugins) and unnamed ones.
+template <class MeshType> std::vector<std::string> custom_scalar_names(const MeshType &m) {
+  std::vector<std::string> names;
+  for (const auto &a : m.vert_attr)
+    if (!a._name.empty() && a._name.compare(0, 6, "pomar_") != 0 && a._type == typeid(float))
+      names.push_back(a._name);
+  return names;
+}
+
+/// The attributes of the kept vertices (remap[v] != UINT32_MAX, in order).
+template <class MeshType>
+void take_attributes(const MeshType &m, const std::vector<uint32_t> &remap, int mask, Mesh &out) {
+  using namespace vcg::tri::io;
+  const auto kept = [&](size_t v) { return !m.vert[v].IsD() && remap[v] != UINT32_MAX; };
+  auto add = [&](AttributeKind kind, const char *name, uint32_t components) -> VertexAttribute & {
+    out.attributes.emplace_back();
+    VertexAttribute &a = out.attributes.back();
+    a.kind = kind;
+    a.name = name;
+    a.components = components;
+    return a;
+  };
+  if ((mask & Mask::IOM_VERTCOLOR) && vcg::tri::HasPerVertexColor(m)) {
+    bool alpha = false;
+    for (size_t v = 0; v < m.vert.size(); ++v)
+      alpha |= kept(v) && m.vert[v].cC()[3] != 255;
+    VertexAttribute &a = add(AttributeKind::Colour, "colour", alpha ? 4 : 3);
+    for (size_t v = 0; v < m.vert.size(); ++v)
+      if (kept(v))
+        for (uint32_t k = 0; k < a.components; ++k)
+          a.colour.push_back(m.vert[v].cC()[k]);
+  }
+  if ((mask & Mask::IOM_VERTNORMAL) && vcg::tri::HasPerVertexNormal(m)) {
+    VertexAttribute &a = add(AttributeKind::Normal, "normal", 3);
+    for (size_t v = 0; v < m.vert.size(); ++v)
+      if (kept(v))
+        for (int k = 0; k < 3; ++k)
+          a.values.push_back(static_cast<float>(m.vert[v].cN()[k]));
+  }
+  if ((mask & Mask::IOM_VERTQUALITY) && vcg::tri::HasPerVertexQuality(m)) {
+    VertexAttribute &a = add(AttributeKind::Scalar, "quality", 1);
+    for (size_t v = 0; v < m.vert.size(); ++v)
+      if (kept(v))
+        a.values.push_back(static_cast<float>(m.vert[v].cQ()));
+  }
+  if ((mask & Mask::IOM_VERTTEXCOORD) && vcg::tri::HasPerVertexTexCoord(m)) {
+    VertexAttribute &a = add(AttributeKind::TexCoord, "texcoord", 2);
+    for (size_t v = 0; v < m.vert.size(); ++v)
+      if (kept(v)) {
+        a.values.push_back(static_cast<float>(m.vert[v].cT().U()));
+        a.values.push_back(static_cast<float>(m.vert[v].cT().V()));
+      }
+    out.texture_files.assign(m.textures.begin(), m.textures.end());
+  }
+  if (mask & kVcgCustomScalars) {
+    MeshType &mm = const_cast<MeshType &>(m); // vcglib's lookup is not const; it reads only
+    for (const std::string &name : custom_scalar_names(m)) {
+      if (name == "quality" && out.find(AttributeKind::Scalar, name))
+        continue;
+      auto h = vcg::tri::Allocator<MeshType>::template FindPerVertexAttribute<float>(mm, name);
+      if (!vcg::tri::Allocator<MeshType>::IsValidHandle(mm, h))
+        continue;
+      VertexAttribute &a = add(AttributeKind::Scalar, name.c_str(), 1);
+      for (size_t v = 0; v < m.vert.size(); ++v)
+        if (kept(v))
+          a.values.push_back(h[v]);
+    }
+  }
 }
 
 } // namespace vcg_detail
@@ -43,9 +134,12 @@ size_t vertex_index(const MeshType &m, const typename MeshType::VertexType *v, s
 /// Deleted vertices and faces (IsD()) are skipped. Vertices that no live face references
 /// are dropped and counted into `*unreferenced` (if given). The remaining vertices keep
 /// their relative order and are renumbered compactly; faces keep their order.
+/// Per-vertex attributes are taken as `attribute_mask` says (see kVcgCustomScalars; 0 =
+/// positions and triangles only), when the mesh type has them (vcg::tri::HasPerVertex*).
 /// Throws pomar::Error if a live face references a deleted vertex or a vertex outside
 /// m.vert, or if a face is not a triangle.
-template <class MeshType> Mesh from_vcg(const MeshType &m, size_t *unreferenced = nullptr) {
+template <class MeshType>
+Mesh from_vcg(const MeshType &m, size_t *unreferenced = nullptr, int attribute_mask = 0) {
   constexpr uint32_t kUnused = UINT32_MAX;
   std::vector<uint32_t> remap(m.vert.size(), kUnused);
   size_t live_faces = 0;
@@ -56,13 +150,15 @@ template <class MeshType> Mesh from_vcg(const MeshType &m, size_t *unreferenced 
     if (face.IsD())
       continue;
     if (face.VN() != 3)
-      throw Error("vcg mesh: face " + std::to_string(f) + " has " + std::to_string(face.VN()) +
-                  " vertices, expected a triangle");
+      throw Error(Error::Kind::InvalidMesh, "vcg mesh: face " + std::to_string(f) + " has " +
+                                                std::to_string(face.VN()) +
+                                                " vertices, expected a triangle");
     for (int k = 0; k < 3; ++k) {
       const size_t v = vcg_detail::vertex_index(m, face.cV(k), f);
       if (m.vert[v].IsD())
-        throw Error("vcg mesh: face " + std::to_string(f) + " references deleted vertex " +
-                    std::to_string(v));
+        throw Error(Error::Kind::InvalidMesh, "vcg mesh: face " + std::to_string(f) +
+                                                  " references deleted vertex " +
+                                                  std::to_string(v));
       remap[v] = 0;
     }
     ++live_faces;
@@ -80,7 +176,7 @@ template <class MeshType> Mesh from_vcg(const MeshType &m, size_t *unreferenced 
       continue;
     }
     if (next == kUnused)
-      throw Error("vcg mesh: too many vertices for 32-bit indices");
+      throw Error(Error::Kind::InvalidMesh, "vcg mesh: too many vertices for 32-bit indices");
     remap[v] = next++;
     const auto &p = m.vert[v].cP();
     out.positions.push_back(static_cast<float>(p[0]));
@@ -100,7 +196,70 @@ template <class MeshType> Mesh from_vcg(const MeshType &m, size_t *unreferenced 
 
   if (unreferenced)
     *unreferenced = dropped;
+  if (attribute_mask)
+    vcg_detail::take_attributes(m, remap, attribute_mask, out);
   return out;
+}
+
+/// Write per-vertex attributes (one value per vertex of m) into m, as to_vcg does; returns
+/// the mask of what was written (see to_vcg).
+template <class MeshType>
+int put_attributes(const std::vector<VertexAttribute> &attributes,
+                   const std::vector<std::string> &texture_files, MeshType &m) {
+  using CoordType = typename MeshType::CoordType;
+  using ScalarType = typename MeshType::ScalarType;
+  const size_t nv = m.vert.size();
+  using namespace vcg::tri::io;
+  int written = 0;
+  for (const VertexAttribute &a : attributes) {
+    if (a.vertex_count() != nv)
+      throw Error("to_vcg: attribute '" + a.name + "' does not have one value per vertex");
+    switch (a.kind) {
+    case AttributeKind::Colour:
+      if (!vcg::tri::HasPerVertexColor(m) || (written & Mask::IOM_VERTCOLOR))
+        break;
+      for (size_t v = 0; v < nv; ++v) {
+        const uint8_t *c = &a.colour[v * a.components];
+        m.vert[v].C() = vcg::Color4b(c[0], c[1], c[2], a.components == 4 ? c[3] : 255);
+      }
+      written |= Mask::IOM_VERTCOLOR;
+      break;
+    case AttributeKind::Normal:
+      if (!vcg::tri::HasPerVertexNormal(m) || (written & Mask::IOM_VERTNORMAL))
+        break;
+      for (size_t v = 0; v < nv; ++v)
+        m.vert[v].N() = CoordType(ScalarType(a.values[3 * v]), ScalarType(a.values[3 * v + 1]),
+                                  ScalarType(a.values[3 * v + 2]));
+      written |= Mask::IOM_VERTNORMAL;
+      break;
+    case AttributeKind::TexCoord:
+      if (!vcg::tri::HasPerVertexTexCoord(m) || (written & Mask::IOM_VERTTEXCOORD))
+        break;
+      for (size_t v = 0; v < nv; ++v) {
+        m.vert[v].T().U() = a.values[2 * v];
+        m.vert[v].T().V() = a.values[2 * v + 1];
+        m.vert[v].T().N() = 0;
+      }
+      if (!texture_files.empty())
+        m.textures.assign(texture_files.begin(), texture_files.end());
+      written |= Mask::IOM_VERTTEXCOORD;
+      break;
+    case AttributeKind::Scalar:
+      if (a.name == "quality" && vcg::tri::HasPerVertexQuality(m) &&
+          !(written & Mask::IOM_VERTQUALITY)) {
+        for (size_t v = 0; v < nv; ++v)
+          m.vert[v].Q() = a.values[v];
+        written |= Mask::IOM_VERTQUALITY;
+      } else {
+        auto h = vcg::tri::Allocator<MeshType>::template GetPerVertexAttribute<float>(m, a.name);
+        for (size_t v = 0; v < nv; ++v)
+          h[v] = a.values[v];
+        written |= kVcgCustomScalars;
+      }
+      break;
+    }
+  }
+  return written;
 }
 
 /// Replace the contents of vcglib mesh `m` by `src`.
@@ -111,23 +270,33 @@ template <class MeshType> Mesh from_vcg(const MeshType &m, size_t *unreferenced 
 /// so attribute handles obtained from m before the call become invalid. Mesh-level data that
 /// Clear() does not touch (textures, shot) is left as it is. Vertices and faces are then
 /// added with vcg::tri::Allocator in the order of `src`, and the bounding box is updated;
-/// normals and adjacency are not computed (call vcg::tri::UpdateNormal/UpdateTopology).
+/// normals and adjacency are not computed (call vcg::tri::UpdateNormal/UpdateTopology)
+/// unless `src` carries them.
+/// Attributes of `src` go where the mesh type has room (vcg::tri::HasPerVertex*: for
+/// optional components, enable them first): colour (RGB gets alpha 255), normal, the scalar
+/// "quality" into Q(), texcoord into T() (and src.texture_files into m.textures), other
+/// scalars into per-vertex float attributes of their names. Returns the vcg::tri::io::Mask
+/// bits of what was written (IOM_VERTCOLOR, IOM_VERTNORMAL, IOM_VERTQUALITY,
+/// IOM_VERTTEXCOORD) plus kVcgCustomScalars if a named scalar was added.
 /// Throws pomar::Error (leaving m untouched) if `src` is malformed: array sizes not a
 /// multiple of 3, an index out of range, or more elements than vcglib's int counters hold.
-template <class MeshType> void to_vcg(const Mesh &src, MeshType &m) {
+template <class MeshType> int to_vcg(const Mesh &src, MeshType &m) {
   using CoordType = typename MeshType::CoordType;
   using ScalarType = typename MeshType::ScalarType;
 
   if (src.positions.size() % 3 != 0 || src.triangles.size() % 3 != 0)
-    throw Error("to_vcg: positions and triangles must hold a multiple of 3 values");
+    throw Error(Error::Kind::InvalidMesh,
+                "to_vcg: positions and triangles must hold a multiple of 3 values");
   const size_t nv = src.vertex_count(), nf = src.triangle_count();
   if (nv > size_t(INT_MAX) || nf > size_t(INT_MAX))
-    throw Error("to_vcg: mesh too large for vcglib (more than INT_MAX vertices or faces)");
+    throw Error(Error::Kind::InvalidMesh,
+                "to_vcg: mesh too large for vcglib (more than INT_MAX vertices or faces)");
   for (size_t i = 0; i < src.triangles.size(); ++i)
     if (src.triangles[i] >= nv)
-      throw Error("to_vcg: triangle " + std::to_string(i / 3) + " references vertex " +
-                  std::to_string(src.triangles[i]) + " but the mesh has " + std::to_string(nv) +
-                  " vertices");
+      throw Error(Error::Kind::InvalidMesh,
+                  "to_vcg: triangle " + std::to_string(i / 3) + " references vertex " +
+                      std::to_string(src.triangles[i]) + " but the mesh has " + std::to_string(nv) +
+                      " vertices");
 
   m.Clear();
   m.ClearAttributes();
@@ -144,6 +313,8 @@ template <class MeshType> void to_vcg(const Mesh &src, MeshType &m) {
       fi->V(k) = &m.vert[src.triangles[3 * f + k]];
 
   vcg::tri::UpdateBounding<MeshType>::Box(m);
+
+  return put_attributes(src.attributes, src.texture_files, m);
 }
 
 } // namespace pomar

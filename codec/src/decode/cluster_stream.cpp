@@ -30,8 +30,10 @@ size_t ClusterStream::more(size_t needed) {
   loaded_ = upto;
   if (loaded_ == size && !checked_) {
     if (!passes_block_check(block_.data(), size, check_))
-      throw Error("damaged .pomar file: checksum mismatch in the block of cluster " +
-                  std::to_string(id_));
+      throw Error(Error::Kind::DamagedFile,
+                  "damaged .pomar file: checksum mismatch in the block of cluster " +
+                      std::to_string(id_))
+          .in_block(Error::kNoBlock, id_);
     checked_ = true;
   }
   return loaded_;
@@ -41,9 +43,11 @@ void ClusterStream::start(bool whole) {
   // A truncated file (accepted with skip_damaged): nothing is allocated for a block that
   // is not there.
   if (offset_ + size_ > source_->size())
-    throw Error("truncated .pomar file: the block of cluster " + std::to_string(id_) +
-                " ends at byte " + std::to_string(offset_ + size_) + ", the file has " +
-                std::to_string(source_->size()));
+    throw Error(Error::Kind::TruncatedFile, "truncated .pomar file: the block of cluster " +
+                                                std::to_string(id_) + " ends at byte " +
+                                                std::to_string(offset_ + size_) +
+                                                ", the file has " + std::to_string(source_->size()))
+        .in_block(Error::kNoBlock, id_);
   if (block_.empty() && size_ > 0)
     block_.resize(size_);
   if (whole)

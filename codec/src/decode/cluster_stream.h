@@ -33,9 +33,7 @@ public:
   /// The block passed its 8-bit check (it has been read whole).
   bool checked() const { return checked_; }
   /// The block, if it has been read whole (else null).
-  const std::vector<uint8_t> *whole_block() const {
-    return loaded_ == size_ ? &block_ : nullptr;
-  }
+  const std::vector<uint8_t> *whole_block() const { return loaded_ == size_ ? &block_ : nullptr; }
   size_t more(size_t needed) override;
 
 private:

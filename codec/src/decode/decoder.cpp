@@ -7,6 +7,8 @@
 
 #include "decode/damage.h"
 #include "decode/global_levels.h"
+#include "attributes/attribute_section.h"
+#include "decode/decoder_codec.h"
 #include "entropy/models.h"
 #include "format/file_format.h"
 #include "pomar/limits.h"
@@ -24,6 +26,8 @@ FileInfo inspect(const uint8_t *data, size_t size) {
     const ClusterIndex index = read_cluster_index(data + layout.index_offset, layout);
     info.cluster_block_bytes = index.size;
   }
+  if (const auto table = load_attribute_table(data, layout))
+    describe_attributes(*table, info);
   return info;
 }
 
@@ -53,7 +57,7 @@ std::vector<DamagedBlock> check_blocks(const uint8_t *data, size_t size) {
     try {
       check_level(data, layout, i);
     } catch (const Error &e) {
-      damaged.push_back({"level " + std::to_string(i + 1), e.what(), static_cast<int>(i)});
+      damaged.push_back(damaged_level(i + 1, e.what()));
     }
   }
   if (!h.clustered())
@@ -68,16 +72,16 @@ std::vector<DamagedBlock> check_blocks(const uint8_t *data, size_t size) {
     else if (!passes_block_check(data + index.offset[c], index.size[c], index.check[c]))
       problem = "checksum mismatch";
     if (problem)
-      damaged.push_back({"cluster " + std::to_string(c),
-                         std::string("damaged .pomar file: block of cluster ") + std::to_string(c) +
-                             ": " + problem,
-                         static_cast<int>(h.global_levels)});
+      damaged.push_back(damaged_cluster(c,
+                                        std::string("damaged .pomar file: block of cluster ") +
+                                            std::to_string(c) + ": " + problem,
+                                        static_cast<int>(h.global_levels)));
   }
   // Version 3: the cluster data as a whole (catches what the 8-bit checks let through).
   const uint64_t end = layout.clusters_offset + h.cluster_bytes;
   if (damaged.empty() && h.has_cluster_checksum && end <= size &&
       checksum(data + layout.clusters_offset, h.cluster_bytes) != h.cluster_checksum)
-    damaged.push_back({"cluster data", kUnlocatedDamage, -1});
+    damaged.push_back(unlocated_damage(kUnlocatedDamage));
   return damaged;
 }
 
@@ -98,9 +102,8 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
   require_known_sections(layout);
   const FileHeader &h = layout.header;
   const size_t levels = h.levels.size();
-  if (options.level < -1 || options.level > static_cast<int>(levels))
-    throw Error("level " + std::to_string(options.level) +
-                " does not exist: the file has levels 0.." + std::to_string(levels));
+  if (options.level != -1) // -1: full resolution
+    check_level_exists(options.level, static_cast<int>(levels));
   check_decode_memory(file_info(layout, size), options.level, options.memory_limit);
   const size_t target = options.level < 0 ? levels : static_cast<size_t>(options.level);
   const size_t global = h.clustered() ? h.global_levels : levels;
@@ -119,6 +122,7 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
     // Checked above for the whole target level; the constructor's check is smaller.
     SelectiveOptions so;
     so.skip_damaged = options.skip_damaged;
+    so.attributes = options.attributes;
     so.memory_limit = kNoMemoryLimit;
     SelectiveDecoder d(std::make_unique<MemorySource>(data, size), so);
     d.want_all(static_cast<int>(target));
@@ -135,10 +139,20 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
   if (reach > 0)
     lm.reserve(h.levels[reach - 1].vertices, h.levels[reach - 1].faces, size);
   Models models;
+  // Attribute codes come with the positions: decoded whatever the mask says.
+  const std::unique_ptr<AttributeTable> attributes = load_attribute_table(data, layout);
+  if (attributes) {
+    init_attributes(*attributes, lm);
+    models.attr = attribute_models(*attributes);
+  }
   r.level = static_cast<int>(decode_global_levels(data, layout, 0, std::min(target, global), lm,
                                                   models, options.progress,
                                                   options.skip_damaged ? &r.damaged : nullptr));
-  return to_mesh(std::move(lm), h.grid);
+  if (!attributes)
+    return to_mesh(std::move(lm), h.grid);
+  Mesh out = to_mesh(lm, h.grid);
+  attach_attributes(*attributes, lm, options.attributes, out);
+  return out;
 }
 
 } // namespace pomar

@@ -18,7 +18,7 @@ public:
   /// Streams and models of what is decoded next: global level `level` (cluster kNone) or
   /// cluster `cluster`'s data of level `level` (named in error messages).
   void set(Models *models, RangeDecoder *conn, RangeDecoder *geom, uint32_t level,
-           uint32_t cluster = 0xFFFFFFFFu) {
+           uint32_t cluster = kNone) {
     m_ = models;
     conn_ = conn;
     geom_ = geom;
@@ -54,18 +54,33 @@ public:
     }
   }
 
+  /// A split vertex's attribute codes: v_to's codes plus the decoded residuals.
+  void attributes(const LevelMesh &mesh, const int64_t *pred, int64_t *codes) {
+    const uint32_t n = mesh.attr_codes;
+    int64_t r[kMaxAttributeCodes];
+    for (uint32_t k = 0; k < n; ++k) {
+      AttributeCodeModels &m = m_->attr[k];
+      r[k] = get_signed(*geom_, m.classes[attribute_context(m, r, k)], m.top);
+      codes[k] = pred[k] + r[k];
+      if (codes[k] < mesh.attr_lo[k] || codes[k] > mesh.attr_hi[k])
+        corrupt("a decoded attribute lies outside its range");
+    }
+  }
+
   [[noreturn]] void corrupt(const char *what) {
     std::string where = "level " + std::to_string(level_);
-    if (cluster_ != 0xFFFFFFFFu)
+    if (cluster_ != kNone)
       where = "cluster " + std::to_string(cluster_) + " " + where;
-    throw Error("damaged .pomar file: " + where + ": " + what);
+    throw Error(Error::Kind::DamagedFile, "damaged .pomar file: " + where + ": " + what)
+        .in_block(cluster_ == kNone ? int(level_) : Error::kNoBlock,
+                  cluster_ == kNone ? Error::kNoBlock : int64_t(cluster_));
   }
 
 private:
   Models *m_ = nullptr;
   RangeDecoder *conn_ = nullptr, *geom_ = nullptr;
   int64_t top_;
-  uint32_t level_ = 0, cluster_ = 0xFFFFFFFFu;
+  uint32_t level_ = 0, cluster_ = kNone;
 };
 
 } // namespace pomar

@@ -4,34 +4,23 @@
 
 #include <string>
 
+#include "decode/damage.h"
 #include "decode/decoder_codec.h"
+#include "geometry/quantize.h"
 #include "refine/level_step.h"
 
 namespace pomar {
 
-namespace {
-/// Quantizer::dequantize for every coordinate, the step computed once.
-std::vector<float> dequantize_all(const std::vector<int32_t> &q, const Quantizer &grid) {
-  std::vector<float> out(q.size());
-  const double step = grid.step();
-  const double origin[3] = {grid.origin[0], grid.origin[1], grid.origin[2]};
-  for (size_t i = 0; i + 2 < q.size(); i += 3)
-    for (int k = 0; k < 3; ++k)
-      out[i + k] = static_cast<float>(origin[k] + double(static_cast<uint32_t>(q[i + k])) * step);
-  return out;
-}
-} // namespace
-
 Mesh to_mesh(const LevelMesh &lm, const Quantizer &grid) {
   Mesh out;
-  out.positions = dequantize_all(lm.q, grid);
+  out.positions = dequantize(grid, lm.q);
   out.triangles = lm.ct.V;
   return out;
 }
 
 Mesh to_mesh(LevelMesh &&lm, const Quantizer &grid) {
   Mesh out;
-  out.positions = dequantize_all(lm.q, grid);
+  out.positions = dequantize(grid, lm.q);
   out.triangles = std::move(lm.ct.V);
   return out;
 }
@@ -45,7 +34,8 @@ LevelMesh base_level_mesh(const uint8_t *data, const FileLayout &layout) {
   try {
     build_corner_table(base.triangles.data(), h.base_faces, h.base_vertices, lm.ct);
   } catch (const Error &e) {
-    throw Error(std::string("damaged .pomar file: invalid base mesh: ") + e.what());
+    throw Error(Error::Kind::DamagedFile,
+                std::string("damaged .pomar file: invalid base mesh: ") + e.what());
   }
   lm.init_lineage();
   return lm;
@@ -78,7 +68,7 @@ size_t decode_global_levels(const uint8_t *data, const FileLayout &layout, size_
       if (!damaged)
         throw;
       // The step checks before it applies: the mesh is still level i.
-      damaged->push_back({"level " + std::to_string(i + 1), err.what(), static_cast<int>(i)});
+      damaged->push_back(damaged_level(i + 1, err.what()));
       return i;
     }
     if (progress)

@@ -56,9 +56,8 @@ std::vector<int> complete_level_map(const std::vector<int> &wanted,
 
 // limit[x] = min over clusters c of cap[c] + d(c, x): buckets by value, lowest first (a
 // multi-source breadth-first search).
-std::vector<int> cap_distance_map(const std::vector<int> &cap,
-                                         const std::vector<uint32_t> &start,
-                                         const std::vector<uint32_t> &adj, int top) {
+std::vector<int> cap_distance_map(const std::vector<int> &cap, const std::vector<uint32_t> &start,
+                                  const std::vector<uint32_t> &adj, int top) {
   std::vector<int> limit(cap.size(), top);
   int low = top;
   for (size_t c = 0; c < cap.size(); ++c) {

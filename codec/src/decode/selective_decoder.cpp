@@ -1,13 +1,18 @@
-// Random access (paper section 6): the level map and selective, incremental decoding.
+// Random access (paper section 6), the orchestration: requests -> the level map completed
+// and limited around damage (decode/level_map.cpp) -> the missing cluster levels, level by
+// level, each through the per-level step (refine/level_step.h) on the cluster's stream
+// (decode/cluster_stream.cpp); coarsening re-decodes from the base clustered mesh.
 #include <algorithm>
 
+#include "decode/cluster_stream.h"
 #include "decode/damage.h"
+#include "attributes/attribute_section.h"
 #include "decode/decoder_codec.h"
 #include "decode/global_levels.h"
-#include "decode/cluster_stream.h"
 #include "decode/level_map.h"
 #include "entropy/static_tables.h"
 #include "format/file_format.h"
+#include "geometry/quantize.h"
 #include "pomar/limits.h"
 #include "pomar/random_access.h"
 #include "refine/level_step.h"
@@ -50,6 +55,10 @@ struct SelectiveDecoder::State {
   int uniform_cap = 1 << 30; // progressive files: the level before a damaged one
 
   LevelStep step;
+
+  // Attributes: descriptors and base codes (the other codes come with the positions).
+  AttributeMask attribute_mask;
+  std::unique_ptr<AttributeTable> attributes;
 
   bool clustered() const { return layout.header.clustered(); }
   void reset_to_snapshot();
@@ -94,7 +103,7 @@ bool SelectiveDecoder::State::skip_cluster(uint32_t c, const Error &e) {
   // (The failed step applied nothing and released its face claims.)
   if (c == kNone || !skip_damaged)
     return false;
-  damaged.push_back({"cluster " + std::to_string(c), e.what(), global_levels});
+  damaged.push_back(damaged_cluster(c, e.what(), global_levels));
   // Levels of this cluster decoded earlier from the same block cannot be trusted either:
   // the cap coarsens it (decode_target re-decodes from the base clustered mesh then).
   cap[c] = global_levels;
@@ -106,16 +115,17 @@ bool SelectiveDecoder::State::skip_cluster(uint32_t c, const Error &e) {
     // say so once (nothing can locate it).
     if (std::none_of(damaged.begin(), damaged.end(),
                      [](const DamagedBlock &b) { return b.level_kept < 0; }))
-      damaged.push_back({"cluster data", kUnplacedDamage, -1});
+      damaged.push_back(unlocated_damage(kUnplacedDamage));
     for (uint32_t k = graph.start[c]; k < graph.start[c + 1]; ++k) {
       const uint32_t nb = graph.adj[k];
       if (cap[nb] == global_levels)
         continue;
       cap[nb] = global_levels;
-      damaged.push_back({"cluster " + std::to_string(nb),
-                         "suspect: its block passes its 8-bit check, but cluster " +
-                             std::to_string(c) + " next to it failed to decode",
-                         global_levels});
+      damaged.push_back(damaged_cluster(nb,
+                                        "suspect: its block passes its 8-bit check, but "
+                                        "cluster " +
+                                            std::to_string(c) + " next to it failed to decode",
+                                        global_levels));
     }
   }
   return true;
@@ -129,6 +139,7 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   State &s = *s_;
   s.source = std::move(source);
   s.skip_damaged = options.skip_damaged;
+  s.attribute_mask = options.attributes;
   const uint64_t file_size = s.source->size();
   // Header: the fixed part, then as much more as header_size() asks for (version 4 needs
   // one more step: its section count says how long the section table is).
@@ -137,8 +148,8 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   size_t hsize = s.global.size();
   for (size_t want; (want = header_size(s.global.data(), hsize)) > hsize;) {
     if (want > file_size)
-      throw Error("truncated .pomar file: the header alone needs " + std::to_string(want) +
-                  " bytes");
+      throw Error(Error::Kind::TruncatedFile, "truncated .pomar file: the header alone needs " +
+                                                  std::to_string(want) + " bytes");
     s.global.resize(want);
     s.source->read(hsize, want - hsize, s.global.data() + hsize);
     hsize = want;
@@ -158,6 +169,11 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   const FileHeader &h = s.layout.header;
   s.finest = static_cast<int>(h.levels.size());
   s.mesh = base_level_mesh(s.global.data(), s.layout);
+  s.attributes = load_attribute_table(s.global.data(), s.layout);
+  if (s.attributes) { // attribute codes come with the positions, whatever the mask says
+    init_attributes(*s.attributes, s.mesh);
+    s.global_models.attr = attribute_models(*s.attributes);
+  }
   if (!s.clustered()) {
     s.global_levels = 0;
     s.snapshot = s.mesh;
@@ -168,7 +184,7 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   check_block(s.global.data() + s.layout.tables_offset, h.tables_bytes, h.tables_checksum,
               "static model tables");
   s.level_models = read_tables(s.global.data() + s.layout.tables_offset, h.tables_bytes,
-                               h.levels.size() - h.global_levels);
+                               h.levels.size() - h.global_levels, s.global_models.attr);
   s.index = read_cluster_index(s.global.data() + s.layout.index_offset, s.layout);
   s.info.cluster_block_bytes = s.index.size;
   decode_global_levels(s.global.data(), s.layout, 0, h.global_levels, s.mesh, s.global_models, {});
@@ -210,25 +226,24 @@ uint32_t SelectiveDecoder::clusters_decoded() const {
 
 // ---------------------------------------------------------------- requests
 
-namespace {
-int check_level(int level, int finest) {
+void check_level_exists(int level, int finest) {
   if (level < 0 || level > finest)
-    throw Error("level " + std::to_string(level) + " does not exist: the file has levels 0.." +
-                std::to_string(finest));
-  return level;
+    throw Error(Error::Kind::Usage, "level " + std::to_string(level) +
+                                        " does not exist: the file has levels 0.." +
+                                        std::to_string(finest));
 }
-} // namespace
 
 void SelectiveDecoder::want_cluster(uint32_t cluster, int level) {
-  check_level(level, s_->finest);
+  check_level_exists(level, s_->finest);
   if (cluster >= s_->clusters.size())
-    throw Error("cluster " + std::to_string(cluster) + " does not exist: the file has " +
-                std::to_string(s_->clusters.size()) + " clusters");
+    throw Error(Error::Kind::Usage, "cluster " + std::to_string(cluster) +
+                                        " does not exist: the file has " +
+                                        std::to_string(s_->clusters.size()) + " clusters");
   s_->wanted[cluster] = std::max(s_->wanted[cluster], level);
 }
 
 void SelectiveDecoder::want_all(int level) {
-  check_level(level, s_->finest);
+  check_level_exists(level, s_->finest);
   if (!s_->clustered()) {
     s_->uniform_level = std::max(s_->uniform_level, level);
     return;
@@ -238,12 +253,13 @@ void SelectiveDecoder::want_all(int level) {
 }
 
 void SelectiveDecoder::want_vertices(const std::vector<uint32_t> &vertices, int level) {
-  check_level(level, s_->finest);
+  check_level_exists(level, s_->finest);
   if (!s_->clustered())
     return;
   for (uint32_t v : vertices) {
     if (v >= s_->mesh.vertex_count())
-      throw Error("vertex " + std::to_string(v) + " is not in the decoded mesh");
+      throw Error(Error::Kind::Usage,
+                  "vertex " + std::to_string(v) + " is not in the decoded mesh");
     int &w = s_->wanted[s_->mesh.cluster_of(v)];
     w = std::max(w, level);
   }
@@ -253,7 +269,7 @@ void SelectiveDecoder::want_faces(const std::vector<uint32_t> &faces, int level)
   std::vector<uint32_t> vertices;
   for (uint32_t f : faces) {
     if (f >= s_->mesh.ct.face_count())
-      throw Error("face " + std::to_string(f) + " is not in the decoded mesh");
+      throw Error(Error::Kind::Usage, "face " + std::to_string(f) + " is not in the decoded mesh");
     vertices.insert(vertices.end(), &s_->mesh.ct.V[3 * f], &s_->mesh.ct.V[3 * f] + 3);
   }
   want_vertices(vertices, level);
@@ -263,13 +279,10 @@ namespace {
 template <class Inside>
 std::vector<uint32_t> vertices_where(const LevelMesh &m, const Quantizer &g, Inside inside) {
   std::vector<uint32_t> out;
-  for (uint32_t v = 0; v < m.vertex_count(); ++v) {
-    const float p[3] = {g.dequantize(0, uint32_t(m.q[3 * v])),
-                        g.dequantize(1, uint32_t(m.q[3 * v + 1])),
-                        g.dequantize(2, uint32_t(m.q[3 * v + 2]))};
-    if (inside(p))
+  const std::vector<float> p = dequantize(g, m.q);
+  for (uint32_t v = 0; v < m.vertex_count(); ++v)
+    if (inside(&p[3 * v]))
       out.push_back(v);
-  }
   return out;
 }
 } // namespace
@@ -307,10 +320,11 @@ void SelectiveDecoder::clear_wanted() {
 
 void SelectiveDecoder::set_wanted(const std::vector<int> &levels) {
   if (levels.size() != s_->clusters.size())
-    throw Error("set_wanted: " + std::to_string(levels.size()) + " levels for " +
-                std::to_string(s_->clusters.size()) + " clusters");
+    throw Error(Error::Kind::Usage, "set_wanted: " + std::to_string(levels.size()) +
+                                        " levels for " + std::to_string(s_->clusters.size()) +
+                                        " clusters");
   for (int l : levels)
-    check_level(l, s_->finest);
+    check_level_exists(l, s_->finest);
   s_->wanted = levels;
 }
 
@@ -326,6 +340,8 @@ void SelectiveDecoder::update(const Progress &progress) {
     if (s.uniform_level < have) {
       s.mesh = s.snapshot;
       s.global_models = Models();
+      if (s.attributes)
+        s.global_models.attr = attribute_models(*s.attributes);
       have = 0;
     }
     const size_t want = size_t(std::min(s.uniform_level, s.uniform_cap));
@@ -413,11 +429,17 @@ void SelectiveDecoder::State::check_cluster_data() {
   if (checksum(blocks) == h.cluster_checksum)
     return;
   if (!skip_damaged)
-    throw Error(kUnlocatedDamage);
-  damaged.push_back({"cluster data", kUnlocatedDamage, -1});
+    throw Error(Error::Kind::DamagedFile, kUnlocatedDamage);
+  damaged.push_back(unlocated_damage(kUnlocatedDamage));
 }
 
-Mesh SelectiveDecoder::mesh() const { return to_mesh(s_->mesh, s_->layout.header.grid); }
+Mesh SelectiveDecoder::mesh() const {
+  const State &s = *s_;
+  Mesh out = to_mesh(s.mesh, s.layout.header.grid);
+  if (s.attributes)
+    attach_attributes(*s.attributes, s.mesh, s.attribute_mask, out);
+  return out;
+}
 
 std::vector<uint32_t> SelectiveDecoder::vertex_cluster() const {
   std::vector<uint32_t> out(s_->mesh.vertex_count(), 0);

@@ -37,8 +37,11 @@ ClusteredLevels encode_clustered_levels(Rebuild &rb, size_t global, FileHeader &
   lm.root_clusters();
   std::vector<uint32_t> next_local(clusters, 1);
   std::vector<Models> level_models(L - global);
+  for (Models &m : level_models)
+    m.attr = rb.attr_models;
   std::vector<SymbolRecorder> recordings(clusters);
   EncoderCodec<RecorderStream> codec(rb.q, rb.dec_to_input, rb.input_to_dec);
+  codec.set_attribute_codes(rb.attr_codes, rb.attr_codes_per_vertex);
   for (size_t r = global; r < L; ++r) {
     const uint32_t level = static_cast<uint32_t>(r + 1);
     codec.begin_level(rb.collapses(level), &level_models[r - global]);
@@ -56,17 +59,21 @@ ClusteredLevels encode_clustered_levels(Rebuild &rb, size_t global, FileHeader &
   freeze_on_recordings(level_models, recordings);
   ClusteredLevels out;
   out.tables = write_tables(level_models);
-  double bits[2] = {0, 0};
+  // Ideal code lengths: [0] connectivity, [1] geometry, [2 + k] attribute code k.
+  double bits[2 + kMaxAttributeCodes] = {};
   out.blocks.reserve(clusters);
   for (const SymbolRecorder &rec : recordings)
     out.blocks.push_back(code_recording(rec, bits));
   uint64_t cluster_bytes = 0;
   for (const auto &b : out.blocks)
     cluster_bytes += b.size();
+  double all_bits = 0;
+  for (double b : bits)
+    all_bits += b;
   header.cluster_connectivity_bytes =
-      bits[0] + bits[1] > 0
-          ? static_cast<uint64_t>(double(cluster_bytes) * bits[0] / (bits[0] + bits[1]))
-          : 0;
+      all_bits > 0 ? static_cast<uint64_t>(double(cluster_bytes) * bits[0] / all_bits) : 0;
+  for (uint32_t k = 0; k < rb.attr_codes_per_vertex; ++k)
+    rb.attr_bits[k] += all_bits > 0 ? 8.0 * double(cluster_bytes) * bits[2 + k] / all_bits : 0;
   return out;
 }
 

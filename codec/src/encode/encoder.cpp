@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 
+#include "attributes/attribute_section.h"
 #include "decimate/decimate.h"
 #include "encode/clusters.h"
 #include "encode/encoder_codec.h"
@@ -30,8 +31,9 @@ std::vector<float> compact_vertices(const Mesh &mesh, std::vector<uint32_t> &tri
   triangles = mesh.triangles;
   for (uint32_t &i : triangles) {
     if (i >= nv)
-      throw Error("a triangle refers to vertex " + std::to_string(i) + " but the mesh has only " +
-                  std::to_string(nv) + " vertices");
+      throw Error(Error::Kind::InvalidMesh, "a triangle refers to vertex " + std::to_string(i) +
+                                                " but the mesh has only " + std::to_string(nv) +
+                                                " vertices");
     if (remap[i] == kNone) {
       remap[i] = 0; // mark used; numbered below in input order
     }
@@ -51,29 +53,32 @@ std::vector<float> compact_vertices(const Mesh &mesh, std::vector<uint32_t> &tri
 
 void check_input(const Mesh &mesh, const EncodeOptions &options) {
   if (options.bits < 4 || options.bits > 24)
-    throw Error("quantization bits must be between 4 and 24 (got " + std::to_string(options.bits) +
-                ")");
+    throw Error(Error::Kind::Usage, "quantization bits must be between 4 and 24 (got " +
+                                        std::to_string(options.bits) + ")");
   if (mesh.positions.size() % 3 || mesh.triangles.size() % 3)
-    throw Error("position and triangle arrays must hold multiples of 3 values");
+    throw Error(Error::Kind::InvalidMesh,
+                "position and triangle arrays must hold multiples of 3 values");
   if (mesh.triangle_count() == 0)
-    throw Error("the mesh contains no triangles");
+    throw Error(Error::Kind::InvalidMesh, "the mesh contains no triangles");
   for (size_t i = 0; i < mesh.positions.size(); ++i)
     if (!std::isfinite(mesh.positions[i]))
-      throw Error("vertex " + std::to_string(i / 3) + " has a non-finite coordinate");
+      throw Error(Error::Kind::InvalidMesh,
+                  "vertex " + std::to_string(i / 3) + " has a non-finite coordinate");
 }
 
 /// The input ready for decimation: referenced vertices only, quantized, renumbered for
 /// memory locality, connectivity built and validated.
 struct PreparedInput {
   Quantizer grid;
-  std::vector<int32_t> q;             // quantized xyz, prepared numbering
+  std::vector<int32_t> q; // quantized xyz, prepared numbering
   CornerTable ct;
-  std::vector<uint32_t> to_input;     // prepared vertex -> the caller's vertex
+  std::vector<uint32_t> to_input; // prepared vertex -> the caller's vertex
   uint32_t vertices = 0, faces = 0;
 };
 
 PreparedInput prepare_input(const Mesh &mesh, const EncodeOptions &options) {
   check_input(mesh, options);
+  validate_attributes(mesh, !options.attributes.exact, options.attributes.keep);
   // The caller already holds the input mesh: an automatic check counts only the rest.
   const uint64_t held =
       mesh.positions.size() * sizeof(float) + mesh.triangles.size() * sizeof(uint32_t);
@@ -133,7 +138,9 @@ std::vector<std::vector<uint8_t>> encode_global_levels(Rebuild &rb, size_t globa
                                                        FileHeader &header, SymbolBits &bits,
                                                        const Progress &progress) {
   Models models;
+  models.attr = rb.attr_models;
   EncoderCodec<RangeEncoder> codec(rb.q, rb.dec_to_input, rb.input_to_dec);
+  codec.set_attribute_codes(rb.attr_codes, rb.attr_codes_per_vertex);
   std::vector<std::vector<uint8_t>> blocks;
   for (size_t r = 0; r < global; ++r) {
     const uint32_t level = static_cast<uint32_t>(r + 1);
@@ -153,6 +160,8 @@ std::vector<std::vector<uint8_t>> encode_global_levels(Rebuild &rb, size_t globa
       progress(double(r + 1) / double(rb.levels()), "encode");
   }
   bits = codec.bits;
+  for (size_t k = 0; k < codec.attr_bits.size(); ++k)
+    rb.attr_bits[k] += codec.attr_bits[k];
   return blocks;
 }
 
@@ -173,6 +182,20 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
   auto t2 = std::chrono::steady_clock::now();
   Rebuild rb(in.q, dec);
   const BaseMesh base = start_from_base_mesh(rb, nv);
+  // Attributes: codes of every vertex (prepared numbering); the base mesh's go to the ATTR
+  // section, the others are coded with their positions by the level steps.
+  AttributeTable attributes = plan_attributes(mesh, options.attributes);
+  const std::vector<int64_t> codes =
+      attributes.codes ? attribute_codes(mesh, attributes, options.attributes, in.to_input)
+                       : std::vector<int64_t>();
+  for (uint32_t v : rb.dec_to_input)
+    attributes.base.insert(attributes.base.end(), codes.begin() + size_t(v) * attributes.codes,
+                           codes.begin() + size_t(v + 1) * attributes.codes);
+  init_attributes(attributes, rb.mesh);
+  rb.attr_codes = &codes;
+  rb.attr_codes_per_vertex = attributes.codes;
+  rb.attr_models = attribute_models(attributes);
+  rb.attr_bits.assign(attributes.codes, 0.0);
   FileHeader header;
   header.grid = in.grid;
   header.vertices = nv;
@@ -188,13 +211,27 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
   if (global < rb.levels())
     clustered = encode_clustered_levels(rb, global, header, options.progress);
   if (rb.mesh.vertex_count() != nv || rb.mesh.ct.face_count() != nf)
-    throw Error("internal encoder error: the refined mesh does not match the input");
+    throw Error(Error::Kind::Internal,
+                "internal encoder error: the refined mesh does not match the input");
 
+  // Attributes (format version 4, "ATTR" section): descriptors, base mesh codes, sizes.
+  std::vector<Section> sections;
+  if (!attributes.stored.empty() || !attributes.texture_files.empty()) {
+    for (size_t i = 0, k = 0; i < attributes.stored.size(); ++i) {
+      double attr_bits = 0;
+      for (uint32_t c = 0; c < attributes.stored[i].codes(); ++c, ++k)
+        attr_bits += rb.attr_bits[k];
+      attributes.estimated_bytes[i] = static_cast<uint64_t>(attr_bits / 8.0 + 0.5);
+    }
+    sections.push_back({kAttributeSectionTag, 0, write_attributes(attributes)}); // optional
+  }
   std::vector<uint8_t> file = write_file(header, pack_base_mesh(base, in.grid.bits), blocks,
-                                         clustered.tables, clustered.blocks);
+                                         clustered.tables, clustered.blocks, sections);
   if (report) {
     const FileLayout layout = read_layout(file.data(), file.size());
     report->info = file_info(layout, file.size());
+    if (const auto table = load_attribute_table(file.data(), layout))
+      describe_attributes(*table, report->info);
     report->input_vertices = mesh.vertex_count();
     report->unreferenced_vertices = mesh.vertex_count() - nv;
     report->quantize_seconds = t_quantize;

@@ -7,10 +7,13 @@
 #pragma once
 
 #include <string>
+#include <type_traits>
 #include <vector>
 
+#include "attributes/attribute_quantize.h"
 #include "decimate/decimate.h"
 #include "entropy/models.h"
+#include "entropy/static_tables.h"
 #include "format/file_format.h"
 #include "refine/level_step.h"
 
@@ -98,10 +101,36 @@ public:
     dec_to_input_.push_back(v_from);
   }
 
-  SymbolBits bits; // ideal code lengths per symbol kind
+  /// The split vertex's attribute codes (from the input), coded against the prediction.
+  void attributes(const LevelMesh &mesh, const int64_t *pred, int64_t *codes) {
+    const uint32_t n = mesh.attr_codes;
+    const uint32_t v_from = (*level_)[current_].v_from;
+    int64_t r[kMaxAttributeCodes];
+    for (uint32_t k = 0; k < n; ++k) {
+      codes[k] = (*attr_codes_)[size_t(v_from) * n + k];
+      r[k] = codes[k] - pred[k];
+      AttributeCodeModels &m = m_->attr[k];
+      FrequencyModel &classes = m.classes[attribute_context(m, r, k)];
+      if constexpr (std::is_same_v<Sink, RecorderStream>) {
+        // Clustered levels: tagged per code for the statistics (code_recording).
+        RecorderStream tagged{geom_->recorder, static_cast<uint8_t>(2 + k)};
+        put_signed(tagged, classes, m.top, r[k]);
+      } else {
+        attr_bits[k] += put_signed(*geom_, classes, m.top, r[k]);
+      }
+    }
+  }
+  /// Attribute codes of every input vertex (encoder numbering), `n` per vertex.
+  void set_attribute_codes(const std::vector<int64_t> *codes, uint32_t n) {
+    attr_codes_ = codes;
+    attr_bits.assign(n, 0.0);
+  }
+
+  SymbolBits bits;               // ideal code lengths per symbol kind
+  std::vector<double> attr_bits; // ideal code lengths per attribute code (global levels)
 
   [[noreturn]] void corrupt(const char *what) {
-    throw Error(std::string("internal encoder error: ") + what);
+    throw Error(Error::Kind::Internal, std::string("internal encoder error: ") + what);
   }
 
 private:
@@ -120,6 +149,7 @@ private:
   std::vector<uint32_t> collapse_at_; // input vertex -> index of its collapse as v_to
   const std::vector<Collapse> *level_ = nullptr;
   Sink *conn_ = nullptr, *geom_ = nullptr;
+  const std::vector<int64_t> *attr_codes_ = nullptr;
   uint32_t current_ = kNone;
   size_t emitted_ = 0;
 };
@@ -134,6 +164,12 @@ struct Rebuild {
   LevelMesh mesh;
   std::vector<uint32_t> dec_to_input, input_to_dec;
   LevelStep step;
+  // Attributes (attributes/): the input vertices' codes, `attr_codes_per_vertex` each, and
+  // the ideal code length of each code over all levels (for `pomar info`).
+  const std::vector<int64_t> *attr_codes = nullptr;
+  uint32_t attr_codes_per_vertex = 0;
+  std::vector<AttributeCodeModels> attr_models; // fresh models for one level set
+  std::vector<double> attr_bits;
 
   size_t levels() const { return dec.levels.size(); }
   /// The collapses that refinement level `level` (1 = first above the base) undoes.

@@ -60,9 +60,22 @@ struct GeometryModels {
   BitModel mantissa[2][kMagnitudeSymbols];
 };
 
+/// Residual models of one integer code of a per-vertex attribute (attributes/): a magnitude
+/// class model per context (the bit length of the previous code's residual of the same
+/// attribute, 0 for its first code) and the modelled bit under the leading one.
+constexpr int kAttributeContexts = 6;
+struct AttributeCodeModels {
+  std::vector<FrequencyModel> classes =
+      std::vector<FrequencyModel>(kAttributeContexts, FrequencyModel(kMagnitudeSymbols));
+  BitModel top[kMagnitudeSymbols];
+  bool first = true; // the first code of its attribute (context 0 always)
+};
+
 struct Models {
   ConnectivityModels conn;
   GeometryModels geom;
+  /// One per attribute code of a vertex (empty for files without attributes).
+  std::vector<AttributeCodeModels> attr;
 };
 
 /// Visit every model of a set in a fixed order (the order of the static tables).
@@ -82,6 +95,21 @@ void for_each_model(Models &m, OnFrequency &&on_frequency, OnBit &&on_bit) {
   for (auto &kind : m.geom.mantissa)
     for (BitModel &b : kind)
       on_bit(b);
+  for (AttributeCodeModels &a : m.attr) {
+    for (FrequencyModel &f : a.classes)
+      on_frequency(f);
+    for (BitModel &b : a.top)
+      on_bit(b);
+  }
+}
+
+/// Context of an attribute code from the previous code's residual of the same attribute.
+inline int attribute_context(const AttributeCodeModels &m, const int64_t *residual, uint32_t k) {
+  if (m.first || k == 0)
+    return 0;
+  const int64_t r = residual[k - 1];
+  const int n = bit_length(static_cast<uint64_t>(r < 0 ? -r : r));
+  return n < kAttributeContexts - 1 ? n : kAttributeContexts - 1;
 }
 
 /// Context of a geometry residual: the bit length of the squared v_to-v_ref length / 2,

@@ -268,12 +268,17 @@ std::vector<uint8_t> write_tables(std::vector<Models> &models) {
   return out;
 }
 
-std::vector<Models> read_tables(const uint8_t *data, size_t size, size_t levels) {
+std::vector<Models> read_tables(const uint8_t *data, size_t size, size_t levels,
+                                const std::vector<AttributeCodeModels> &attributes) {
   std::vector<Models> models(levels);
+  for (Models &m : models)
+    m.attr = attributes;
   RangeDecoder rc(data, size);
   TableModels t;
   History history;
-  auto bad = [] { throw Error("damaged .pomar file: invalid static model tables"); };
+  auto bad = [] {
+    throw Error(Error::Kind::DamagedFile, "damaged .pomar file: invalid static model tables");
+  };
   for (Models &m : models) {
     size_t slot = 0;
     for_each_model(

@@ -23,7 +23,7 @@ public:
     uint32_t value;
     uint8_t kind;  // 0 frequency symbol, 1 binary, 2 bypass bits
     uint8_t nbits; // bypass only
-    uint8_t stream; // 0 connectivity, 1 geometry (statistics only)
+    uint8_t stream; // 0 connectivity, 1 geometry, 2 + k attribute code k (statistics only)
   };
   void encode(FrequencyModel &m, int s) { events.push_back({&m, uint32_t(s), 0, 0, stream}); }
   void encode_bit(BitModel &m, int bit) { events.push_back({&m, uint32_t(bit), 1, 0, stream}); }
@@ -59,12 +59,15 @@ void freeze_on_recordings(std::vector<Models> &models,
                           const std::vector<SymbolRecorder> &recordings);
 
 /// Range-code a recording with the (frozen) models its events point to. Adds the ideal
-/// code lengths per stream to bits[0] (connectivity) and bits[1] (geometry).
+/// code lengths per stream to bits[stream]: 0 connectivity, 1 geometry, 2 + k attribute
+/// code k (the array must have room for every stream recorded).
 std::vector<uint8_t> code_recording(const SymbolRecorder &recording, double bits[2]);
 
 /// Serialize / read back the frozen models of every clustered level.
 std::vector<uint8_t> write_tables(std::vector<Models> &models);
-/// Throws pomar::Error on damaged tables.
-std::vector<Models> read_tables(const uint8_t *data, size_t size, size_t levels);
+/// Throws pomar::Error on damaged tables. `attributes`: the file's attribute code models
+/// (Models::attr; their frozen tables follow the geometry's in each level).
+std::vector<Models> read_tables(const uint8_t *data, size_t size, size_t levels,
+                                const std::vector<AttributeCodeModels> &attributes = {});
 
 } // namespace pomar

@@ -53,7 +53,7 @@ public:
 private:
   uint32_t get(int n) {
     if (size_ - pos_ < size_t(n) || pos_ > size_)
-      throw Error(std::string(what_) + " is truncated");
+      throw Error(Error::Kind::DamagedFile, std::string(what_) + " is truncated");
     uint32_t v = 0;
     for (int i = 0; i < n; ++i)
       v |= uint32_t(p_[pos_ + i]) << (8 * i);
@@ -98,7 +98,7 @@ public:
     uint32_t v = 0;
     for (int i = 0; i < nbits; ++i, ++bit_) {
       if (bit_ / 8 >= size_)
-        throw Error("base mesh block is truncated");
+        throw Error(Error::Kind::DamagedFile, "base mesh block is truncated");
       v |= uint32_t((p_[bit_ / 8] >> (bit_ % 8)) & 1u) << i;
     }
     return v;

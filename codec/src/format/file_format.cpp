@@ -118,7 +118,9 @@ std::vector<uint8_t> pack_cluster_index(const std::vector<std::vector<uint8_t>> 
   return out;
 }
 
-[[noreturn]] void bad(const std::string &what) { throw Error("not a valid .pomar file: " + what); }
+[[noreturn]] void bad(const std::string &what) {
+  throw Error(Error::Kind::DamagedFile, "not a valid .pomar file: " + what);
+}
 
 // No .pomar file is this large: every size read from a header is checked against it before
 // it takes part in a sum, so offsets computed from sizes can never wrap (2^48 bytes leaves
@@ -191,7 +193,7 @@ std::vector<uint8_t> write_file(FileHeader header, const std::vector<uint8_t> &b
                                 const std::vector<std::vector<uint8_t>> &cluster_blocks,
                                 const std::vector<Section> &sections) {
   if (sections.size() > kMaxSections)
-    throw Error("internal error: more than " + std::to_string(kMaxSections) + " sections");
+    throw Error(Error::Kind::Internal, "internal error: more than " + std::to_string(kMaxSections) + " sections");
   header.version = !sections.empty() ? kSectionsFormatVersion
                    : header.clustered() ? kClusteredFormatVersion
                                         : kFormatVersion;
@@ -270,8 +272,9 @@ FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size, boo
   FileHeader &h = L.header;
   h.version = r.u16();
   if (h.version < kFormatVersion || h.version > kSectionsFormatVersion)
-    throw Error("unsupported .pomar version " + std::to_string(h.version) +
-                " (this build reads versions 1 to 4)");
+    throw Error(Error::Kind::Unsupported, "unsupported .pomar version " +
+                                              std::to_string(h.version) +
+                                              " (this build reads versions 1 to 4)");
   h.flags = r.u16();
   const bool v4 = h.version == kSectionsFormatVersion;
   const bool flags_ok = v4 ? (h.flags & ~(kFlagClustered | kFlagSections)) == 0 && (h.flags & kFlagSections)
@@ -421,8 +424,9 @@ FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size, boo
                           : L.level_offset.empty() ? L.global_bytes
                                                    : L.level_offset[0]; // base + sections
   if (needed > file_size)
-    throw Error("truncated .pomar file: " + std::to_string(file_size) +
-                " bytes, the header announces " + std::to_string(offset));
+    throw Error(Error::Kind::TruncatedFile, "truncated .pomar file: " + std::to_string(file_size) +
+                                                " bytes, the header announces " +
+                                                std::to_string(offset));
   if (h.vertices > 512 * uint64_t(file_size) + 64)
     bad("the announced vertex count is implausible for the file size");
   return L;
@@ -432,9 +436,9 @@ BaseMesh read_base_mesh(const uint8_t *data, const FileLayout &L) {
   const FileHeader &h = L.header;
   const uint8_t *p = data + L.base_offset;
   if (checksum(p, h.base_bytes) != h.base_checksum)
-    throw Error("damaged .pomar file: base mesh checksum mismatch");
+    throw Error(Error::Kind::DamagedFile, "damaged .pomar file: base mesh checksum mismatch");
   auto bad = [](const char *what) {
-    throw Error(std::string("damaged .pomar file: base mesh ") + what);
+    throw Error(Error::Kind::DamagedFile, std::string("damaged .pomar file: base mesh ") + what);
   };
   BaseMesh b;
   RangeDecoder rc(p, h.base_bytes);
@@ -472,12 +476,15 @@ void check_level(const uint8_t *data, const FileLayout &L, size_t i) {
   const LevelEntry &e = L.header.levels[i];
   const size_t n = size_t(e.connectivity_bytes) + e.geometry_bytes;
   if (L.level_offset[i] + n > L.file_size)
-    throw Error("truncated .pomar file: level " + std::to_string(i + 1) + " ends at byte " +
-                std::to_string(L.level_offset[i] + n) + ", the file has " +
-                std::to_string(L.file_size));
+    throw Error(Error::Kind::TruncatedFile, "truncated .pomar file: level " +
+                                                std::to_string(i + 1) + " ends at byte " +
+                                                std::to_string(L.level_offset[i] + n) +
+                                                ", the file has " + std::to_string(L.file_size))
+        .in_block(int(i + 1));
   if (checksum(data + L.level_offset[i], n) != e.checksum)
-    throw Error("damaged .pomar file: checksum mismatch in level " + std::to_string(i + 1) +
-                " block");
+    throw Error(Error::Kind::DamagedFile, "damaged .pomar file: checksum mismatch in level " +
+                                              std::to_string(i + 1) + " block")
+        .in_block(int(i + 1));
 }
 
 ClusterIndex read_cluster_index(const uint8_t *data, const FileLayout &L) {
@@ -501,10 +508,12 @@ ClusterIndex read_cluster_index(const uint8_t *data, const FileLayout &L) {
     offset += n;
     total += n;
     if (total > h.cluster_bytes)
-      throw Error("damaged .pomar file: cluster index exceeds the cluster data");
+      throw Error(Error::Kind::DamagedFile,
+                  "damaged .pomar file: cluster index exceeds the cluster data");
   }
   if (total != h.cluster_bytes || rc.overrun())
-    throw Error("damaged .pomar file: cluster index does not match the cluster data");
+    throw Error(Error::Kind::DamagedFile,
+                "damaged .pomar file: cluster index does not match the cluster data");
   return index;
 }
 
@@ -532,25 +541,25 @@ int find_section(const FileLayout &L, uint32_t tag) {
 const uint8_t *section_body(const uint8_t *data, const FileLayout &L, size_t i) {
   const SectionEntry &e = L.header.sections.at(i);
   if (L.section_offset[i] + e.bytes > L.file_size)
-    throw Error("truncated .pomar file: section " + section_name(e.tag) + " ends at byte " +
+    throw Error(Error::Kind::TruncatedFile, "truncated .pomar file: section " + section_name(e.tag) + " ends at byte " +
                 std::to_string(L.section_offset[i] + e.bytes) + ", the file has " +
                 std::to_string(L.file_size));
   const uint8_t *p = data + L.section_offset[i];
   if (checksum(p, e.bytes) != e.checksum)
-    throw Error("damaged .pomar file: checksum mismatch in section " + section_name(e.tag));
+    throw Error(Error::Kind::DamagedFile, "damaged .pomar file: checksum mismatch in section " + section_name(e.tag));
   return p;
 }
 
 const std::vector<uint32_t> &known_sections() {
   // The sections this build's decoders honour (issues 12 and 13 add theirs here).
-  static const std::vector<uint32_t> known;
+  static const std::vector<uint32_t> known = {section_tag("ATTR")};
   return known;
 }
 
 void require_known_sections(const FileLayout &L, const std::vector<uint32_t> &known) {
   for (const SectionEntry &e : L.header.sections)
     if ((e.flags & kSectionRequired) && std::find(known.begin(), known.end(), e.tag) == known.end())
-      throw Error("this build of pomar cannot read the file's section " + section_name(e.tag) +
+      throw Error(Error::Kind::Unsupported, "this build of pomar cannot read the file's section " + section_name(e.tag) +
                   ", which it needs (written by a newer pomar?)");
 }
 
@@ -586,7 +595,8 @@ std::vector<uint8_t> with_sections(const uint8_t *file, size_t size,
 
 void check_block(const uint8_t *data, size_t size, uint32_t expected, const char *what) {
   if (checksum(data, size) != expected)
-    throw Error(std::string("damaged .pomar file: ") + what + " checksum mismatch");
+    throw Error(Error::Kind::DamagedFile,
+                std::string("damaged .pomar file: ") + what + " checksum mismatch");
 }
 
 FileInfo file_info(const FileLayout &L, uint64_t file_size) {
@@ -628,6 +638,8 @@ FileInfo file_info(const FileLayout &L, uint64_t file_size) {
     for (int k = 0; k < 4; ++k)
       name += static_cast<char>(e.tag >> (8 * k));
     info.sections.push_back({name, e.bytes, (e.flags & kSectionRequired) != 0});
+    if (e.tag == section_tag("ATTR"))
+      info.attribute_bytes += e.bytes;
   }
   return info;
 }

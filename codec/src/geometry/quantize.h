@@ -16,4 +16,7 @@ Quantizer make_quantizer(const float *positions, size_t vertex_count, int bits);
 /// Quantize every position to the nearest grid point (clamped into the grid).
 std::vector<int32_t> quantize(const Quantizer &grid, const float *positions, size_t count);
 
+/// The positions of quantized xyz values `q` (Quantizer::dequantize on every coordinate).
+std::vector<float> dequantize(const Quantizer &grid, const std::vector<int32_t> &q);
+
 } // namespace pomar

@@ -10,8 +10,16 @@
 
 namespace pomar::io {
 
+[[noreturn]] void fail(Error::Kind kind, const std::string &path, const std::string &what) {
+  throw Error(kind, path + ": " + what).with_path(path);
+}
+
 [[noreturn]] void fail(const std::string &path, const std::string &what) {
-  throw Error(path + ": " + what);
+  fail(Error::Kind::InvalidMesh, path, what);
+}
+
+[[noreturn]] void fail_io(const std::string &path, const std::string &what) {
+  fail(Error::Kind::Io, path, what);
 }
 
 void run_size_check(const SizeCheck &check, const std::string &path, uint64_t vertices,
@@ -21,7 +29,7 @@ void run_size_check(const SizeCheck &check, const std::string &path, uint64_t ve
   try {
     check(vertices, faces);
   } catch (const Error &e) {
-    fail(path, e.what());
+    fail(e.kind(), path, e.what());
   }
 }
 
@@ -128,15 +136,15 @@ void add_ignored_from_mask(int mask, std::vector<std::string> &out) {
 uint64_t check_regular_file(const std::string &path) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0)
-    fail(path, "cannot open: " + errno_text(errno));
+    fail_io(path, "cannot open: " + errno_text(errno));
   FdGuard guard(fd);
   struct stat st;
   if (::fstat(fd, &st) != 0)
-    fail(path, "cannot stat: " + errno_text(errno));
+    fail_io(path, "cannot stat: " + errno_text(errno));
   if (S_ISDIR(st.st_mode))
-    fail(path, "is a directory");
+    fail_io(path, "is a directory");
   if (!S_ISREG(st.st_mode))
-    fail(path, "not a regular file");
+    fail_io(path, "not a regular file");
   return static_cast<uint64_t>(st.st_size);
 }
 
@@ -156,7 +164,7 @@ ChunkedFileWriter::ChunkedFileWriter(const std::string &target)
     : target_(target), tmp_(target), buf_(size_t(1) << 20) {
   fd_ = ::open(tmp_.path().c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
   if (fd_ < 0)
-    fail(target_, "cannot create temporary file '" + tmp_.path() + "': " + errno_text(errno));
+    fail_io(target_, "cannot create temporary file '" + tmp_.path() + "': " + errno_text(errno));
 }
 
 ChunkedFileWriter::~ChunkedFileWriter() {
@@ -166,7 +174,7 @@ ChunkedFileWriter::~ChunkedFileWriter() {
 
 void ChunkedFileWriter::flush() {
   if (!write_all(fd_, buf_.data(), used_))
-    fail(target_, "cannot write: " + errno_text(errno));
+    fail_io(target_, "cannot write: " + errno_text(errno));
   used_ = 0;
 }
 
@@ -184,11 +192,11 @@ void ChunkedFileWriter::put(const void *data, size_t size) {
 void ChunkedFileWriter::commit() {
   flush();
   if (::fsync(fd_) != 0)
-    fail(target_, "fsync failed: " + errno_text(errno));
+    fail_io(target_, "fsync failed: " + errno_text(errno));
   const int fd = fd_;
   fd_ = -1;
   if (::close(fd) != 0)
-    fail(target_, "cannot write (close): " + errno_text(errno));
+    fail_io(target_, "cannot write (close): " + errno_text(errno));
   tmp_.commit(false);
 }
 
@@ -251,9 +259,9 @@ void append_vertices(std::string &out, const Mesh &mesh, const char *prefix) {
 void check_written_size(const std::string &file, uint64_t expected, const std::string &target) {
   struct stat st;
   if (::stat(file.c_str(), &st) != 0)
-    fail(target, "cannot stat temporary file: " + errno_text(errno));
+    fail_io(target, "cannot stat temporary file: " + errno_text(errno));
   if (static_cast<uint64_t>(st.st_size) != expected)
-    fail(target, "short write (" + num(uint64_t(st.st_size)) + " of " + num(expected) +
+    fail_io(target, "short write (" + num(uint64_t(st.st_size)) + " of " + num(expected) +
                      " bytes; disk full?)");
 }
 

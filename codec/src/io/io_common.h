@@ -38,9 +38,13 @@ namespace pomar::io {
 
 // ---- Errors, names, numbers (io_common.cpp) ----
 
-/// Throws pomar::Error("<path>: <what>"): every error message starts with the path of the
-/// file concerned.
+/// Throws pomar::Error("<path>: <what>") of `kind` naming `path`: every error message
+/// starts with the path of the file concerned.
+[[noreturn]] void fail(Error::Kind kind, const std::string &path, const std::string &what);
+/// fail() for a file whose content cannot be used (Error::Kind::InvalidMesh).
 [[noreturn]] void fail(const std::string &path, const std::string &what);
+/// fail() for a file that cannot be opened, read or written (Error::Kind::Io).
+[[noreturn]] void fail_io(const std::string &path, const std::string &what);
 /// Runs the caller's size check (if any), prefixing its error with the path.
 void run_size_check(const SizeCheck &check, const std::string &path, uint64_t vertices,
                     uint64_t faces);
@@ -93,7 +97,7 @@ public:
     size_ = check_regular_file(path);
     fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
     if (fd_ < 0)
-      fail(path, "cannot open: " + errno_text(errno));
+      fail_io(path, "cannot open: " + errno_text(errno));
     buf_.resize(1 << 16);
   }
   ~FileReader() { ::close(fd_); }
@@ -133,7 +137,7 @@ public:
       begin_ += static_cast<size_t>(n);
     } else {
       if (::lseek(fd_, static_cast<off_t>(pos_ + n), SEEK_SET) < 0)
-        fail(path_, "cannot seek: " + errno_text(errno));
+        fail_io(path_, "cannot seek: " + errno_text(errno));
       begin_ = end_ = 0;
     }
     pos_ += n;
@@ -171,7 +175,7 @@ private:
       if (r < 0 && errno == EINTR)
         continue;
       if (r < 0)
-        fail(path_, "cannot read: " + errno_text(errno));
+        fail_io(path_, "cannot read: " + errno_text(errno));
       begin_ = 0, end_ = static_cast<size_t>(r);
       return r > 0;
     }
@@ -194,7 +198,7 @@ public:
     dir_ = slash == std::string::npos ? "." : target.substr(0, slash + 1);
     const std::string base = slash == std::string::npos ? target : target.substr(slash + 1);
     if (base.empty())
-      fail(target, "not a file name");
+      fail_io(target, "not a file name");
     const std::string prefix = slash == std::string::npos ? "" : dir_;
     path_ = prefix + "." + base + ".tmp." + num(static_cast<uint64_t>(::getpid())) + "." +
             num(counter++);
@@ -216,7 +220,7 @@ public:
     if (sync)
       sync_file();
     if (::rename(path_.c_str(), target_.c_str()) != 0)
-      fail(target_, "cannot rename temporary file into place: " + errno_text(errno));
+      fail_io(target_, "cannot rename temporary file into place: " + errno_text(errno));
     committed_ = true;
     unregister_temporary(slot_);
     slot_ = -1;
@@ -231,10 +235,10 @@ private:
   void sync_file() {
     const int fd = ::open(path_.c_str(), O_RDONLY | O_CLOEXEC);
     if (fd < 0)
-      fail(target_, "cannot reopen temporary file: " + errno_text(errno));
+      fail_io(target_, "cannot reopen temporary file: " + errno_text(errno));
     FdGuard guard(fd);
     if (::fsync(fd) != 0)
-      fail(target_, "fsync failed: " + errno_text(errno));
+      fail_io(target_, "fsync failed: " + errno_text(errno));
   }
 
   std::string target_, dir_, path_;
@@ -281,10 +285,13 @@ class IoEdge;
 class IoFace;
 struct IoTypes : vcg::UsedTypes<vcg::Use<IoVertex>::AsVertexType, vcg::Use<IoEdge>::AsEdgeType,
                                 vcg::Use<IoFace>::AsFaceType> {};
-// The normal is only there because ImporterOFF stores the normals of an NOFF file without
-// asking whether the vertex type has them (EmptyCore::N() asserts). They are dropped.
+// Per-vertex colour, normal, quality and texture coordinates hold the attributes a file
+// keeps (PLY: read by our walk and stored here; OFF: by vcglib's importer), so that
+// from_vcg drops them with their unreferenced vertices.
 class IoVertex
-    : public vcg::Vertex<IoTypes, vcg::vertex::Coord3f, vcg::vertex::Normal3f, vcg::vertex::BitFlags> {};
+    : public vcg::Vertex<IoTypes, vcg::vertex::Coord3f, vcg::vertex::Normal3f,
+                         vcg::vertex::Color4b, vcg::vertex::Qualityf, vcg::vertex::TexCoord2f,
+                         vcg::vertex::BitFlags> {};
 // Edges only so that the PLY importer has somewhere to put an "edge" element: without an
 // edge container it asserts. They are dropped.
 class IoEdge : public vcg::Edge<IoTypes, vcg::edge::VertexRef, vcg::edge::BitFlags> {};
@@ -323,7 +330,7 @@ auto guarded(const std::string &path, F &&call) -> decltype(call()) {
   } catch (const Error &) {
     throw;
   } catch (const std::bad_alloc &) {
-    fail(path, "out of memory while reading");
+    fail(Error::Kind::MemoryLimit, path, "out of memory while reading");
   } catch (const std::exception &e) {
     fail(path, std::string("read failed: ") + e.what());
   }
@@ -350,6 +357,10 @@ std::string ply_ascii_text(const Mesh &mesh);
 /// the tests compare with and the path on big-endian hosts).
 void save_ply_binary(const std::string &path, const Mesh &mesh);
 void save_ply_binary_vcg(const std::string &path, const Mesh &mesh);
+/// A PLY file (ASCII or binary little-endian) with the mesh's attributes as vertex
+/// properties (red green blue [alpha] uchar, nx ny nz, texture_u texture_v, one float per
+/// scalar by its name) and "comment TextureFile" lines.
+std::string ply_with_attributes(const Mesh &mesh, bool binary, const std::string &path);
 // off_io.cpp
 Mesh load_off(const std::string &path, LoadReport &report, const SizeCheck &check);
 std::string off_text(const Mesh &mesh);

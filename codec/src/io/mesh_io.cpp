@@ -47,8 +47,9 @@ Format format_of(const std::string &path) {
   if (ext == ".stl")
     return Format::Stl;
   if (ext.empty())
-    fail(path, std::string("no file extension to tell the mesh format (") + kSupported + ")");
-  fail(path, "unknown mesh file extension '" + ext + "' (" + kSupported + ")");
+    fail(Error::Kind::Usage, path,
+         std::string("no file extension to tell the mesh format (") + kSupported + ")");
+  fail(Error::Kind::Usage, path, "unknown mesh file extension '" + ext + "' (" + kSupported + ")");
 }
 
 const char *format_name(Format f) {
@@ -87,12 +88,12 @@ void check_mesh_for_save(const Mesh &mesh, const std::string &path) {
 std::vector<uint8_t> read_file(const std::string &path) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0)
-    fail(path, "cannot open: " + errno_text(errno));
+    fail_io(path, "cannot open: " + errno_text(errno));
   FdGuard guard(fd);
   struct stat st;
   const bool have_stat = ::fstat(fd, &st) == 0;
   if (have_stat && S_ISDIR(st.st_mode))
-    fail(path, "is a directory");
+    fail_io(path, "is a directory");
   // A regular file is read into a buffer of its size (+1 to see the end): growing by
   // doubling would briefly hold 1.5 times a large file.
   std::vector<uint8_t> data;
@@ -106,7 +107,7 @@ std::vector<uint8_t> read_file(const std::string &path) {
     if (r < 0 && errno == EINTR)
       continue;
     if (r < 0)
-      fail(path, "cannot read: " + errno_text(errno));
+      fail_io(path, "cannot read: " + errno_text(errno));
     if (r == 0)
       break;
     used += static_cast<size_t>(r);
@@ -121,15 +122,15 @@ void write_file_atomic(const std::string &path, const void *data, size_t size) {
   TempFile tmp(path);
   const int fd = ::open(tmp.path().c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
   if (fd < 0)
-    fail(path, "cannot create temporary file '" + tmp.path() + "': " + errno_text(errno));
+    fail_io(path, "cannot create temporary file '" + tmp.path() + "': " + errno_text(errno));
   FdGuard guard(fd);
   if (!write_all(fd, static_cast<const char *>(data), size))
-    fail(path, "cannot write: " + errno_text(errno));
+    fail_io(path, "cannot write: " + errno_text(errno));
   if (::fsync(fd) != 0)
-    fail(path, "fsync failed: " + errno_text(errno));
+    fail_io(path, "fsync failed: " + errno_text(errno));
   guard.fd = -1;
   if (::close(fd) != 0)
-    fail(path, "cannot write (close): " + errno_text(errno));
+    fail_io(path, "cannot write (close): " + errno_text(errno));
   tmp.commit(false);
 }
 
@@ -165,9 +166,12 @@ void save_mesh(const std::string &path, const Mesh &mesh, bool binary) {
   std::string text;
   switch (format) {
   case Format::Ply:
-    if (binary)
+    if (!mesh.attributes.empty() || !mesh.texture_files.empty())
+      text = ply_with_attributes(mesh, binary, path);
+    else if (binary)
       return save_ply_binary(path, mesh);
-    text = ply_ascii_text(mesh);
+    else
+      text = ply_ascii_text(mesh);
     break;
   case Format::Stl:
     if (binary)

@@ -3,6 +3,8 @@
 // writing formatted here (vcglib's exporter needs material code).
 #include "io/io_common.h"
 
+#include <cmath>
+
 #include <tiny_obj_loader.h>
 
 #include <climits>
@@ -151,8 +153,96 @@ size_t drop_unreferenced(Mesh &mesh) {
   for (auto &t : mesh.triangles)
     t = remap[t];
   const size_t dropped = mesh.vertex_count() - next;
+  for (VertexAttribute &a : mesh.attributes) { // the attributes of the kept vertices
+    const size_t n = a.components;
+    auto compact = [&](auto &values) {
+      size_t out = 0;
+      for (size_t v = 0; v < remap.size(); ++v)
+        if (remap[v] != kUnused)
+          for (size_t k = 0; k < n; ++k)
+            values[out++] = values[v * n + k];
+      values.resize(out);
+    };
+    if (a.kind == AttributeKind::Colour)
+      compact(a.colour);
+    else
+      compact(a.values);
+  }
   mesh.positions.swap(kept);
   return dropped;
+}
+
+/// Per-vertex normals or texture coordinates from OBJ's per-corner indices (`which`: the
+/// corner's normal_index or texcoord_index): kept when every corner of each vertex uses the
+/// same values; otherwise empty and `why` says where they differ.
+std::vector<float> per_vertex(const std::vector<tinyobj::shape_t> &shapes,
+                              const std::vector<float> &table, size_t width, size_t vertices,
+                              int tinyobj::index_t::*which, std::string &why) {
+  std::vector<float> out(vertices * width, 0.0f);
+  std::vector<int> index(vertices, -1);
+  for (const auto &shape : shapes)
+    for (const tinyobj::index_t &c : shape.mesh.indices) {
+      const int i = c.*which;
+      if (i < 0 || size_t(i) * width + width > table.size()) {
+        why = "not given for every corner";
+        return {};
+      }
+      const size_t v = size_t(c.vertex_index);
+      if (index[v] >= 0 && index[v] != i &&
+          !std::equal(&table[size_t(i) * width], &table[size_t(i) * width] + width,
+                      &table[size_t(index[v]) * width])) {
+        why = "per corner, differing at vertex " + std::to_string(v + 1);
+        return {};
+      }
+      index[v] = i;
+      std::copy(&table[size_t(i) * width], &table[size_t(i) * width] + width, &out[v * width]);
+    }
+  return out;
+}
+
+/// The OBJ file's vertex colours (8-bit: round(255 c)), normals and texture coordinates that
+/// are per vertex; the others are named in `ignored`.
+void take_obj_attributes(const tinyobj::attrib_t &attrib,
+                         const std::vector<tinyobj::shape_t> &shapes, const ObjScan &scan,
+                         size_t vertices, Mesh &mesh, std::vector<std::string> &ignored) {
+  if (scan.colors && attrib.colors.size() == 3 * vertices) {
+    VertexAttribute c;
+    c.kind = AttributeKind::Colour;
+    c.name = "colour";
+    c.components = 3;
+    for (float x : attrib.colors)
+      c.colour.push_back(static_cast<uint8_t>(std::lround(std::min(1.0f, std::max(0.0f, x)) * 255)));
+    mesh.attributes.push_back(std::move(c));
+  } else if (scan.colors) {
+    add_unique(ignored, "colors");
+  }
+  const struct {
+    bool present;
+    const std::vector<float> &table;
+    size_t width;
+    int tinyobj::index_t::*which;
+    AttributeKind kind;
+    const char *name, *label;
+  } kinds[] = {{scan.normals, attrib.normals, 3, &tinyobj::index_t::normal_index,
+                AttributeKind::Normal, "normal", "normals"},
+               {scan.texcoords, attrib.texcoords, 2, &tinyobj::index_t::texcoord_index,
+                AttributeKind::TexCoord, "texcoord", "texture coordinates"}};
+  for (const auto &k : kinds) {
+    if (!k.present)
+      continue;
+    std::string why;
+    std::vector<float> values = per_vertex(shapes, k.table, k.width, vertices, k.which, why);
+    if (values.empty()) {
+      add_unique(ignored, (std::string(k.label) + " (" + why + ")").c_str());
+      continue;
+    }
+    VertexAttribute a;
+    a.kind = k.kind;
+    a.name = k.name;
+    a.components = static_cast<uint32_t>(k.width);
+    a.values = std::move(values);
+    mesh.attributes.push_back(std::move(a));
+  }
 }
 
 } // namespace
@@ -190,22 +280,53 @@ Mesh load_obj(const std::string &path, LoadReport &report, const SizeCheck &chec
     fail(path, "triangulation produced " + num(mesh.triangles.size() / 3) + " triangles, expected " +
                    num(scan.triangles));
   mesh.positions.assign(attrib.vertices.begin(), attrib.vertices.end());
+  take_obj_attributes(attrib, shapes, scan, scan.vertices, mesh, report.ignored_attributes);
 
   report.file_vertices = scan.vertices;
   report.file_faces = scan.faces;
   report.polygons_triangulated = scan.polygons;
   report.unreferenced_vertices = drop_unreferenced(mesh);
-  if (scan.normals) add_unique(report.ignored_attributes, "normals");
-  if (scan.texcoords) add_unique(report.ignored_attributes, "texture coordinates");
-  if (scan.colors) add_unique(report.ignored_attributes, "colors");
   if (scan.materials) add_unique(report.ignored_attributes, "materials");
   return mesh;
 }
 
 std::string obj_text(const Mesh &mesh) {
+  const VertexAttribute *colour = mesh.find(AttributeKind::Colour);
+  const VertexAttribute *normal = mesh.find(AttributeKind::Normal);
+  const VertexAttribute *uv = mesh.find(AttributeKind::TexCoord);
   std::string s = "# pomar\n";
-  append_vertices(s, mesh, "v ");
-  append_triangles(s, mesh, "f ", 1);
+  for (size_t v = 0; v < mesh.vertex_count(); ++v) {
+    s += "v ";
+    append_point(s, &mesh.positions[3 * v]);
+    if (colour && colour->vertex_count() == mesh.vertex_count())
+      for (int k = 0; k < 3; ++k) { // r g b in [0, 1]; RGBA loses its alpha
+        s += ' ';
+        append_float(s, float(colour->colour[v * colour->components + k]) / 255.0f);
+      }
+    s += '\n';
+  }
+  auto table = [&](const VertexAttribute *a, const char *prefix) {
+    if (!a || a->vertex_count() != mesh.vertex_count())
+      return false;
+    for (size_t v = 0; v < mesh.vertex_count(); ++v) {
+      s += prefix;
+      for (uint32_t k = 0; k < a->components; ++k) {
+        s += ' ';
+        append_float(s, a->values[v * a->components + k]);
+      }
+      s += '\n';
+    }
+    return true;
+  };
+  const bool vt = table(uv, "vt"), vn = table(normal, "vn");
+  for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+    s += 'f';
+    for (int k = 0; k < 3; ++k) {
+      const std::string i = std::to_string(mesh.triangles[3 * t + k] + 1);
+      s += ' ' + i + (vt || vn ? "/" + (vt ? i : "") + (vn ? "/" + i : "") : "");
+    }
+    s += '\n';
+  }
   return s;
 }
 

@@ -18,7 +18,7 @@ class OffLines {
 public:
   explicit OffLines(const std::string &path) : in_(path) {
     if (!in_)
-      fail(path, "cannot open: " + errno_text(errno));
+      fail_io(path, "cannot open: " + errno_text(errno));
   }
   bool failed() const { return in_.fail(); }
 
@@ -182,7 +182,11 @@ Mesh load_off(const std::string &path, LoadReport &report, const SizeCheck &chec
   const int err = guarded(path, [&] { return OffImporter::Open(m, path.c_str(), mask); });
   if (err != OffImporter::NoError)
     fail(path, "OFF import failed: " + vcg_message<OffImporter>(err, 7));
-  add_ignored_from_mask(mask, report.ignored_attributes);
+  // Per-vertex colours (COFF) and normals (NOFF) are kept; texture coordinates (STOFF)
+  // are not: vcglib's importer announces them without storing them.
+  using M = vcg::tri::io::Mask;
+  const int kept = mask & (M::IOM_VERTCOLOR | M::IOM_VERTNORMAL);
+  add_ignored_from_mask(mask & ~kept, report.ignored_attributes);
   check_counts(m, layout.vertices, layout.triangles, path, "vcglib's OFF importer");
   clear_flags(m); // the importer marks polygon diagonals as faux edges
   check_finite(m, path, false);
@@ -190,7 +194,7 @@ Mesh load_off(const std::string &path, LoadReport &report, const SizeCheck &chec
   report.file_vertices = layout.vertices;
   report.file_faces = layout.faces;
   report.polygons_triangulated = layout.polygons;
-  return from_vcg(m, &report.unreferenced_vertices);
+  return from_vcg(m, &report.unreferenced_vertices, kept);
 }
 
 std::string off_text(const Mesh &mesh) {

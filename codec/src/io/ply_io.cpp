@@ -50,6 +50,7 @@ bool is_scalar_of(const PlyProperty *p, PlyType type) {
 struct PlyHeader {
   enum Encoding { Ascii, BinaryLittle, BinaryBig } encoding = Ascii;
   std::vector<PlyElement> elements;
+  std::vector<std::string> texture_files; ///< "comment TextureFile <name>" lines
 };
 
 size_t type_size(PlyType t) {
@@ -139,6 +140,13 @@ PlyHeader read_ply_header(FileReader &in, const std::string &path) {
       bad("empty line");
     if (tok[0] == "comment" || tok[0] == "obj_info") {
       check_texture_comment(line, path);
+      const size_t at = line.find("TextureFile");
+      if (tok[0] == "comment" && tok.size() >= 3 && tok[1] == "TextureFile") {
+        std::string name = line.substr(line.find_first_not_of(" \t", at + 11));
+        while (!name.empty() && (name.back() == '\r' || name.back() == ' '))
+          name.pop_back();
+        h.texture_files.push_back(name);
+      }
     } else if (tok[0] == "end_header") {
       break;
     } else if (tok[0] == "format") {
@@ -199,6 +207,40 @@ public:
     if (enc_ == PlyHeader::BinaryBig)
       std::reverse(b, b + n);
     v = decode(t, b);
+    return true;
+  }
+
+  /// One value of any type as a float (doubles rounded); false at the end of the file.
+  bool real(PlyType t, float &v) {
+    if (enc_ == PlyHeader::Ascii) {
+      if (!in_.token(tok_))
+        return false;
+      int64_t i = 0;
+      if (t == PlyType::F32 || t == PlyType::F64) {
+        if (tok_.find('(') != std::string::npos || !parse_float(tok_, v))
+          fail(path_, "bad number '" + tok_ + "' in PLY data");
+      } else {
+        if (!parse_int(tok_, i))
+          fail(path_, "bad integer '" + tok_ + "' in PLY data");
+        v = static_cast<float>(i);
+      }
+      return true;
+    }
+    unsigned char b[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+    const size_t n = type_size(t);
+    if (!in_.read(b, n))
+      return false;
+    if (enc_ == PlyHeader::BinaryBig)
+      std::reverse(b, b + n);
+    if (t == PlyType::F32) {
+      std::memcpy(&v, b, 4);
+    } else if (t == PlyType::F64) {
+      double d;
+      std::memcpy(&d, b, 8);
+      v = static_cast<float>(d);
+    } else {
+      v = static_cast<float>(decode(t, b));
+    }
     return true;
   }
 
@@ -263,17 +305,111 @@ private:
   std::string path_, tok_;
 };
 
-/// Walks the rest of the PLY body, validating the connectivity element.
+/// The per-vertex attributes of a PLY file and which vertex property feeds which of them.
+struct PlyVertexPlan {
+  struct Slot {
+    int attribute = -1; // index into attributes, -1: not kept
+    uint32_t component = 0;
+  };
+  std::vector<Slot> slots; // per property of the vertex element
+  std::vector<VertexAttribute> attributes;
+};
+
+/// Decides what of the vertex element is kept: colour (8-bit red, green, blue [alpha], or
+/// diffuse_*), normal (nx, ny, nz), texture coordinates (texture_u/texture_v, u/v or s/t)
+/// and every other scalar property as a scalar of its name (values converted to float).
+/// Colours with wider channels are not kept (named in `ignored`).
+PlyVertexPlan plan_vertex_attributes(const PlyElement *vertex, std::vector<std::string> &ignored) {
+  PlyVertexPlan plan;
+  if (!vertex)
+    return plan;
+  plan.slots.resize(vertex->props.size());
+  std::vector<bool> taken(vertex->props.size(), false);
+  auto index = [&](const char *name) -> int {
+    for (size_t i = 0; i < vertex->props.size(); ++i)
+      if (vertex->props[i].name == name && !vertex->props[i].is_list)
+        return static_cast<int>(i);
+    return -1;
+  };
+  auto is_float = [&](int i) {
+    return vertex->props[i].type == PlyType::F32 || vertex->props[i].type == PlyType::F64;
+  };
+  auto add = [&](AttributeKind kind, const std::string &name, const std::vector<int> &props) {
+    VertexAttribute a;
+    a.kind = kind;
+    a.name = name;
+    a.components = static_cast<uint32_t>(props.size());
+    for (size_t k = 0; k < props.size(); ++k) {
+      plan.slots[props[k]] = {static_cast<int>(plan.attributes.size()), static_cast<uint32_t>(k)};
+      taken[props[k]] = true;
+    }
+    plan.attributes.push_back(a);
+  };
+  for (const char *prefix : {"", "diffuse_"}) {
+    const std::string p = prefix;
+    const int r = index((p + "red").c_str()), g = index((p + "green").c_str()),
+              b = index((p + "blue").c_str()), a = index((p + "alpha").c_str());
+    if (r < 0 || g < 0 || b < 0 || (taken[r] | taken[g] | taken[b]))
+      continue;
+    std::vector<int> props = {r, g, b};
+    if (a >= 0)
+      props.push_back(a);
+    bool bytes = true;
+    for (int i : props)
+      bytes &= vertex->props[i].type == PlyType::U8;
+    if (bytes) {
+      add(AttributeKind::Colour, "colour", props);
+    } else {
+      add_unique(ignored, vertex->props[r].type == PlyType::U16
+                              ? "colors (16-bit channels: pomar keeps 8-bit colour)"
+                              : "colors (channels not 8-bit: pomar keeps 8-bit colour)");
+      for (int i : props)
+        taken[i] = true;
+    }
+  }
+  const int nx = index("nx"), ny = index("ny"), nz = index("nz");
+  if (nx >= 0 && ny >= 0 && nz >= 0 && is_float(nx) && is_float(ny) && is_float(nz))
+    add(AttributeKind::Normal, "normal", {nx, ny, nz});
+  for (const auto &uv : {std::pair<const char *, const char *>{"texture_u", "texture_v"},
+                         {"u", "v"},
+                         {"s", "t"}}) {
+    const int u = index(uv.first), v = index(uv.second);
+    if (u >= 0 && v >= 0 && !taken[u] && !taken[v] && is_float(u) && is_float(v)) {
+      add(AttributeKind::TexCoord, "texcoord", {u, v});
+      break;
+    }
+  }
+  for (size_t i = 0; i < vertex->props.size(); ++i) {
+    const PlyProperty &prop = vertex->props[i];
+    if (taken[i] || prop.name == "x" || prop.name == "y" || prop.name == "z")
+      continue;
+    if (prop.name == "flags")
+      add_unique(ignored, "flags");
+    else if (prop.is_list)
+      add_unique(ignored, ("vertex list property '" + prop.name + "'").c_str());
+    else if (prop.name.empty() || prop.name.size() > 255)
+      add_unique(ignored, "vertex property with an unusable name");
+    else
+      add(AttributeKind::Scalar, prop.name, {static_cast<int>(i)});
+  }
+  return plan;
+}
+
+/// Walks the rest of the PLY body, validating the connectivity element (and reading the
+/// vertex attributes of `plan`, if given).
 class PlyWalker {
 public:
-  PlyWalker(FileReader &in, const PlyHeader &h, const std::string &path)
-      : in_(in), h_(h), path_(path), values_(in, h.encoding, path) {}
+  PlyWalker(FileReader &in, const PlyHeader &h, const std::string &path,
+            PlyVertexPlan *plan = nullptr)
+      : in_(in), h_(h), path_(path), values_(in, h.encoding, path), plan_(plan) {}
 
   PlyLayout run() {
     choose_elements();
     for (const PlyElement &e : h_.elements) {
       if (&e == conn_)
         walk(e, e.name == "tristrips");
+      else if (e.name == "vertex" && plan_ && !plan_->attributes.empty())
+        read_vertices(e);
       else
         skip_element(e);
       layout_.edges |= e.name == "edge" && e.count > 0;
@@ -390,6 +526,34 @@ private:
     return values_.skip(p.type, static_cast<uint64_t>(n));
   }
 
+  /// Reads the vertex element's attribute values (the plan's), skipping the rest.
+  void read_vertices(const PlyElement &e) {
+    for (VertexAttribute &a : plan_->attributes) {
+      const size_t n = size_t(std::min<uint64_t>(e.count, in_.remaining())) * a.components;
+      if (a.kind == AttributeKind::Colour)
+        a.colour.reserve(n);
+      else
+        a.values.reserve(n);
+    }
+    for (uint64_t i = 0; i < e.count; ++i)
+      for (size_t j = 0; j < e.props.size(); ++j) {
+        const PlyVertexPlan::Slot &slot = plan_->slots[j];
+        if (slot.attribute < 0) {
+          if (!skip_unstored(e.props[j]))
+            truncated(e, i);
+          continue;
+        }
+        float x = 0;
+        if (!values_.real(e.props[j].type, x))
+          truncated(e, i);
+        VertexAttribute &a = plan_->attributes[size_t(slot.attribute)];
+        if (a.kind == AttributeKind::Colour)
+          a.colour.push_back(static_cast<uint8_t>(x));
+        else
+          a.values.push_back(x);
+      }
+  }
+
   /// Reads every item of the connectivity element and checks its index list.
   void walk(const PlyElement &e, bool strips) {
     for (uint64_t i = 0; i < e.count; ++i)
@@ -464,6 +628,7 @@ private:
   const PlyProperty *conn_prop_ = nullptr;
   std::vector<int64_t> list_;
   PlyLayout layout_;
+  PlyVertexPlan *plan_ = nullptr;
 };
 
 // ======================================================================================
@@ -572,32 +737,45 @@ bool read_simple_ply(FileReader &in, const PlyHeader &h, Mesh &out, size_t &unre
 
 Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &check) {
   PlyLayout layout;
+  PlyVertexPlan plan;
+  std::vector<std::string> texture_files;
   {
     FileReader in(path);
     const PlyHeader header = read_ply_header(in, path);
     const uint64_t faces = element_count(header, "face");
     run_size_check(check, path, element_count(header, "vertex"), faces);
+    const PlyElement *vertex = nullptr;
+    for (const PlyElement &e : header.elements)
+      if (e.name == "vertex")
+        vertex = &e;
+    plan = plan_vertex_attributes(vertex, report.ignored_attributes);
+    texture_files = header.texture_files;
     const uint64_t data_start = in.pos();
     Mesh fast;
     size_t unreferenced = 0;
-    if (read_simple_ply(in, header, fast, unreferenced)) {
+    if (texture_files.empty() && read_simple_ply(in, header, fast, unreferenced)) {
       report.file_vertices = header.elements[0].count;
       report.file_faces = faces;
       report.unreferenced_vertices = unreferenced;
       return fast;
     }
     if (in.pos() == data_start) {
-      layout = PlyWalker(in, header, path).run();
+      layout = PlyWalker(in, header, path, &plan).run();
     } else { // the general path reads the data from its start
       FileReader again(path);
       read_ply_header(again, path);
-      layout = PlyWalker(again, header, path).run();
+      layout = PlyWalker(again, header, path, &plan).run();
     }
     if (layout.triangles > faces) // polygons or triangle strips
       run_size_check(check, path, layout.vertices, layout.triangles);
   }
   int file_mask = 0; // what the file has, whatever our mesh type can store
   PlyImporter::LoadMask(path.c_str(), file_mask);
+  {
+    using M = vcg::tri::io::Mask; // per-vertex data is read by the walk (plan)
+    file_mask &= ~(M::IOM_VERTCOLOR | M::IOM_VERTNORMAL | M::IOM_VERTQUALITY |
+                   M::IOM_VERTTEXCOORD | M::IOM_VERTRADIUS | M::IOM_VERTFLAGS);
+  }
   add_ignored_from_mask(file_mask, report.ignored_attributes);
   if (layout.edges)
     add_unique(report.ignored_attributes, "edges");
@@ -617,7 +795,13 @@ Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &chec
   report.file_vertices = layout.vertices;
   report.file_faces = layout.faces;
   report.polygons_triangulated = layout.polygons;
-  return from_vcg(m, &report.unreferenced_vertices);
+  for (const VertexAttribute &a : plan.attributes)
+    if (a.vertex_count() != m.vert.size())
+      fail(path, "PLY vertex attribute '" + a.name + "' was not read for every vertex");
+  const int attribute_mask = put_attributes(plan.attributes, texture_files, m);
+  Mesh mesh = from_vcg(m, &report.unreferenced_vertices, attribute_mask);
+  mesh.texture_files = texture_files; // also without per-vertex texture coordinates
+  return mesh;
 }
 
 std::string ply_ascii_text(const Mesh &mesh) {
@@ -629,6 +813,98 @@ std::string ply_ascii_text(const Mesh &mesh) {
   return s;
 }
 
+namespace {
+void put_le(std::string &out, uint32_t v, int bytes) {
+  for (int i = 0; i < bytes; ++i)
+    out += static_cast<char>((v >> (8 * i)) & 0xFF);
+}
+void put_float(std::string &out, float f) {
+  uint32_t v;
+  std::memcpy(&v, &f, 4);
+  put_le(out, v, 4);
+}
+} // namespace
+
+std::string ply_with_attributes(const Mesh &mesh, bool binary, const std::string &path) {
+  validate_attributes(mesh, false);
+  const size_t nv = mesh.vertex_count();
+  std::string s = std::string("ply\nformat ") + (binary ? "binary_little_endian" : "ascii") +
+                  " 1.0\ncomment pomar\n";
+  for (const std::string &t : mesh.texture_files) {
+    if (t.find_first_of("\r\n") != std::string::npos || t.size() > 200)
+      fail(path, "texture file name cannot be stored in a PLY comment: " + t.substr(0, 64));
+    s += "comment TextureFile " + t + "\n";
+  }
+  s += "element vertex " + num(nv) + "\nproperty float x\nproperty float y\nproperty float z\n";
+  std::vector<std::string> used = {"x", "y", "z"};
+  auto declare = [&](const char *type, const std::string &name) {
+    if (std::find(used.begin(), used.end(), name) != used.end())
+      fail(path, "two PLY vertex properties would be named '" + name + "'");
+    if (name.find_first_of(" \t\r\n") != std::string::npos)
+      fail(path, "attribute name '" + name + "' cannot be a PLY property name (white space)");
+    used.push_back(name);
+    s += std::string("property ") + type + " " + name + "\n";
+  };
+  for (const VertexAttribute &a : mesh.attributes) {
+    switch (a.kind) {
+    case AttributeKind::Colour:
+      for (const char *c : {"red", "green", "blue", "alpha"})
+        if (c[0] != 'a' || a.components == 4)
+          declare("uchar", c);
+      break;
+    case AttributeKind::Normal:
+      for (const char *c : {"nx", "ny", "nz"})
+        declare("float", c);
+      break;
+    case AttributeKind::TexCoord:
+      declare("float", "texture_u");
+      declare("float", "texture_v");
+      break;
+    case AttributeKind::Scalar:
+      declare("float", a.name);
+      break;
+    }
+  }
+  s += "element face " + num(mesh.triangle_count()) +
+       "\nproperty list uchar int vertex_indices\nend_header\n";
+  for (size_t v = 0; v < nv; ++v) {
+    for (int k = 0; k < 3; ++k) {
+      if (binary) {
+        put_float(s, mesh.positions[3 * v + k]);
+      } else {
+        if (k)
+          s += ' ';
+        append_float(s, mesh.positions[3 * v + k]);
+      }
+    }
+    for (const VertexAttribute &a : mesh.attributes)
+      for (uint32_t k = 0; k < a.components; ++k) {
+        if (a.kind == AttributeKind::Colour) {
+          if (binary)
+            s += static_cast<char>(a.colour[v * a.components + k]);
+          else
+            s += ' ' + std::to_string(a.colour[v * a.components + k]);
+        } else if (binary) {
+          put_float(s, a.values[v * a.components + k]);
+        } else {
+          s += ' ';
+          append_float(s, a.values[v * a.components + k]);
+        }
+      }
+    if (!binary)
+      s += '\n';
+  }
+  if (!binary) {
+    append_triangles(s, mesh, "3 ", 0);
+    return s;
+  }
+  for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+    s += static_cast<char>(3);
+    for (int k = 0; k < 3; ++k)
+      put_le(s, mesh.triangles[3 * t + k], 4);
+  }
+  return s;
+}
 
 void save_ply_binary(const std::string &path, const Mesh &mesh) {
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
@@ -664,8 +940,9 @@ void save_ply_binary_vcg(const std::string &path, const Mesh &mesh) {
   errno = 0;
   const int err = Exporter::Save(m, tmp.path().c_str(), true);
   if (err != 0)
-    fail(path, "cannot write: " + vcg_message<Exporter>(err, vcg::tri::io::PlyInfo::E_MAXPLYINFOERRORS) +
-                   errno_suffix());
+    fail_io(path, "cannot write: " +
+                      vcg_message<Exporter>(err, vcg::tri::io::PlyInfo::E_MAXPLYINFOERRORS) +
+                      errno_suffix());
   check_written_size(tmp.path(), ply_header_size(tmp.path(), path) + 12 * nv + 13 * nf, path);
   tmp.commit(true);
 }

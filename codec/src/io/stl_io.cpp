@@ -264,7 +264,7 @@ void save_stl_binary(const std::string &path, const Mesh &mesh) {
   errno = 0;
   const int err = Exporter::Save(m, tmp.path().c_str(), true);
   if (err != 0)
-    fail(path, "cannot write: " + vcg_message<Exporter>(err, 3) + errno_suffix());
+    fail_io(path, "cannot write: " + vcg_message<Exporter>(err, 3) + errno_suffix());
   check_written_size(tmp.path(), 84 + 50 * nf, path);
   tmp.commit(true);
 }

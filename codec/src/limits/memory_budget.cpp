@@ -218,9 +218,10 @@ uint64_t parse_memory_size(const std::string &text) {
   if (t == "auto")
     return 0;
   auto bad = [&] {
-    return Error("bad memory size '" + text +
-                 "': expected bytes or a number with K, M, G or T (e.g. 512M, 1.5GiB), "
-                 "'auto' or 'none'");
+    return Error(Error::Kind::Usage,
+                 "bad memory size '" + text +
+                     "': expected bytes or a number with K, M, G or T (e.g. 512M, 1.5GiB), "
+                     "'auto' or 'none'");
   };
   size_t digits = 0;
   while (digits < t.size() &&
@@ -245,7 +246,8 @@ uint64_t parse_memory_size(const std::string &text) {
     throw bad();
   const double bytes = std::ceil(std::ldexp(value, shift));
   if (bytes >= 18446744073709551615.0)
-    throw Error("memory size '" + text + "' is too large (use 'none' for no limit)");
+    throw Error(Error::Kind::Usage,
+                "memory size '" + text + "' is too large (use 'none' for no limit)");
   return static_cast<uint64_t>(bytes);
 }
 
@@ -281,10 +283,11 @@ void check_memory(const char *action, uint64_t vertices, uint64_t faces, uint64_
       return;
     have = "the limit is " + format_memory_size(limit);
   }
-  throw Error(std::string("not enough memory to ") + action + " " + grouped(vertices) +
-              " vertices and " + grouped(faces) + " faces: needs about " +
-              format_memory_size(need) + (need != needed ? " more" : "") + ", " + have +
-              "; use --max-memory to change the limit");
+  throw Error(Error::Kind::MemoryLimit, std::string("not enough memory to ") + action + " " +
+                                            grouped(vertices) + " vertices and " + grouped(faces) +
+                                            " faces: needs about " + format_memory_size(need) +
+                                            (need != needed ? " more" : "") + ", " + have +
+                                            "; use --max-memory to change the limit");
 }
 
 void check_encode_memory(uint64_t vertices, uint64_t faces, uint64_t limit, uint64_t held) {

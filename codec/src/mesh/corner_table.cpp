@@ -110,11 +110,13 @@ void match_opposites(const uint32_t *t, size_t nt, size_t nv, CornerTable &ct) {
     }
   }
   if (nonmanifold)
-    throw Error("non-manifold mesh: " + std::to_string(nonmanifold) +
-                " edges are shared by more than two faces; e.g. " + nm_example);
+    throw Error(Error::Kind::InvalidMesh, "non-manifold mesh: " + std::to_string(nonmanifold) +
+                                              " edges are shared by more than two faces; e.g. " +
+                                              nm_example);
   if (flipped)
-    throw Error("inconsistently oriented mesh: " + std::to_string(flipped) +
-                " edges are used twice in the same direction; e.g. " + flip_example);
+    throw Error(Error::Kind::InvalidMesh,
+                "inconsistently oriented mesh: " + std::to_string(flipped) +
+                    " edges are used twice in the same direction; e.g. " + flip_example);
 }
 
 // A manifold vertex has a single fan of faces: walking it must reach every face.
@@ -130,18 +132,20 @@ void check_vertex_fans(const CornerTable &ct, const std::vector<uint32_t> &faces
       example = v;
   }
   if (bad)
-    throw Error("non-manifold mesh: " + std::to_string(bad) +
-                " vertices join separate fans of faces; e.g. vertex " + std::to_string(example) +
-                " (" + std::to_string(faces_at[example]) + " faces)");
+    throw Error(Error::Kind::InvalidMesh,
+                "non-manifold mesh: " + std::to_string(bad) +
+                    " vertices join separate fans of faces; e.g. vertex " +
+                    std::to_string(example) + " (" + std::to_string(faces_at[example]) + " faces)");
 }
 
 } // namespace
 
 void build_corner_table(const uint32_t *t, size_t nt, size_t nv, CornerTable &ct) {
   if (nt == 0)
-    throw Error("the mesh contains no triangles");
+    throw Error(Error::Kind::InvalidMesh, "the mesh contains no triangles");
   if (nt > (size_t(1) << 30) || nv >= kNone)
-    throw Error("the mesh is too large (" + std::to_string(nt) + " triangles)");
+    throw Error(Error::Kind::InvalidMesh,
+                "the mesh is too large (" + std::to_string(nt) + " triangles)");
   size_t repeated = 0, out_of_range = 0, rep_example = 0, oor_example = 0;
   for (size_t f = 0; f < nt; ++f) {
     const uint32_t a = t[3 * f], b = t[3 * f + 1], c = t[3 * f + 2];
@@ -154,11 +158,13 @@ void build_corner_table(const uint32_t *t, size_t nt, size_t nv, CornerTable &ct
     }
   }
   if (out_of_range)
-    throw Error(std::to_string(out_of_range) + " faces use a vertex index >= the vertex count " +
-                std::to_string(nv) + "; e.g. " + face_text(t, oor_example));
+    throw Error(Error::Kind::InvalidMesh,
+                std::to_string(out_of_range) + " faces use a vertex index >= the vertex count " +
+                    std::to_string(nv) + "; e.g. " + face_text(t, oor_example));
   if (repeated)
-    throw Error("degenerate faces: " + std::to_string(repeated) +
-                " faces repeat a vertex; e.g. " + face_text(t, rep_example));
+    throw Error(Error::Kind::InvalidMesh, "degenerate faces: " + std::to_string(repeated) +
+                                              " faces repeat a vertex; e.g. " +
+                                              face_text(t, rep_example));
   ct.V.assign(t, t + 3 * nt);
   ct.O.assign(3 * nt, kNone);
   ct.VC.assign(nv, kNone);

@@ -25,6 +25,12 @@ struct LevelMesh {
   std::vector<Tag> tag;
   std::vector<uint32_t> parent, local;
   std::vector<uint16_t> face_claim; // per face: last level whose patch held it
+  // Per-vertex attributes (attributes/): `attr_codes` integer codes per vertex, each in
+  // [attr_lo[k], attr_hi[k]]; a split vertex's codes are coded after its position.
+  uint32_t attr_codes = 0;
+  std::vector<int64_t> attr, attr_lo, attr_hi;
+  int normal_code = -1; // first code of a quantized normal attribute (-1: none)
+  int normal_bits = 0;  // its octahedral bits
   uint32_t vertex_count() const { return ct.vertex_count(); }
   uint32_t level_of(uint32_t v) const { return tag[v].level; }
   uint32_t cluster_of(uint32_t v) const { return tag[v].cluster; }

@@ -55,8 +55,8 @@ public:
   /// Refine one cluster by one clustered level; `next_local` is the cluster's counter of
   /// created vertices (LevelMesh::local), advanced by the splits.
   template <class Codec, class Check = NoCheck>
-  void cluster_level(LevelMesh &mesh, Codec &codec, const ClusterLevel &where,
-                     uint32_t &next_local, const Check &check = {}) {
+  void cluster_level(LevelMesh &mesh, Codec &codec, const ClusterLevel &where, uint32_t &next_local,
+                     const Check &check = {}) {
     const LevelView view{where.level, where.older_than};
     traverse_and_check(mesh, where.level, check, [&] {
       traverse_cluster(mesh, codec, scratch_, where.cluster, view, splits_);
@@ -96,6 +96,7 @@ private:
       const uint32_t v_from = mesh.vertex_count();
       apply_split(mesh.ct, ps.op, v_from);
       mesh.q.insert(mesh.q.end(), ps.v_from.position, ps.v_from.position + 3);
+      mesh.attr.insert(mesh.attr.end(), ps.v_from.attr, ps.v_from.attr + mesh.attr_codes);
       mesh.tag.push_back({cluster, static_cast<uint16_t>(level)});
       mesh.parent.push_back(ps.op.v_to);
       if (next_local)

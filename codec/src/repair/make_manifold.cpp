@@ -293,7 +293,7 @@ std::vector<uint32_t> split_fans(const std::vector<uint32_t> &t, size_t nv,
         vertex_of_root[root] = v;
       } else {
         if (nv + copy_of.size() >= kNone)
-          throw Error("the repaired mesh would have too many vertices");
+          throw Error(Error::Kind::InvalidMesh, "the repaired mesh would have too many vertices");
         vertex_of_root[root] = static_cast<uint32_t>(nv + copy_of.size());
         copy_of.push_back(v);
       }
@@ -355,15 +355,18 @@ RepairReport make_manifold(Mesh &mesh) {
   RepairReport r;
   const size_t nv = mesh.vertex_count();
   if (mesh.positions.size() % 3 != 0 || mesh.triangles.size() % 3 != 0)
-    throw Error("position and triangle arrays must hold multiples of 3 values");
+    throw Error(Error::Kind::InvalidMesh,
+                "position and triangle arrays must hold multiples of 3 values");
   if (nv >= kNone || mesh.triangles.size() >= kNone)
-    throw Error("the mesh is too large to repair (" + std::to_string(mesh.triangle_count()) +
-                " triangles)");
+    throw Error(Error::Kind::InvalidMesh, "the mesh is too large to repair (" +
+                                              std::to_string(mesh.triangle_count()) +
+                                              " triangles)");
   for (size_t c = 0; c < mesh.triangles.size(); ++c)
     if (mesh.triangles[c] >= nv)
-      throw Error("face " + std::to_string(c / 3) + " uses vertex " +
-                  std::to_string(mesh.triangles[c]) + " but the mesh has only " +
-                  std::to_string(nv) + " vertices");
+      throw Error(Error::Kind::InvalidMesh, "face " + std::to_string(c / 3) + " uses vertex " +
+                                                std::to_string(mesh.triangles[c]) +
+                                                " but the mesh has only " + std::to_string(nv) +
+                                                " vertices");
 
   std::vector<uint32_t> t = mesh.triangles, origin;
   remove_bad_faces(t, nv, origin, r);
@@ -395,6 +398,21 @@ RepairReport make_manifold(Mesh &mesh) {
   for (uint32_t v : copy_of)
     for (int a = 0; a < 3; ++a)
       mesh.positions.push_back(mesh.positions[3 * v + a]);
+  // A copy carries the attributes of its vertex (attributes of another length are left
+  // alone: the encoder reports them).
+  for (VertexAttribute &attr : mesh.attributes) {
+    const size_t n = attr.components;
+    const bool colour = attr.kind == AttributeKind::Colour;
+    if (n == 0 || (colour ? attr.colour.size() : attr.values.size()) != n * nv)
+      continue;
+    for (uint32_t v : copy_of)
+      for (size_t k = 0; k < n; ++k) {
+        if (colour)
+          attr.colour.push_back(attr.colour[n * v + k]);
+        else
+          attr.values.push_back(attr.values[n * v + k]);
+      }
+  }
 
   // The codec's own check must accept the result (see the argument at the top of this
   // file); if it ever does not, say so rather than hand back a wrong mesh.
@@ -403,10 +421,20 @@ RepairReport make_manifold(Mesh &mesh) {
     build_corner_table(mesh.triangles.data(), mesh.triangle_count(), mesh.vertex_count(), ct);
   } catch (const Error &e) {
     if (mesh.triangle_count() != 0)
-      throw Error(std::string("internal repair error: the repaired mesh is still invalid: ") +
-                  e.what());
+      throw Error(Error::Kind::Internal,
+                  std::string("internal repair error: the repaired mesh is still invalid: ") +
+                      e.what());
   }
   return r;
+}
+
+bool repair_would_change(const Mesh &mesh) {
+  Mesh copy = mesh;
+  try {
+    return make_manifold(copy).changed();
+  } catch (const Error &) {
+    return false;
+  }
 }
 
 } // namespace pomar

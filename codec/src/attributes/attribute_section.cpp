@@ -1,0 +1,283 @@
+// Per-vertex attributes in the bitstream: the ATTR section (descriptors, texture files, the
+// base mesh's codes) and the pieces the level coding shares (byte layout: docs/format.md).
+#include "attributes/attribute_section.h"
+
+#include <algorithm>
+#include <string>
+
+#include "format/bit_io.h"
+#include "refine/level_traversal.h"
+
+namespace pomar {
+namespace {
+
+[[noreturn]] void damaged(const std::string &what) {
+  throw Error("damaged .pomar file: ATTR section: " + what);
+}
+
+/// Range-code `count` vertices of codes, each predicted by the previous one (the first by
+/// zeros): the base mesh's codes.
+template <class Coder> void code_base(Coder &&code_one, uint32_t count, uint32_t n) {
+  for (uint32_t v = 0; v < count; ++v)
+    for (uint32_t k = 0; k < n; ++k)
+      code_one(v, k);
+}
+
+/// kind, name, components, bits and bound of a stored attribute into a VertexAttribute or
+/// an AttributeInfo.
+template <class Out> Out described(const StoredAttribute &s) {
+  Out a;
+  a.kind = s.kind;
+  a.name = s.name;
+  a.components = s.components;
+  a.bits = s.bits;
+  a.bound = s.bound();
+  return a;
+}
+
+} // namespace
+
+AttributeTable plan_attributes(const Mesh &mesh, const AttributeOptions &options) {
+  AttributeTable t;
+  for (const VertexAttribute &a : mesh.attributes)
+    if (options.keep.keeps(a.kind)) {
+      t.stored.push_back(describe(a, options));
+      t.codes += t.stored.back().codes();
+    }
+  if (t.stored.size() > 255)
+    throw Error("at most 255 attributes can be stored (the mesh has " +
+                std::to_string(t.stored.size()) + ")");
+  if (t.codes > kMaxAttributeCodes)
+    throw Error("the attributes need " + std::to_string(t.codes) + " values per vertex; at most " +
+                std::to_string(kMaxAttributeCodes) +
+                " are supported (colour 3-4, quantized normal 2, texcoord 2, scalar 1): "
+                "drop some (--drop)");
+  if (options.keep.texcoords)
+    t.texture_files = mesh.texture_files;
+  t.estimated_bytes.assign(t.stored.size(), 0);
+  return t;
+}
+
+std::vector<int64_t> attribute_codes(const Mesh &mesh, const AttributeTable &table,
+                                     const AttributeOptions &options,
+                                     const std::vector<uint32_t> &to_input) {
+  std::vector<const VertexAttribute *> kept;
+  for (const VertexAttribute &a : mesh.attributes)
+    if (options.keep.keeps(a.kind))
+      kept.push_back(&a);
+  std::vector<int64_t> codes(to_input.size() * table.codes);
+  for (size_t v = 0; v < to_input.size(); ++v) {
+    int64_t *c = &codes[v * table.codes];
+    for (size_t i = 0; i < kept.size(); ++i) {
+      to_codes(table.stored[i], *kept[i], to_input[v], c);
+      c += table.stored[i].codes();
+    }
+  }
+  return codes;
+}
+
+std::vector<AttributeCodeModels> attribute_models(const AttributeTable &table) {
+  std::vector<AttributeCodeModels> models;
+  for (const StoredAttribute &s : table.stored)
+    for (uint32_t k = 0; k < s.codes(); ++k) {
+      models.emplace_back();
+      models.back().first = k == 0;
+    }
+  return models;
+}
+
+void init_attributes(const AttributeTable &table, LevelMesh &lm) {
+  lm.attr_codes = table.codes;
+  lm.attr = table.base;
+  lm.attr_lo.clear();
+  lm.attr_hi.clear();
+  lm.normal_code = -1;
+  for (const StoredAttribute &s : table.stored) {
+    if (s.kind == AttributeKind::Normal && s.bits && lm.normal_code < 0) {
+      lm.normal_code = static_cast<int>(lm.attr_lo.size());
+      lm.normal_bits = s.bits;
+    }
+    for (uint32_t k = 0; k < s.codes(); ++k) {
+      int64_t lo, hi;
+      code_range(s, k, lo, hi);
+      lm.attr_lo.push_back(lo);
+      lm.attr_hi.push_back(hi);
+    }
+  }
+}
+
+std::vector<uint8_t> write_attributes(const AttributeTable &t) {
+  std::vector<uint8_t> out;
+  ByteWriter w(out);
+  w.u8(kAttributeSectionVersion);
+  w.u8(static_cast<uint8_t>(t.stored.size()));
+  for (size_t i = 0; i < t.stored.size(); ++i) {
+    const StoredAttribute &s = t.stored[i];
+    w.u8(static_cast<uint8_t>(s.kind));
+    w.u8(static_cast<uint8_t>(s.components));
+    w.u8(static_cast<uint8_t>(s.bits));
+    w.u8(static_cast<uint8_t>(s.name.size()));
+    w.bytes(reinterpret_cast<const uint8_t *>(s.name.data()), s.name.size());
+    for (size_t k = 0; k < s.lo.size(); ++k) {
+      w.f32(s.lo[k]);
+      w.f32(s.hi[k]);
+    }
+    w.u32(static_cast<uint32_t>(t.estimated_bytes[i]));
+    w.u32(static_cast<uint32_t>(t.estimated_bytes[i] >> 32));
+  }
+  if (t.texture_files.size() > 0xFFFF)
+    throw Error("too many texture files (" + std::to_string(t.texture_files.size()) + ")");
+  w.u16(static_cast<uint16_t>(t.texture_files.size()));
+  for (const std::string &f : t.texture_files) {
+    if (f.size() > 0xFFFF)
+      throw Error("texture file name too long: " + f.substr(0, 64) + "...");
+    w.u16(static_cast<uint16_t>(f.size()));
+    w.bytes(reinterpret_cast<const uint8_t *>(f.data()), f.size());
+  }
+  const uint32_t n = t.codes, count = n ? static_cast<uint32_t>(t.base.size() / n) : 0;
+  w.u32(count);
+  std::vector<uint8_t> stream;
+  RangeEncoder rc(&stream);
+  std::vector<AttributeCodeModels> m = attribute_models(t);
+  std::vector<int64_t> r(n);
+  code_base(
+      [&](uint32_t v, uint32_t k) {
+        const int64_t pred = v ? t.base[size_t(v - 1) * n + k] : 0;
+        r[k] = t.base[size_t(v) * n + k] - pred;
+        put_signed(rc, m[k].classes[attribute_context(m[k], r.data(), k)], m[k].top, r[k]);
+      },
+      count, n);
+  rc.finish();
+  w.u32(static_cast<uint32_t>(stream.size()));
+  w.bytes(stream.data(), stream.size());
+  return out;
+}
+
+AttributeTable read_attributes(const uint8_t *data, size_t size, uint32_t base_vertices) {
+  ByteReader r(data, size, "damaged .pomar file: ATTR section");
+  AttributeTable t;
+  const uint8_t version = r.u8();
+  if (version != kAttributeSectionVersion)
+    throw Error("ATTR section version " + std::to_string(version) +
+                " is not supported (this pomar reads version 1)");
+  const uint32_t count = r.u8();
+  auto read_string = [&](size_t len) {
+    std::string s;
+    for (size_t i = 0; i < len; ++i)
+      s.push_back(static_cast<char>(r.u8()));
+    return s;
+  };
+  for (uint32_t i = 0; i < count; ++i) {
+    StoredAttribute s;
+    const uint8_t kind = r.u8();
+    if (kind < 1 || kind > 4)
+      damaged("attribute " + std::to_string(i) + " has unknown kind " + std::to_string(kind));
+    s.kind = static_cast<AttributeKind>(kind);
+    s.components = r.u8();
+    s.bits = r.u8();
+    s.name = read_string(r.u8());
+    const uint32_t want = s.kind == AttributeKind::Normal     ? 3
+                          : s.kind == AttributeKind::TexCoord ? 2
+                          : s.kind == AttributeKind::Scalar   ? 1
+                                                              : s.components;
+    const bool bits_ok = s.kind == AttributeKind::Colour ? s.bits == 0
+                         : s.kind == AttributeKind::Normal
+                             ? s.bits == 0 || (s.bits >= 4 && s.bits <= 16)
+                             : s.bits <= 24;
+    if (s.components != want || want < 1 || want > 4 ||
+        (s.kind == AttributeKind::Colour && want < 3) || !bits_ok || s.name.empty())
+      damaged("attribute '" + s.name + "' has an invalid descriptor");
+    if (s.bits && s.kind != AttributeKind::Normal)
+      for (uint32_t k = 0; k < s.components; ++k) {
+        s.lo.push_back(r.f32());
+        s.hi.push_back(r.f32());
+      }
+    const uint64_t low = r.u32();
+    t.estimated_bytes.push_back(low | uint64_t(r.u32()) << 32);
+    t.codes += s.codes();
+    t.stored.push_back(std::move(s));
+  }
+  if (t.codes > kMaxAttributeCodes)
+    damaged("too many attribute values per vertex");
+  const uint32_t textures = r.u16();
+  for (uint32_t i = 0; i < textures; ++i)
+    t.texture_files.push_back(read_string(r.u16()));
+  const uint32_t n = t.codes;
+  if (r.u32() != base_vertices)
+    damaged("its vertex count does not match the base mesh");
+  const uint32_t bytes = r.u32();
+  if (uint64_t(r.position()) + bytes != size)
+    damaged("its stream does not fill the section");
+  t.base_stream_bytes = bytes;
+  RangeDecoder rc(data + r.position(), bytes);
+  std::vector<AttributeCodeModels> m = attribute_models(t);
+  t.base.resize(size_t(base_vertices) * n);
+  std::vector<int64_t> res(n);
+  std::vector<int64_t> lo(n), hi(n);
+  for (size_t i = 0, k = 0; i < t.stored.size(); ++i)
+    for (uint32_t c = 0; c < t.stored[i].codes(); ++c, ++k)
+      code_range(t.stored[i], c, lo[k], hi[k]);
+  code_base(
+      [&](uint32_t v, uint32_t k) {
+        res[k] = get_signed(rc, m[k].classes[attribute_context(m[k], res.data(), k)], m[k].top);
+        const int64_t pred = v ? t.base[size_t(v - 1) * n + k] : 0;
+        const int64_t c = pred + res[k];
+        if (c < lo[k] || c > hi[k])
+          damaged("a base mesh attribute lies outside its range");
+        t.base[size_t(v) * n + k] = c;
+      },
+      base_vertices, n);
+  if (rc.overrun())
+    damaged("its stream ends too early");
+  return t;
+}
+
+std::unique_ptr<AttributeTable> load_attribute_table(const uint8_t *data,
+                                                     const FileLayout &layout) {
+  const int i = find_section(layout, kAttributeSectionTag);
+  if (i < 0)
+    return nullptr;
+  const uint8_t *body = section_body(data, layout, size_t(i)); // checks its XXH32
+  return std::make_unique<AttributeTable>(
+      read_attributes(body, layout.header.sections[size_t(i)].bytes, layout.header.base_vertices));
+}
+
+void attach_attributes(const AttributeTable &t, const LevelMesh &lm, const AttributeMask &mask,
+                       Mesh &out) {
+  if (mask.texcoords)
+    out.texture_files = t.texture_files;
+  const uint32_t nv = lm.vertex_count(), n = t.codes;
+  if (lm.attr.size() != size_t(nv) * n)
+    throw Error("internal error: the decoded mesh lacks attribute codes");
+  for (size_t i = 0, first = 0; i < t.stored.size(); first += t.stored[i].codes(), ++i) {
+    const StoredAttribute &s = t.stored[i];
+    if (!mask.keeps(s.kind))
+      continue;
+    VertexAttribute a = described<VertexAttribute>(s);
+    if (s.kind == AttributeKind::Colour)
+      a.colour.resize(size_t(nv) * s.components);
+    else
+      a.values.resize(size_t(nv) * s.components);
+    for (uint32_t v = 0; v < nv; ++v)
+      from_codes(s, &lm.attr[size_t(v) * n + first], a, v);
+    out.attributes.push_back(std::move(a));
+  }
+}
+
+void describe_attributes(const AttributeTable &t, FileInfo &info) {
+  info.attributes.clear();
+  uint64_t total = 0;
+  for (size_t i = 0; i < t.stored.size(); ++i) {
+    const StoredAttribute &s = t.stored[i];
+    AttributeInfo a = described<AttributeInfo>(s);
+    a.bytes = t.estimated_bytes[i];
+    total += a.bytes;
+    info.attributes.push_back(a);
+  }
+  info.texture_files = t.texture_files;
+  // The level streams and cluster blocks carry the attributes with the geometry: count
+  // them apart (the split is the encoder's estimate, as for clustered levels).
+  info.geometry_bytes -= std::min(info.geometry_bytes, total);
+}
+
+} // namespace pomar

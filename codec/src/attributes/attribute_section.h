@@ -1,0 +1,66 @@
+// Per-vertex attributes in the bitstream (format version 4).
+//
+// Each vertex's attributes are integer codes (attribute_quantize.h). The codes of the base
+// mesh vertices are stored in the "ATTR" section, with the descriptors of the attributes;
+// every other vertex's codes are coded where its position is, in the level streams and
+// cluster blocks (refine/level_traversal.h code_vertex -> Codec::attributes): predicted by
+// the codes of v_to (the vertex it is split from) and the residuals range-coded with one
+// model set per code (adaptive in global levels, frozen per level in clustered levels, as
+// the geometry). So every decode (any level, any selection, incremental) holds exactly the
+// attributes of the vertices it decoded, and reads only the blocks it decodes.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "attributes/attribute_quantize.h"
+#include "entropy/models.h"
+#include "format/file_format.h"
+#include "pomar/pomar.h"
+
+namespace pomar {
+
+struct LevelMesh;
+
+constexpr uint32_t kAttributeSectionTag = section_tag("ATTR"); // optional (flags 0)
+constexpr uint8_t kAttributeSectionVersion = 1;
+
+/// The attributes of a file: descriptors, texture files and the codes of the base mesh.
+struct AttributeTable {
+  std::vector<StoredAttribute> stored;
+  std::vector<uint64_t> estimated_bytes; // per attribute, in the whole file (informative)
+  std::vector<std::string> texture_files;
+  uint32_t codes = 0;             // integer codes per vertex (all attributes)
+  std::vector<int64_t> base;      // codes of the base mesh vertices
+  uint64_t base_stream_bytes = 0; // the section's coded base codes
+};
+
+/// The encoder's side: what is kept of `mesh`'s attributes and how (empty table: nothing).
+/// Throws pomar::Error if they need more than kMaxAttributeCodes codes per vertex.
+AttributeTable plan_attributes(const Mesh &mesh, const AttributeOptions &options);
+/// Codes of every vertex, in the order of `to_input` (to_input[i] = the mesh's vertex).
+std::vector<int64_t> attribute_codes(const Mesh &mesh, const AttributeTable &table,
+                                     const AttributeOptions &options,
+                                     const std::vector<uint32_t> &to_input);
+/// The models of the attribute codes (Models::attr) for a table.
+std::vector<AttributeCodeModels> attribute_models(const AttributeTable &table);
+/// Give `lm` (the base mesh) its attribute codes and ranges from the table.
+void init_attributes(const AttributeTable &table, LevelMesh &lm);
+
+/// The ATTR section body of `table` (table.base holds the base vertices' codes).
+std::vector<uint8_t> write_attributes(const AttributeTable &table);
+/// Parse a section body (bounds-checked; "damaged .pomar file: ATTR section ..." errors).
+AttributeTable read_attributes(const uint8_t *data, size_t size, uint32_t base_vertices);
+/// The table of the file's ATTR section (checksum checked), or nullptr if it has none.
+std::unique_ptr<AttributeTable> load_attribute_table(const uint8_t *data, const FileLayout &layout);
+
+/// Add the attributes `mask` keeps of every vertex of `lm` to `out` (and the texture files).
+void attach_attributes(const AttributeTable &table, const LevelMesh &lm, const AttributeMask &mask,
+                       Mesh &out);
+
+/// The file's attribute summary for FileInfo; `bytes` per attribute from the encoder's
+/// ideal code lengths of its residuals in the whole file (0 if unknown).
+void describe_attributes(const AttributeTable &table, FileInfo &info);
+
+} // namespace pomar

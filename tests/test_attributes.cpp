@@ -1,0 +1,528 @@
+// Attribute quantizers, checks and (with the encoder) round trips of every attribute kind.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <map>
+#include <memory>
+#include <random>
+
+#include "attributes/attribute_quantize.h"
+#include "pomar/pomar.h"
+#include "pomar/random_access.h"
+#include "support/mesh_gen.h"
+
+namespace pomar {
+namespace {
+
+double angle_degrees(const float a[3], const float b[3]) {
+  // atan2 of |a x b| and a.b: acos of the dot loses small angles to float rounding.
+  const double x = double(a[1]) * b[2] - double(a[2]) * b[1];
+  const double y = double(a[2]) * b[0] - double(a[0]) * b[2];
+  const double z = double(a[0]) * b[1] - double(a[1]) * b[0];
+  const double dot = double(a[0]) * b[0] + double(a[1]) * b[1] + double(a[2]) * b[2];
+  return std::atan2(std::sqrt(x * x + y * y + z * z), dot) * 180.0 / M_PI;
+}
+
+/// Normals uniform on the sphere, plus the axes, the octahedron's edges and its folds.
+std::vector<std::array<float, 3>> test_normals(size_t count, uint32_t seed) {
+  std::vector<std::array<float, 3>> out;
+  for (int a = 0; a < 3; ++a)
+    for (float s : {-1.0f, 1.0f}) {
+      std::array<float, 3> n = {0, 0, 0};
+      n[a] = s;
+      out.push_back(n);
+    }
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> g;
+  std::uniform_real_distribution<float> u(-1, 1);
+  while (out.size() < count) {
+    std::array<float, 3> n = {g(rng), g(rng), g(rng)};
+    if (out.size() % 7 == 0)
+      n[out.size() % 3] = 0; // on a fold / an edge of the octahedron
+    if (out.size() % 11 == 0)
+      n = {u(rng), 1.0f - std::fabs(n[0]), 0.0f};
+    if (n[0] == 0 && n[1] == 0 && n[2] == 0)
+      continue;
+    out.push_back(n);
+  }
+  return out;
+}
+
+TEST(AttributeQuantize, YCoCgRIsExactOnEveryColour) {
+  for (int r = 0; r < 256; r += 1)
+    for (int g = 0; g < 256; g += 3)
+      for (int b = 0; b < 256; b += 5) {
+        const uint8_t rgb[3] = {uint8_t(r), uint8_t(g), uint8_t(b)};
+        int32_t c[3];
+        rgb_to_ycocg(rgb, c);
+        ASSERT_GE(c[0], 0);
+        ASSERT_LE(c[0], 255);
+        ASSERT_GE(c[1], -255);
+        ASSERT_LE(c[2], 255);
+        uint8_t back[3];
+        ycocg_to_rgb(c, back);
+        ASSERT_EQ(0, std::memcmp(rgb, back, 3)) << r << " " << g << " " << b;
+      }
+}
+
+TEST(AttributeQuantize, FloatCodesAreOrderedAndExact) {
+  const float values[] = {-std::numeric_limits<float>::infinity(),
+                          -1e30f,
+                          -1.0f,
+                          -1e-40f,
+                          -0.0f,
+                          0.0f,
+                          1e-45f,
+                          1e-40f,
+                          0.5f,
+                          1.0f,
+                          3e38f,
+                          std::numeric_limits<float>::infinity()};
+  for (size_t i = 0; i < sizeof(values) / sizeof(float); ++i) {
+    const float back = code_float(float_code(values[i]));
+    EXPECT_EQ(0, std::memcmp(&back, &values[i], 4)) << values[i];
+    if (i) {
+      EXPECT_LT(float_code(values[i - 1]), float_code(values[i]));
+    }
+  }
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float back = code_float(float_code(nan));
+  EXPECT_EQ(0, std::memcmp(&back, &nan, 4));
+}
+
+// The bound table (normal_error_bound) against measured errors; prints the measurement.
+// (The table was measured with 2,000,000 samples: POMAR_NORMAL_SAMPLES=2000000.)
+const size_t kNormalSamples =
+    std::getenv("POMAR_NORMAL_SAMPLES") ? std::stoul(std::getenv("POMAR_NORMAL_SAMPLES")) : 200000;
+TEST(AttributeQuantize, OctahedralNormalsStayWithinTheirBound) {
+  const auto normals = test_normals(kNormalSamples, 7);
+  for (int bits = 4; bits <= 16; ++bits) {
+    double worst = 0;
+    for (const auto &n : normals) {
+      uint32_t u, v;
+      octahedral_encode(n.data(), bits, u, v);
+      ASSERT_LE(u, (1u << bits) - 2);
+      ASSERT_LE(v, (1u << bits) - 2);
+      float d[3];
+      octahedral_decode(u, v, bits, d);
+      worst = std::max(worst, angle_degrees(n.data(), d));
+      ASSERT_NEAR(1.0, std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), 1e-6);
+    }
+    std::printf("normal bits %2d: max error %.5f degrees (bound %.4f)\n", bits, worst,
+                normal_error_bound(bits));
+    EXPECT_LE(worst, normal_error_bound(bits)) << bits;
+    EXPECT_GT(worst, normal_error_bound(bits) / 4) << "bound too loose at " << bits;
+  }
+  EXPECT_LE(normal_error_bound(AttributeOptions().normal_bits), 0.5);
+}
+
+TEST(AttributeQuantize, RangeQuantizerWithinHalfAStep) {
+  VertexAttribute a;
+  a.kind = AttributeKind::TexCoord;
+  a.name = "texcoord";
+  a.components = 2;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-0.25f, 1.5f), w(0.0f, 0.001f);
+  for (int i = 0; i < 5000; ++i) {
+    a.values.push_back(u(rng));
+    a.values.push_back(w(rng));
+  }
+  for (int bits : {1, 8, 12, 16, 24}) {
+    AttributeOptions o;
+    o.texcoord_bits = bits;
+    const StoredAttribute s = describe(a, o);
+    VertexAttribute out = a;
+    for (size_t v = 0; v < a.vertex_count(); ++v) {
+      int64_t codes[2];
+      to_codes(s, a, v, codes);
+      from_codes(s, codes, out, v);
+    }
+    double worst = 0;
+    for (size_t i = 0; i < a.values.size(); ++i)
+      worst = std::max(worst, std::fabs(double(out.values[i]) - a.values[i]));
+    EXPECT_LE(worst, s.bound()) << bits;
+    EXPECT_GT(worst, s.bound() / 4) << bits;
+  }
+}
+
+Mesh triangle_with(VertexAttribute a) {
+  Mesh m;
+  m.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  m.triangles = {0, 1, 2};
+  m.attributes.push_back(std::move(a));
+  return m;
+}
+
+void expect_error(const Mesh &m, bool quantized, const char *fragment) {
+  try {
+    validate_attributes(m, quantized);
+    ADD_FAILURE() << "no error, expected one containing: " << fragment;
+  } catch (const Error &e) {
+    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+  }
+}
+
+TEST(AttributeQuantize, ValidationNamesTheProblem) {
+  VertexAttribute c;
+  c.kind = AttributeKind::Colour;
+  c.name = "colour";
+  c.components = 3;
+  c.colour = {1, 2, 3, 4, 5, 6};
+  expect_error(triangle_with(c), false, "has 6 values, the mesh has 3 vertices x 3 = 9");
+  c.components = 2;
+  c.colour.assign(6, 0);
+  expect_error(triangle_with(c), false, "colour needs 3 (RGB) or 4 (RGBA)");
+  c.components = 4;
+  c.colour.assign(12, 7);
+  EXPECT_NO_THROW(validate_attributes(triangle_with(c), true));
+  c.name.clear();
+  expect_error(triangle_with(c), false, "a name of 1 to 255 bytes");
+
+  VertexAttribute s;
+  s.kind = AttributeKind::Scalar;
+  s.name = "confidence";
+  s.values = {0.5f, std::numeric_limits<float>::quiet_NaN(), 1.0f};
+  expect_error(triangle_with(s), true, "scalar attribute 'confidence' of vertex 1 is NaN");
+  EXPECT_NO_THROW(validate_attributes(triangle_with(s), false)); // exact mode keeps NaN
+  Mesh two = triangle_with(s);
+  two.attributes.push_back(s);
+  expect_error(two, false, "two attributes are named 'confidence'");
+
+  VertexAttribute n;
+  n.kind = AttributeKind::Normal;
+  n.name = "normal";
+  n.components = 3;
+  n.values = {0, 0, 1, 0, 0, 0, 1, 0, 0};
+  expect_error(triangle_with(n), true, "of vertex 1 has length 0");
+  EXPECT_NO_THROW(validate_attributes(triangle_with(n), false));
+}
+
+// ---------------------------------------------------------------- round trips
+
+/// Which attributes with_attributes adds.
+enum Has { kColour = 1, kAlpha = 2, kNormals = 4, kScalars = 8, kTexcoords = 16, kAll = 31 };
+
+/// `m` with smooth colours (plus noise in the low bits), normals (the radial direction,
+/// plus noise), scalars "quality" (smooth) and "confidence" (random), spherical UVs.
+Mesh with_attributes(Mesh m, int has, uint32_t seed = 1) {
+  const size_t nv = m.vertex_count();
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<int> noise(-3, 3);
+  std::uniform_real_distribution<float> unit(0, 1);
+  auto p = [&](size_t v, int k) { return m.positions[3 * v + k]; };
+  auto make = [](AttributeKind kind, const char *name, uint32_t components) {
+    VertexAttribute a;
+    a.kind = kind;
+    a.name = name;
+    a.components = components;
+    return a;
+  };
+  if (has & kColour) {
+    VertexAttribute a = make(AttributeKind::Colour, "colour", (has & kAlpha) ? 4 : 3);
+    for (size_t v = 0; v < nv; ++v)
+      for (uint32_t k = 0; k < a.components; ++k) {
+        const int c = int(127.5 + 120 * std::sin(2.0 * p(v, k % 3) + k)) + noise(rng);
+        a.colour.push_back(static_cast<uint8_t>(std::max(0, std::min(255, c))));
+      }
+    m.attributes.push_back(a);
+  }
+  if (has & kNormals) {
+    VertexAttribute a = make(AttributeKind::Normal, "normal", 3);
+    for (size_t v = 0; v < nv; ++v)
+      for (int k = 0; k < 3; ++k)
+        a.values.push_back(p(v, k) + 0.05f * (unit(rng) - 0.5f));
+    m.attributes.push_back(a);
+  }
+  if (has & kScalars) {
+    VertexAttribute q = make(AttributeKind::Scalar, "quality", 1);
+    VertexAttribute c = make(AttributeKind::Scalar, "confidence", 1);
+    for (size_t v = 0; v < nv; ++v) {
+      q.values.push_back(100.0f * p(v, 0) * p(v, 1) + 3.0f * p(v, 2));
+      c.values.push_back(unit(rng));
+    }
+    m.attributes.push_back(q);
+    m.attributes.push_back(c);
+  }
+  if (has & kTexcoords) {
+    VertexAttribute a = make(AttributeKind::TexCoord, "texcoord", 2);
+    for (size_t v = 0; v < nv; ++v) {
+      a.values.push_back(0.5f + std::atan2(p(v, 1), p(v, 0)) / 6.2831853f);
+      a.values.push_back(0.5f + 0.5f * p(v, 2));
+    }
+    m.attributes.push_back(a);
+    m.texture_files = {"skin.png", "detail map.jpg"};
+  }
+  return m;
+}
+
+struct Coded {
+  Mesh input;
+  std::vector<uint8_t> file;
+  EncodeReport report;
+};
+
+Coded encode_with(Mesh m, bool clustered, const AttributeOptions &attributes = {}) {
+  Coded c;
+  c.input = std::move(m);
+  EncodeOptions o;
+  o.bits = 16; // positions (nearly) unique: the tests match vertices by position
+  o.progressive = !clustered;
+  o.cluster_ratio = 0.02;
+  o.attributes = attributes;
+  c.file = encode(c.input, o, &c.report);
+  return c;
+}
+
+/// Decoded attribute `got` of decoded vertex v against input vertex i.
+void expect_close(const VertexAttribute &in, const VertexAttribute &got, size_t i, size_t v,
+                  bool exact) {
+  ASSERT_EQ(in.components, got.components);
+  if (in.kind == AttributeKind::Colour) {
+    for (uint32_t k = 0; k < in.components; ++k)
+      ASSERT_EQ(in.colour[i * in.components + k], got.colour[v * in.components + k])
+          << in.name << " vertex " << v;
+    return;
+  }
+  const float *a = &in.values[i * in.components], *b = &got.values[v * in.components];
+  if (exact) {
+    ASSERT_EQ(0, std::memcmp(a, b, 4 * in.components)) << in.name << " vertex " << v;
+    return;
+  }
+  if (in.kind == AttributeKind::Normal) {
+    ASSERT_LE(angle_degrees(a, b), got.bound) << in.name << " vertex " << v;
+    return;
+  }
+  for (uint32_t k = 0; k < in.components; ++k)
+    ASSERT_LE(std::fabs(double(a[k]) - b[k]), got.bound) << in.name << " vertex " << v;
+}
+
+/// Every attribute of `out` (a full decode) against the input.
+void expect_round_trip(const Coded &c, const Mesh &out, bool exact) {
+  ASSERT_EQ(out.attributes.size(), c.input.attributes.size());
+  EXPECT_EQ(out.texture_files, c.input.texture_files);
+  for (const VertexAttribute &in : c.input.attributes) {
+    const VertexAttribute *got = out.find(in.kind, in.name);
+    ASSERT_NE(got, nullptr) << in.name;
+    ASSERT_EQ(got->vertex_count(), out.vertex_count());
+    if (exact || in.kind == AttributeKind::Colour) {
+      EXPECT_EQ(got->bits, 0);
+    }
+    for (size_t v = 0; v < out.vertex_count(); ++v)
+      expect_close(in, *got, c.report.decoded_to_input[v], v, exact);
+  }
+}
+
+using Position = std::array<float, 3>;
+Position position_of(const Mesh &m, size_t v) {
+  return {m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]};
+}
+
+/// `part` (an intermediate or selective decode) has, for each of its vertices, the
+/// attributes the full decode `full` gives the vertex at the same position (a vertex keeps
+/// its position from the level that creates it on).
+void expect_same_as_full(const Mesh &part, const Mesh &full) {
+  std::map<Position, size_t> at;
+  for (size_t v = 0; v < full.vertex_count(); ++v)
+    ASSERT_TRUE(at.emplace(position_of(full, v), v).second) << "positions must be unique";
+  ASSERT_EQ(part.attributes.size(), full.attributes.size());
+  for (size_t i = 0; i < full.attributes.size(); ++i) {
+    const VertexAttribute &f = full.attributes[i], &p = part.attributes[i];
+    ASSERT_EQ(p.name, f.name);
+    ASSERT_EQ(p.vertex_count(), part.vertex_count());
+    const uint32_t n = f.components;
+    for (size_t v = 0; v < part.vertex_count(); ++v) {
+      const auto it = at.find(position_of(part, v));
+      ASSERT_NE(it, at.end());
+      if (f.kind == AttributeKind::Colour)
+        ASSERT_EQ(0, std::memcmp(&p.colour[v * n], &f.colour[it->second * n], n)) << f.name;
+      else
+        ASSERT_EQ(0, std::memcmp(&p.values[v * n], &f.values[it->second * n], 4 * n)) << f.name;
+    }
+  }
+  EXPECT_EQ(part.texture_files, full.texture_files);
+}
+
+TEST(AttributeRoundTrip, EveryCombinationProgressiveAndClustered) {
+  const Mesh sphere = gen::noisy_sphere(1500, 4, 0.1);
+  for (int has :
+       {int(kColour), kColour | kAlpha, int(kNormals), int(kScalars), int(kTexcoords), int(kAll)})
+    for (bool clustered : {false, true}) {
+      SCOPED_TRACE("attributes " + std::to_string(has) + (clustered ? " clustered" : ""));
+      const Coded c = encode_with(with_attributes(sphere, has), clustered);
+      const FileInfo info = inspect(c.file.data(), c.file.size());
+      EXPECT_EQ(info.version, 4u);
+      EXPECT_EQ(info.clustered(), clustered);
+      EXPECT_EQ(info.attributes.size(), c.input.attributes.size());
+      EXPECT_GT(info.attribute_bytes, 0u);
+      expect_round_trip(c, decode(c.file.data(), c.file.size()), false);
+    }
+}
+
+TEST(AttributeRoundTrip, SeveralBitDepths) {
+  const Mesh m = with_attributes(gen::noisy_sphere(800, 2, 0.1), kAll);
+  for (int bits : {4, 8, 12, 16}) {
+    SCOPED_TRACE(bits);
+    AttributeOptions o;
+    o.normal_bits = bits;
+    o.scalar_bits = bits;
+    o.texcoord_bits = bits;
+    const Coded c = encode_with(m, true, o);
+    const Mesh out = decode(c.file.data(), c.file.size());
+    expect_round_trip(c, out, false);
+    EXPECT_EQ(out.find(AttributeKind::Normal)->bits, bits);
+    EXPECT_DOUBLE_EQ(out.find(AttributeKind::Normal)->bound, normal_error_bound(bits));
+  }
+}
+
+TEST(AttributeRoundTrip, ExactModeIsBitExactWithSpecialValues) {
+  Mesh m = with_attributes(gen::noisy_sphere(600, 3, 0.1), kAll);
+  VertexAttribute &q = *m.find(AttributeKind::Scalar, "quality");
+  q.values[0] = std::numeric_limits<float>::quiet_NaN();
+  q.values[1] = -std::numeric_limits<float>::infinity();
+  q.values[2] = 1e-42f; // denormal
+  q.values[3] = -0.0f;
+  VertexAttribute &n = *m.find(AttributeKind::Normal);
+  n.values[3] = n.values[4] = n.values[5] = 0; // zero-length normal
+  AttributeOptions o;
+  o.exact = true;
+  EXPECT_THROW(encode_with(m, false), Error); // quantized: NaN is an error
+  for (bool clustered : {false, true}) {
+    const Coded c = encode_with(m, clustered, o);
+    expect_round_trip(c, decode(c.file.data(), c.file.size()), true);
+  }
+}
+
+TEST(AttributeRoundTrip, IntermediateLevelsHaveTheFullDecodesAttributes) {
+  const Mesh m = with_attributes(gen::noisy_sphere(1200, 5, 0.1), kAll);
+  for (bool clustered : {false, true}) {
+    const Coded c = encode_with(m, clustered);
+    const Mesh full = decode(c.file.data(), c.file.size());
+    const FileInfo info = inspect(c.file.data(), c.file.size());
+    for (int level = 0; level <= int(info.levels.size()); ++level) {
+      SCOPED_TRACE("level " + std::to_string(level));
+      expect_same_as_full(decode(c.file.data(), c.file.size(), level), full);
+    }
+  }
+}
+
+TEST(AttributeRoundTrip, SelectiveDecodesHaveTheFullDecodesAttributes) {
+  const Coded c = encode_with(with_attributes(gen::noisy_sphere(3000, 6, 0.1), kAll), true);
+  const Mesh full = decode(c.file.data(), c.file.size());
+  SelectiveDecoder d(std::make_unique<MemorySource>(c.file.data(), c.file.size()));
+  expect_same_as_full(d.mesh(), full); // base clustered mesh
+  const float centre[3] = {1, 0, 0};
+  d.want_sphere(centre, 0.5f, d.finest_level());
+  d.update();
+  EXPECT_GT(d.clusters_decoded(), 0u);
+  EXPECT_LT(d.mesh().vertex_count(), full.vertex_count());
+  expect_same_as_full(d.mesh(), full);
+  const float other[3] = {-1, 0, 0};
+  d.want_sphere(other, 0.5f, d.finest_level() - 1); // incremental
+  d.update();
+  expect_same_as_full(d.mesh(), full);
+  d.clear_wanted(); // coarsening re-decodes
+  d.want_cluster(3, d.finest_level());
+  d.update();
+  expect_same_as_full(d.mesh(), full);
+}
+
+TEST(AttributeRoundTrip, DropAndSkip) {
+  const Mesh m = with_attributes(gen::noisy_sphere(500, 7, 0.1), kAll);
+  AttributeOptions o;
+  o.keep.colour = false;
+  o.keep.texcoords = false;
+  const Coded c = encode_with(m, true, o);
+  Mesh out = decode(c.file.data(), c.file.size());
+  EXPECT_EQ(out.find(AttributeKind::Colour), nullptr);
+  EXPECT_EQ(out.find(AttributeKind::TexCoord), nullptr);
+  EXPECT_TRUE(out.texture_files.empty());
+  EXPECT_NE(out.find(AttributeKind::Normal), nullptr);
+  EXPECT_EQ(out.attributes.size(), 3u);
+  DecodeOptions none;
+  none.attributes = AttributeMask::none();
+  for (int level : {-1, 0, 2}) {
+    none.level = level;
+    EXPECT_TRUE(decode(c.file.data(), c.file.size(), none).attributes.empty());
+  }
+  DecodeOptions scalars_only;
+  scalars_only.attributes = AttributeMask::none();
+  scalars_only.attributes.scalars = true;
+  out = decode(c.file.data(), c.file.size(), scalars_only);
+  ASSERT_EQ(out.attributes.size(), 2u);
+  EXPECT_EQ(out.attributes[1].name, "confidence");
+
+  // Nothing kept: the file is the same as without attributes (version 1/3).
+  AttributeOptions drop_all;
+  drop_all.keep = AttributeMask::none();
+  Mesh plain = m;
+  plain.attributes.clear();
+  plain.texture_files.clear();
+  EXPECT_EQ(encode_with(m, true, drop_all).file, encode_with(plain, true).file);
+  EXPECT_EQ(
+      inspect(encode_with(plain, false).file.data(), encode_with(plain, false).file.size()).version,
+      1u);
+}
+
+TEST(AttributeRoundTrip, BadInputIsRefused) {
+  Mesh m = with_attributes(gen::noisy_sphere(200, 8, 0.1), kColour | kScalars);
+  m.attributes[0].colour.pop_back();
+  EXPECT_THROW(encode(m), Error);
+  m = with_attributes(gen::noisy_sphere(200, 8, 0.1), kScalars);
+  m.attributes[0].values[5] = std::numeric_limits<float>::infinity();
+  try {
+    encode(m);
+    ADD_FAILURE();
+  } catch (const Error &e) {
+    EXPECT_NE(std::string(e.what()).find("'quality' of vertex 5 is infinite"), std::string::npos)
+        << e.what();
+  }
+  AttributeOptions dropped;
+  dropped.keep.scalars = false; // a dropped attribute is not checked
+  EncodeOptions o;
+  o.attributes = dropped;
+  EXPECT_NO_THROW(encode(m, o));
+}
+
+TEST(AttributeRoundTrip, DamagedSectionIsAClearError) {
+  const Coded c = encode_with(with_attributes(gen::noisy_sphere(300, 9, 0.1), kColour), false);
+  const FileInfo info = inspect(c.file.data(), c.file.size());
+  std::vector<uint8_t> bad = c.file;
+  bad[info.header_bytes + info.base_bytes + 3] ^= 0x10; // inside the ATTR body
+  try {
+    decode(bad.data(), bad.size());
+    ADD_FAILURE();
+  } catch (const Error &e) {
+    EXPECT_NE(std::string(e.what()).find("ATTR"), std::string::npos) << e.what();
+  }
+  // The base mesh's codes are there: a decode without attributes needs them too (the other
+  // vertices' codes are interleaved with their positions).
+  DecodeOptions none;
+  none.attributes = AttributeMask::none();
+  EXPECT_THROW(decode(bad.data(), bad.size(), none), Error);
+}
+
+// Attributes are coded with the positions, in the level streams and cluster blocks: a
+// selective decode reads only the blocks of its clusters, whose size grows with them.
+TEST(AttributeRoundTrip, SelectiveDecodesReadOnlyTheirBlocks) {
+  const Mesh plain = gen::noisy_sphere(3000, 10, 0.1);
+  const Coded with = encode_with(with_attributes(plain, kAll), true);
+  const Coded without = encode_with(plain, true);
+  const FileInfo a = inspect(with.file.data(), with.file.size());
+  const FileInfo b = inspect(without.file.data(), without.file.size());
+  EXPECT_EQ(a.clusters, b.clusters);
+  EXPECT_GT(a.cluster_bytes, b.cluster_bytes + 3000); // the attributes are in the blocks
+  EXPECT_LT(a.attribute_bytes, a.total_bytes / 20);   // the section: base mesh only
+  SelectiveDecoder d(std::make_unique<MemorySource>(with.file.data(), with.file.size()));
+  d.want_cluster(0, d.base_clustered_level() + 2);
+  d.update();
+  EXPECT_LT(d.blocks_read(), a.clusters / 4);
+  EXPECT_LT(d.bytes_read(), a.global_bytes + a.cluster_bytes / 4); // not the other blocks
+  expect_same_as_full(d.mesh(), decode(with.file.data(), with.file.size()));
+}
+
+} // namespace
+} // namespace pomar
