@@ -425,6 +425,11 @@ def main():
                         ">= %d vertices always 1)" % SINGLE_RUN_VERTICES)
     p.add_argument("--build", default=os.path.join(REPO, "build"), help="CMake build folder")
     p.add_argument("--no-draco", action="store_true", help="skip the Draco columns")
+    p.add_argument("--generated", metavar="N,N,...",
+                   help="vertex counts of the generated spheres (default %s)"
+                        % ",".join(str(n) for n in GENERATED))
+    p.add_argument("--no-random-access", action="store_true",
+                   help="skip the random-access section")
     args = p.parse_args()
     t_start = time.perf_counter()
     load_at_start = os.getloadavg()[0] if hasattr(os, "getloadavg") else None
@@ -468,7 +473,8 @@ def main():
                         notes.append("data/%s: not found in %s" % (name, data))
             else:
                 notes.append("real meshes: %s not found (use --data DIR)" % data)
-        generated = [] if args.no_generated else (GENERATED[:1] if args.quick else GENERATED)
+        sizes = [int(n) for n in args.generated.split(",")] if args.generated else GENERATED
+        generated = [] if args.no_generated else (sizes[:1] if args.quick else sizes)
         for n in generated:
             inputs.append(("gen/noisy_sphere_%dk" % (n // 1000), n, "generated"))
 
@@ -494,7 +500,7 @@ def main():
             shutil.rmtree(mesh_dir, ignore_errors=True)
 
         ra_blocks, ra_notes = [], []
-        if not args.quick:
+        if not args.quick and not args.no_random_access:
             ra_blocks, ra_notes = random_access(args, tools, workdir, data)
 
         elapsed = time.perf_counter() - t_start

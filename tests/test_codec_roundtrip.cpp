@@ -179,5 +179,20 @@ TEST(Codec, LevelOutOfRangeIsAnError) {
   EXPECT_THROW(decode(file.data(), file.size(), -2), Error);
 }
 
+// Decimation evaluates its candidates on several threads: the file must not depend on how
+// many (the mesh is large enough for every thread to get a slice).
+TEST(Codec, FileDoesNotDependOnThreadCount) {
+  const Mesh mesh = gen::noisy_sphere(70000, 7);
+  std::vector<uint8_t> files[3];
+  const unsigned threads[3] = {1, 2, 7};
+  for (int i = 0; i < 3; ++i) {
+    EncodeOptions options;
+    options.threads = threads[i];
+    files[i] = encode(mesh, options);
+  }
+  EXPECT_EQ(files[0], files[1]);
+  EXPECT_EQ(files[0], files[2]);
+}
+
 } // namespace
 } // namespace pomar

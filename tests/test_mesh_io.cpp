@@ -286,9 +286,10 @@ TEST_F(MeshIoTest, ObjAttributesRoundTrip) {
     // coordinates are per corner: vertex 4, which no face uses, has none (zeros).
     EXPECT_EQ(b->colour, a.colour);
     const size_t four = 4 * size_t(a.components);
-    if (!a.values.empty())
+    if (!a.values.empty()) {
       EXPECT_EQ(std::vector<float>(b->values.begin(), b->values.begin() + four),
                 std::vector<float>(a.values.begin(), a.values.begin() + four));
+    }
   }
 }
 
@@ -817,3 +818,54 @@ TEST_F(MeshIoTest, WriteAndReadFile) {
 }
 
 } // namespace
+
+// save_mesh writes binary PLY from the flat arrays, not through vcglib's exporter: the
+// bytes must still be exactly the exporter's (its header, float xyz, uchar 3 + int x3).
+TEST_F(MeshIoTest, BinaryPlyHasVcglibsExactBytes) {
+  pomar::Mesh m;
+  m.positions = {0.f, 1.5f, -2.f, 3.25f, 4.f, 5.f, -0.f, 1e-7f, 6.f, 7.f, 8.f, 9.f};
+  m.triangles = {0, 1, 2, 0, 2, 3, 3, 2, 1};
+  pomar::save_mesh(path("m.ply"), m, true);
+  std::string want = "ply\nformat binary_little_endian 1.0\ncomment VCGLIB generated\n"
+                     "element vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+                     "element face 3\nproperty list uchar int vertex_indices\nend_header\n";
+  want.append(reinterpret_cast<const char *>(m.positions.data()), 4 * m.positions.size());
+  for (size_t f = 0; f < 3; ++f) {
+    want.push_back(3);
+    for (int k = 0; k < 3; ++k) {
+      const int32_t v = static_cast<int32_t>(m.triangles[3 * f + k]);
+      want.append(reinterpret_cast<const char *>(&v), 4);
+    }
+  }
+  EXPECT_EQ(read_text(path("m.ply")), want);
+  EXPECT_EQ(list_dir().size(), 1u); // no temporary file left behind
+}
+
+// Binary PLY of float xyz + uchar/int triangles is read without vcglib: unreferenced
+// vertices are still dropped and counted, the others keep their order; a file outside that
+// case (here: a quad) goes through the general reader.
+TEST_F(MeshIoTest, SimpleBinaryPlyKeepsAndCountsUnreferencedVertices) {
+  pomar::Mesh m;
+  m.positions = {0, 0, 0, 9, 9, 9, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+  m.triangles = {0, 2, 3, 0, 3, 4, 0, 4, 2, 2, 4, 3};
+  pomar::save_mesh(path("t.ply"), m, true);
+  pomar::LoadReport report;
+  const pomar::Mesh back = pomar::load_mesh(path("t.ply"), &report);
+  EXPECT_EQ(report.unreferenced_vertices, 1u);
+  EXPECT_EQ(report.file_vertices, 5u);
+  EXPECT_EQ(report.file_faces, 4u);
+  EXPECT_EQ(back.positions, m.positions); // kept: the codec stores them (lossless stage)
+  EXPECT_EQ(back.triangles, m.triangles);
+
+  std::string quad = "ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\n"
+                     "property float y\nproperty float z\nelement face 1\n"
+                     "property list uchar int vertex_indices\nend_header\n";
+  const float xyz[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+  quad.append(reinterpret_cast<const char *>(xyz), sizeof xyz);
+  quad.push_back(4);
+  for (int32_t v = 0; v < 4; ++v)
+    quad.append(reinterpret_cast<const char *>(&v), 4);
+  const pomar::Mesh two = pomar::load_mesh(write("q.ply", quad), &report);
+  EXPECT_EQ(two.triangle_count(), 2u);
+  EXPECT_EQ(report.polygons_triangulated, 1u);
+}

@@ -84,6 +84,7 @@ struct EncodeArgs {
   double cluster_ratio = 0.01;
   bool progressive = false, quiet = false, repair = false, strict = false, keep_order = false;
   std::string max_memory = "auto";
+  unsigned threads = 0;
   pomar::AttributeOptions attributes;
   std::string drop;
 };
@@ -161,6 +162,7 @@ int run_encode(const EncodeArgs &a) {
   opt.clusters = a.clusters;
   opt.cluster_ratio = a.cluster_ratio;
   opt.progressive = a.progressive;
+  opt.threads = a.threads;
   opt.progress = terminal_progress(a.quiet);
   opt.memory_limit = memory_limit;
   opt.attributes = a.attributes;
@@ -780,6 +782,10 @@ int main(int argc, char **argv) {
       ->capture_default_str();
   enc->add_flag("--progressive", ea.progressive,
                 "Pure progressive mode: global levels only, no random access (a little smaller)");
+  enc->add_option("--threads", ea.threads,
+                  "Threads for decimation (0 = every core this process may use); the output is the "
+                  "same for any number")
+      ->capture_default_str();
   enc->add_flag("--repair", ea.repair,
                 "Opt-in: first cut a non-manifold, inconsistently oriented or degenerate mesh into "
                 "a manifold one (remove faces repeating a vertex and exact duplicate faces, "

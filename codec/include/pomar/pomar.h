@@ -118,6 +118,9 @@ struct EncodeOptions {
   uint32_t clusters = 0;
   double cluster_ratio = 0.01;
   bool progressive = false; ///< pure progressive mode: global levels only, no clusters
+  /// Threads for the encoder's parallel steps (decimation's candidate evaluation); 0 = the
+  /// cores this process may run on. The file does not depend on it.
+  unsigned threads = 0;
   Progress progress;        ///< optional
   /// Peak memory allowed, in bytes: encode() throws pomar::Error before its large
   /// allocations if it would need more (pomar/limits.h). 0 = automatic (the memory

@@ -2,6 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
+#include <exception>
+#include <mutex>
+#include <thread>
+
+#ifdef __linux__
+#include <sched.h>
+#endif
 
 namespace pomar {
 namespace {
@@ -41,17 +49,24 @@ struct Candidate {
   }
 };
 
-class Decimator {
+/// What evaluating a collapse reads and its scratch (rings, options, link marks): one per
+/// thread while the candidates of a level are evaluated, the first one also for the
+/// greedy pass. Evaluation only reads the mesh.
+class Evaluator {
 public:
-  Decimator(CornerTable &ct, const std::vector<int32_t> &q, const DecimationOptions &opt)
-      : ct_(ct), q_(q), opt_(opt),
-        target_mark_(ct.vertex_count(), 0), dirty_(ct.vertex_count(), 0),
-        nb_stamp_(ct.vertex_count(), 0) {}
+  Evaluator(const CornerTable &ct, const std::vector<int32_t> &q, const DecimationOptions &opt)
+      : ct_(ct), q_(q), opt_(opt), nb_stamp_(ct.vertex_count(), 0) {}
 
-  /// Run one level; returns its collapses.
-  std::vector<Collapse> run_level(std::vector<uint32_t> &alive);
+  /// The candidates of the vertices [first, last) of `alive`, in that order.
+  void evaluate(const uint32_t *first, const uint32_t *last, std::vector<Candidate> &out) {
+    for (const uint32_t *v = first; v != last; ++v) {
+      get_ring(ct_, *v, from_);
+      Candidate c;
+      if (best_option(*v, c))
+        out.push_back(c);
+    }
+  }
 
-private:
   uint32_t v_l_index(uint32_t i) const { // index of v_l in ring_from_, or kNone
     const uint32_t m = from_.size();
     if (from_.closed)
@@ -68,27 +83,50 @@ private:
     const uint32_t m = from_.size();
     return k != i && k != (from_.closed ? (i + m - 1) % m : i - 1);
   }
+  bool link_ok(uint32_t v_from, uint32_t i);
+
+  Ring from_, to_;
+
+private:
   bool allowed_direction(uint32_t i) const;
   int64_t metric(uint32_t i) const;
-  bool link_ok(uint32_t v_from, uint32_t i);
   bool normals_ok(uint32_t v_from, uint32_t i) const;
   bool best_option(uint32_t v_from, Candidate &out);
+
+  const CornerTable &ct_;
+  const std::vector<int32_t> &q_;
+  const DecimationOptions &opt_;
+  std::vector<uint32_t> nb_stamp_; // scratch marks for the link condition
+  uint32_t nb_counter_ = 0;
+  std::vector<Option> options_;
+};
+
+class Decimator {
+public:
+  Decimator(CornerTable &ct, const std::vector<int32_t> &q, const DecimationOptions &opt)
+      : ct_(ct), target_mark_(ct.vertex_count(), 0), dirty_(ct.vertex_count(), 0) {
+    const unsigned threads = std::max(1u, opt.threads);
+    for (unsigned t = 0; t < threads; ++t)
+      eval_.emplace_back(ct, q, opt);
+  }
+
+  /// Run one level; returns its collapses.
+  std::vector<Collapse> run_level(std::vector<uint32_t> &alive);
+
+private:
+  std::vector<Candidate> candidates(const std::vector<uint32_t> &alive);
   Collapse collapse(uint32_t v_from, uint32_t i);
 
   CornerTable &ct_;
-  const std::vector<int32_t> &q_;
-  const DecimationOptions &opt_;
   std::vector<uint32_t> target_mark_; // level stamp of vertices already used as v_to
   std::vector<uint32_t> dirty_;       // level stamp of vertices whose ring changed
-  std::vector<uint32_t> nb_stamp_;    // scratch marks for the link condition
-  uint32_t level_stamp_ = 0, nb_counter_ = 0;
-  Ring from_, to_;
-  std::vector<Option> options_;
+  uint32_t level_stamp_ = 0;
+  std::deque<Evaluator> eval_;        // eval_[0]: also the greedy pass's
 };
 
 // Boundary rule: a boundary vertex may only slide along its boundary (onto the first or
 // last neighbour of its open fan); an interior vertex may collapse onto any neighbour.
-bool Decimator::allowed_direction(uint32_t i) const {
+bool Evaluator::allowed_direction(uint32_t i) const {
   const uint32_t m = from_.size();
   if (m < 3)
     return false; // v_from would leave no face behind
@@ -97,7 +135,7 @@ bool Decimator::allowed_direction(uint32_t i) const {
 
 // Length^2 of v_to-v_ref, v_ref being the farthest vertex that gets a new edge to v_to.
 // With no new edge (v_from of valence 3), v_ref is v_l (or v_r on a boundary).
-int64_t Decimator::metric(uint32_t i) const {
+int64_t Evaluator::metric(uint32_t i) const {
   const uint32_t v_to = from_.neighbour[i];
   const uint32_t il = v_l_index(i), ir = v_r_index(i);
   int64_t best = -1;
@@ -111,7 +149,7 @@ int64_t Decimator::metric(uint32_t i) const {
 
 // Link condition: v_from and v_to may share no neighbour but v_l and v_r. Also refuse to
 // collapse an edge of a tetrahedron (two closed valence-3 vertices).
-bool Decimator::link_ok(uint32_t v_from, uint32_t i) {
+bool Evaluator::link_ok(uint32_t v_from, uint32_t i) {
   const uint32_t v_to = from_.neighbour[i];
   get_ring(ct_, v_to, to_);
   if (from_.closed && to_.closed && from_.size() == 3 && to_.size() == 3)
@@ -131,7 +169,7 @@ bool Decimator::link_ok(uint32_t v_from, uint32_t i) {
 }
 
 // No surviving patch face may turn its normal by more than acos(normal_cosine).
-bool Decimator::normals_ok(uint32_t v_from, uint32_t i) const {
+bool Evaluator::normals_ok(uint32_t v_from, uint32_t i) const {
   (void)v_from;
   const uint32_t v_to = from_.neighbour[i];
   const double c2 = opt_.normal_cosine * opt_.normal_cosine;
@@ -156,7 +194,7 @@ bool Decimator::normals_ok(uint32_t v_from, uint32_t i) const {
 }
 
 // The admissible halfedge of v_from with the smallest metric (ring from_ is filled).
-bool Decimator::best_option(uint32_t v_from, Candidate &out) {
+bool Evaluator::best_option(uint32_t v_from, Candidate &out) {
   options_.clear();
   for (uint32_t i = 0; i < from_.size(); ++i)
     if (allowed_direction(i))
@@ -175,8 +213,10 @@ bool Decimator::best_option(uint32_t v_from, Candidate &out) {
 
 // Halfedge collapse v_from -> v_to = from_.neighbour[i] on the corner table.
 Collapse Decimator::collapse(uint32_t v_from, uint32_t i) {
+  const Evaluator &e = eval_[0];
+  const Ring &from_ = e.from_;
   const uint32_t m = from_.size();
-  const uint32_t il = v_l_index(i), ir = v_r_index(i);
+  const uint32_t il = e.v_l_index(i), ir = e.v_r_index(i);
   const uint32_t v_to = from_.neighbour[i];
   Collapse op{v_from, v_to, il == kNone ? kNone : from_.neighbour[il],
               ir == kNone ? kNone : from_.neighbour[ir]};
@@ -186,7 +226,7 @@ Collapse Decimator::collapse(uint32_t v_from, uint32_t i) {
                                       : kNone;
   // Relabel the surviving faces of v_from (the patch).
   for (uint32_t k = 0; k < from_.faces(); ++k) {
-    if (!face_survives(k, i))
+    if (!e.face_survives(k, i))
       continue;
     ct_.V[from_.corner[k]] = v_to;
     ct_.VC[v_to] = from_.corner[k];
@@ -218,17 +258,48 @@ Collapse Decimator::collapse(uint32_t v_from, uint32_t i) {
   return op;
 }
 
+// Every alive vertex's best collapse. Evaluation only reads the mesh: with several threads
+// each evaluates one contiguous slice of `alive`, and the slices are joined in order, so
+// the list is the same whatever the thread count.
+std::vector<Candidate> Decimator::candidates(const std::vector<uint32_t> &alive) {
+  constexpr size_t kMinSlice = 16384; // below this a thread costs more than it saves
+  const size_t n = alive.size();
+  const size_t threads = std::min<size_t>(eval_.size(), std::max<size_t>(1, n / kMinSlice));
+  std::vector<std::vector<Candidate>> part(threads);
+  const auto slice = [&](size_t t) {
+    part[t].reserve(n / threads + 1);
+    eval_[t].evaluate(alive.data() + n * t / threads, alive.data() + n * (t + 1) / threads,
+                      part[t]);
+  };
+  std::vector<std::thread> pool;
+  std::exception_ptr error;
+  std::mutex error_mutex;
+  const auto guarded_slice = [&](size_t t) {
+    try {
+      slice(t);
+    } catch (...) {
+      const std::lock_guard<std::mutex> lock(error_mutex);
+      error = std::current_exception();
+    }
+  };
+  for (size_t t = 1; t < threads; ++t)
+    pool.emplace_back(guarded_slice, t);
+  guarded_slice(0);
+  for (std::thread &th : pool)
+    th.join();
+  if (error)
+    std::rethrow_exception(error);
+  for (size_t t = 1; t < threads; ++t)
+    part[0].insert(part[0].end(), part[t].begin(), part[t].end());
+  return std::move(part[0]);
+}
+
 std::vector<Collapse> Decimator::run_level(std::vector<uint32_t> &alive) {
   ++level_stamp_;
-  std::vector<Candidate> candidates;
-  candidates.reserve(alive.size());
-  for (uint32_t v : alive) {
-    get_ring(ct_, v, from_);
-    Candidate c;
-    if (best_option(v, c))
-      candidates.push_back(c);
-  }
+  std::vector<Candidate> candidates = this->candidates(alive);
   std::sort(candidates.begin(), candidates.end());
+  Evaluator &e = eval_[0];
+  Ring &from_ = e.from_;
   // Greedy pass, shortest first. A candidate whose v_from has an unchanged ring still has
   // untouched faces (a collapse touching one of them would have changed that ring) and an
   // unchanged metric and normal test; only the link condition depends on v_to's ring.
@@ -238,7 +309,7 @@ std::vector<Collapse> Decimator::run_level(std::vector<uint32_t> &alive) {
       continue;
     get_ring(ct_, c.v_from, from_);
     const int i = from_.index_of(c.v_to);
-    if (i < 0 || (dirty_[c.v_to] == level_stamp_ && !link_ok(c.v_from, static_cast<uint32_t>(i))))
+    if (i < 0 || (dirty_[c.v_to] == level_stamp_ && !e.link_ok(c.v_from, static_cast<uint32_t>(i))))
       continue;
     done.push_back(collapse(c.v_from, static_cast<uint32_t>(i)));
   }
@@ -249,6 +320,15 @@ std::vector<Collapse> Decimator::run_level(std::vector<uint32_t> &alive) {
 }
 
 } // namespace
+
+unsigned available_cores() {
+#ifdef __linux__
+  cpu_set_t set;
+  if (sched_getaffinity(0, sizeof set, &set) == 0 && CPU_COUNT(&set) > 0)
+    return static_cast<unsigned>(CPU_COUNT(&set));
+#endif
+  return std::max(1u, std::thread::hardware_concurrency());
+}
 
 Decimation decimate(CornerTable ct, const std::vector<int32_t> &q,
                     const DecimationOptions &options, const Progress &progress) {

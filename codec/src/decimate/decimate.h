@@ -26,6 +26,7 @@ struct DecimationOptions {
   double normal_cosine = 0.7;  ///< reject collapses turning a patch face normal more
   double min_level_fraction = 0.002; ///< stop when a level removes fewer vertices than this
   uint32_t max_levels = 250;
+  unsigned threads = 1; ///< threads evaluating the candidates (the result does not depend on it)
 };
 
 struct Decimation {
@@ -34,6 +35,9 @@ struct Decimation {
   std::vector<std::vector<Collapse>> levels;
   std::vector<uint32_t> base_triangles; ///< surviving faces, input vertex ids
 };
+
+/// The cores this process may run on (its CPU affinity mask; at least 1).
+unsigned available_cores();
 
 /// Decimate the mesh described by `ct` (consumed) with quantized positions `q` (xyz).
 Decimation decimate(CornerTable ct, const std::vector<int32_t> &q,

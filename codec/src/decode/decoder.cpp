@@ -1,6 +1,7 @@
 // pomar::decode (a global level target decodes the global levels here; a clustered target
 // goes through the SelectiveDecoder), pomar::inspect, pomar::check_blocks,
 // pomar::describe_damage.
+#include <algorithm>
 #include <memory>
 #include <string>
 
@@ -148,6 +149,9 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
     }
   }
   LevelMesh lm = base_level_mesh(data, layout);
+  const size_t reach = std::min(target, global);
+  if (reach > 0)
+    lm.reserve(h.levels[reach - 1].vertices, h.levels[reach - 1].faces, size);
   Models models;
   // Attribute codes come with the positions: decoded whatever the mask says.
   const std::unique_ptr<AttributeTable> attributes = load_attribute_table(data, layout);
@@ -158,9 +162,13 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
   r.level = static_cast<int>(decode_global_levels(data, layout, 0, std::min(target, global), lm,
                                                   models, options.progress,
                                                   options.skip_damaged ? &r.damaged : nullptr));
-  Mesh mesh = to_mesh(lm, h.grid);
-  if (attributes)
+  Mesh mesh;
+  if (attributes) {
+    mesh = to_mesh(lm, h.grid);
     attach_attributes(*attributes, lm, options.attributes, mesh);
+  } else {
+    mesh = to_mesh(std::move(lm), h.grid); // hands over the triangles: no copy
+  }
   if (r.level == static_cast<int>(levels)) {
     try {
       undo_cut(data, layout, mesh); // the full mesh: as it was input (attributes follow)

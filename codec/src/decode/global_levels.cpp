@@ -18,6 +18,13 @@ Mesh to_mesh(const LevelMesh &lm, const Quantizer &grid) {
   return out;
 }
 
+Mesh to_mesh(LevelMesh &&lm, const Quantizer &grid) {
+  Mesh out;
+  out.positions = dequantize(grid, lm.q);
+  out.triangles = std::move(lm.ct.V);
+  return out;
+}
+
 LevelMesh base_level_mesh(const uint8_t *data, const FileLayout &layout) {
   const FileHeader &h = layout.header;
   const BaseMesh base = read_base_mesh(data, layout);

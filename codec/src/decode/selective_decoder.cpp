@@ -386,6 +386,12 @@ void SelectiveDecoder::State::decode_target(const Progress &progress, uint32_t &
   size_t todo = 0, done = 0;
   for (size_t c = 0; c < target.size(); ++c)
     todo += size_t(target[c] - clusters[c].level);
+  // The whole mesh to one level (a full decode): the level table gives the final counts.
+  const auto [lo, hi] = std::minmax_element(target.begin(), target.end());
+  if (!target.empty() && *lo == *hi && *hi > global_levels) {
+    const LevelEntry &e = layout.header.levels[size_t(*hi - 1)];
+    mesh.reserve(e.vertices, e.faces, source->size());
+  }
   for (int level = global_levels + 1; level <= finest; ++level) {
     // Nothing finer than level-1 exists yet: every current vertex is older than `level`.
     int finest_now = global_levels;

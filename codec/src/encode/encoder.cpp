@@ -181,7 +181,9 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
   const double t_quantize = seconds_since(t0);
 
   auto t1 = std::chrono::steady_clock::now();
-  const Decimation dec = decimate(std::move(in.ct), in.q, DecimationOptions{}, options.progress);
+  DecimationOptions decimation;
+  decimation.threads = options.threads ? options.threads : available_cores();
+  const Decimation dec = decimate(std::move(in.ct), in.q, decimation, options.progress);
   const double t_decimate = seconds_since(t1);
 
   auto t2 = std::chrono::steady_clock::now();

@@ -48,9 +48,12 @@ std::vector<int32_t> quantize(const Quantizer &g, const float *p, size_t n) {
 }
 
 std::vector<float> dequantize(const Quantizer &g, const std::vector<int32_t> &q) {
+  // Quantizer::dequantize for every coordinate, the step computed once (same floats).
   std::vector<float> p(q.size());
+  const double step = g.step();
+  const double origin[3] = {g.origin[0], g.origin[1], g.origin[2]};
   for (size_t i = 0; i < q.size(); ++i)
-    p[i] = g.dequantize(static_cast<int>(i % 3), static_cast<uint32_t>(q[i]));
+    p[i] = static_cast<float>(origin[i % 3] + double(static_cast<uint32_t>(q[i])) * step);
   return p;
 }
 

@@ -160,6 +160,46 @@ bool write_all(int fd, const char *data, size_t size) {
   return true;
 }
 
+ChunkedFileWriter::ChunkedFileWriter(const std::string &target)
+    : target_(target), tmp_(target), buf_(size_t(1) << 20) {
+  fd_ = ::open(tmp_.path().c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (fd_ < 0)
+    fail_io(target_, "cannot create temporary file '" + tmp_.path() + "': " + errno_text(errno));
+}
+
+ChunkedFileWriter::~ChunkedFileWriter() {
+  if (fd_ >= 0)
+    ::close(fd_);
+}
+
+void ChunkedFileWriter::flush() {
+  if (!write_all(fd_, buf_.data(), used_))
+    fail_io(target_, "cannot write: " + errno_text(errno));
+  used_ = 0;
+}
+
+void ChunkedFileWriter::put(const void *data, size_t size) {
+  const char *p = static_cast<const char *>(data);
+  while (size > 0) {
+    if (used_ == buf_.size())
+      flush();
+    const size_t n = std::min(size, buf_.size() - used_);
+    std::memcpy(buf_.data() + used_, p, n);
+    used_ += n, p += n, size -= n;
+  }
+}
+
+void ChunkedFileWriter::commit() {
+  flush();
+  if (::fsync(fd_) != 0)
+    fail_io(target_, "fsync failed: " + errno_text(errno));
+  const int fd = fd_;
+  fd_ = -1;
+  if (::close(fd) != 0)
+    fail_io(target_, "cannot write (close): " + errno_text(errno));
+  tmp_.commit(false);
+}
+
 void clear_flags(IoMesh &m) {
   for (auto &v : m.vert)
     v.Flags() = 0;

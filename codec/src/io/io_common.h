@@ -249,6 +249,35 @@ private:
 /// Writes all of data to fd, retrying after signals and short writes.
 bool write_all(int fd, const char *data, size_t size);
 
+/// Writes a file atomically (like write_file_atomic) from pieces, through a 1 MiB buffer:
+/// put() / reserve() fill it, commit() flushes, fsyncs and renames the temporary file over
+/// the target. Destroyed without commit(), it removes the temporary file.
+class ChunkedFileWriter {
+public:
+  explicit ChunkedFileWriter(const std::string &target);
+  ~ChunkedFileWriter();
+  ChunkedFileWriter(const ChunkedFileWriter &) = delete;
+  ChunkedFileWriter &operator=(const ChunkedFileWriter &) = delete;
+  void put(const void *data, size_t size);
+  /// Room for `size` (<= 4096) bytes at the end of the buffer, which the caller fills.
+  char *reserve(size_t size) {
+    if (used_ + size > buf_.size())
+      flush();
+    char *p = buf_.data() + used_;
+    used_ += size;
+    return p;
+  }
+  void commit();
+
+private:
+  void flush();
+  std::string target_;
+  TempFile tmp_;
+  int fd_ = -1;
+  std::vector<char> buf_;
+  size_t used_ = 0;
+};
+
 // ---- The vcglib mesh the importers fill ----
 
 class IoVertex;
@@ -323,8 +352,11 @@ void check_written_size(const std::string &file, uint64_t expected, const std::s
 // ply_io.cpp
 Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &check);
 std::string ply_ascii_text(const Mesh &mesh);
-/// Binary PLY through vcglib's exporter, via a temporary file.
+/// Binary little-endian PLY, byte for byte what vcglib's exporter writes, from the flat
+/// arrays in large chunks (save_ply_binary_vcg: through vcglib's exporter, the reference
+/// the tests compare with and the path on big-endian hosts).
 void save_ply_binary(const std::string &path, const Mesh &mesh);
+void save_ply_binary_vcg(const std::string &path, const Mesh &mesh);
 /// A PLY file (ASCII or binary little-endian) with the mesh's attributes as vertex
 /// properties (red green blue [alpha] uchar, nx ny nz, texture_u texture_v, one float per
 /// scalar by its name) and "comment TextureFile" lines.

@@ -9,6 +9,7 @@
 #include <wrap/io_trimesh/import_ply.h>
 
 #include <climits>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 
@@ -657,6 +658,71 @@ uint64_t ply_header_size(const std::string &file, const std::string &target) {
   fail(target, "vcglib wrote a PLY file without end_header");
 }
 
+/// The common case read straight into the flat arrays: binary little-endian, a vertex
+/// element of exactly float x, y, z, then a face element of exactly one uchar-counted int
+/// or uint "vertex_indices" list, all triangles with valid indices, finite coordinates.
+/// Returns false for anything else (attributes, polygons, damage, ...) having changed only
+/// `in`'s position: the general path then reads the file (and names what is wrong).
+bool read_simple_ply(FileReader &in, const PlyHeader &h, Mesh &out, size_t &unreferenced) {
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+  if (h.encoding != PlyHeader::BinaryLittle || h.elements.size() != 2)
+    return false;
+  const PlyElement &ve = h.elements[0], &fe = h.elements[1];
+  if (ve.name != "vertex" || ve.props.size() != 3 || fe.name != "face" || fe.props.size() != 1)
+    return false;
+  for (int k = 0; k < 3; ++k)
+    if (ve.props[size_t(k)].is_list || ve.props[size_t(k)].type != PlyType::F32 ||
+        ve.props[size_t(k)].name != std::string(1, char('x' + k)))
+      return false;
+  const PlyProperty &list = fe.props[0];
+  if (list.name != "vertex_indices" || !is_list_of(&list, list.type, PlyType::U8) ||
+      (list.type != PlyType::I32 && list.type != PlyType::U32))
+    return false;
+  const uint64_t nv = ve.count, nf = fe.count;
+  if (nv == 0 || nf == 0 || nv >= UINT32_MAX || nf > UINT32_MAX / 3 ||
+      in.remaining() / 13 < nf || in.remaining() - 13 * nf < 12 * nv)
+    return false;
+  std::vector<float> positions(3 * nv);
+  if (!in.read(positions.data(), 12 * nv))
+    return false;
+  for (uint64_t i = 0; i < 3 * nv; ++i)
+    if (!std::isfinite(positions[i]))
+      return false;
+  std::vector<uint32_t> triangles(3 * nf);
+  std::vector<uint32_t> used(nv, 0);
+  constexpr uint64_t kChunk = 65536;
+  std::vector<unsigned char> buf(13 * kChunk);
+  for (uint64_t f0 = 0; f0 < nf; f0 += kChunk) {
+    const uint64_t n = std::min(kChunk, nf - f0);
+    if (!in.read(buf.data(), 13 * n))
+      return false;
+    for (uint64_t f = 0; f < n; ++f) {
+      const unsigned char *p = &buf[13 * f];
+      if (p[0] != 3)
+        return false;
+      uint32_t *t = &triangles[3 * (f0 + f)];
+      std::memcpy(t, p + 1, 12);
+      for (int k = 0; k < 3; ++k) { // (int indices: negative ones are >= nv as uint32)
+        if (t[k] >= nv)
+          return false;
+        used[t[k]] = 1;
+      }
+    }
+  }
+  // As from_vcg(..., keep_unreferenced): vertices no face uses are counted and kept (the
+  // codec stores them).
+  unreferenced = 0;
+  for (uint64_t v = 0; v < nv; ++v)
+    unreferenced += used[v] == 0;
+  out.positions = std::move(positions);
+  out.triangles = std::move(triangles);
+  return true;
+#else
+  (void)in, (void)h, (void)out, (void)unreferenced;
+  return false;
+#endif
+}
+
 } // namespace
 
 Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &check) {
@@ -674,7 +740,22 @@ Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &chec
         vertex = &e;
     plan = plan_vertex_attributes(vertex, report.ignored_attributes);
     texture_files = header.texture_files;
-    layout = PlyWalker(in, header, path, &plan).run();
+    const uint64_t data_start = in.pos();
+    Mesh fast;
+    size_t unreferenced = 0;
+    if (texture_files.empty() && read_simple_ply(in, header, fast, unreferenced)) {
+      report.file_vertices = header.elements[0].count;
+      report.file_faces = faces;
+      report.unreferenced_vertices = unreferenced;
+      return fast;
+    }
+    if (in.pos() == data_start) {
+      layout = PlyWalker(in, header, path, &plan).run();
+    } else { // the general path reads the data from its start
+      FileReader again(path);
+      read_ply_header(again, path);
+      layout = PlyWalker(again, header, path, &plan).run();
+    }
     if (layout.triangles > faces) // polygons or triangle strips
       run_size_check(check, path, layout.vertices, layout.triangles);
   }
@@ -817,6 +898,31 @@ std::string ply_with_attributes(const Mesh &mesh, bool binary, const std::string
 }
 
 void save_ply_binary(const std::string &path, const Mesh &mesh) {
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+  // The bytes vcglib's exporter writes for our mesh type (same header, float xyz, a uchar
+  // count and three ints per face), written from the flat arrays in large chunks instead
+  // of through a vcglib copy and one fwrite per value.
+  const uint64_t nv = mesh.vertex_count(), nf = mesh.triangle_count();
+  const std::string header = "ply\nformat binary_little_endian 1.0\ncomment VCGLIB generated\n"
+                             "element vertex " + num(nv) +
+                             "\nproperty float x\nproperty float y\nproperty float z\n"
+                             "element face " + num(nf) +
+                             "\nproperty list uchar int vertex_indices\nend_header\n";
+  ChunkedFileWriter out(path);
+  out.put(header.data(), header.size());
+  out.put(mesh.positions.data(), 12 * nv);
+  for (uint64_t f = 0; f < nf; ++f) {
+    char *p = out.reserve(13);
+    p[0] = 3;
+    std::memcpy(p + 1, &mesh.triangles[3 * f], 12);
+  }
+  out.commit();
+#else
+  save_ply_binary_vcg(path, mesh);
+#endif
+}
+
+void save_ply_binary_vcg(const std::string &path, const Mesh &mesh) {
   IoMesh m;
   to_vcg(mesh, m);
   TempFile tmp(path);

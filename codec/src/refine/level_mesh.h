@@ -42,6 +42,23 @@ struct LevelMesh {
       parent[v] = v;
     face_claim.assign(ct.face_count(), 0);
   }
+  /// Room for the counts a decode will reach (from the level table), so that applying the
+  /// splits appends without reallocating. A hint: counts no plausible file of
+  /// `file_bytes` bytes reaches (a hostile header) reserve nothing.
+  void reserve(uint64_t vertices, uint64_t faces, uint64_t file_bytes) {
+    const uint64_t plausible = 64 * file_bytes + 1024;
+    if (vertices > plausible || faces > 2 * plausible)
+      return;
+    ct.V.reserve(3 * faces);
+    ct.O.reserve(3 * faces);
+    ct.VC.reserve(vertices);
+    q.reserve(3 * vertices);
+    tag.reserve(vertices);
+    parent.reserve(vertices);
+    if (!local.empty())
+      local.reserve(vertices);
+    face_claim.reserve(faces);
+  }
   /// Make the current mesh the base clustered mesh (paper section 5.2): each vertex
   /// roots the cluster with its id; vertices created later inherit their v_to's cluster.
   void root_clusters() {

@@ -116,36 +116,51 @@ inline uint32_t view_of(const LevelMesh &mesh, uint32_t v, const LevelView &view
 }
 
 /// Like get_ring, mapping neighbours through view_of and skipping the faces that collapse
-/// in the view (one pass for an interior vertex).
+/// in the view. One walk round the fan collects its corners (counter-clockwise from the
+/// fan's clockwise end); one pass over them maps the neighbours and keeps, in place, the
+/// corners of the faces the view does not skip.
 inline void get_view_ring(const LevelMesh &mesh, uint32_t v, const LevelView &level, Ring &view) {
   const CornerTable &ct = mesh.ct;
+  std::vector<uint32_t> &corner = view.corner;
   view.neighbour.clear();
-  view.corner.clear();
+  corner.clear();
   view.closed = true;
   const uint32_t start = ct.VC[v];
   if (start == kNone)
     return;
-  uint32_t first = start;
-  for (uint32_t c = ct.swing_ccw(start); c != start; c = ct.swing_ccw(c)) {
-    if (c == kNone) { // open fan: start from its clockwise end
+  uint32_t c = start;
+  do {
+    corner.push_back(c);
+    const uint32_t o = ct.O[CornerTable::next(c)];
+    if (o == kNone) {
       view.closed = false;
-      for (uint32_t b = ct.swing_cw(first); b != kNone; b = ct.swing_cw(b))
-        first = b;
       break;
     }
+    c = CornerTable::next(o);
+  } while (c != start);
+  if (!view.closed) { // open fan: the corners clockwise of `start` go first
+    const size_t after = corner.size();
+    for (uint32_t b = ct.swing_cw(start); b != kNone; b = ct.swing_cw(b))
+      corner.push_back(b);
+    if (corner.size() > after) {
+      std::rotate(corner.begin(), corner.begin() + after, corner.end());
+      std::reverse(corner.begin(), corner.begin() + (corner.size() - after));
+    }
   }
-  uint32_t prev = view_of(mesh, ct.V[CornerTable::next(first)], level);
+  const size_t n = corner.size();
+  uint32_t prev = view_of(mesh, ct.V[CornerTable::next(corner[0])], level);
   view.neighbour.push_back(prev);
-  uint32_t c = first;
-  do {
-    const uint32_t next = view_of(mesh, ct.V[CornerTable::prev(c)], level);
+  size_t kept = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const uint32_t ci = corner[i];
+    const uint32_t next = view_of(mesh, ct.V[CornerTable::prev(ci)], level);
     if (next != prev) {
-      view.corner.push_back(c);
+      corner[kept++] = ci;
       view.neighbour.push_back(next);
     }
     prev = next;
-    c = ct.swing_ccw(c);
-  } while (c != kNone && c != first);
+  }
+  corner.resize(kept);
   if (view.closed && view.neighbour.size() > 1)
     view.neighbour.pop_back(); // the wrap-around repeats the first neighbour
 }
@@ -255,6 +270,20 @@ void queue_neighbours(TraversalScratch &s, uint32_t v, uint32_t from, const Ring
   }
 }
 
+/// The walks are memory bound: fetch the corners of the vertex 8 places ahead in the
+/// queue, and the corner reference of the one 16 places ahead.
+inline void prefetch_ahead(const LevelMesh &mesh, const TraversalScratch &s, size_t head) {
+  if (head + 8 < s.queue.size()) {
+    const uint32_t ahead = mesh.ct.VC[s.queue[head + 8].first];
+    if (ahead != kNone) {
+      __builtin_prefetch(&mesh.ct.O[ahead]);
+      __builtin_prefetch(&mesh.ct.V[ahead]);
+    }
+  }
+  if (head + 16 < s.queue.size())
+    __builtin_prefetch(&mesh.ct.VC[s.queue[head + 16].first]);
+}
+
 /// Traverse the whole mesh once for global level `level` (all components, seeded by the
 /// base faces in order), appending the splits to `splits`. `s` is begun by the caller.
 template <class Codec>
@@ -270,16 +299,7 @@ void traverse_level(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t
     s.marks[b].queued = s.stamp;
     s.queue.emplace_back(b, a);
     while (head < s.queue.size()) {
-      // The walk is memory bound: fetch the corners of a vertex a few steps ahead.
-      if (head + 8 < s.queue.size()) {
-        const uint32_t ahead = mesh.ct.VC[s.queue[head + 8].first];
-        if (ahead != kNone) {
-          __builtin_prefetch(&mesh.ct.O[ahead]);
-          __builtin_prefetch(&mesh.ct.V[ahead]);
-        }
-      }
-      if (head + 16 < s.queue.size())
-        __builtin_prefetch(&mesh.ct.VC[s.queue[head + 16].first]);
+      prefetch_ahead(mesh, s, head);
       const auto [v, from] = s.queue[head++];
       get_ring(mesh.ct, v, s.ring);
       code_vertex(mesh, codec, s, v, s.ring, level, id, splits);
@@ -309,6 +329,7 @@ void traverse_cluster(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32
   s.marks[root].queued = s.stamp;
   s.queue.emplace_back(root, from);
   for (size_t head = 0; head < s.queue.size();) {
+    prefetch_ahead(mesh, s, head);
     const auto [v, came_from] = s.queue[head++];
     get_view_ring(mesh, v, level, s.ring);
     code_vertex(mesh, codec, s, v, s.ring, level.level, key, splits);

@@ -40,11 +40,24 @@ void rank_edges(const LevelMesh &mesh, uint32_t v, const Ring &ring, std::vector
     ranked[i] = i;
     len2[i] = squared_distance(mesh.q, v, ring.neighbour[i]);
   }
-  std::sort(ranked.begin(), ranked.end(), [&](uint32_t a, uint32_t b) {
+  const auto before = [&](uint32_t a, uint32_t b) {
     if (len2[a] != len2[b])
       return len2[a] > len2[b];
     return key(ring.neighbour[a]) < key(ring.neighbour[b]);
-  });
+  };
+  if (m > 16) {
+    std::sort(ranked.begin(), ranked.end(), before);
+    return;
+  }
+  // What std::sort does with 16 elements or fewer, inlined: an insertion sort. (A view
+  // ring can name one neighbour twice: such ties must stay in std::sort's order.)
+  for (uint32_t i = 1; i < m; ++i) {
+    const uint32_t x = ranked[i];
+    uint32_t j = i;
+    for (; j > 0 && before(x, ranked[j - 1]); --j)
+      ranked[j] = ranked[j - 1];
+    ranked[j] = x;
+  }
 }
 
 /// Turn (s_e, s_l, s_r) into ring positions; false if they do not describe a valid patch.
