@@ -286,9 +286,21 @@ EMSCRIPTEN_KEEPALIVE int pw_damaged_count(Handle *h) { return int(h->decoder->da
 /// indices per face), pw_vertex_cluster, pw_vertex_level point at it until the next call.
 EMSCRIPTEN_KEEPALIVE int pw_extract(Handle *h) {
   return guarded([&] {
-    h->mesh = h->decoder->mesh();
-    h->vertex_cluster = h->decoder->vertex_cluster();
-    h->vertex_level = h->decoder->vertex_level();
+    // Every cluster at the finest level: exactly the encoded input (a lossless record
+    // undone, as `pomar decode` gives it); otherwise the coded mesh. Cluster and level
+    // follow each vertex from the coded mesh (a vertex no coded face uses takes those of
+    // vertex 0: it draws nothing).
+    std::vector<uint32_t> from;
+    h->mesh = h->decoder->exact_mesh(&from);
+    const std::vector<uint32_t> cluster = h->decoder->vertex_cluster();
+    const std::vector<uint32_t> level = h->decoder->vertex_level();
+    h->vertex_cluster.resize(from.size());
+    h->vertex_level.resize(from.size());
+    for (size_t v = 0; v < from.size(); ++v) {
+      const uint32_t f = from[v] < cluster.size() ? from[v] : 0;
+      h->vertex_cluster[v] = cluster.empty() ? 0 : cluster[f];
+      h->vertex_level[v] = level.empty() ? 0 : level[f];
+    }
     return 0;
   });
 }
