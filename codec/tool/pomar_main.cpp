@@ -276,19 +276,41 @@ std::vector<double> parse_spec(const std::string &spec, size_t count, int finest
   return v;
 }
 
-// Exit statuses (README "Exit codes"). Errors exit 1 whatever their pomar::Error kind
-// (invalid mesh, damaged or truncated file, I/O, memory limit, bad argument): scripts and
-// the end-to-end tests rely on that; only a broken invariant of the codec (a bug) gets its
-// own status. exit_status() is the one place that maps kinds to statuses.
-constexpr int kExitError = 1;
-/// verify: the mesh differs; info --check / decode --skip-damaged: damaged blocks found
-/// (the decode still wrote its output).
-constexpr int kExitMismatch = 3;
-constexpr int kExitDamaged = 3;
-constexpr int kExitInternal = 70; // EX_SOFTWARE
+// Exit statuses (README "Exit codes"): one per kind of failure, so that scripts can tell
+// a bad mesh from a damaged file from a full disk without reading the message.
+// exit_status() is the one place that maps pomar::Error kinds to statuses.
+constexpr int kExitError = 1;       // any other error
+constexpr int kExitUsage = 2;       // a value the command cannot use (level, cluster, size...)
+constexpr int kExitMismatch = 3;    // verify: the mesh differs
+constexpr int kExitDamaged = 4;     // a damaged or truncated .pomar file; info --check and
+                                    // decode --skip-damaged: damaged blocks (output written)
+constexpr int kExitInvalidMesh = 5; // a mesh the codec cannot take (or an unreadable mesh file)
+constexpr int kExitIo = 6;          // a file that cannot be read or written
+constexpr int kExitMemory = 7;      // the memory limit
+constexpr int kExitUnsupported = 8; // a .pomar version or section this build does not read
+constexpr int kExitInternal = 70;   // EX_SOFTWARE: a broken invariant of the codec (a bug)
 
 int exit_status(const pomar::Error &e) {
-  return e.kind() == pomar::Error::Kind::Internal ? kExitInternal : kExitError;
+  using Kind = pomar::Error::Kind;
+  switch (e.kind()) {
+  case Kind::Usage:
+    return kExitUsage;
+  case Kind::DamagedFile:
+  case Kind::TruncatedFile:
+    return kExitDamaged;
+  case Kind::InvalidMesh:
+    return kExitInvalidMesh;
+  case Kind::Io:
+    return kExitIo;
+  case Kind::MemoryLimit:
+    return kExitMemory;
+  case Kind::Unsupported:
+    return kExitUnsupported;
+  case Kind::Internal:
+    return kExitInternal;
+  default:
+    return kExitError;
+  }
 }
 
 /// List skipped blocks on stderr; returns the exit status (0 or kExitDamaged).
@@ -753,10 +775,14 @@ int main(int argc, char **argv) {
       "  pomar encode messy.stl fixed.pomar --repair # keep the cut (manifold) mesh instead\n"
       "  pomar verify messy.stl fixed.pomar --repair # lossless w.r.t. the repaired mesh\n"};
   app.require_subcommand(1);
+  app.footer("Exit status: 0 success, 1 other error, 2 unusable value (level, cluster, size), "
+             "3 verify mismatch, 4 damaged or truncated .pomar (or damaged blocks found or "
+             "skipped), 5 mesh the codec cannot take, 6 I/O, 7 memory limit, 8 unsupported "
+             ".pomar version or section, 70 internal error.");
   // Ctrl-C or kill during a write: no temporary file left, the old output untouched.
   pomar::remove_temporary_files_on_signals();
   app.set_version_flag("--version",
-                       "pomar 0.1.0 (writes .pomar format versions 1, 3 and 4 (attributes), reads 1 to 4)");
+                       "pomar 0.1.0 (writes .pomar format versions 1, 3 and 4, reads 1 to 4)");
 
   EncodeArgs ea;
   auto *enc =
@@ -864,7 +890,7 @@ int main(int argc, char **argv) {
                 "of failing: a damaged cluster stays at the base clustered level and its "
                 "neighbours at most one level finer per step, a damaged global level stops the "
                 "decoding before it. Skipped blocks are listed on stderr and the exit status is "
-                "3 (the output is written). The header, base mesh, tables and index must be "
+                "4 (the output is written). The header, base mesh, tables and index must be "
                 "intact");
   dec->add_flag("-q,--quiet", da.quiet, "Print nothing on success");
   dec->add_flag("--no-attributes", da.no_attributes,
@@ -887,7 +913,7 @@ int main(int argc, char **argv) {
                 "One JSON object (keys: vertices, faces, bits, levels, "
                 "connectivity_bits, geometry_bits, total_bytes, ...)");
   inf->add_flag("--check", info_check,
-                "Check every block's checksum instead (no decoding); exit status 3 lists the "
+                "Check every block's checksum instead (no decoding); exit status 4 lists the "
                 "damaged or missing blocks");
 
   std::string v_orig, v_file, v_decoded, v_drop;
