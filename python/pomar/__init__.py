@@ -54,8 +54,8 @@ class Mesh:
 
     def _attributes(self):
         """The attribute fields as the keyword arguments of _pomar's encode/write_mesh."""
-        return {"colors": self.colors, "normals": self.normals, "scalars": self.scalars,
-                "texcoords": self.texcoords, "texture_files": self.texture_files}
+        return {key: getattr(self, key, None)
+                for key in ("colors", "normals", "scalars", "texcoords", "texture_files")}
 
     def __repr__(self):
         kinds = [name for name in ("colors", "normals", "texcoords")
@@ -90,7 +90,7 @@ def encode(vertices, faces=None, *, bits=12, clusters=0, cluster_ratio=0.01,
     if isinstance(vertices, Mesh):
         if faces is not None:
             raise TypeError("encode(mesh) takes no faces argument")
-        attributes = vertices._attributes()
+        attributes = Mesh._attributes(vertices)
         vertices, faces = vertices.vertices, vertices.faces
     elif faces is None:
         raise TypeError("encode() needs faces (or a pomar.Mesh)")
@@ -144,7 +144,7 @@ def write(path, mesh, *, binary=True, **encode_options):
         return
     if encode_options:
         raise TypeError(f"options {sorted(encode_options)} apply to .pomar files only")
-    _pomar.write_mesh(path, mesh.vertices, mesh.faces, binary, mesh._attributes())
+    _pomar.write_mesh(path, mesh.vertices, mesh.faces, binary, Mesh._attributes(mesh))
 
 
 class SelectiveDecoder(_pomar.SelectiveDecoder):

@@ -21,9 +21,9 @@ std::string shape_text(const py::array &array) {
 /// `columns` values a row (0: one dimension; `alt_columns`, if not 0, is also accepted),
 /// `rows` rows unless rows < 0. Otherwise a TypeError/ValueError naming `name`.
 template <class T>
-py::array_t<T> checked_array(const py::handle &object, const std::string &name,
-                             const char *dtype, const char *shape, py::ssize_t columns,
-                             py::ssize_t alt_columns = 0, py::ssize_t rows = -1) {
+py::array_t<T> checked_array(const py::handle &object, const std::string &name, const char *dtype,
+                             const char *shape, py::ssize_t columns, py::ssize_t alt_columns = 0,
+                             py::ssize_t rows = -1) {
   if (!py::isinstance<py::array>(object))
     throw py::type_error(name + " must be a numpy array of " + dtype + ", shape " + shape +
                          "; got " + std::string(py::str(py::type::of(object))));
@@ -32,22 +32,34 @@ py::array_t<T> checked_array(const py::handle &object, const std::string &name,
     throw py::type_error(name + " must have dtype " + dtype + ", not " +
                          std::string(py::str(array.dtype())) + " (convert with " + name +
                          ".astype(numpy." + dtype + "))");
-  const bool shape_ok =
-      columns == 0 ? array.ndim() == 1
-                   : array.ndim() == 2 && (array.shape(1) == columns ||
-                                           (alt_columns && array.shape(1) == alt_columns));
+  const bool shape_ok = columns == 0
+                            ? array.ndim() == 1
+                            : array.ndim() == 2 && (array.shape(1) == columns ||
+                                                    (alt_columns && array.shape(1) == alt_columns));
   if (!shape_ok)
     throw py::value_error(name + " must have shape " + shape + ", not " + shape_text(array));
   if (rows >= 0 && array.shape(0) != rows)
-    throw py::value_error(name + " has " + std::to_string(array.shape(0)) +
-                          " rows but there are " + std::to_string(rows) +
-                          " vertices: one row per vertex");
+    throw py::value_error(name + " has " + std::to_string(array.shape(0)) + " rows but there are " +
+                          std::to_string(rows) + " vertices: one row per vertex");
   if (!(array.flags() & py::array::c_style))
     throw py::value_error(name +
                           " is not C-contiguous (a slice, a transpose or Fortran order?): "
                           "pass numpy.ascontiguousarray(" +
                           name + ")");
   return py::reinterpret_borrow<py::array_t<T>>(array);
+}
+
+/// An attribute's description and precision (VertexAttribute or AttributeInfo): the
+/// entries of Mesh.attribute_info and of info()["attributes"].
+template <class A> py::dict attribute_entry(const A &a) {
+  py::dict entry;
+  entry["kind"] = pomar::kind_name(a.kind);
+  entry["name"] = a.name;
+  entry["components"] = a.components;
+  entry["bits"] = a.bits;
+  entry["exact"] = a.bits == 0;
+  entry["bound"] = a.bound;
+  return entry;
 }
 
 template <class T> std::vector<T> copy_values(const py::array_t<T> &array) {
@@ -59,8 +71,7 @@ template <class T> std::vector<T> copy_values(const py::array_t<T> &array) {
 
 pomar::Mesh mesh_from_arrays(const py::handle &vertices, const py::handle &faces) {
   pomar::Mesh mesh;
-  mesh.positions =
-      copy_values(checked_array<float>(vertices, "vertices", "float32", "(n, 3)", 3));
+  mesh.positions = copy_values(checked_array<float>(vertices, "vertices", "float32", "(n, 3)", 3));
   mesh.triangles = copy_values(checked_array<uint32_t>(faces, "faces", "uint32", "(m, 3)", 3));
   return mesh;
 }
@@ -105,8 +116,8 @@ void add_attributes(pomar::Mesh &mesh, const py::handle &colors, const py::handl
     }
   }
   if (!texcoords.is_none())
-    add(pomar::AttributeKind::TexCoord, "texcoord", 2)->values = copy_values(
-        checked_array<float>(texcoords, "texcoords", "float32", "(n, 2)", 2, 0, n));
+    add(pomar::AttributeKind::TexCoord, "texcoord", 2)->values =
+        copy_values(checked_array<float>(texcoords, "texcoords", "float32", "(n, 2)", 2, 0, n));
   if (!texture_files.is_none()) {
     if (py::isinstance<py::str>(texture_files) || !py::isinstance<py::sequence>(texture_files))
       throw py::type_error("texture_files must be a list of str");
@@ -126,22 +137,22 @@ py::tuple arrays_from_mesh(pomar::Mesh &&mesh) {
   for (pomar::VertexAttribute &a : mesh.attributes) {
     const char *key = nullptr;
     switch (a.kind) {
-    case pomar::AttributeKind::Colour: key = "colors"; break;
-    case pomar::AttributeKind::Normal: key = "normals"; break;
-    case pomar::AttributeKind::TexCoord: key = "texcoords"; break;
-    case pomar::AttributeKind::Scalar: break;
+    case pomar::AttributeKind::Colour:
+      key = "colors";
+      break;
+    case pomar::AttributeKind::Normal:
+      key = "normals";
+      break;
+    case pomar::AttributeKind::TexCoord:
+      key = "texcoords";
+      break;
+    case pomar::AttributeKind::Scalar:
+      break;
     }
     // A second colour/normal/texcoord attribute (not made by the readers) has no field.
     if (key && attributes.contains(key))
       continue;
-    py::dict entry;
-    entry["kind"] = pomar::kind_name(a.kind);
-    entry["name"] = a.name;
-    entry["components"] = a.components;
-    entry["bits"] = a.bits;
-    entry["exact"] = a.bits == 0;
-    entry["bound"] = a.bound;
-    info.append(entry);
+    info.append(attribute_entry(a));
     if (a.kind == pomar::AttributeKind::Colour)
       attributes[key] = array_from_vector(std::move(a.colour), a.components);
     else if (key)
@@ -257,13 +268,7 @@ py::dict info_dict(const pomar::FileInfo &i) {
   d["geometry_bpv"] = bpv(i.geometry_bytes);
   py::list attributes;
   for (const pomar::AttributeInfo &a : i.attributes) {
-    py::dict entry;
-    entry["kind"] = pomar::kind_name(a.kind);
-    entry["name"] = a.name;
-    entry["components"] = a.components;
-    entry["bits"] = a.bits;
-    entry["exact"] = a.bits == 0;
-    entry["bound"] = a.bound;
+    py::dict entry = attribute_entry(a);
     entry["bytes"] = a.bytes;
     entry["bpv"] = bpv(a.bytes);
     attributes.append(entry);

@@ -16,8 +16,8 @@ namespace {
 
 void check_bits(const char *name, int bits, int low, int high) {
   if (bits < low || bits > high)
-    throw py::value_error(std::string(name) + " must be between " + std::to_string(low) +
-                          " and " + std::to_string(high) + ", not " + std::to_string(bits));
+    throw py::value_error(std::string(name) + " must be between " + std::to_string(low) + " and " +
+                          std::to_string(high) + ", not " + std::to_string(bits));
 }
 
 /// The mesh of write()/encode(): arrays plus attributes (a dict with the keys of
@@ -139,9 +139,8 @@ PYBIND11_MODULE(_pomar, m) {
   m.attr("__version__") = pomar::version();
   m.def("encode", &encode, py::arg("vertices"), py::arg("faces"), py::arg("bits"),
         py::arg("clusters"), py::arg("cluster_ratio"), py::arg("progressive"),
-        py::arg("memory_limit"), py::arg("progress"), py::arg("attributes"),
-        py::arg("normal_bits"), py::arg("scalar_bits"), py::arg("texcoord_bits"),
-        py::arg("exact_attributes"));
+        py::arg("memory_limit"), py::arg("progress"), py::arg("attributes"), py::arg("normal_bits"),
+        py::arg("scalar_bits"), py::arg("texcoord_bits"), py::arg("exact_attributes"));
   m.def("decode", &decode, py::arg("data"), py::arg("level"), py::arg("skip_damaged"),
         py::arg("memory_limit"), py::arg("progress"), py::arg("attributes"));
   m.def("info", &info, py::arg("data"));

@@ -569,3 +569,18 @@ def test_bad_attributes_raise_clear_errors():
     with pytest.raises(ValueError, match="colors has 10 rows"):
         pomar.write("never-written.ply", pomar.Mesh(vertices, faces, colors=colors[:10].copy()))
     assert not os.path.exists("never-written.ply")
+
+
+def test_selective_decoder_carries_attributes():
+    vertices, faces = torus(80, 48)
+    colors, normals, scalars, _ = torus_attributes(vertices)
+    d = pomar.SelectiveDecoder(pomar.encode(vertices, faces, colors=colors, normals=normals,
+                                            scalars=scalars, clusters=8))
+    d.want_cluster(0)
+    d.update()
+    part = d.mesh()
+    n = len(part.vertices)
+    assert part.colors.shape == (n, 3) and part.normals.shape == (n, 3)
+    assert part.scalars["quality"].shape == (n,)
+    k = input_index(part.vertices, vertices)
+    assert np.array_equal(part.colors, colors[k])
