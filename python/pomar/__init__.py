@@ -5,6 +5,7 @@
     mesh = pomar.decode(data, level=5)             # pomar.Mesh: .vertices, .faces
     pomar.info(data)["levels"]                     # the keys of `pomar info --json`
     mesh = pomar.read("bunny.ply")                 # .ply .obj .off .stl .pomar
+    mesh.colors, mesh.normals, mesh.scalars        # per-vertex attributes (None / {} if absent)
     pomar.write("bunny.pomar", mesh, bits=14)
 
 Failures of the library raise pomar.Error (str(e) is the message, e.kind what went
@@ -23,77 +24,127 @@ __all__ = ["Mesh", "Error", "encode", "decode", "info", "read", "write", "Select
 
 class Mesh:
     """A triangle mesh: vertices float32 (n, 3), faces uint32 (m, 3), counter-clockwise
-    seen from outside. Per-vertex attributes (issue 12) will be further fields, None when
-    a mesh has none."""
+    seen from outside, and optional per-vertex attributes, one row per vertex:
 
-    __slots__ = ("vertices", "faces", "damaged")
+    colors: uint8 (n, 3) RGB or (n, 4) RGBA, or None (always stored exactly)
+    normals: float32 (n, 3), or None
+    scalars: dict name -> float32 (n,) (MeshLab's "quality", PLY "confidence", ...)
+    texcoords: float32 (n, 2) (u, v), or None; texture_files: the images they refer to
+    attribute_info: of a decoded mesh, one dict per attribute with "kind", "name",
+        "components", "bits" (0 = exact), "exact" and "bound" (the largest error against
+        the input: normals in degrees, scalars and texcoords absolute per component)
+    """
 
-    def __init__(self, vertices, faces, damaged=()):
+    __slots__ = ("vertices", "faces", "damaged", "colors", "normals", "scalars", "texcoords",
+                 "texture_files", "attribute_info")
+
+    def __init__(self, vertices, faces, damaged=(), *, colors=None, normals=None, scalars=None,
+                 texcoords=None, texture_files=(), attribute_info=()):
         self.vertices = vertices
         self.faces = faces
         #: blocks a decode with skip_damaged=True decoded around: dicts with "block"
         #: ("cluster 17", "level 9"), "problem" and "level_kept"; empty when intact.
         self.damaged = list(damaged)
+        self.colors = colors
+        self.normals = normals
+        self.scalars = dict(scalars or {})
+        self.texcoords = texcoords
+        self.texture_files = list(texture_files)
+        self.attribute_info = list(attribute_info)
+
+    def _attributes(self):
+        """The attribute fields as the keyword arguments of _pomar's encode/write_mesh."""
+        return {key: getattr(self, key, None)
+                for key in ("colors", "normals", "scalars", "texcoords", "texture_files")}
 
     def __repr__(self):
-        return f"pomar.Mesh({len(self.vertices)} vertices, {len(self.faces)} faces)"
+        kinds = [name for name in ("colors", "normals", "texcoords")
+                 if getattr(self, name) is not None]
+        kinds += [f"scalar {name!r}" for name in self.scalars]
+        extra = f", {', '.join(kinds)}" if kinds else ""
+        return f"pomar.Mesh({len(self.vertices)} vertices, {len(self.faces)} faces{extra})"
 
 
 def encode(vertices, faces=None, *, bits=12, clusters=0, cluster_ratio=0.01,
-           progressive=False, memory_limit=None, progress=None):
-    """Compress a manifold, consistently oriented triangle mesh into .pomar bytes.
+           progressive=False, memory_limit=None, progress=None, colors=None, normals=None,
+           scalars=None, texcoords=None, texture_files=None, normal_bits=9, scalar_bits=16,
+           texcoord_bits=12, exact_attributes=False):
+    """Compress a triangle mesh into .pomar bytes.
 
     vertices: float32 array (n, 3), faces: uint32 array (m, 3), both C-contiguous; or a
-    pomar.Mesh as the only argument. bits: quantization grid, 4..24. The file is random
+    pomar.Mesh as the only argument (its attributes are encoded; the attribute keywords
+    replace a field). Per-vertex attributes as the fields of pomar.Mesh: colors (exact),
+    normals (octahedral, normal_bits 4..16 a coordinate: 9 keeps them within 0.33 degrees),
+    scalars (dict, scalar_bits 1..24 over each one's range), texcoords (texcoord_bits
+    1..24 over the range of u and of v); exact_attributes=True stores every float bit for
+    bit (NaN and infinities included, which are an error otherwise).
+    bits: quantization grid of the positions, 4..24. The file is random
     access (about cluster_ratio x vertices clusters, or `clusters`) unless progressive=True.
     memory_limit: bytes or "512M" / "auto" / "none" (default: the memory available).
     progress: None or a callable(fraction, stage) called now and then (Ctrl-C interrupts
     the call in any case; an exception raised by progress stops it and propagates).
     """
+    given = {"colors": colors, "normals": normals, "scalars": scalars, "texcoords": texcoords,
+             "texture_files": texture_files}
+    attributes = {}
     if isinstance(vertices, Mesh):
         if faces is not None:
             raise TypeError("encode(mesh) takes no faces argument")
+        attributes = Mesh._attributes(vertices)
         vertices, faces = vertices.vertices, vertices.faces
     elif faces is None:
         raise TypeError("encode() needs faces (or a pomar.Mesh)")
+    attributes.update({key: value for key, value in given.items() if value is not None})
     return _pomar.encode(vertices, faces, bits, clusters, cluster_ratio, progressive,
-                         memory_limit, progress)
+                         memory_limit, progress, attributes, normal_bits, scalar_bits,
+                         texcoord_bits, exact_attributes)
 
 
-def decode(data, level=None, *, skip_damaged=False, memory_limit=None, progress=None):
+def _mesh(vertices, faces, damaged, attributes):
+    return Mesh(vertices, faces, damaged, **attributes)
+
+
+def decode(data, level=None, *, skip_damaged=False, memory_limit=None, progress=None,
+           attributes=True):
     """Decode .pomar bytes (bytes, bytearray, memoryview) to a Mesh after `level`
-    refinement levels (0 = base mesh, None = full resolution).
+    refinement levels (0 = base mesh, None = full resolution), with the file's per-vertex
+    attributes (attributes=False: positions and faces only) and their precision in
+    mesh.attribute_info.
 
     skip_damaged=True decodes around damaged or missing blocks instead of raising (a
     damaged global level stops before it, a damaged cluster stays coarse) and lists them
     in mesh.damaged; damage in the header, base mesh or tables still raises pomar.Error.
     progress: as for encode()."""
-    return Mesh(*_pomar.decode(data, level, skip_damaged, memory_limit, progress))
+    vertices, faces, damaged, fields = _pomar.decode(data, level, skip_damaged, memory_limit,
+                                                     progress, attributes)
+    return _mesh(vertices, faces, damaged, fields)
 
 
 def read(path, level=None):
-    """Read a mesh file: .ply .obj .off .stl (positions and triangles; what else the file
-    carries is dropped), or .pomar (decoded after `level` levels, None = all)."""
+    """Read a mesh file: .ply .obj .off .stl (positions, triangles and the per-vertex
+    colours, normals, scalars and texture coordinates the readers know), or .pomar
+    (decoded after `level` levels, None = all)."""
     path = os.fspath(path)
     if path.lower().endswith(".pomar"):
         with open(path, "rb") as f:
             return decode(f.read(), level)
     if level is not None:
         raise ValueError("level applies to .pomar files only")
-    vertices, faces, _report = _pomar.read_mesh(path)
-    return Mesh(vertices, faces)
+    vertices, faces, _report, fields = _pomar.read_mesh(path)
+    return _mesh(vertices, faces, (), fields)
 
 
 def write(path, mesh, *, binary=True, **encode_options):
     """Write a Mesh, replacing `path` atomically: .ply .stl (binary unless binary=False),
-    .obj .off, or .pomar (encode_options as for encode(), e.g. bits=14)."""
+    .obj .off, or .pomar (encode_options as for encode(), e.g. bits=14). The attributes
+    go to PLY and OBJ files (OFF and STL keep positions and faces)."""
     path = os.fspath(path)
     if path.lower().endswith(".pomar"):
         _pomar.write_bytes(path, encode(mesh, **encode_options))
         return
     if encode_options:
         raise TypeError(f"options {sorted(encode_options)} apply to .pomar files only")
-    _pomar.write_mesh(path, mesh.vertices, mesh.faces, binary)
+    _pomar.write_mesh(path, mesh.vertices, mesh.faces, binary, Mesh._attributes(mesh))
 
 
 class SelectiveDecoder(_pomar.SelectiveDecoder):
@@ -111,4 +162,5 @@ class SelectiveDecoder(_pomar.SelectiveDecoder):
 
     def mesh(self):
         """The current mesh (after the last update())."""
-        return Mesh(*self.mesh_arrays())
+        vertices, faces, fields = self.mesh_arrays()
+        return _mesh(vertices, faces, (), fields)

@@ -10,30 +10,56 @@ namespace pomar_python {
 
 namespace {
 
-/// The C-contiguous (n, 3) array of T behind `object`, or a TypeError/ValueError.
+std::string shape_text(const py::array &array) {
+  std::string shape = "(";
+  for (py::ssize_t d = 0; d < array.ndim(); ++d)
+    shape += (d ? ", " : "") + std::to_string(array.shape(d));
+  return shape + (array.ndim() == 1 ? ",)" : ")");
+}
+
+/// The C-contiguous array of T behind `object` with shape `shape` ("(n, 3)", "(n,)"):
+/// `columns` values a row (0: one dimension; `alt_columns`, if not 0, is also accepted),
+/// `rows` rows unless rows < 0. Otherwise a TypeError/ValueError naming `name`.
 template <class T>
-py::array_t<T> checked_rows(const py::handle &object, const char *name, const char *dtype) {
+py::array_t<T> checked_array(const py::handle &object, const std::string &name, const char *dtype,
+                             const char *shape, py::ssize_t columns, py::ssize_t alt_columns = 0,
+                             py::ssize_t rows = -1) {
   if (!py::isinstance<py::array>(object))
-    throw py::type_error(std::string(name) + " must be a numpy array of " + dtype +
-                         ", shape (n, 3); got " + std::string(py::str(py::type::of(object))));
+    throw py::type_error(name + " must be a numpy array of " + dtype + ", shape " + shape +
+                         "; got " + std::string(py::str(py::type::of(object))));
   auto array = py::reinterpret_borrow<py::array>(object);
   if (!array.dtype().is(py::dtype::of<T>()))
-    throw py::type_error(std::string(name) + " must have dtype " + dtype + ", not " +
+    throw py::type_error(name + " must have dtype " + dtype + ", not " +
                          std::string(py::str(array.dtype())) + " (convert with " + name +
                          ".astype(numpy." + dtype + "))");
-  if (array.ndim() != 2 || array.shape(1) != 3) {
-    std::string shape = "(";
-    for (py::ssize_t d = 0; d < array.ndim(); ++d)
-      shape += (d ? ", " : "") + std::to_string(array.shape(d));
-    throw py::value_error(std::string(name) + " must have shape (n, 3), not " + shape +
-                          (array.ndim() == 1 ? ",)" : ")"));
-  }
+  const bool shape_ok = columns == 0
+                            ? array.ndim() == 1
+                            : array.ndim() == 2 && (array.shape(1) == columns ||
+                                                    (alt_columns && array.shape(1) == alt_columns));
+  if (!shape_ok)
+    throw py::value_error(name + " must have shape " + shape + ", not " + shape_text(array));
+  if (rows >= 0 && array.shape(0) != rows)
+    throw py::value_error(name + " has " + std::to_string(array.shape(0)) + " rows but there are " +
+                          std::to_string(rows) + " vertices: one row per vertex");
   if (!(array.flags() & py::array::c_style))
-    throw py::value_error(std::string(name) +
+    throw py::value_error(name +
                           " is not C-contiguous (a slice, a transpose or Fortran order?): "
                           "pass numpy.ascontiguousarray(" +
                           name + ")");
   return py::reinterpret_borrow<py::array_t<T>>(array);
+}
+
+/// An attribute's description and precision (VertexAttribute or AttributeInfo): the
+/// entries of Mesh.attribute_info and of info()["attributes"].
+template <class A> py::dict attribute_entry(const A &a) {
+  py::dict entry;
+  entry["kind"] = pomar::kind_name(a.kind);
+  entry["name"] = a.name;
+  entry["components"] = a.components;
+  entry["bits"] = a.bits;
+  entry["exact"] = a.bits == 0;
+  entry["bound"] = a.bound;
+  return entry;
 }
 
 template <class T> std::vector<T> copy_values(const py::array_t<T> &array) {
@@ -45,14 +71,100 @@ template <class T> std::vector<T> copy_values(const py::array_t<T> &array) {
 
 pomar::Mesh mesh_from_arrays(const py::handle &vertices, const py::handle &faces) {
   pomar::Mesh mesh;
-  mesh.positions = copy_values(checked_rows<float>(vertices, "vertices", "float32"));
-  mesh.triangles = copy_values(checked_rows<uint32_t>(faces, "faces", "uint32"));
+  mesh.positions = copy_values(checked_array<float>(vertices, "vertices", "float32", "(n, 3)", 3));
+  mesh.triangles = copy_values(checked_array<uint32_t>(faces, "faces", "uint32", "(m, 3)", 3));
   return mesh;
 }
 
+void add_attributes(pomar::Mesh &mesh, const py::handle &colors, const py::handle &normals,
+                    const py::handle &scalars, const py::handle &texcoords,
+                    const py::handle &texture_files) {
+  const auto n = static_cast<py::ssize_t>(mesh.positions.size() / 3);
+  auto add = [&](pomar::AttributeKind kind, std::string name, uint32_t components) {
+    pomar::VertexAttribute &a = mesh.attributes.emplace_back();
+    a.kind = kind;
+    a.name = std::move(name);
+    a.components = components;
+    return &a;
+  };
+  if (!colors.is_none()) {
+    const auto array =
+        checked_array<uint8_t>(colors, "colors", "uint8", "(n, 3) or (n, 4)", 3, 4, n);
+    add(pomar::AttributeKind::Colour, "colour", static_cast<uint32_t>(array.shape(1)))->colour =
+        copy_values(array);
+  }
+  if (!normals.is_none())
+    add(pomar::AttributeKind::Normal, "normal", 3)->values =
+        copy_values(checked_array<float>(normals, "normals", "float32", "(n, 3)", 3, 0, n));
+  if (!scalars.is_none()) {
+    if (!py::isinstance<py::dict>(scalars))
+      throw py::type_error("scalars must be a dict name -> float32 array (n,), not " +
+                           std::string(py::str(py::type::of(scalars))));
+    for (const auto &[key, value] : py::reinterpret_borrow<py::dict>(scalars)) {
+      if (!py::isinstance<py::str>(key))
+        throw py::type_error("scalars' names must be str, not " +
+                             std::string(py::str(py::type::of(key))));
+      const std::string name = key.cast<std::string>();
+      if (name.empty() || name.size() > 255)
+        throw py::value_error("a scalar's name must have 1..255 bytes: '" + name + "'");
+      for (const pomar::VertexAttribute &a : mesh.attributes)
+        if (a.name == name)
+          throw py::value_error("scalar name '" + name +
+                                "' is taken by another attribute: choose another name");
+      add(pomar::AttributeKind::Scalar, name, 1)->values = copy_values(
+          checked_array<float>(value, "scalars['" + name + "']", "float32", "(n,)", 0, 0, n));
+    }
+  }
+  if (!texcoords.is_none())
+    add(pomar::AttributeKind::TexCoord, "texcoord", 2)->values =
+        copy_values(checked_array<float>(texcoords, "texcoords", "float32", "(n, 2)", 2, 0, n));
+  if (!texture_files.is_none()) {
+    if (py::isinstance<py::str>(texture_files) || !py::isinstance<py::sequence>(texture_files))
+      throw py::type_error("texture_files must be a list of str");
+    for (const py::handle &file : py::reinterpret_borrow<py::sequence>(texture_files)) {
+      if (!py::isinstance<py::str>(file))
+        throw py::type_error("texture_files must be a list of str, it holds a " +
+                             std::string(py::str(py::type::of(file))));
+      mesh.texture_files.push_back(file.cast<std::string>());
+    }
+  }
+}
+
 py::tuple arrays_from_mesh(pomar::Mesh &&mesh) {
+  py::dict attributes;
+  py::dict scalars;
+  py::list info;
+  for (pomar::VertexAttribute &a : mesh.attributes) {
+    const char *key = nullptr;
+    switch (a.kind) {
+    case pomar::AttributeKind::Colour:
+      key = "colors";
+      break;
+    case pomar::AttributeKind::Normal:
+      key = "normals";
+      break;
+    case pomar::AttributeKind::TexCoord:
+      key = "texcoords";
+      break;
+    case pomar::AttributeKind::Scalar:
+      break;
+    }
+    // A second colour/normal/texcoord attribute (not made by the readers) has no field.
+    if (key && attributes.contains(key))
+      continue;
+    info.append(attribute_entry(a));
+    if (a.kind == pomar::AttributeKind::Colour)
+      attributes[key] = array_from_vector(std::move(a.colour), a.components);
+    else if (key)
+      attributes[key] = array_from_vector(std::move(a.values), a.components);
+    else
+      scalars[py::str(a.name)] = array_from_vector(std::move(a.values), 0);
+  }
+  attributes["scalars"] = scalars;
+  attributes["texture_files"] = py::cast(mesh.texture_files);
+  attributes["attribute_info"] = info;
   return py::make_tuple(array_from_vector(std::move(mesh.positions), 3),
-                        array_from_vector(std::move(mesh.triangles), 3));
+                        array_from_vector(std::move(mesh.triangles), 3), attributes);
 }
 
 ReadBuffer::ReadBuffer(const py::handle &object, const char *what) {
@@ -156,13 +268,7 @@ py::dict info_dict(const pomar::FileInfo &i) {
   d["geometry_bpv"] = bpv(i.geometry_bytes);
   py::list attributes;
   for (const pomar::AttributeInfo &a : i.attributes) {
-    py::dict entry;
-    entry["kind"] = pomar::kind_name(a.kind);
-    entry["name"] = a.name;
-    entry["components"] = a.components;
-    entry["bits"] = a.bits;
-    entry["exact"] = a.bits == 0;
-    entry["bound"] = a.bound;
+    py::dict entry = attribute_entry(a);
     entry["bytes"] = a.bytes;
     entry["bpv"] = bpv(a.bytes);
     attributes.append(entry);

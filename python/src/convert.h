@@ -32,7 +32,17 @@ template <class T> py::array_t<T> array_from_vector(std::vector<T> &&values, siz
   return py::array_t<T>({rows, columns}, {columns * sizeof(T), sizeof(T)}, owned->data(), owner);
 }
 
-/// (vertices, faces) numpy arrays that take over the mesh's storage.
+/// The per-vertex attributes given to encode()/write() (each None when absent) added to
+/// `mesh` (whose positions are set): colors uint8 (n, 3) or (n, 4), normals float32 (n, 3),
+/// scalars a dict name -> float32 (n,), texcoords float32 (n, 2), texture_files a sequence
+/// of str. TypeError/ValueError (naming the argument) for a wrong type, dtype or shape.
+void add_attributes(pomar::Mesh &mesh, const py::handle &colors, const py::handle &normals,
+                    const py::handle &scalars, const py::handle &texcoords,
+                    const py::handle &texture_files);
+
+/// (vertices, faces, attributes) taking over the mesh's storage: numpy arrays and a dict
+/// with the keyword arguments of pomar.Mesh for the attributes ("colors", "normals",
+/// "scalars", "texcoords", "texture_files", "attribute_info").
 py::tuple arrays_from_mesh(pomar::Mesh &&mesh);
 
 /// A contiguous bytes-like object (bytes, bytearray, memoryview, numpy uint8 array) held

@@ -14,13 +14,41 @@ using namespace pomar_python;
 
 namespace {
 
+void check_bits(const char *name, int bits, int low, int high) {
+  if (bits < low || bits > high)
+    throw py::value_error(std::string(name) + " must be between " + std::to_string(low) + " and " +
+                          std::to_string(high) + ", not " + std::to_string(bits));
+}
+
+/// The mesh of write()/encode(): arrays plus attributes (a dict with the keys of
+/// add_attributes' arguments).
+pomar::Mesh mesh_with_attributes(const py::handle &vertices, const py::handle &faces,
+                                 const py::dict &attributes) {
+  pomar::Mesh mesh = mesh_from_arrays(vertices, faces);
+  auto field = [&](const char *key) -> py::object {
+    if (!attributes.contains(key))
+      return py::none();
+    return attributes[key];
+  };
+  add_attributes(mesh, field("colors"), field("normals"), field("scalars"), field("texcoords"),
+                 field("texture_files"));
+  return mesh;
+}
+
 py::bytes encode(const py::handle &vertices, const py::handle &faces, int bits, uint32_t clusters,
                  double cluster_ratio, bool progressive, const py::handle &max_memory,
-                 const py::handle &progress) {
-  if (bits < 4 || bits > 24)
-    throw py::value_error("bits must be between 4 and 24, not " + std::to_string(bits));
-  pomar::Mesh mesh = mesh_from_arrays(vertices, faces);
+                 const py::handle &progress, const py::dict &attributes, int normal_bits,
+                 int scalar_bits, int texcoord_bits, bool exact_attributes) {
+  check_bits("bits", bits, 4, 24);
+  check_bits("normal_bits", normal_bits, 4, 16);
+  check_bits("scalar_bits", scalar_bits, 1, 24);
+  check_bits("texcoord_bits", texcoord_bits, 1, 24);
+  pomar::Mesh mesh = mesh_with_attributes(vertices, faces, attributes);
   pomar::EncodeOptions options;
+  options.attributes.normal_bits = normal_bits;
+  options.attributes.scalar_bits = scalar_bits;
+  options.attributes.texcoord_bits = texcoord_bits;
+  options.attributes.exact = exact_attributes;
   options.bits = bits;
   options.clusters = clusters;
   options.cluster_ratio = cluster_ratio;
@@ -36,9 +64,11 @@ py::bytes encode(const py::handle &vertices, const py::handle &faces, int bits, 
 }
 
 py::tuple decode(const py::handle &data, const py::handle &level, bool skip_damaged,
-                 const py::handle &max_memory, const py::handle &progress) {
+                 const py::handle &max_memory, const py::handle &progress, bool attributes) {
   const ReadBuffer buffer(data, "decode()");
   pomar::DecodeOptions options;
+  if (!attributes)
+    options.attributes = pomar::AttributeMask::none();
   options.skip_damaged = skip_damaged;
   options.memory_limit = memory_limit(max_memory);
   options.progress = python_progress(progress);
@@ -56,7 +86,7 @@ py::tuple decode(const py::handle &data, const py::handle &level, bool skip_dama
     });
   }
   py::tuple arrays = arrays_from_mesh(std::move(mesh));
-  return py::make_tuple(arrays[0], arrays[1], damaged_list(report.damaged));
+  return py::make_tuple(arrays[0], arrays[1], damaged_list(report.damaged), arrays[2]);
 }
 
 py::dict info(const py::handle &data) {
@@ -85,12 +115,12 @@ py::tuple read_mesh(const std::string &path) {
   r["polygons_triangulated"] = report.polygons_triangulated;
   r["ignored_attributes"] = py::cast(report.ignored_attributes);
   py::tuple arrays = arrays_from_mesh(std::move(mesh));
-  return py::make_tuple(arrays[0], arrays[1], r);
+  return py::make_tuple(arrays[0], arrays[1], r, arrays[2]);
 }
 
 void write_mesh(const std::string &path, const py::handle &vertices, const py::handle &faces,
-                bool binary) {
-  const pomar::Mesh mesh = mesh_from_arrays(vertices, faces);
+                bool binary, const py::dict &attributes) {
+  const pomar::Mesh mesh = mesh_with_attributes(vertices, faces, attributes);
   py::gil_scoped_release unlocked;
   call_library("io", [&] { pomar::save_mesh(path, mesh, binary); });
 }
@@ -109,13 +139,14 @@ PYBIND11_MODULE(_pomar, m) {
   m.attr("__version__") = pomar::version();
   m.def("encode", &encode, py::arg("vertices"), py::arg("faces"), py::arg("bits"),
         py::arg("clusters"), py::arg("cluster_ratio"), py::arg("progressive"),
-        py::arg("memory_limit"), py::arg("progress"));
+        py::arg("memory_limit"), py::arg("progress"), py::arg("attributes"), py::arg("normal_bits"),
+        py::arg("scalar_bits"), py::arg("texcoord_bits"), py::arg("exact_attributes"));
   m.def("decode", &decode, py::arg("data"), py::arg("level"), py::arg("skip_damaged"),
-        py::arg("memory_limit"), py::arg("progress"));
+        py::arg("memory_limit"), py::arg("progress"), py::arg("attributes"));
   m.def("info", &info, py::arg("data"));
   m.def("read_mesh", &read_mesh, py::arg("path"));
   m.def("write_mesh", &write_mesh, py::arg("path"), py::arg("vertices"), py::arg("faces"),
-        py::arg("binary"));
+        py::arg("binary"), py::arg("attributes"));
   m.def("write_bytes", &write_bytes, py::arg("path"), py::arg("data"));
   register_selective_decoder(m);
 }

@@ -396,3 +396,191 @@ def test_progress_callback_and_interruption(bunny):
     with pytest.raises(TypeError, match="callable"):
         pomar.decode(data, progress=3)
     assert len(pomar.decode(data).faces) == len(bunny.faces)  # nothing left behind
+
+
+# Per-vertex attributes (issue 16, issue 12).
+
+def torus_attributes(vertices, alpha=False):
+    """Colours, unit normals, two scalars and texture coordinates for torus() vertices."""
+    n = len(vertices)
+    rng = np.random.default_rng(16)
+    colors = rng.integers(0, 256, size=(n, 4 if alpha else 3), dtype=np.uint8)
+    ring = vertices.copy()
+    ring[:, 2] = 0
+    ring /= np.linalg.norm(ring, axis=1, keepdims=True)
+    normals = vertices - ring  # from the tube's centre line (big = 1) to the surface
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    scalars = {"quality": rng.uniform(-3, 5, n).astype(np.float32),
+               "confidence": rng.uniform(0, 1, n).astype(np.float32)}
+    texcoords = rng.uniform(0, 1, (n, 2)).astype(np.float32)
+    return colors, normals.astype(np.float32), scalars, texcoords
+
+
+def input_index(decoded, vertices):
+    """For each decoded vertex, the input vertex nearest to it (the order may differ)."""
+    d = np.abs(decoded[:, None, :] - vertices[None, :, :]).max(-1)
+    return d.argmin(-1)
+
+
+def test_attribute_round_trip_within_the_bounds():
+    vertices, faces = torus()
+    for alpha in (False, True):
+        colors, normals, scalars, texcoords = torus_attributes(vertices, alpha)
+        data = pomar.encode(vertices, faces, bits=16, colors=colors, normals=normals,
+                            scalars=scalars, texcoords=texcoords, texture_files=["skin.png"])
+        mesh = pomar.decode(data)
+        k = input_index(mesh.vertices, vertices)
+        assert len(set(k.tolist())) == len(vertices)
+        assert mesh.colors.dtype == np.uint8 and mesh.colors.shape == colors.shape
+        assert np.array_equal(mesh.colors, colors[k])  # colours are exact, RGB and RGBA
+        info = {a["name"]: a for a in mesh.attribute_info}
+        assert sorted(info) == ["colour", "confidence", "normal", "quality", "texcoord"]
+        assert info["colour"]["exact"] and info["colour"]["kind"] == "colour"
+        assert info["normal"]["bits"] == 9 and 0 < info["normal"]["bound"] < 0.34
+        assert mesh.normals.dtype == np.float32 and mesh.normals.shape == (len(vertices), 3)
+        cos = np.clip((mesh.normals * normals[k]).sum(1), -1, 1)
+        assert np.degrees(np.arccos(cos)).max() <= info["normal"]["bound"] * 1.0001 + 1e-4
+        assert sorted(mesh.scalars) == ["confidence", "quality"]
+        for name, values in scalars.items():
+            assert mesh.scalars[name].dtype == np.float32 and mesh.scalars[name].shape == (len(vertices),)
+            assert info[name]["bits"] == 16 and info[name]["bound"] > 0
+            assert np.abs(mesh.scalars[name] - values[k]).max() <= info[name]["bound"] * 1.0001
+        assert mesh.texcoords.dtype == np.float32 and mesh.texcoords.shape == (len(vertices), 2)
+        assert np.abs(mesh.texcoords - texcoords[k]).max() <= info["texcoord"]["bound"] * 1.0001
+        assert mesh.texture_files == ["skin.png"]
+        assert "colors" in repr(mesh) and "scalar 'quality'" in repr(mesh)
+        # The file's info lists the same attributes.
+        assert sorted(a["name"] for a in pomar.info(data)["attributes"]) == sorted(info)
+    # Fewer bits: a larger bound, still kept.
+    coarse = pomar.decode(pomar.encode(vertices, faces, normals=normals, normal_bits=6,
+                                       scalars=scalars, scalar_bits=6, texcoords=texcoords,
+                                       texcoord_bits=5))
+    k = input_index(coarse.vertices, vertices)
+    info = {a["name"]: a for a in coarse.attribute_info}
+    assert info["normal"]["bits"] == 6 and info["normal"]["bound"] > 1
+    cos = np.clip((coarse.normals * normals[k]).sum(1), -1, 1)
+    assert np.degrees(np.arccos(cos)).max() <= info["normal"]["bound"] * 1.0001 + 1e-4
+    assert np.abs(coarse.scalars["quality"] - scalars["quality"][k]).max() <= info["quality"]["bound"] * 1.0001
+    assert np.abs(coarse.texcoords - texcoords[k]).max() <= info["texcoord"]["bound"] * 1.0001
+
+
+def test_exact_attributes_bit_for_bit():
+    vertices, faces = torus()
+    colors, normals, scalars, texcoords = torus_attributes(vertices)
+    scalars["quality"][5] = np.nan  # exact mode keeps what quantization refuses
+    scalars["quality"][6] = -np.inf
+    normals[9] = 0  # a zero-length normal
+    with pytest.raises(pomar.Error) as e:
+        pomar.encode(vertices, faces, normals=normals, scalars=scalars)
+    assert e.value.kind == "invalid_mesh"
+    mesh = pomar.Mesh(vertices, faces, colors=colors, normals=normals, scalars=scalars,
+                      texcoords=texcoords)
+    back = pomar.decode(pomar.encode(mesh, bits=16, exact_attributes=True))
+    k = input_index(back.vertices, vertices)
+    assert all(a["exact"] and a["bits"] == 0 and a["bound"] == 0 for a in back.attribute_info)
+    assert np.array_equal(back.colors, colors[k])
+    assert np.array_equal(back.normals.view(np.uint32), normals[k].view(np.uint32))
+    for name, values in scalars.items():
+        assert np.array_equal(back.scalars[name].view(np.uint32), values[k].view(np.uint32))
+    assert np.array_equal(back.texcoords.view(np.uint32), texcoords[k].view(np.uint32))
+
+
+def test_decode_without_attributes_and_mesh_fields():
+    vertices, faces = torus()
+    colors, normals, scalars, texcoords = torus_attributes(vertices)
+    plain = pomar.decode(pomar.encode(vertices, faces))
+    assert plain.colors is None and plain.normals is None and plain.texcoords is None
+    assert plain.scalars == {} and plain.texture_files == [] and plain.attribute_info == []
+    data = pomar.encode(vertices, faces, colors=colors, scalars=scalars)
+    full = pomar.decode(data)
+    assert full.colors is not None and sorted(full.scalars) == ["confidence", "quality"]
+    assert full.normals is None and full.texcoords is None
+    bare = pomar.decode(data, attributes=False)
+    assert bare.colors is None and bare.scalars == {} and bare.attribute_info == []
+    assert np.array_equal(bare.vertices, full.vertices) and np.array_equal(bare.faces, full.faces)
+    # encode(mesh): the mesh's fields, a keyword replacing one of them.
+    mesh = pomar.Mesh(vertices, faces, colors=colors)
+    again = pomar.decode(pomar.encode(mesh, normals=normals))
+    assert again.colors is not None and again.normals is not None
+    # Coarser levels carry the attributes of their vertices.
+    base = pomar.decode(data, level=0)
+    assert len(base.colors) == len(base.vertices) < len(vertices)
+    assert len(base.scalars["quality"]) == len(base.vertices)
+
+
+def test_files_with_attributes(tmp_path):
+    vertices, faces = torus()
+    colors, normals, scalars, texcoords = torus_attributes(vertices, alpha=True)
+    mesh = pomar.Mesh(vertices, faces, colors=colors, normals=normals,
+                      scalars={"quality": scalars["quality"]}, texcoords=texcoords,
+                      texture_files=["skin.png"])
+    for binary in (True, False):
+        path = tmp_path / f"t{int(binary)}.ply"
+        pomar.write(path, mesh, binary=binary)
+        back = pomar.read(path)
+        assert np.array_equal(back.vertices, vertices)
+        assert np.array_equal(back.colors, colors)
+        assert np.array_equal(back.normals, normals)
+        assert np.array_equal(back.scalars["quality"], scalars["quality"])
+        assert np.array_equal(back.texcoords, texcoords)
+        assert back.texture_files == ["skin.png"]
+    rgb = pomar.Mesh(vertices, faces, colors=colors[:, :3].copy())
+    pomar.write(tmp_path / "rgb.ply", rgb)
+    assert np.array_equal(pomar.read(tmp_path / "rgb.ply").colors, colors[:, :3])
+    # .pomar files carry them too.
+    pomar.write(tmp_path / "t.pomar", mesh, bits=16)
+    back = pomar.read(tmp_path / "t.pomar")
+    k = input_index(back.vertices, vertices)
+    assert np.array_equal(back.colors, colors[k]) and back.texture_files == ["skin.png"]
+
+
+def test_bad_attributes_raise_clear_errors():
+    vertices, faces = torus()
+    colors, normals, scalars, texcoords = torus_attributes(vertices)
+    n = len(vertices)
+    with pytest.raises(TypeError, match=r"colors must have dtype uint8, not float32"):
+        pomar.encode(vertices, faces, colors=colors.astype(np.float32))
+    with pytest.raises(ValueError, match=r"colors must have shape \(n, 3\) or \(n, 4\), not \(960, 2\)"):
+        pomar.encode(vertices, faces, colors=colors[:, :2].copy())
+    with pytest.raises(ValueError, match=rf"colors has 10 rows but there are {n} vertices"):
+        pomar.encode(vertices, faces, colors=colors[:10].copy())
+    with pytest.raises(TypeError, match="normals must be a numpy array of float32"):
+        pomar.encode(vertices, faces, normals=normals.tolist())
+    with pytest.raises(TypeError, match="normals must have dtype float32, not float64"):
+        pomar.encode(vertices, faces, normals=normals.astype(np.float64))
+    with pytest.raises(ValueError, match="normals is not C-contiguous"):
+        pomar.encode(vertices, faces, normals=np.asfortranarray(normals))
+    with pytest.raises(TypeError, match="scalars must be a dict"):
+        pomar.encode(vertices, faces, scalars=scalars["quality"])
+    with pytest.raises(ValueError, match=r"scalars\['quality'\] must have shape \(n,\), not \(960, 1\)"):
+        pomar.encode(vertices, faces, scalars={"quality": scalars["quality"][:, None].copy()})
+    with pytest.raises(TypeError, match="scalars' names must be str"):
+        pomar.encode(vertices, faces, scalars={3: scalars["quality"]})
+    with pytest.raises(ValueError, match="scalar name 'colour' is taken"):
+        pomar.encode(vertices, faces, colors=colors, scalars={"colour": scalars["quality"]})
+    with pytest.raises(ValueError, match=r"texcoords must have shape \(n, 2\), not \(960, 3\)"):
+        pomar.encode(vertices, faces, texcoords=normals)
+    with pytest.raises(TypeError, match="texture_files must be a list of str"):
+        pomar.encode(vertices, faces, texcoords=texcoords, texture_files="skin.png")
+    with pytest.raises(ValueError, match="normal_bits must be between 4 and 16, not 3"):
+        pomar.encode(vertices, faces, normals=normals, normal_bits=3)
+    with pytest.raises(ValueError, match="scalar_bits must be between 1 and 24, not 25"):
+        pomar.encode(vertices, faces, scalar_bits=25)
+    with pytest.raises(ValueError, match="colors has 10 rows"):
+        pomar.write("never-written.ply", pomar.Mesh(vertices, faces, colors=colors[:10].copy()))
+    assert not os.path.exists("never-written.ply")
+
+
+def test_selective_decoder_carries_attributes():
+    vertices, faces = torus(80, 48)
+    colors, normals, scalars, _ = torus_attributes(vertices)
+    d = pomar.SelectiveDecoder(pomar.encode(vertices, faces, colors=colors, normals=normals,
+                                            scalars=scalars, clusters=8))
+    d.want_cluster(0)
+    d.update()
+    part = d.mesh()
+    n = len(part.vertices)
+    assert part.colors.shape == (n, 3) and part.normals.shape == (n, 3)
+    assert part.scalars["quality"].shape == (n,)
+    k = input_index(part.vertices, vertices)
+    assert np.array_equal(part.colors, colors[k])
