@@ -297,7 +297,15 @@ class IoVertex
 class IoEdge : public vcg::Edge<IoTypes, vcg::edge::VertexRef, vcg::edge::BitFlags> {};
 class IoFace : public vcg::Face<IoTypes, vcg::face::VertexRef, vcg::face::BitFlags> {};
 class IoMesh
-    : public vcg::tri::TriMesh<std::vector<IoVertex>, std::vector<IoFace>, std::vector<IoEdge>> {};
+    : public vcg::tri::TriMesh<std::vector<IoVertex>, std::vector<IoFace>, std::vector<IoEdge>> {
+public:
+  IoMesh() = default;
+  IoMesh(const IoMesh &) = delete; // the attribute handles below are owned, not copyable
+  IoMesh &operator=(const IoMesh &) = delete;
+  // vcglib's ~TriMesh leaves the user attributes (the PLY readers' per-vertex colour,
+  // normals, scalars...) allocated: free them here.
+  ~IoMesh() { ClearAttributes(); }
+};
 
 /// vcglib's message for an importer/exporter code, guarding against its off-by-one
 /// tables (codes at the table size, empty entries).
