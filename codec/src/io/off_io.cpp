@@ -136,6 +136,15 @@ private:
       const long n = long(tokens_.size()) - long(k_) - (h.texcoords ? 2 : 0);
       if (n < 0 || n > 4)
         fail(path_, "OFF vertex " + num(i) + " has a bad color");
+      if (n == 1) {
+        // One value is an index into vcglib's 148-entry colour map, which its importer
+        // reads without a range check (found by fuzz_mesh_readers): digits below 148 only.
+        const std::string index = strip_cr(tokens_[k_]);
+        if (index.empty() || index.size() > 3 ||
+            index.find_first_not_of("0123456789") != std::string::npos || std::stoi(index) >= 148)
+          fail(path_, "OFF vertex " + num(i) + " has a colour map index '" + index +
+                          "' outside 0..147");
+      }
       k_ += static_cast<size_t>(n);
     }
     for (int j = 0; h.texcoords && j < 2; ++j)
