@@ -45,6 +45,23 @@ TEST(FuzzRegressions, MalformedAsciiStlIsRefusedWithoutLeakingAFile) {
   fs::remove(stl);
 }
 
+TEST(FuzzRegressions, OffColourMapIndexOutOfRangeIsRefused) {
+  // A COFF vertex with one colour value (a colour map index) of 255: vcglib's importer
+  // indexed its 148-entry map with it (undefined behaviour found by fuzz_mesh_readers).
+  const fs::path input =
+      kRegressions / "readers-ub-off-colormap-6395a3bbed1ac736d4e77c2f3808ef9e5cb09a1d";
+  ASSERT_TRUE(fs::exists(input));
+  const fs::path off = fs::path(::testing::TempDir()) / "pomar_fuzz_regression.off";
+  fs::copy_file(input, off, fs::copy_options::overwrite_existing);
+  try {
+    load_mesh(off.string());
+    FAIL() << "the out-of-range colour map index was accepted";
+  } catch (const Error &e) {
+    EXPECT_NE(std::string(e.what()).find("colour map index"), std::string::npos) << e.what();
+  }
+  fs::remove(off);
+}
+
 TEST(FuzzRegressions, TristripPlyLoadsOrFailsCleanly) {
   const fs::path input =
       kRegressions / "readers-leak-fb23e152d22760b7390a120c0738d301e73bd637";
