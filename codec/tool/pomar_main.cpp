@@ -227,6 +227,7 @@ struct DecodeArgs {
   std::vector<std::string> clusters, spheres, boxes;
   bool ascii = false, quiet = false, stats = false, skip_damaged = false;
   bool no_attributes = false;
+  unsigned threads = 0;
   std::string max_memory = "auto";
   bool selective() const { return !clusters.empty() || !spheres.empty() || !boxes.empty(); }
 };
@@ -354,6 +355,7 @@ int run_selective_decode(const DecodeArgs &a) {
   pomar::SelectiveOptions options;
   options.skip_damaged = a.skip_damaged;
   options.memory_limit = pomar::parse_memory_size(a.max_memory);
+  options.threads = a.threads;
   if (a.no_attributes)
     options.attributes = pomar::AttributeMask::none();
   pomar::SelectiveDecoder d(std::make_unique<pomar::FileSource>(a.in), options);
@@ -416,6 +418,7 @@ int run_decode(const DecodeArgs &a) {
   options.level = a.level;
   options.skip_damaged = a.skip_damaged;
   options.memory_limit = memory_limit;
+  options.threads = a.threads;
   options.progress = terminal_progress(a.quiet);
   if (a.no_attributes)
     options.attributes = pomar::AttributeMask::none();
@@ -893,6 +896,11 @@ int main(int argc, char **argv) {
                 "4 (the output is written). The header, base mesh, tables and index must be "
                 "intact");
   dec->add_flag("-q,--quiet", da.quiet, "Print nothing on success");
+  dec->add_option("--threads", da.threads,
+                  "Threads for the clusters of a random-access file (0 = every core this process "
+                  "may use; pure progressive files decode on one); the output is the same for "
+                  "any number")
+      ->capture_default_str();
   dec->add_flag("--no-attributes", da.no_attributes,
                 "Write positions and triangles only: leave out colour, normals, scalars and "
                 "texture coordinates (their codes are interleaved with the positions and are "

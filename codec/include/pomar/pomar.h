@@ -13,7 +13,11 @@
 // several threads at once, on different or on the same (unmodified) inputs. An object
 // (SelectiveDecoder, FileSource, MemorySource) is used by one thread at a time; distinct
 // objects are independent. Callbacks (Progress, SizeCheck) run on the calling thread,
-// before the function returns. Nothing starts threads of its own.
+// before the function returns. encode (decimation) and decode (the clusters of a random-
+// access file) also work on threads of their own (EncodeOptions::threads,
+// DecodeOptions::threads, SelectiveOptions::threads; 0 = the cores available), all joined
+// before they return (a SelectiveDecoder keeps its idle threads until it is destroyed);
+// results do not depend on the thread count.
 //
 // Ownership: functions take inputs by const reference or as (pointer, size) and do not
 // keep them after returning (exception: MemorySource, see random_access.h); results are
@@ -309,6 +313,10 @@ struct DecodeOptions {
   /// Which stored attributes the returned mesh carries (AttributeMask::none(): positions
   /// and triangles only; the codes are interleaved with the positions and decoded anyway).
   AttributeMask attributes;
+  /// Threads for the clustered levels of a random-access file (their clusters are decoded
+  /// in parallel); 0 = the cores this process may run on. The mesh does not depend on it.
+  /// Global levels, and so pure progressive files, are decoded on one thread.
+  unsigned threads = 0;
 };
 
 struct DecodeReport {

@@ -9,7 +9,8 @@
 //   d.want_cluster(17, d.finest_level());  d.update();   // delta refinement
 //
 // Threads and ownership: a SelectiveDecoder owns its ByteSource and calls it only from
-// inside its own member functions; use each decoder (and each source) from one thread at a
+// inside its own member functions (from its own threads too, one call at a time: see
+// SelectiveOptions::threads); use each decoder (and each source) from one thread at a
 // time (several decoders on several threads are independent, also on the same file).
 // The const members (info, levels, mesh, ...) read state only and may be called
 // concurrently with each other, not with update() or a want_*() call.
@@ -77,6 +78,10 @@ struct SelectiveOptions {
   /// Which stored attributes mesh() returns (AttributeMask::none(): none). Their codes
   /// are decoded with the positions, block by block, whatever this says.
   AttributeMask attributes;
+  /// Threads update() decodes the clusters of a level on (0 = the cores this process may
+  /// run on); the mesh is the same for any number. With more than one, the ByteSource is
+  /// called from the decoder's threads, one call at a time.
+  unsigned threads = 0;
 };
 
 /// Selective, incremental decoder of a .pomar file. Levels are numbered as everywhere

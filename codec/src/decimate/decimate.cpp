@@ -7,9 +7,6 @@
 #include <mutex>
 #include <thread>
 
-#ifdef __linux__
-#include <sched.h>
-#endif
 
 namespace pomar {
 namespace {
@@ -320,15 +317,6 @@ std::vector<Collapse> Decimator::run_level(std::vector<uint32_t> &alive) {
 }
 
 } // namespace
-
-unsigned available_cores() {
-#ifdef __linux__
-  cpu_set_t set;
-  if (sched_getaffinity(0, sizeof set, &set) == 0 && CPU_COUNT(&set) > 0)
-    return static_cast<unsigned>(CPU_COUNT(&set));
-#endif
-  return std::max(1u, std::thread::hardware_concurrency());
-}
 
 Decimation decimate(CornerTable ct, const std::vector<int32_t> &q,
                     const DecimationOptions &options, const Progress &progress) {

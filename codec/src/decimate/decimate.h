@@ -36,9 +36,6 @@ struct Decimation {
   std::vector<uint32_t> base_triangles; ///< surviving faces, input vertex ids
 };
 
-/// The cores this process may run on (its CPU affinity mask; at least 1).
-unsigned available_cores();
-
 /// Decimate the mesh described by `ct` (consumed) with quantized positions `q` (xyz).
 Decimation decimate(CornerTable ct, const std::vector<int32_t> &q,
                     const DecimationOptions &options, const Progress &progress);

@@ -18,22 +18,32 @@ void ClusterStream::init(ByteSource *source, uint32_t id, uint64_t offset, uint3
   stats_ = stats;
 }
 
+void ClusterStream::fail_check() const {
+  throw Error(Error::Kind::DamagedFile,
+              "damaged .pomar file: checksum mismatch in the block of cluster " +
+                  std::to_string(id_))
+      .in_block(Error::kNoBlock, id_);
+}
+
 size_t ClusterStream::more(size_t needed) {
+  if (failed_)
+    fail_check();
   const size_t size = block_.size();
   if (loaded_ >= size)
     return loaded_; // past the end: the decoder reads zeros (and notices overruns)
   const size_t upto = std::min(size, std::max(needed, loaded_ + kChunk));
-  source_->read(offset_ + loaded_, upto - loaded_, block_.data() + loaded_);
-  stats_->bytes += upto - loaded_;
-  if (loaded_ == 0)
-    ++stats_->blocks;
+  {
+    const std::lock_guard<std::mutex> guard(stats_->lock);
+    source_->read(offset_ + loaded_, upto - loaded_, block_.data() + loaded_);
+    stats_->bytes += upto - loaded_;
+    if (loaded_ == 0)
+      ++stats_->blocks;
+  }
   loaded_ = upto;
   if (loaded_ == size && !checked_) {
-    if (!passes_block_check(block_.data(), size, check_))
-      throw Error(Error::Kind::DamagedFile,
-                  "damaged .pomar file: checksum mismatch in the block of cluster " +
-                      std::to_string(id_))
-          .in_block(Error::kNoBlock, id_);
+    failed_ = !passes_block_check(block_.data(), size, check_);
+    if (failed_)
+      fail_check();
     checked_ = true;
   }
   return loaded_;
@@ -48,6 +58,8 @@ void ClusterStream::start(bool whole) {
                                                 std::to_string(offset_ + size_) +
                                                 ", the file has " + std::to_string(source_->size()))
         .in_block(Error::kNoBlock, id_);
+  if (failed_)
+    fail_check();
   if (block_.empty() && size_ > 0)
     block_.resize(size_);
   if (whole)

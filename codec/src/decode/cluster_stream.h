@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <mutex>
 #include <vector>
 
 #include "entropy/range_coder.h"
@@ -12,10 +13,13 @@
 
 namespace pomar {
 
-/// Bytes and blocks read so far, shared by all streams of a decoder.
+/// Bytes and blocks read so far, shared by all streams of a decoder, and the lock of the
+/// source they read from (streams are decoded on several threads; a ByteSource needs not
+/// be thread-safe: it is called by one thread at a time).
 struct ReadStats {
   uint64_t bytes = 0;
   uint32_t blocks = 0;
+  std::mutex lock;
 };
 
 class ClusterStream : public StreamRefill {
@@ -37,6 +41,7 @@ public:
   size_t more(size_t needed) override;
 
 private:
+  [[noreturn]] void fail_check() const;
   ByteSource *source_ = nullptr;
   ReadStats *stats_ = nullptr;
   uint32_t id_ = 0, size_ = 0;
@@ -45,6 +50,7 @@ private:
   std::vector<uint8_t> block_; // sized to the whole block; [0, loaded_) read so far
   size_t loaded_ = 0;
   bool checked_ = false;
+  bool failed_ = false; // read whole, the check failed: every later start fails the same way
   RangeDecoder rc_;
 };
 

@@ -131,6 +131,7 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
     so.skip_damaged = options.skip_damaged;
     so.attributes = options.attributes;
     so.memory_limit = kNoMemoryLimit;
+    so.threads = options.threads;
     SelectiveDecoder d(std::make_unique<MemorySource>(data, size), so);
     d.want_all(static_cast<int>(target));
     d.update(options.progress);

@@ -2,6 +2,9 @@
 // and limited around damage (decode/level_map.cpp) -> the missing cluster levels, level by
 // level, each through the per-level step (refine/level_step.h) on the cluster's stream
 // (decode/cluster_stream.cpp); coarsening re-decodes from the base clustered mesh.
+// With several threads, the clusters of a level are traversed in parallel in batches and
+// applied in cluster order (LevelStep::traverse_cluster_level / apply_cluster_level): the
+// mesh is the same for any thread count.
 #include <algorithm>
 
 #include "decode/cluster_stream.h"
@@ -14,6 +17,7 @@
 #include "format/file_format.h"
 #include "geometry/quantize.h"
 #include "lossless/lossless_stage.h"
+#include "parallel/thread_pool.h"
 #include "pomar/limits.h"
 #include "pomar/random_access.h"
 #include "refine/level_step.h"
@@ -55,7 +59,13 @@ struct SelectiveDecoder::State {
   bool data_checked = false; // the version 3 checksum of all cluster data was verified
   int uniform_cap = 1 << 30; // progressive files: the level before a damaged one
 
-  LevelStep step;
+  // steps[0]: the sequential step; with threads > 1, one step per thread of `pool` and
+  // the traversals of the batch being decoded.
+  unsigned threads = 1;
+  std::unique_ptr<ThreadPool> pool;
+  std::vector<LevelStep> steps{1};
+  std::vector<TraversedCluster> traversed;
+  std::vector<RangeDecoder> stream_before; // each batch cluster's stream before its traversal
 
   // Attributes: descriptors and base codes (the other codes come with the positions).
   AttributeMask attribute_mask;
@@ -64,6 +74,9 @@ struct SelectiveDecoder::State {
   bool clustered() const { return layout.header.clustered(); }
   void reset_to_snapshot();
   void decode_cluster_level(uint32_t c, int level, uint32_t older_than);
+  void decode_batch(const uint32_t *batch, size_t n, int level, uint32_t older_than,
+                    const std::function<void()> &applied, uint32_t &decoding);
+  DecoderCodec cluster_codec(uint32_t c, int level);
   void decode_target(const Progress &progress, uint32_t &decoding);
   void check_cluster_data();
   bool skip_cluster(uint32_t c, const Error &e);
@@ -79,22 +92,83 @@ void SelectiveDecoder::State::reset_to_snapshot() {
   }
 }
 
-/// Cluster c's data of `level` (the cluster is at level - 1); a damaged block throws and
-/// leaves the mesh as it was.
-void SelectiveDecoder::State::decode_cluster_level(uint32_t c, int level, uint32_t older_than) {
+/// The codec reading cluster c's data of `level` (the cluster is at level - 1) from its
+/// stream, (re)started at the cluster's first clustered level.
+DecoderCodec SelectiveDecoder::State::cluster_codec(uint32_t c, int level) {
   Cluster &k = clusters[c];
-  if (k.level == global_levels) // first clustered level of this cluster: (re)start its stream
+  if (k.level == global_levels)
     k.stream.start(skip_damaged || target_of(c) == finest);
   RangeDecoder &rc = k.stream.decoder();
   DecoderCodec codec(layout.header.grid.bits);
   codec.set(&level_models[size_t(level - global_levels - 1)], &rc, &rc,
             static_cast<uint32_t>(level), c);
-  step.cluster_level(mesh, codec, {c, static_cast<uint32_t>(level), older_than}, k.next_local,
-                     [&](const StepCounts &) {
-                       if (rc.overrun())
-                         codec.corrupt("the block ends too early");
-                     });
+  return codec;
+}
+
+/// The check after a cluster's traversal: its stream must not have run out.
+struct StreamCheck {
+  const RangeDecoder &rc;
+  DecoderCodec &codec;
+  void operator()(const StepCounts &) const {
+    if (rc.overrun())
+      codec.corrupt("the block ends too early");
+  }
+};
+
+/// Cluster c's data of `level` (the cluster is at level - 1); a damaged block throws and
+/// leaves the mesh as it was.
+void SelectiveDecoder::State::decode_cluster_level(uint32_t c, int level, uint32_t older_than) {
+  Cluster &k = clusters[c];
+  DecoderCodec codec = cluster_codec(c, level);
+  steps[0].cluster_level(mesh, codec, {c, static_cast<uint32_t>(level), older_than}, k.next_local,
+                         StreamCheck{k.stream.decoder(), codec});
   k.level = level;
+}
+
+/// The data of `level` of clusters batch[0..n), in increasing order: traversed in parallel,
+/// applied in order. Throws what decode_cluster_level would throw for the first cluster
+/// that fails (`decoding` names it), with the clusters before it applied and the others as
+/// they were (their streams put back).
+void SelectiveDecoder::State::decode_batch(const uint32_t *batch, size_t n, int level,
+                                           uint32_t older_than,
+                                           const std::function<void()> &applied,
+                                           uint32_t &decoding) {
+  if (traversed.size() < n) {
+    traversed.resize(n);
+    stream_before.resize(n);
+  }
+  const uint32_t l = static_cast<uint32_t>(level);
+  pool->run(n, [&](size_t i, unsigned thread) {
+    const uint32_t c = batch[i];
+    TraversedCluster &out = traversed[i];
+    stream_before[i] = clusters[c].stream.decoder();
+    try {
+      DecoderCodec codec = cluster_codec(c, level);
+      steps[thread].traverse_cluster_level(mesh, codec, {c, l, older_than},
+                                           StreamCheck{clusters[c].stream.decoder(), codec}, out);
+    } catch (...) { // (the stream did not start)
+      out.splits.clear();
+      out.claims.clear();
+      out.error = std::current_exception();
+    }
+  });
+  for (size_t i = 0; i < n; ++i) {
+    const uint32_t c = batch[i];
+    Cluster &k = clusters[c];
+    decoding = c;
+    try {
+      DecoderCodec codec(layout.header.grid.bits); // (names the cluster in errors)
+      codec.set(nullptr, nullptr, nullptr, l, c);
+      steps[0].apply_cluster_level(mesh, codec, {c, l, older_than}, k.next_local, traversed[i]);
+    } catch (...) {
+      for (size_t j = i + 1; j < n; ++j)
+        clusters[batch[j]].stream.decoder() = stream_before[j];
+      throw;
+    }
+    k.level = level;
+    decoding = kNone;
+    applied();
+  }
 }
 
 /// After `e` while decoding cluster `c` (kNone: not in a cluster): with skip_damaged,
@@ -140,6 +214,7 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   State &s = *s_;
   s.source = std::move(source);
   s.skip_damaged = options.skip_damaged;
+  s.threads = resolve_threads(options.threads);
   s.attribute_mask = options.attributes;
   const uint64_t file_size = s.source->size();
   // Header: the fixed part, then as much more as header_size() asks for (version 4 needs
@@ -386,6 +461,14 @@ void SelectiveDecoder::State::decode_target(const Progress &progress, uint32_t &
   size_t todo = 0, done = 0;
   for (size_t c = 0; c < target.size(); ++c)
     todo += size_t(target[c] - clusters[c].level);
+  const std::function<void()> applied = [&] {
+    if (progress && (++done % 64 == 0 || done == todo))
+      progress(double(done) / double(todo), "decode");
+  };
+  if (threads > 1 && !pool && todo > 0) {
+    pool = std::make_unique<ThreadPool>(threads);
+    steps.resize(pool->size());
+  }
   // The whole mesh to one level (a full decode): the level table gives the final counts.
   const auto [lo, hi] = std::minmax_element(target.begin(), target.end());
   if (!target.empty() && *lo == *hi && *hi > global_levels) {
@@ -398,14 +481,24 @@ void SelectiveDecoder::State::decode_target(const Progress &progress, uint32_t &
     for (const auto &k : clusters)
       finest_now = std::max(finest_now, k.level);
     const uint32_t older_than = finest_now < level ? mesh.vertex_count() : 0;
-    for (uint32_t c = 0; c < target.size(); ++c) {
-      if (target[c] < level || clusters[c].level >= level)
-        continue;
+    std::vector<uint32_t> refine; // the clusters to refine to `level`
+    for (uint32_t c = 0; c < target.size(); ++c)
+      if (target[c] >= level && clusters[c].level < level)
+        refine.push_back(c);
+    if (pool && pool->size() > 1) {
+      // Batches bound the splits held at once; their size does not depend on the thread
+      // count (neither does anything else the decoder does).
+      constexpr size_t kBatch = 256;
+      for (size_t b = 0; b < refine.size(); b += kBatch)
+        decode_batch(&refine[b], std::min(kBatch, refine.size() - b), level, older_than, applied,
+                     decoding);
+      continue;
+    }
+    for (uint32_t c : refine) {
       decoding = c;
       decode_cluster_level(c, level, older_than);
       decoding = kNone;
-      if (progress && (++done % 64 == 0 || done == todo))
-        progress(double(done) / double(todo), "decode");
+      applied();
     }
   }
   levels = target;

@@ -15,6 +15,7 @@
 #include "geometry/quantize.h"
 #include "lossless/lossless_stage.h"
 #include "mesh/reorder.h"
+#include "parallel/thread_pool.h"
 #include "pomar/limits.h"
 
 namespace pomar {
@@ -182,7 +183,7 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
 
   auto t1 = std::chrono::steady_clock::now();
   DecimationOptions decimation;
-  decimation.threads = options.threads ? options.threads : available_cores();
+  decimation.threads = resolve_threads(options.threads);
   const Decimation dec = decimate(std::move(in.ct), in.q, decimation, options.progress);
   const double t_decimate = seconds_since(t1);
 

@@ -15,9 +15,18 @@
 // throws, it releases them before the exception leaves, and the mesh is exactly as before
 // the step (damage never half-applies; the other clusters of the level can still claim
 // those faces).
+//
+// The clusters of one clustered level can also be refined in two phases (the selective
+// decoder's threads): traverse_cluster_level runs step 1 and 2 of several clusters at once,
+// each on its own LevelStep, without touching the mesh (face claims included); then
+// apply_cluster_level, in cluster order, checks each cluster's claims against the clusters
+// applied before it and applies its splits. A cluster's traversal does not depend on the
+// splits of other clusters of its level (the level-(l-1) view), so this gives the mesh,
+// the vertex numbering and the errors of cluster_level called in cluster order.
 #pragma once
 
 #include <cstdint>
+#include <exception>
 #include <vector>
 
 #include "refine/level_traversal.h"
@@ -42,6 +51,13 @@ struct NoCheck {
   void operator()(const StepCounts &) const {}
 };
 
+/// A cluster traversed but not yet applied (traverse_cluster_level -> apply_cluster_level).
+struct TraversedCluster {
+  std::vector<PendingSplit> splits;
+  std::vector<uint32_t> claims; // the faces its patches hold, in claim order
+  std::exception_ptr error;     // what its traversal or check threw (nothing to apply)
+};
+
 class LevelStep {
 public:
   /// Refine the whole mesh by global level `level` (vertices get cluster 0).
@@ -49,7 +65,7 @@ public:
   void global_level(LevelMesh &mesh, Codec &codec, uint32_t level, const Check &check = {}) {
     traverse_and_check(mesh, level, check,
                        [&] { traverse_level(mesh, codec, scratch_, level, splits_); });
-    apply_splits(mesh, level, 0, nullptr);
+    apply_splits(mesh, splits_, level, 0, nullptr);
   }
 
   /// Refine one cluster by one clustered level; `next_local` is the cluster's counter of
@@ -61,7 +77,46 @@ public:
     traverse_and_check(mesh, where.level, check, [&] {
       traverse_cluster(mesh, codec, scratch_, where.cluster, view, splits_);
     });
-    apply_splits(mesh, where.level, where.cluster, &next_local);
+    apply_splits(mesh, splits_, where.level, where.cluster, &next_local);
+  }
+
+  /// Steps 1 and 2 of cluster_level, leaving the mesh as it is (other LevelSteps may
+  /// traverse other clusters of the level on the same mesh at the same time): the splits,
+  /// the claims and what the traversal or the check threw go to `out`.
+  template <class Codec, class Check = NoCheck>
+  void traverse_cluster_level(LevelMesh &mesh, Codec &codec, const ClusterLevel &where,
+                              const Check &check, TraversedCluster &out) {
+    const LevelView view{where.level, where.older_than};
+    scratch_.defer_claims = true;
+    out.error = nullptr;
+    try {
+      traverse_and_check(mesh, where.level, check, [&] {
+        traverse_cluster(mesh, codec, scratch_, where.cluster, view, splits_);
+      });
+    } catch (...) {
+      out.error = std::current_exception();
+    }
+    scratch_.defer_claims = false;
+    out.splits.swap(splits_);
+    out.claims.swap(scratch_.claims);
+  }
+
+  /// Step 3 of a cluster traversed by traverse_cluster_level, the clusters of the level
+  /// taken in cluster order: a patch face an earlier cluster holds is damage (reported
+  /// first: cluster_level would have stopped there), then the traversal's error is
+  /// rethrown, else the claims are made and the splits applied. Throws with the mesh as it
+  /// was.
+  template <class Codec>
+  void apply_cluster_level(LevelMesh &mesh, Codec &codec, const ClusterLevel &where,
+                           uint32_t &next_local, TraversedCluster &in) {
+    for (uint32_t f : in.claims)
+      if (mesh.face_claim[f] == where.level)
+        codec.corrupt(kSharedFace);
+    if (in.error)
+      std::rethrow_exception(in.error);
+    for (uint32_t f : in.claims)
+      mesh.face_claim[f] = static_cast<uint16_t>(where.level);
+    apply_splits(mesh, in.splits, where.level, where.cluster, &next_local);
   }
 
 private:
@@ -82,17 +137,20 @@ private:
     }
   }
 
-  /// Undo the face claims of this step's traversal of `level`.
+  /// Undo the face claims of this step's traversal of `level` (none were made if deferred).
   void release_claims(LevelMesh &mesh, uint32_t level) const {
-    for (uint32_t f = 0; f < mesh.face_claim.size(); ++f)
-      if (scratch_.claimed[f] == scratch_.stamp && mesh.face_claim[f] == level)
+    if (scratch_.defer_claims)
+      return;
+    for (uint32_t f : scratch_.claims)
+      if (mesh.face_claim[f] == level)
         mesh.face_claim[f] = static_cast<uint16_t>(level - 1);
   }
 
   /// Apply the splits in traversal order; new vertices get consecutive ids. A cluster's
   /// new vertices are numbered inside the cluster by `next_local`.
-  void apply_splits(LevelMesh &mesh, uint32_t level, uint32_t cluster, uint32_t *next_local) {
-    for (const PendingSplit &ps : splits_) {
+  static void apply_splits(LevelMesh &mesh, const std::vector<PendingSplit> &splits,
+                           uint32_t level, uint32_t cluster, uint32_t *next_local) {
+    for (const PendingSplit &ps : splits) {
       const uint32_t v_from = mesh.vertex_count();
       apply_split(mesh.ct, ps.op, v_from);
       mesh.q.insert(mesh.q.end(), ps.v_from.position, ps.v_from.position + 3);

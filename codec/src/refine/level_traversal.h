@@ -57,6 +57,10 @@ struct TraversalScratch {
   std::vector<VertexMarks> marks;
   std::vector<uint32_t> claimed; // per face: stamp of the level whose patch holds it
   uint32_t stamp = 0;
+  std::vector<uint32_t> claims; // the faces this traversal's patches hold, in claim order
+  // Leave LevelMesh::face_claim to the caller (clusters traversed in parallel: the caller
+  // checks and writes their claims in cluster order, refine/level_step.h).
+  bool defer_claims = false;
   std::vector<std::pair<uint32_t, uint32_t>> queue; // (vertex, came from)
   Ring ring;
   std::vector<uint32_t> ranked;
@@ -68,6 +72,7 @@ struct TraversalScratch {
       claimed.resize(faces, 0);
     ++stamp;
     queue.clear();
+    claims.clear();
   }
   bool queued(uint32_t v) const { return marks[v].queued == stamp; }
   bool split(uint32_t v) const { return marks[v].split == stamp; }
@@ -208,6 +213,9 @@ inline void predict_attributes(const LevelMesh &mesh, uint32_t v_to, const Ring 
   pred[mesh.normal_code + 1] = w;
 }
 
+/// What a stream whose patches overlap is told.
+constexpr const char *kSharedFace = "two vertex splits of one level share a face";
+
 /// Code (or decode) s_v at v and, for a split vertex, the split: symbols, patch, claim of
 /// its faces, prediction and position. `ring` is v's ring as the level sees it.
 template <class Codec, class Key>
@@ -227,10 +235,12 @@ void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v,
   // independent); a stream that says otherwise is damaged.
   for (uint32_t t = 0; t < p.faces; ++t) {
     const uint32_t f = ring.corner[(p.first_face + t) % ring.size()] / 3;
-    if (mesh.face_claim[f] == level)
-      codec.corrupt("two vertex splits of one level share a face");
-    mesh.face_claim[f] = static_cast<uint16_t>(level);
+    if (mesh.face_claim[f] == level || s.claimed[f] == s.stamp)
+      codec.corrupt(kSharedFace);
+    if (!s.defer_claims)
+      mesh.face_claim[f] = static_cast<uint16_t>(level);
     s.claimed[f] = s.stamp;
+    s.claims.push_back(f);
   }
   // The split walks the patch faces counter-clockwise in the actual mesh: they must be the
   // ring's faces (true for valid data; a damaged stream could point across a boundary or a

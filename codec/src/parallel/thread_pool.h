@@ -1,0 +1,56 @@
+// The threads of the codec's parallel steps: how many this process may use, and a small
+// pool that runs the items of one step on all of them and returns when every item is done.
+// Whatever runs on it must give the same result for any thread count (the steps write
+// per-item results and join them in item order).
+#pragma once
+
+#include <condition_variable>
+#include <cstddef>
+#include <cstdint>
+#include <exception>
+#include <functional>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace pomar {
+
+/// The cores this process may run on (its CPU affinity mask; at least 1; 1 in a
+/// WebAssembly build without threads).
+unsigned available_cores();
+
+/// `threads` if non-zero, else available_cores() (the meaning of the options' 0).
+unsigned resolve_threads(unsigned threads);
+
+class ThreadPool {
+public:
+  /// `threads` threads in all, the caller's included (it works too); fewer if the system
+  /// refuses to start more.
+  explicit ThreadPool(unsigned threads);
+  ~ThreadPool();
+  ThreadPool(const ThreadPool &) = delete;
+  ThreadPool &operator=(const ThreadPool &) = delete;
+  unsigned size() const { return static_cast<unsigned>(workers_.size()) + 1; }
+  /// Run task(i, thread) for every i in [0, n) on the pool's threads (`thread` in
+  /// [0, size()): one thread runs one item at a time), the items taken in increasing order;
+  /// returns when all are done, rethrowing the first exception a task let out.
+  using Task = std::function<void(size_t item, unsigned thread)>;
+  void run(size_t n, const Task &task);
+
+private:
+  void work(unsigned thread);
+  void drain(unsigned thread);
+
+  std::vector<std::thread> workers_;
+  std::mutex mutex_;
+  std::condition_variable wake_, done_;
+  const Task *task_ = nullptr; // the job (set under mutex_ before the workers wake)
+  size_t items_ = 0;
+  size_t next_ = 0;         // next item to take (under mutex_)
+  unsigned busy_ = 0;       // workers not yet through the current job
+  uint64_t generation_ = 0; // counts jobs: a worker runs each one once
+  bool stop_ = false;
+  std::exception_ptr error_;
+};
+
+} // namespace pomar
