@@ -1,5 +1,7 @@
 #include "entropy/static_tables.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 
@@ -14,16 +16,42 @@ constexpr int kLogCodes = 104;
 
 uint32_t log_frequency(uint32_t q) { return q == 0 ? 0 : ((8u + (q & 7)) << (q >> 3)) >> 3; }
 
-uint32_t log_code(uint32_t f) { // the code whose frequency is nearest to f (f >= 1)
+/// log_frequency of every code, built once (non-decreasing in q: the small codes repeat 1).
+const uint32_t *log_frequencies() {
+  static const auto table = [] {
+    std::array<uint32_t, kLogCodes> t{};
+    for (uint32_t q = 0; q < uint32_t(kLogCodes); ++q)
+      t[q] = log_frequency(q);
+    return t;
+  }();
+  return table.data();
+}
+
+} // namespace
+
+uint32_t log_code(uint32_t f) {
+  // The smallest code whose frequency is nearest to f: binary search instead of trying all
+  // 103 codes (the table writer and reader call this for every symbol of every model of
+  // every level). Candidates: the first code at or above f, and the first code of the
+  // value just below it (equal values: the smaller code wins, ties go to the lower value).
+  const uint32_t *F = log_frequencies();
+  const uint32_t hi = uint32_t(std::lower_bound(F + 1, F + kLogCodes, f) - F);
+  if (hi == 1)
+    return 1;
+  const uint32_t lo = uint32_t(std::lower_bound(F + 1, F + kLogCodes, F[hi - 1]) - F);
+  if (hi == uint32_t(kLogCodes))
+    return lo;
+  return f - F[lo] <= F[hi] - f ? lo : hi;
+}
+
+uint32_t log_code_reference(uint32_t f) {
   uint32_t best = 1;
-  for (uint32_t q = 1; q < kLogCodes; ++q)
+  for (uint32_t q = 1; q < uint32_t(kLogCodes); ++q)
     if (std::abs(int64_t(log_frequency(q)) - int64_t(f)) <
         std::abs(int64_t(log_frequency(best)) - int64_t(f)))
       best = q;
   return best;
 }
-
-} // namespace
 
 namespace {
 
@@ -292,9 +320,9 @@ std::vector<Models> read_tables(const uint8_t *data, size_t size, size_t levels,
               freq[s] = 1;
             before.clear();
           } else {
-            std::vector<uint32_t> q(n, 0);
+            uint32_t q[FrequencyModel::kMaxSymbols] = {}; // no allocation per model
             if (!before.empty() && rc.decode_bit(t.same[0])) {
-              q = before;
+              std::copy(before.begin(), before.end(), q);
             } else if (!before.empty()) {
               for (size_t s = 0; s < n; ++s)
                 q[s] = get_step(rc, t.across, before[s]);
@@ -311,7 +339,7 @@ std::vector<Models> read_tables(const uint8_t *data, size_t size, size_t levels,
                 bad();
               freq[s] = static_cast<uint16_t>(log_frequency(q[s]));
             }
-            before = q;
+            before.assign(q, q + n);
           }
           if (!f.freeze_with(freq))
             bad();

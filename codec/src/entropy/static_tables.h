@@ -21,8 +21,8 @@ public:
   struct Event {
     void *model; // FrequencyModel* or BitModel*; null for bypass bits
     uint32_t value;
-    uint8_t kind;  // 0 frequency symbol, 1 binary, 2 bypass bits
-    uint8_t nbits; // bypass only
+    uint8_t kind;   // 0 frequency symbol, 1 binary, 2 bypass bits
+    uint8_t nbits;  // bypass only
     uint8_t stream; // 0 connectivity, 1 geometry, 2 + k attribute code k (statistics only)
   };
   void encode(FrequencyModel &m, int s) { events.push_back({&m, uint32_t(s), 0, 0, stream}); }
@@ -62,6 +62,11 @@ void freeze_on_recordings(std::vector<Models> &models,
 /// code lengths per stream to bits[stream]: 0 connectivity, 1 geometry, 2 + k attribute
 /// code k (the array must have room for every stream recorded).
 std::vector<uint8_t> code_recording(const SymbolRecorder &recording, double bits[2]);
+
+/// The log-scale code (1..103) whose stored frequency is nearest to f >= 1 (smallest code
+/// on ties); log_code_reference is the plain search over every code, kept for the tests.
+uint32_t log_code(uint32_t f);
+uint32_t log_code_reference(uint32_t f);
 
 /// Serialize / read back the frozen models of every clustered level.
 std::vector<uint8_t> write_tables(std::vector<Models> &models);
