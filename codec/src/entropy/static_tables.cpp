@@ -73,8 +73,7 @@ double data_bits(const std::vector<uint32_t> &counts, const uint16_t *freq, int 
 
 } // namespace
 
-void freeze_on_recordings(std::vector<Models> &models,
-                          const std::vector<SymbolRecorder> &recordings) {
+void LevelFreezer::freeze(Models &m, const std::vector<SymbolRecorder> &recordings) {
   std::unordered_map<const void *, std::vector<uint32_t>> counts;
   for (const SymbolRecorder &r : recordings)
     for (const SymbolRecorder::Event &e : r.events) {
@@ -85,10 +84,10 @@ void freeze_on_recordings(std::vector<Models> &models,
       c.resize(n, 0);
       ++c[e.value];
     }
-  // Level after level; a model whose previous-level table codes this level's symbols
-  // nearly as well as its own would (within what storing its own costs) reuses it.
-  std::vector<std::vector<uint16_t>> previous; // per slot: frozen frequencies (empty: unused)
-  for (Models &m : models) {
+  // A model whose previous-level table codes this level's symbols nearly as well as its
+  // own would (within what storing its own costs) reuses it.
+  std::vector<std::vector<uint16_t>> &previous = previous_;
+  {
     size_t slot = 0;
     auto prev_of = [&]() -> std::vector<uint16_t> & {
       if (previous.size() <= slot)
@@ -152,9 +151,7 @@ void freeze_on_recordings(std::vector<Models> &models,
   }
 }
 
-std::vector<uint8_t> code_recording(const SymbolRecorder &r, double bits[2]) {
-  std::vector<uint8_t> out;
-  RangeEncoder rc(&out);
+void code_recording(const SymbolRecorder &r, RangeEncoder &rc, double *bits) {
   for (const SymbolRecorder::Event &e : r.events) {
     switch (e.kind) {
     case 0: {
@@ -174,8 +171,6 @@ std::vector<uint8_t> code_recording(const SymbolRecorder &r, double bits[2]) {
       rc.encode_bypass(e.value, e.nbits);
     }
   }
-  rc.finish();
-  return out;
 }
 
 // Table stream, level after level, each model in for_each_model order:

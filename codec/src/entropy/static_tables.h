@@ -54,14 +54,23 @@ struct RecorderStream {
   void finish() {}
 };
 
-/// Freeze `models` (one Models per clustered level) on the symbols of `recordings`.
-void freeze_on_recordings(std::vector<Models> &models,
-                          const std::vector<SymbolRecorder> &recordings);
+/// Freezes the models of the clustered levels, level after level, each on the symbols its
+/// level recorded (so the encoder can code and forget a level before recording the next).
+/// A model whose previous-level frequencies code this level nearly as well as its own
+/// would (within what storing its own costs) reuses them: call freeze() in level order.
+class LevelFreezer {
+public:
+  void freeze(Models &level, const std::vector<SymbolRecorder> &recordings);
 
-/// Range-code a recording with the (frozen) models its events point to. Adds the ideal
-/// code lengths per stream to bits[stream]: 0 connectivity, 1 geometry, 2 + k attribute
-/// code k (the array must have room for every stream recorded).
-std::vector<uint8_t> code_recording(const SymbolRecorder &recording, double bits[2]);
+private:
+  std::vector<std::vector<uint16_t>> previous_; // per model slot: frozen frequencies (empty: unused)
+};
+
+/// Range-code a recording into `rc` with the (frozen) models its events point to (a
+/// cluster's encoder lives across levels: call once per level, finish() after the last).
+/// Adds the ideal code lengths per stream to bits[stream]: 0 connectivity, 1 geometry,
+/// 2 + k attribute code k (the array must have room for every stream recorded).
+void code_recording(const SymbolRecorder &recording, RangeEncoder &rc, double *bits);
 
 /// The log-scale code (1..103) whose stored frequency is nearest to f >= 1 (smallest code
 /// on ties); log_code_reference is the plain search over every code, kept for the tests.
