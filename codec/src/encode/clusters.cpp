@@ -60,7 +60,9 @@ ClusteredLevels encode_clustered_levels(Rebuild &rb, size_t global, FileHeader &
     Models &models = level_models[r - global];
     codec.begin_level(rb.collapses(level), &models);
     const uint32_t older_than = lm.vertex_count(); // levels are encoded in order
+    const ModelAddresses addresses(models);
     for (uint32_t c = 0; c < clusters; ++c) {
+      recordings[c].addresses = &addresses;
       RecorderStream conn{&recordings[c], 0}, geom{&recordings[c], 1};
       codec.set_sinks(&conn, &geom);
       rb.step.cluster_level(lm, codec, {c, level, older_than}, next_local[c]);

@@ -73,16 +73,49 @@ double data_bits(const std::vector<uint32_t> &counts, const uint16_t *freq, int 
 
 } // namespace
 
+ModelAddresses::ModelAddresses(Models &m) {
+  auto add = [&](const void *begin, size_t bytes) {
+    const uintptr_t b = reinterpret_cast<uintptr_t>(begin);
+    if (bytes)
+      ranges_.push_back({b, b + bytes});
+  };
+  auto add_vector = [&](const std::vector<FrequencyModel> &v) {
+    add(v.data(), v.size() * sizeof(FrequencyModel));
+  };
+  add(&m, sizeof(Models)); // the models held in the struct itself (sv, mantissa)
+  add_vector(m.conn.se);
+  add_vector(m.conn.faces);
+  add_vector(m.conn.sl);
+  for (const auto &kind : m.geom.magnitude)
+    add_vector(kind);
+  add(m.attr.data(), m.attr.size() * sizeof(AttributeCodeModels)); // their `top` models
+  for (const AttributeCodeModels &a : m.attr)
+    add_vector(a.classes);
+  std::sort(ranges_.begin(), ranges_.end());
+  if (ranges_.size() > 256)
+    throw Error(Error::Kind::Internal, "internal encoder error: too many model arrays");
+}
+
+uint32_t ModelAddresses::name(const void *model) const {
+  const uintptr_t p = reinterpret_cast<uintptr_t>(model);
+  auto it = std::upper_bound(ranges_.begin(), ranges_.end(), std::make_pair(p, ~uintptr_t(0)));
+  if (it == ranges_.begin() || p >= (it - 1)->second || p - (it - 1)->first > 0xFFFFFFu)
+    throw Error(Error::Kind::Internal, "internal encoder error: a model outside its level");
+  --it;
+  return uint32_t(it - ranges_.begin()) << 24 | uint32_t(p - it->first);
+}
+
 void LevelFreezer::freeze(Models &m, const std::vector<SymbolRecorder> &recordings) {
   std::unordered_map<const void *, std::vector<uint32_t>> counts;
   for (const SymbolRecorder &r : recordings)
     for (const SymbolRecorder::Event &e : r.events) {
-      if (e.kind == 2)
+      if (e.kind() == 2)
         continue;
-      auto &c = counts[e.model];
-      const size_t n = e.kind == 0 ? size_t(static_cast<FrequencyModel *>(e.model)->symbols()) : 2;
+      void *model = r.model(e);
+      auto &c = counts[model];
+      const size_t n = e.kind() == 0 ? size_t(static_cast<FrequencyModel *>(model)->symbols()) : 2;
       c.resize(n, 0);
-      ++c[e.value];
+      ++c[e.value()];
     }
   // A model whose previous-level table codes this level's symbols nearly as well as its
   // own would (within what storing its own costs) reuses it.
@@ -153,22 +186,22 @@ void LevelFreezer::freeze(Models &m, const std::vector<SymbolRecorder> &recordin
 
 void code_recording(const SymbolRecorder &r, RangeEncoder &rc, double *bits) {
   for (const SymbolRecorder::Event &e : r.events) {
-    switch (e.kind) {
+    switch (e.kind()) {
     case 0: {
-      auto &m = *static_cast<FrequencyModel *>(e.model);
-      bits[e.stream] += cost_bits(m, int(e.value));
-      rc.encode(m, int(e.value));
+      auto &m = *static_cast<FrequencyModel *>(r.model(e));
+      bits[e.stream()] += cost_bits(m, int(e.value()));
+      rc.encode(m, int(e.value()));
       break;
     }
     case 1: {
-      auto &m = *static_cast<BitModel *>(e.model);
-      bits[e.stream] += cost_bits(m, int(e.value));
-      rc.encode_bit(m, int(e.value));
+      auto &m = *static_cast<BitModel *>(r.model(e));
+      bits[e.stream()] += cost_bits(m, int(e.value()));
+      rc.encode_bit(m, int(e.value()));
       break;
     }
     default:
-      bits[e.stream] += e.nbits;
-      rc.encode_bypass(e.value, e.nbits);
+      bits[e.stream()] += e.nbits();
+      rc.encode_bypass(e.value(), int(e.nbits()));
     }
   }
 }
