@@ -136,6 +136,21 @@ pass
 run verify "$BUNNY" "$WORK/bunny.pomar" "$WORK/decoded_ascii.ply"
 expect_rc 0
 
+section "decode --threads 1, 2 and 7 write the same file (full and selective decodes)"
+for t in 1 2 7; do
+  run decode -q --threads "$t" "$WORK/bunny.pomar" "$WORK/threads$t.ply"
+  expect_rc 0
+  run decode -q --threads "$t" "$WORK/bunny.pomar" "$WORK/threads_sel$t.ply" --sphere -0.06,0.16,0.0,0.03 --level 12
+  expect_rc 0
+done
+for t in 2 7; do
+  cmp -s "$WORK/threads1.ply" "$WORK/threads$t.ply" || fail "decode --threads $t differs from --threads 1"
+  pass
+  cmp -s "$WORK/threads_sel1.ply" "$WORK/threads_sel$t.ply" || fail "selective decode --threads $t differs from --threads 1"
+  pass
+done
+rm -f "$WORK"/threads*.ply
+
 section "verify reports a mismatch with exit 3"
 run decode -q --level 0 "$WORK/bunny.pomar" "$WORK/base.ply"
 expect_rc 0
