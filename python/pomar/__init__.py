@@ -65,6 +65,11 @@ class Mesh:
         return f"pomar.Mesh({len(self.vertices)} vertices, {len(self.faces)} faces{extra})"
 
 
+def _check_threads(threads):
+    if isinstance(threads, bool) or not isinstance(threads, int) or threads < 0:
+        raise ValueError("threads must be an integer >= 0 (0: every core), not %r" % (threads,))
+
+
 def encode(vertices, faces=None, *, bits=12, clusters=0, cluster_ratio=0.01,
            progressive=False, memory_limit=None, progress=None, colors=None, normals=None,
            scalars=None, texcoords=None, texture_files=None, normal_bits=9, scalar_bits=16,
@@ -91,8 +96,7 @@ def encode(vertices, faces=None, *, bits=12, clusters=0, cluster_ratio=0.01,
     input order). threads: for the encoder's parallel steps, 0 = every core this process
     may use (the bytes do not depend on it).
     """
-    if isinstance(threads, bool) or not isinstance(threads, int) or threads < 0:
-        raise ValueError("threads must be an integer >= 0 (0: every core), not %r" % (threads,))
+    _check_threads(threads)
     given = {"colors": colors, "normals": normals, "scalars": scalars, "texcoords": texcoords,
              "texture_files": texture_files}
     attributes = {}
@@ -115,7 +119,7 @@ def _mesh(vertices, faces, damaged, attributes):
 
 
 def decode(data, level=None, *, skip_damaged=False, memory_limit=None, progress=None,
-           attributes=True):
+           attributes=True, threads=0):
     """Decode .pomar bytes (bytes, bytearray, memoryview) to a Mesh after `level`
     refinement levels (0 = base mesh, None = full resolution), with the file's per-vertex
     attributes (attributes=False: positions and faces only) and their precision in
@@ -124,9 +128,11 @@ def decode(data, level=None, *, skip_damaged=False, memory_limit=None, progress=
     skip_damaged=True decodes around damaged or missing blocks instead of raising (a
     damaged global level stops before it, a damaged cluster stays coarse) and lists them
     in mesh.damaged; damage in the header, base mesh or tables still raises pomar.Error.
-    progress: as for encode()."""
+    progress: as for encode(). threads: for the clusters of a random-access file, 0 = every
+    core this process may use (the mesh does not depend on it)."""
+    _check_threads(threads)
     vertices, faces, damaged, fields = _pomar.decode(data, level, skip_damaged, memory_limit,
-                                                     progress, attributes)
+                                                     progress, attributes, threads)
     return _mesh(vertices, faces, damaged, fields)
 
 
@@ -167,8 +173,15 @@ class SelectiveDecoder(_pomar.SelectiveDecoder):
         part = d.mesh()                          # + d.vertex_cluster(), d.vertex_level()
         d.bytes_read
 
-    One thread at a time per decoder (calls from several threads wait for each other).
+    One thread at a time per decoder (calls from several threads wait for each other);
+    update() decodes the clusters of a level on `threads` threads of its own (keyword of
+    the constructor, 0 = every core this process may use; the mesh does not depend on it).
     """
+
+    def __init__(self, source, *, skip_damaged=False, memory_limit=None, threads=0):
+        _check_threads(threads)
+        super().__init__(source, skip_damaged=skip_damaged, memory_limit=memory_limit,
+                         threads=threads)
 
     def mesh(self):
         """The current mesh (after the last update())."""

@@ -68,9 +68,11 @@ py::bytes encode(const py::handle &vertices, const py::handle &faces, int bits, 
 }
 
 py::tuple decode(const py::handle &data, const py::handle &level, bool skip_damaged,
-                 const py::handle &max_memory, const py::handle &progress, bool attributes) {
+                 const py::handle &max_memory, const py::handle &progress, bool attributes,
+                 unsigned threads) {
   const ReadBuffer buffer(data, "decode()");
   pomar::DecodeOptions options;
+  options.threads = threads;
   if (!attributes)
     options.attributes = pomar::AttributeMask::none();
   options.skip_damaged = skip_damaged;
@@ -147,7 +149,7 @@ PYBIND11_MODULE(_pomar, m) {
         py::arg("scalar_bits"), py::arg("texcoord_bits"), py::arg("exact_attributes"),
         py::arg("strict"), py::arg("keep_order"), py::arg("threads"));
   m.def("decode", &decode, py::arg("data"), py::arg("level"), py::arg("skip_damaged"),
-        py::arg("memory_limit"), py::arg("progress"), py::arg("attributes"));
+        py::arg("memory_limit"), py::arg("progress"), py::arg("attributes"), py::arg("threads"));
   m.def("info", &info, py::arg("data"));
   m.def("read_mesh", &read_mesh, py::arg("path"));
   m.def("write_mesh", &write_mesh, py::arg("path"), py::arg("vertices"), py::arg("faces"),

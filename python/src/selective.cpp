@@ -32,7 +32,8 @@ private:
 
 class Decoder {
 public:
-  Decoder(const py::handle &source, bool skip_damaged, const py::handle &max_memory) {
+  Decoder(const py::handle &source, bool skip_damaged, const py::handle &max_memory,
+          unsigned threads) {
     std::unique_ptr<pomar::ByteSource> bytes;
     std::string path;
     if (py::isinstance<py::str>(source) || py::hasattr(source, "__fspath__")) {
@@ -45,6 +46,7 @@ public:
     pomar::SelectiveOptions options;
     options.skip_damaged = skip_damaged;
     options.memory_limit = memory_limit(max_memory);
+    options.threads = threads;
     py::gil_scoped_release unlocked;
     decoder_ = call_library("damaged_file", [&] {
       if (!bytes)
@@ -95,8 +97,9 @@ using D = pomar::SelectiveDecoder;
 
 void register_selective_decoder(py::module_ &m) {
   py::class_<Decoder>(m, "SelectiveDecoder")
-      .def(py::init<const py::handle &, bool, const py::handle &>(), py::arg("source"),
-           py::kw_only(), py::arg("skip_damaged") = false, py::arg("memory_limit") = py::none())
+      .def(py::init<const py::handle &, bool, const py::handle &, unsigned>(), py::arg("source"),
+           py::kw_only(), py::arg("skip_damaged") = false, py::arg("memory_limit") = py::none(),
+           py::arg("threads") = 0u)
       .def_property_readonly("info",
                              [](Decoder &s) {
                                pomar::FileInfo i = s.locked([](D &d) { return d.info(); });

@@ -615,3 +615,27 @@ def test_messy_meshes_strict_keep_order_and_threads():
     assert one == pomar.encode(vertices, faces, bits=16, threads=3) == data
     with pytest.raises(ValueError, match="threads must be an integer >= 0"):
         pomar.encode(vertices, faces, threads=-1)
+
+
+def test_decode_threads_give_the_same_mesh(bunny):
+    """The clusters of a random-access file decode on several threads: the mesh does not
+    depend on how many (full and selective decodes)."""
+    data = pomar.encode(bunny, cluster_ratio=0.02)
+    one = pomar.decode(data, threads=1)
+    for t in (2, 7):
+        other = pomar.decode(data, threads=t)
+        assert np.array_equal(one.vertices, other.vertices)
+        assert np.array_equal(one.faces, other.faces)
+    meshes = []
+    for t in (1, 2, 7):
+        d = pomar.SelectiveDecoder(data, threads=t)
+        d.want_sphere((-0.06, 0.16, 0.0), 0.03)
+        d.update()
+        meshes.append(d.mesh())
+    for m in meshes[1:]:
+        assert np.array_equal(meshes[0].vertices, m.vertices)
+        assert np.array_equal(meshes[0].faces, m.faces)
+    with pytest.raises(ValueError, match="threads must be an integer >= 0"):
+        pomar.decode(data, threads=-1)
+    with pytest.raises(ValueError, match="threads must be an integer >= 0"):
+        pomar.SelectiveDecoder(data, threads=1.5)
