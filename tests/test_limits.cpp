@@ -258,11 +258,23 @@ TEST(MemoryCheck, DecodeAndSelectiveDecoderRefuseAfterTheHeader) {
   ASSERT_TRUE(info.clustered());
   // Full resolution needs the full estimate; level 0 only the base mesh's.
   const uint64_t full = decode_memory_estimate(info.vertices, info.faces, true);
-  EXPECT_THROW(decode(file.data(), file.size(), -1, {}, full - 1), Error);
-  EXPECT_EQ(decode(file.data(), file.size(), -1, {}, full).vertex_count(), info.vertices);
-  EXPECT_EQ(decode(file.data(), file.size(), 0, {}, full - 1).vertex_count(), info.base_vertices);
+  const auto decode_on = [&](int level, uint64_t limit, unsigned threads = 1) {
+    DecodeOptions o;
+    o.level = level;
+    o.memory_limit = limit;
+    o.threads = threads;
+    return decode(file.data(), file.size(), o);
+  };
+  EXPECT_THROW(decode_on(-1, full - 1), Error);
+  EXPECT_EQ(decode_on(-1, full).vertex_count(), info.vertices);
+  EXPECT_EQ(decode_on(0, full - 1).vertex_count(), info.base_vertices);
   // A level above the global ones goes through the selective decoder: still the full check.
-  EXPECT_THROW(decode(file.data(), file.size(), int(info.levels.size()), {}, full - 1), Error);
+  EXPECT_THROW(decode_on(int(info.levels.size()), full - 1), Error);
+  // Each thread past the first holds marks of the whole mesh.
+  const uint64_t three = full + 2 * decode_thread_memory(info.vertices, info.faces);
+  EXPECT_EQ(decode_thread_memory(1000, 2000), 16000u);
+  EXPECT_THROW(decode_on(-1, three - 1, 3), Error);
+  EXPECT_EQ(decode_on(-1, three, 3).vertex_count(), info.vertices);
   const std::string msg = error_of([&] {
     SelectiveDecoder d(std::make_unique<MemorySource>(file.data(), file.size()), {false, 1024, {}});
   });

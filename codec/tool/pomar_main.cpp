@@ -898,8 +898,8 @@ int main(int argc, char **argv) {
   dec->add_flag("-q,--quiet", da.quiet, "Print nothing on success");
   dec->add_option("--threads", da.threads,
                   "Threads for the clusters of a random-access file (0 = every core this process "
-                  "may use; pure progressive files decode on one); the output is the same for "
-                  "any number")
+                  "may use, at most 8; pure progressive files decode on one); the output is the "
+                  "same for any number")
       ->capture_default_str();
   dec->add_flag("--no-attributes", da.no_attributes,
                 "Write positions and triangles only: leave out colour, normals, scalars and "

@@ -67,4 +67,12 @@ void check_encode_memory(uint64_t vertices, uint64_t faces, uint64_t limit, uint
 /// of the file `info` describes (action "decode").
 void check_decode_memory(const FileInfo &info, int level, uint64_t limit);
 
+/// What each decoding thread past the first adds to decode_memory_estimate for a clustered
+/// file: its traversal marks, 8 bytes per vertex and 4 per face.
+uint64_t decode_thread_memory(uint64_t vertices, uint64_t faces);
+
+/// check_decode_memory for a decode on `threads` threads (DecodeOptions::threads resolved:
+/// a clustered file's clusters decode on all of them).
+void check_decode_memory(const FileInfo &info, int level, uint64_t limit, unsigned threads);
+
 } // namespace pomar

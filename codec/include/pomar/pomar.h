@@ -314,7 +314,9 @@ struct DecodeOptions {
   /// and triangles only; the codes are interleaved with the positions and decoded anyway).
   AttributeMask attributes;
   /// Threads for the clustered levels of a random-access file (their clusters are decoded
-  /// in parallel); 0 = the cores this process may run on. The mesh does not depend on it.
+  /// in parallel); 0 = the cores this process may run on; at most 8 (each one holds 8 bytes
+  /// per vertex and 4 per face: pomar/limits.h decode_thread_memory). The mesh does not
+  /// depend on it.
   /// Global levels, and so pure progressive files, are decoded on one thread.
   unsigned threads = 0;
 };

@@ -11,6 +11,7 @@
 #include "decode/decoder_codec.h"
 #include "entropy/models.h"
 #include "format/file_format.h"
+#include "parallel/thread_pool.h"
 #include "lossless/lossless_stage.h"
 #include "pomar/limits.h"
 #include "pomar/random_access.h"
@@ -111,7 +112,8 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
   const size_t levels = h.levels.size();
   if (options.level != -1) // -1: full resolution
     check_level_exists(options.level, static_cast<int>(levels));
-  check_decode_memory(file_info(layout, size), options.level, options.memory_limit);
+  const unsigned threads = decode_threads(options.threads);
+  check_decode_memory(file_info(layout, size), options.level, options.memory_limit, threads);
   const size_t target = options.level < 0 ? levels : static_cast<size_t>(options.level);
   const size_t global = h.clustered() ? h.global_levels : levels;
   // Clustered levels go through the selective decoder, unless a global level they build
@@ -131,7 +133,7 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
     so.skip_damaged = options.skip_damaged;
     so.attributes = options.attributes;
     so.memory_limit = kNoMemoryLimit;
-    so.threads = options.threads;
+    so.threads = threads;
     SelectiveDecoder d(std::make_unique<MemorySource>(data, size), so);
     d.want_all(static_cast<int>(target));
     d.update(options.progress);

@@ -214,7 +214,7 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   State &s = *s_;
   s.source = std::move(source);
   s.skip_damaged = options.skip_damaged;
-  s.threads = resolve_threads(options.threads);
+  s.threads = decode_threads(options.threads);
   s.attribute_mask = options.attributes;
   const uint64_t file_size = s.source->size();
   // Header: the fixed part, then as much more as header_size() asks for (version 4 needs
@@ -236,7 +236,7 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   // mesh). Further refinement is what the caller asks for, region by region.
   check_decode_memory(file_info(s.layout, file_size),
                       s.layout.header.clustered() ? int(s.layout.header.global_levels) : 0,
-                      options.memory_limit);
+                      options.memory_limit, s.threads);
   // The global part (a truncated progressive file: what is there of it).
   s.global.resize(std::min<uint64_t>(s.layout.global_bytes, file_size));
   s.source->read(hsize, s.global.size() - hsize, s.global.data() + hsize);

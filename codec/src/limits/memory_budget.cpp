@@ -295,13 +295,24 @@ void check_encode_memory(uint64_t vertices, uint64_t faces, uint64_t limit, uint
 }
 
 void check_decode_memory(const FileInfo &info, int level, uint64_t limit) {
+  check_decode_memory(info, level, limit, 1);
+}
+
+uint64_t decode_thread_memory(uint64_t vertices, uint64_t faces) {
+  return add_mul(add_mul(0, vertices, 8), faces, 4);
+}
+
+void check_decode_memory(const FileInfo &info, int level, uint64_t limit, unsigned threads) {
   uint64_t v = info.vertices, f = info.faces;
   if (level == 0) {
     v = info.base_vertices, f = info.base_faces;
   } else if (level > 0 && static_cast<size_t>(level) <= info.levels.size()) {
     v = info.levels[size_t(level) - 1].vertices, f = info.levels[size_t(level) - 1].faces;
   }
-  check_memory("decode", v, f, decode_memory_estimate(v, f, info.clustered()), 0, limit);
+  uint64_t needed = decode_memory_estimate(v, f, info.clustered());
+  if (info.clustered() && threads > 1)
+    needed = add_mul(needed, threads - 1, decode_thread_memory(v, f));
+  check_memory("decode", v, f, needed, 0, limit);
 }
 
 } // namespace pomar

@@ -25,6 +25,10 @@ unsigned available_cores() {
 
 unsigned resolve_threads(unsigned threads) { return threads ? threads : available_cores(); }
 
+unsigned decode_threads(unsigned threads) {
+  return std::min(resolve_threads(threads), kMaxDecodeThreads);
+}
+
 ThreadPool::ThreadPool(unsigned threads) {
   for (unsigned t = 1; t < threads; ++t) {
     try {

@@ -22,6 +22,12 @@ unsigned available_cores();
 /// `threads` if non-zero, else available_cores() (the meaning of the options' 0).
 unsigned resolve_threads(unsigned threads);
 
+/// The decoder's threads for DecodeOptions/SelectiveOptions::threads: resolve_threads, at
+/// most kMaxDecodeThreads (each thread holds marks of 8 bytes per vertex and 4 per face,
+/// pomar/limits.h decode_thread_memory, and applying the splits stays sequential).
+constexpr unsigned kMaxDecodeThreads = 8;
+unsigned decode_threads(unsigned threads);
+
 class ThreadPool {
 public:
   /// `threads` threads in all, the caller's included (it works too); fewer if the system
