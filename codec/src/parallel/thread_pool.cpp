@@ -52,21 +52,23 @@ ThreadPool::~ThreadPool() {
 void ThreadPool::run(size_t n, const Task &task) {
   if (n == 0)
     return;
+  uint64_t generation;
   {
     const std::lock_guard<std::mutex> lock(mutex_);
     task_ = &task;
     items_ = n;
     next_ = 0;
-    busy_ = static_cast<unsigned>(workers_.size());
+    finished_ = 0;
     error_ = nullptr;
-    ++generation_;
+    generation = ++generation_;
   }
-  wake_.notify_all();
-  drain(0);
+  if (!workers_.empty())
+    wake_.notify_all();
+  drain(0, generation);
   std::exception_ptr error;
   {
     std::unique_lock<std::mutex> lock(mutex_);
-    done_.wait(lock, [&] { return busy_ == 0; });
+    done_.wait(lock, [&] { return finished_ == items_; });
     task_ = nullptr;
     std::swap(error, error_);
   }
@@ -84,31 +86,33 @@ void ThreadPool::work(unsigned thread) {
         return;
       seen = generation_;
     }
-    drain(thread);
-    const std::lock_guard<std::mutex> lock(mutex_);
-    if (--busy_ == 0)
-      done_.notify_one();
+    drain(thread, seen);
   }
 }
 
-void ThreadPool::drain(unsigned thread) {
+void ThreadPool::drain(unsigned thread, uint64_t generation) {
   for (;;) {
     size_t i;
+    const Task *task;
     {
-      // One lock per item: the items are large (a cluster's traversal), and taking them
-      // under the mutex keeps the job's fields and the item counter in one place.
+      // One lock per item: the items are large (a cluster's traversal).
       const std::lock_guard<std::mutex> lock(mutex_);
-      if (next_ >= items_)
+      if (generation_ != generation || next_ >= items_)
         return;
       i = next_++;
+      task = task_;
     }
+    std::exception_ptr error;
     try {
-      (*task_)(i, thread);
+      (*task)(i, thread);
     } catch (...) {
-      const std::lock_guard<std::mutex> lock(mutex_);
-      if (!error_)
-        error_ = std::current_exception();
+      error = std::current_exception();
     }
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (error && !error_)
+      error_ = error;
+    if (++finished_ == items_)
+      done_.notify_all();
   }
 }
 

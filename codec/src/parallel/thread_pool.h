@@ -39,22 +39,25 @@ public:
   unsigned size() const { return static_cast<unsigned>(workers_.size()) + 1; }
   /// Run task(i, thread) for every i in [0, n) on the pool's threads (`thread` in
   /// [0, size()): one thread runs one item at a time), the items taken in increasing order;
-  /// returns when all are done, rethrowing the first exception a task let out.
+  /// returns when all are done, rethrowing the first exception a task let out. The caller
+  /// does not wait for workers that have not started (a busy machine): it takes their items.
   using Task = std::function<void(size_t item, unsigned thread)>;
   void run(size_t n, const Task &task);
 
 private:
   void work(unsigned thread);
-  void drain(unsigned thread);
+  void drain(unsigned thread, uint64_t generation);
 
   std::vector<std::thread> workers_;
   std::mutex mutex_;
   std::condition_variable wake_, done_;
-  const Task *task_ = nullptr; // the job (set under mutex_ before the workers wake)
+  // The job, all under mutex_: an item is taken with the job's generation, so a worker
+  // waking late never touches a later job's items with an earlier job's task.
+  const Task *task_ = nullptr;
   size_t items_ = 0;
-  size_t next_ = 0;         // next item to take (under mutex_)
-  unsigned busy_ = 0;       // workers not yet through the current job
-  uint64_t generation_ = 0; // counts jobs: a worker runs each one once
+  size_t next_ = 0;         // next item to take
+  size_t finished_ = 0;     // items done
+  uint64_t generation_ = 0; // counts jobs
   bool stop_ = false;
   std::exception_ptr error_;
 };
