@@ -20,13 +20,8 @@ constexpr unsigned kThreadCounts[] = {1, 2, 7};
 /// A noisy sphere with a colour and a scalar per vertex.
 Mesh sphere_with_attributes(size_t vertices, uint32_t seed) {
   Mesh m = gen::noisy_sphere(vertices, seed);
-  VertexAttribute colour, quality;
-  colour.kind = AttributeKind::Colour;
-  colour.name = "colour";
-  colour.components = 3;
-  quality.kind = AttributeKind::Scalar;
-  quality.name = "quality";
-  quality.components = 1;
+  VertexAttribute colour{AttributeKind::Colour, "colour", 3, {}, {}};
+  VertexAttribute quality{AttributeKind::Scalar, "quality", 1, {}, {}};
   for (size_t v = 0; v < m.vertex_count(); ++v) {
     for (int k = 0; k < 3; ++k)
       colour.colour.push_back(
@@ -72,8 +67,8 @@ struct Snapshot {
 };
 
 Snapshot snapshot(const SelectiveDecoder &d) {
-  return {d.mesh(), d.vertex_cluster(), d.vertex_level(), d.levels(), d.bytes_read(),
-          d.blocks_read()};
+  return {d.mesh(),   d.vertex_cluster(), d.vertex_level(),
+          d.levels(), d.bytes_read(),     d.blocks_read()};
 }
 
 void expect_same(const Snapshot &a, const Snapshot &b, const std::string &what) {
@@ -130,8 +125,8 @@ TEST(DecodeThreads, FullDecodesAreTheSameForAnyThreadCount) {
     const std::vector<uint8_t> file = encode_with(c.mesh, c.ratio);
     const Mesh one = full_decode(file, 1);
     for (unsigned t : kThreadCounts)
-      expect_same_mesh(one, full_decode(file, t), std::string(c.name) + ", " +
-                                                      std::to_string(t) + " threads");
+      expect_same_mesh(one, full_decode(file, t),
+                       std::string(c.name) + ", " + std::to_string(t) + " threads");
     // A level between the base clustered mesh and the finest.
     const FileInfo info = inspect(file.data(), file.size());
     const int mid = int(info.global_levels + info.levels.size()) / 2 + 1;
@@ -149,8 +144,9 @@ TEST(DecodeThreads, SelectiveSessionsAreTheSameForAnyThreadCount) {
       const std::vector<Snapshot> other = selective_session(file, t);
       ASSERT_EQ(one.size(), other.size());
       for (size_t i = 0; i < one.size(); ++i)
-        expect_same(one[i], other[i], std::string(c.name) + ", request " + std::to_string(i) +
-                                          ", " + std::to_string(t) + " threads");
+        expect_same(one[i], other[i],
+                    std::string(c.name) + ", request " + std::to_string(i) + ", " +
+                        std::to_string(t) + " threads");
     }
   }
 }
@@ -203,8 +199,8 @@ TEST(DecodeThreads, DamagedFilesGiveTheSameResultForAnyThreadCount) {
       skipped += !one.damaged.empty();
       for (unsigned t : {2u, 7u}) {
         const Outcome other = damaged_decode(bad, t, skip);
-        const std::string what = "trial " + std::to_string(trial) + (skip ? ", skip" : "") +
-                                 ", " + std::to_string(t) + " threads";
+        const std::string what = "trial " + std::to_string(trial) + (skip ? ", skip" : "") + ", " +
+                                 std::to_string(t) + " threads";
         EXPECT_EQ(one.error, other.error) << what;
         EXPECT_EQ(one.damaged, other.damaged) << what;
         expect_same_mesh(one.mesh, other.mesh, what);

@@ -79,8 +79,9 @@ struct SelectiveOptions {
   /// are decoded with the positions, block by block, whatever this says.
   AttributeMask attributes;
   /// Threads update() decodes the clusters of a level on (0 = the cores this process may
-  /// run on; at most 8, as DecodeOptions::threads); the mesh is the same for any number. With more than one, the ByteSource is
-  /// called from the decoder's threads, one call at a time.
+  /// run on; at most 8, as DecodeOptions::threads); the mesh is the same for any number.
+  /// With more than one, the ByteSource is called from the decoder's threads, one call at
+  /// a time.
   unsigned threads = 0;
 };
 

@@ -5,14 +5,14 @@
 #include <memory>
 #include <string>
 
-#include "decode/damage.h"
-#include "decode/global_levels.h"
 #include "attributes/attribute_section.h"
+#include "decode/damage.h"
 #include "decode/decoder_codec.h"
+#include "decode/global_levels.h"
 #include "entropy/models.h"
 #include "format/file_format.h"
-#include "parallel/thread_pool.h"
 #include "lossless/lossless_stage.h"
+#include "parallel/thread_pool.h"
 #include "pomar/limits.h"
 #include "pomar/random_access.h"
 

@@ -7,9 +7,9 @@
 // mesh is the same for any thread count.
 #include <algorithm>
 
+#include "attributes/attribute_section.h"
 #include "decode/cluster_stream.h"
 #include "decode/damage.h"
-#include "attributes/attribute_section.h"
 #include "decode/decoder_codec.h"
 #include "decode/global_levels.h"
 #include "decode/level_map.h"

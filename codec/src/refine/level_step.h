@@ -148,8 +148,8 @@ private:
 
   /// Apply the splits in traversal order; new vertices get consecutive ids. A cluster's
   /// new vertices are numbered inside the cluster by `next_local`.
-  static void apply_splits(LevelMesh &mesh, const std::vector<PendingSplit> &splits,
-                           uint32_t level, uint32_t cluster, uint32_t *next_local) {
+  static void apply_splits(LevelMesh &mesh, const std::vector<PendingSplit> &splits, uint32_t level,
+                           uint32_t cluster, uint32_t *next_local) {
     for (const PendingSplit &ps : splits) {
       const uint32_t v_from = mesh.vertex_count();
       apply_split(mesh.ct, ps.op, v_from);
