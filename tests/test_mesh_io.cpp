@@ -241,10 +241,10 @@ TEST_F(MeshIoTest, ObjRelativeIndicesSlashesGroupsAndAttributes) {
   const Mesh m = pomar::load_mesh(file, &r);
   EXPECT_EQ(m.triangles, (std::vector<uint32_t>{0, 1, 2, 1, 3, 2}));
   // Vertex colours and the one normal every corner uses are kept; the texture coordinate
-  // is missing on the second face's corners, and materials are not kept.
+  // is missing on the second face's corners, and the material library is not there.
   EXPECT_EQ(r.ignored_attributes,
             (std::vector<std::string>{"texture coordinates (not given for every corner)",
-                                      "materials"}));
+                                      "materials (material library 'x.mtl' not found)"}));
   ASSERT_EQ(m.attributes.size(), 2u);
   EXPECT_EQ(m.find(AttributeKind::Colour)->colour,
             (std::vector<uint8_t>{255, 0, 0, 255, 0, 0, 255, 0, 0, 255, 0, 0}));
