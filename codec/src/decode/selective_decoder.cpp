@@ -172,7 +172,11 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   s.mesh = base_level_mesh(s.global.data(), s.layout);
   s.attributes = load_attribute_table(s.global.data(), s.layout);
   if (s.attributes) { // attribute codes come with the positions, whatever the mask says
-    init_attributes(*s.attributes, s.mesh);
+    describe_attributes(*s.attributes, s.info);
+    // Checked again with the attributes, which only the global part describes.
+    check_decode_memory(s.info, s.clustered() ? int(h.global_levels) : 0, options.memory_limit,
+                        options.attributes);
+    init_attributes(*s.attributes, s.mesh, options.attributes);
     s.global_models.attr = attribute_models(*s.attributes);
   }
   if (!s.clustered()) {
