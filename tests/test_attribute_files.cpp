@@ -18,34 +18,12 @@
 
 #include "support/mesh_attributes.h"
 #include "support/mesh_gen.h"
+#include "support/temp_dir.h"
 
 namespace pomar {
 namespace {
 
-/// A fresh directory, removed with its files afterwards.
-class AttributeFiles : public ::testing::Test {
-protected:
-  void SetUp() override {
-    std::string pattern = ::testing::TempDir() + "/pomar_attr_files_XXXXXX";
-    ASSERT_NE(mkdtemp(&pattern[0]), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override {
-    if (DIR *d = opendir(dir_.c_str())) {
-      while (dirent *e = readdir(d))
-        if (e->d_name[0] != '.' || (e->d_name[1] != '\0' && e->d_name[1] != '.'))
-          std::remove((dir_ + "/" + e->d_name).c_str());
-      closedir(d);
-    }
-    rmdir(dir_.c_str());
-  }
-  std::string path(const std::string &name) const { return dir_ + "/" + name; }
-  std::string write(const std::string &name, const std::string &text) const {
-    std::ofstream(path(name), std::ios::binary) << text;
-    return path(name);
-  }
-  std::string dir_;
-};
+using AttributeFiles = test::TempDirTest;
 
 std::string read_text(const std::string &path) {
   std::ifstream in(path, std::ios::binary);

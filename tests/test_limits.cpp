@@ -87,6 +87,46 @@ TEST(MemoryEstimate, IsAboveTheMeasuredPeaks) {
   }
 }
 
+TEST(MemoryEstimate, AttributesAreAboveTheMeasuredPeaks) {
+  // bench/README.md, "Memory", per-vertex attributes: a 1M-vertex torus (2M faces) and a
+  // 490k one with RGB colour, normal, quality and UV (8 codes), and the 1M one with quality
+  // only (1 code); peak RSS in KiB (decode: binary PLY out).
+  Mesh eight, one;
+  auto add = [](Mesh &m, AttributeKind kind, uint32_t components) {
+    VertexAttribute a;
+    a.kind = kind;
+    a.components = components;
+    m.attributes.push_back(a);
+  };
+  add(eight, AttributeKind::Colour, 3);
+  add(eight, AttributeKind::Normal, 3);
+  add(eight, AttributeKind::Scalar, 1);
+  add(eight, AttributeKind::TexCoord, 2);
+  add(one, AttributeKind::Scalar, 1);
+  FileInfo eight_info, one_info;
+  for (const VertexAttribute &a : eight.attributes)
+    eight_info.attributes.push_back({a.kind, "", a.components, a.kind == AttributeKind::Colour ? 0 : 9});
+  one_info.attributes.push_back({AttributeKind::Scalar, "", 1, 16});
+  struct Peak {
+    uint64_t v, f;
+    const Mesh *mesh;
+    const FileInfo *info;
+    uint64_t enc, dec;
+  } peaks[] = {{1000000, 2000000, &eight, &eight_info, 1062080, 242540},
+               {490000, 980000, &eight, &eight_info, 548196, 121848},
+               {1000000, 2000000, &one, &one_info, 547292, 157952}};
+  for (const Peak &p : peaks) {
+    const uint64_t enc = encode_attribute_bytes_per_vertex(*p.mesh, AttributeOptions());
+    const uint64_t dec = decode_attribute_bytes_per_vertex(*p.info, AttributeMask());
+    EXPECT_GT(encode_memory_estimate(p.v, p.f) + p.v * enc, p.enc * 1024 * 11 / 10) << p.v;
+    EXPECT_GT(decode_memory_estimate(p.v, p.f, true) + p.v * dec, p.dec * 1024 * 11 / 10) << p.v;
+  }
+  EXPECT_EQ(decode_attribute_bytes_per_vertex(eight_info, AttributeMask::none()), 0u);
+  AttributeOptions dropped;
+  dropped.keep = AttributeMask::none();
+  EXPECT_EQ(encode_attribute_bytes_per_vertex(eight, dropped), 0u);
+}
+
 TEST(MemoryEstimate, GrowsWithTheMeshAndSaturates) {
   EXPECT_LT(encode_memory_estimate(1000, 2000), encode_memory_estimate(2000, 2000));
   EXPECT_LT(encode_memory_estimate(1000, 2000), encode_memory_estimate(1000, 4000));

@@ -907,8 +907,8 @@ int main(int argc, char **argv) {
   dec->add_flag("-q,--quiet", da.quiet, "Print nothing on success");
   dec->add_flag("--no-attributes", da.no_attributes,
                 "Write positions and triangles only: leave out colour, normals, scalars and "
-                "texture coordinates (their codes are interleaved with the positions and are "
-                "read anyway)");
+                "texture coordinates (their codes, interleaved with the positions, are read "
+                "past without being decoded into values: less memory, a little less time)");
   dec->add_option("--max-memory", da.max_memory,
                   "Refuse (exit 1, no output file) a file whose decoding would need more than "
                   "SIZE of memory, checked from its header (with --cluster/--sphere/--box: for "

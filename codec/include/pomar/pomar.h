@@ -307,7 +307,8 @@ struct DecodeOptions {
   /// UINT64_MAX = do not check; see pomar/limits.h).
   uint64_t memory_limit = 0;
   /// Which stored attributes the returned mesh carries (AttributeMask::none(): positions
-  /// and triangles only; the codes are interleaved with the positions and decoded anyway).
+  /// and triangles only; the codes, interleaved with the positions, are then read past
+  /// without being stored or predicted: less memory and time).
   AttributeMask attributes;
 };
 

@@ -154,14 +154,14 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
     }
   }
   LevelMesh lm = base_level_mesh(data, layout);
-  const size_t reach = std::min(target, global);
-  if (reach > 0)
-    lm.reserve(h.levels[reach - 1].vertices, h.levels[reach - 1].faces, size);
   Models models;
   if (attributes) {
     init_attributes(*attributes, lm, options.attributes);
     models.attr = attribute_models(*attributes);
   }
+  const size_t reach = std::min(target, global);
+  if (reach > 0)
+    lm.reserve(h.levels[reach - 1].vertices, h.levels[reach - 1].faces, size);
   r.level = static_cast<int>(decode_global_levels(data, layout, 0, std::min(target, global), lm,
                                                   models, options.progress,
                                                   options.skip_damaged ? &r.damaged : nullptr));

@@ -56,6 +56,7 @@ struct LevelMesh {
     ct.O.reserve(3 * faces);
     ct.VC.reserve(vertices);
     q.reserve(3 * vertices);
+    attr.reserve(attr_codes * vertices);
     tag.reserve(vertices);
     parent.reserve(vertices);
     if (!local.empty())
