@@ -12,7 +12,7 @@ same number of bits per coordinate); colour is 8-bit and exact in both. Draco's 
 keeps position, normal, colour and texture coordinates only: named scalars (confidence,
 intensity, quality) are "n/a" for it. Also: encode and decode time of the mesh with and
 without its attributes, and the decode of the file with attributes with `--no-attributes`
-(fastest of --runs; decode writes a binary PLY). Besides the data folder's meshes: samples/bunny.ply
+(CPU seconds, user + system, the least of --runs; decode writes a binary PLY). Besides the data folder's meshes: samples/bunny.ply
 and a generated noisy sphere (`pomar_gen_mesh`, --sphere vertices) given generated
 attributes (colour from the position, radial normals, a smooth quality, spherical UVs).
 Markdown on stdout, progress on stderr.
@@ -21,12 +21,12 @@ import math
 import argparse
 import json
 import os
+import resource
 import shutil
 import struct
 import subprocess
 import sys
 import tempfile
-import time
 
 TYPES = {'char': 'b', 'int8': 'b', 'uchar': 'B', 'uint8': 'B', 'short': 'h', 'int16': 'h',
          'ushort': 'H', 'uint16': 'H', 'int': 'i', 'int32': 'i', 'uint': 'I', 'uint32': 'I',
@@ -129,12 +129,15 @@ def run(cmd):
 
 
 def timed(cmd, runs):
+    """CPU seconds (user + system) of the command, the smallest of `runs`: on a shared,
+    loaded machine wall-clock ratios mostly measure the other processes."""
     times = []
     for _ in range(runs):
-        t0 = time.perf_counter()
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
         run(cmd)
-        times.append(time.perf_counter() - t0)
-    return min(times) # the least disturbed run: the machine is shared
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        times.append(after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
+    return min(times)
 
 
 # (file, attribute groups: label -> (PLY properties, pomar --drop word)), extra encode flags
@@ -236,9 +239,9 @@ def main():
         print('| %s | %d | %s | %s | %s | %s | %s | %s |' % (r[0], r[1], r[2], r[3], fmt(r[4]),
                                                          fmt(r[5]), fmt(r[6]), fmt(r[7])))
     print()
-    print('| mesh | vertices | encode s (no attributes) | encode s (attributes) | '
-          'decode s (no attributes) | decode s (attributes) | decode ratio | '
-          'decode s (attributes, --no-attributes) | its ratio |')
+    print('| mesh | vertices | encode CPU s (no attributes) | encode CPU s (attributes) | '
+          'decode CPU s (no attributes) | decode CPU s (attributes) | decode ratio | '
+          'decode CPU s (attributes, --no-attributes) | its ratio |')
     print('|:--|--:|--:|--:|--:|--:|--:|--:|--:|')
     for t in times:
         print('| %s | %d | %.3f | %.3f | %.3f | %.3f | %.2f | %.3f | %.2f |' % (

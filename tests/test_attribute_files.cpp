@@ -123,7 +123,6 @@ TEST_F(AttributeFiles, ObjMaterialsNotKeptAreNamed) {
   ASSERT_EQ(mkdir(path("dir.mtl").c_str(), 0700), 0);
   load_mesh(write("c.obj", uv_grid_obj(4, "dir.mtl", "m")), &r);
   EXPECT_NE(joined(r.ignored_attributes).find("'dir.mtl' not found"), std::string::npos);
-  rmdir(path("dir.mtl").c_str());
 }
 
 TEST_F(AttributeFiles, TextureNamesWithLineBreaksAreRefused) {

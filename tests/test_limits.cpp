@@ -5,6 +5,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <string>
@@ -16,6 +17,7 @@
 #include "pomar/pomar.h"
 #include "pomar/random_access.h"
 #include "support/mesh_gen.h"
+#include "support/temp_dir.h"
 
 namespace pomar {
 namespace {
@@ -173,18 +175,11 @@ TEST(MemoryCheck, DecodeCheckUsesTheCountsOfTheRequestedLevel) {
 // ------------------------------------------------------------------ available memory
 
 /// A fake root with /proc and /sys files, removed afterwards.
-class FakeRoot : public ::testing::Test {
+class FakeRoot : public test::TempDirTest {
 protected:
-  void SetUp() override {
-    std::string pattern = ::testing::TempDir() + "/pomar_limits_XXXXXX";
-    ASSERT_NE(mkdtemp(&pattern[0]), nullptr);
-    root_ = pattern;
-  }
-  void TearDown() override { std::system(("rm -rf '" + root_ + "'").c_str()); }
-
   void put(const std::string &rel, const std::string &text) {
-    const std::string full = root_ + rel;
-    std::system(("mkdir -p '" + full.substr(0, full.find_last_of('/')) + "'").c_str());
+    const std::string full = dir_ + rel;
+    std::filesystem::create_directories(full.substr(0, full.find_last_of('/')));
     std::ofstream(full) << text;
   }
   /// The rlimits are the process's own: tests that expect none to bind skip if one is set.
@@ -195,13 +190,12 @@ protected:
         return true;
     return false;
   }
-  std::string root_;
 };
 
 TEST_F(FakeRoot, NothingReadableMeansUnknownAndNoRefusal) {
   if (rlimits_set())
     GTEST_SKIP() << "an address-space or data rlimit is set for this process";
-  const AvailableMemory a = available_memory(root_);
+  const AvailableMemory a = available_memory(dir_);
   EXPECT_FALSE(a.known);
 }
 
@@ -210,7 +204,7 @@ TEST_F(FakeRoot, MemAvailableAlone) {
     GTEST_SKIP() << "an address-space or data rlimit is set for this process";
   put("/proc/meminfo", "MemTotal:       16000000 kB\nMemFree:  100 kB\n"
                        "MemAvailable:    7444889 kB\nBuffers: 1 kB\n");
-  const AvailableMemory a = available_memory(root_);
+  const AvailableMemory a = available_memory(dir_);
   ASSERT_TRUE(a.known);
   EXPECT_EQ(a.bytes, 7444889ull * 1024);
   EXPECT_EQ(a.source, "MemAvailable");
@@ -228,7 +222,7 @@ TEST_F(FakeRoot, CgroupV2LimitBindsWhenSmaller) {
   put("/sys/fs/cgroup/job/memory.max", "1073741824\n");
   put("/sys/fs/cgroup/job/memory.current", "314572800\n");
   put("/sys/fs/cgroup/job/memory.stat", "anon 1\ninactive_file 104857600\nactive_file 5\n");
-  const AvailableMemory a = available_memory(root_);
+  const AvailableMemory a = available_memory(dir_);
   ASSERT_TRUE(a.known);
   EXPECT_EQ(a.bytes, (1024ull - 200) << 20);
   EXPECT_EQ(a.source, "cgroup memory.max");
@@ -244,13 +238,13 @@ TEST_F(FakeRoot, CgroupV1LimitAndUnlimitedMarker) {
   put("/sys/fs/cgroup/memory/box/memory.limit_in_bytes", "2147483648\n");
   put("/sys/fs/cgroup/memory/box/memory.usage_in_bytes", "1073741824\n");
   put("/sys/fs/cgroup/memory/box/memory.stat", "cache 9\ntotal_inactive_file 0\n");
-  AvailableMemory a = available_memory(root_);
+  AvailableMemory a = available_memory(dir_);
   ASSERT_TRUE(a.known);
   EXPECT_EQ(a.bytes, 1ull << 30);
   EXPECT_EQ(a.source, "cgroup memory.limit_in_bytes");
   // Over the limit (usage can exceed it briefly): nothing available, not a wrap-around.
   put("/sys/fs/cgroup/memory/box/memory.usage_in_bytes", "3000000000\n");
-  a = available_memory(root_);
+  a = available_memory(dir_);
   EXPECT_EQ(a.bytes, 0u);
 }
 
@@ -261,7 +255,7 @@ TEST_F(FakeRoot, MemAvailableBindsWhenSmallerThanTheCgroup) {
   put("/proc/self/cgroup", "0::/\n");
   put("/sys/fs/cgroup/memory.max", "1073741824\n");
   put("/sys/fs/cgroup/memory.current", "0\n");
-  const AvailableMemory a = available_memory(root_);
+  const AvailableMemory a = available_memory(dir_);
   EXPECT_EQ(a.bytes, 1u << 20);
   EXPECT_EQ(a.source, "MemAvailable");
 }

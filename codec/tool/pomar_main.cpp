@@ -876,7 +876,9 @@ int main(int argc, char **argv) {
   auto *dec = app.add_subcommand("decode", "Decompress a .pomar file into a mesh file");
   dec->add_option("input", da.in, "Input .pomar file")->required();
   dec->add_option("output", da.out,
-                  "Output mesh; the format follows the extension (.ply .obj .off .stl)")
+                  "Output mesh; the format follows the extension (.ply .obj .off .stl). PLY keeps "
+                  "every attribute; OBJ colour, normals, UVs and texture names (OUT.mtl beside "
+                  "it); OFF colour and normals; STL none (a warning names what is not written)")
       ->required();
   dec->add_option("-l,--level", da.level,
                   "Stop after L refinement levels (0 = base mesh; default: full resolution). With "

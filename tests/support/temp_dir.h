@@ -1,14 +1,15 @@
-// A gtest fixture with a fresh directory under ::testing::TempDir(), removed with its files
-// afterwards (the files, not subdirectories: a test that makes one removes it).
+// A gtest fixture with a fresh directory under ::testing::TempDir(), removed with everything
+// in it afterwards.
 #pragma once
 
 #include <gtest/gtest.h>
 
-#include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include <dirent.h>
@@ -24,9 +25,8 @@ protected:
     dir_ = pattern;
   }
   void TearDown() override {
-    for (const std::string &name : list_dir())
-      std::remove((dir_ + "/" + name).c_str());
-    rmdir(dir_.c_str());
+    std::error_code ignored;
+    std::filesystem::remove_all(dir_, ignored);
   }
 
   std::string path(const std::string &name) const { return dir_ + "/" + name; }
