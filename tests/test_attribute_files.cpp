@@ -119,10 +119,15 @@ TEST_F(AttributeFiles, ObjMaterialsNotKeptAreNamed) {
       << ignored;
   EXPECT_NE(ignored.find("which material each face uses (2 materials"), std::string::npos)
       << ignored;
-  // A library that is a directory is not read.
+  // A library that is a directory, a device or a /proc file (which could block) is not read.
   ASSERT_EQ(mkdir(path("dir.mtl").c_str(), 0700), 0);
-  load_mesh(write("c.obj", uv_grid_obj(4, "dir.mtl", "m")), &r);
-  EXPECT_NE(joined(r.ignored_attributes).find("'dir.mtl' not found"), std::string::npos);
+  for (const char *name : {"dir.mtl", "/dev/zero", "/proc/self/status"}) {
+    load_mesh(write("c.obj", uv_grid_obj(4, name, "m")), &r);
+    EXPECT_NE(joined(r.ignored_attributes)
+                  .find("'" + std::string(name) + "' not a regular file of 1 byte to 64 MiB"),
+              std::string::npos)
+        << joined(r.ignored_attributes);
+  }
 }
 
 TEST_F(AttributeFiles, TextureNamesWithLineBreaksAreRefused) {

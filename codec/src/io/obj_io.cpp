@@ -218,8 +218,10 @@ void take_obj_attributes(const tinyobj::attrib_t &attrib,
 }
 
 /// Reads the material libraries an OBJ file names (`mtllib`), relative to the OBJ file's
-/// directory (or absolute), with tinyobjloader's MTL parser; records the names it could not
-/// read. Only regular files are opened (a FIFO or a directory counts as missing).
+/// directory (or absolute), with tinyobjloader's MTL parser; records the ones it did not
+/// read and why. Only regular files of 1 byte to 64 MiB are read: a FIFO, a device, a
+/// directory or a /proc file (size 0; /proc/kmsg would block) is not, nor a huge file that
+/// cannot be a material library.
 class MaterialLibraries : public tinyobj::MaterialReader {
 public:
   explicit MaterialLibraries(const std::string &obj_path) {
@@ -231,17 +233,22 @@ public:
                   std::string *err) override {
     const std::string path = !name.empty() && name[0] == '/' ? name : dir_ + name;
     struct stat st;
+    const char *why = nullptr;
     std::ifstream in;
-    if (::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode))
-      in.open(path, std::ios::binary);
-    if (!in.is_open() || !in) {
-      missing.push_back(name);
+    if (::stat(path.c_str(), &st) != 0)
+      why = "not found";
+    else if (!S_ISREG(st.st_mode) || st.st_size == 0 || st.st_size > (64 << 20))
+      why = "not a regular file of 1 byte to 64 MiB";
+    else if (in.open(path, std::ios::binary), !in.is_open())
+      why = "cannot be read";
+    if (why) {
+      missing.push_back("material library '" + name + "' " + why);
       return false;
     }
     tinyobj::LoadMtl(names, materials, &in, warn, err);
     return true;
   }
-  std::vector<std::string> missing;
+  std::vector<std::string> missing; ///< "material library 'NAME' not found", ...
 
 private:
   std::string dir_;
@@ -286,8 +293,8 @@ void take_obj_materials(const std::vector<tinyobj::material_t> &materials,
         std::find(mesh.texture_files.begin(), mesh.texture_files.end(), m.diffuse_texname) ==
             mesh.texture_files.end())
       mesh.texture_files.push_back(m.diffuse_texname);
-  for (const std::string &name : libraries.missing)
-    add_unique(ignored, ("materials (material library '" + name + "' not found)").c_str());
+  for (const std::string &why : libraries.missing)
+    add_unique(ignored, ("materials (" + why + ")").c_str());
   std::vector<std::string> keys;
   for (const tinyobj::material_t &m : materials)
     other_material_properties(m, keys);
