@@ -2,35 +2,12 @@
 // URL parameters: ?file=URL opens a file; &test=1 runs the scripted browser test
 // (web/test/browser_test.py) and reports to the test server.
 import { open } from './pomar.js';
+import { frameMesh, orbitCamera, viewOf } from './camera.js';
 
 const $ = (id) => document.getElementById(id);
 const canvas = $('view');
 const gl = canvas.getContext('webgl2', { antialias: true, preserveDrawingBuffer: true });
 const params = new URLSearchParams(location.search);
-
-// ------------------------------------------------------------------ small matrix helpers
-function perspective(fovY, aspect, near, far) {
-  const f = 1 / Math.tan(fovY / 2);
-  const nf = 1 / (near - far);
-  return [f / aspect, 0, 0, 0, 0, f, 0, 0, 0, 0, (far + near) * nf, -1, 0, 0, 2 * far * near * nf, 0];
-}
-function lookAt(eye, target, up) {
-  const sub = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-  const norm = (a) => { const l = Math.hypot(...a) || 1; return a.map((x) => x / l); };
-  const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
-  const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-  const z = norm(sub(eye, target));
-  const x = norm(cross(up, z));
-  const y = cross(z, x);
-  return [x[0], y[0], z[0], 0, x[1], y[1], z[1], 0, x[2], y[2], z[2], 0, -dot(x, eye), -dot(y, eye), -dot(z, eye), 1];
-}
-function multiply(a, b) {
-  const out = new Array(16).fill(0);
-  for (let c = 0; c < 4; ++c)
-    for (let r = 0; r < 4; ++r)
-      for (let k = 0; k < 4; ++k) out[4 * c + r] += a[4 * k + r] * b[4 * c + k];
-  return out;
-}
 
 // ------------------------------------------------------------------ renderer
 const VS = `#version 300 es
@@ -115,7 +92,7 @@ function upload(mesh, model) {
 }
 
 // ------------------------------------------------------------------ camera
-const camera = { target: [0, 0, 0], distance: 1, yaw: 0.6, pitch: 0.3, fovY: Math.PI / 4, extent: 1 };
+const camera = orbitCamera();
 let cameraVersion = 0;
 function view() {
   const dpr = window.devicePixelRatio || 1;
@@ -125,14 +102,7 @@ function view() {
     canvas.width = w;
     canvas.height = h;
   }
-  const c = camera;
-  const eye = [c.target[0] + c.distance * Math.cos(c.pitch) * Math.sin(c.yaw),
-    c.target[1] + c.distance * Math.sin(c.pitch),
-    c.target[2] + c.distance * Math.cos(c.pitch) * Math.cos(c.yaw)];
-  const near = Math.max(c.distance * 0.01, c.extent * 1e-4);
-  const far = c.distance + 4 * c.extent;
-  const viewProj = multiply(perspective(c.fovY, w / h, near, far), lookAt(eye, c.target, [0, 1, 0]));
-  return { eye, viewProj, fovY: c.fovY, height: h, near };
+  return viewOf(camera, w, h);
 }
 function frame(model) {
   if (!program) return;
@@ -205,16 +175,7 @@ async function openSource(source, extraOptions = {}) {
   });
   model = m;
   // The header's box is the quantization cube; frame the base mesh's own box instead.
-  const p = m.mesh.positions;
-  const lo = [Infinity, Infinity, Infinity];
-  const hi = [-Infinity, -Infinity, -Infinity];
-  for (let i = 0; i < p.length; ++i) {
-    lo[i % 3] = Math.min(lo[i % 3], p[i]);
-    hi[i % 3] = Math.max(hi[i % 3], p[i]);
-  }
-  camera.target = [0, 1, 2].map((k) => (lo[k] + hi[k]) / 2);
-  camera.extent = Math.max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
-  camera.distance = 1.6 * camera.extent;
+  frameMesh(camera, m.mesh.positions);
   ++cameraVersion;
   onMesh(m.mesh, m);
   if (m.info.clusters === 0) await m.want({ all: m.info.finestLevel }); // progressive: no regions

@@ -2,6 +2,8 @@
 // the server and headless Chromium, then checks what this posts to /report/).
 // ?file=URL of an intact file; &missing=, &truncatedGlobal=, &truncatedBlocks=,
 // &damagedBlocks=, &noRange= URLs of the error cases.
+import { closeUp } from '../camera.js';
+
 const params = new URLSearchParams(location.search);
 const targetPixels = Number(params.get('target') || 3);
 const closeup = Number(params.get('closeup') || 0.3);
@@ -73,18 +75,7 @@ export async function run(v) {
 
     // Close-up: the surface point facing the camera, seen from `closeup` x the model's size.
     const center = v.camera.target.slice();
-    const eye = v.view().eye;
-    const p = model.mesh.positions;
-    let best = 0;
-    let bestDot = -Infinity;
-    const dir = [0, 1, 2].map((k) => eye[k] - v.camera.target[k]);
-    for (let i = 0; i < p.length / 3; ++i) {
-      const d = (p[3 * i] - v.camera.target[0]) * dir[0] + (p[3 * i + 1] - v.camera.target[1]) * dir[1] +
-        (p[3 * i + 2] - v.camera.target[2]) * dir[2];
-      if (d > bestDot) { bestDot = d; best = i; }
-    }
-    v.camera.target = [p[3 * best], p[3 * best + 1], p[3 * best + 2]];
-    v.camera.distance = closeup * v.camera.extent;
+    closeUp(v.camera, model.mesh.positions, closeup);
     const before = model.stats.bytesFetched;
     result.closeupSteps = await settle(v, 'close-up');
     result.closeup = snapshot(model, await screenshot('closeup', v), { bytesForCloseup: model.stats.bytesFetched - before });
