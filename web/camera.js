@@ -58,7 +58,7 @@ export function viewOf(c, width, height) {
   const near = Math.max(c.distance * 0.01, c.extent * 1e-4);
   const far = c.distance + 4 * c.extent;
   const viewProj = multiply(perspective(c.fovY, width / height, near, far), lookAt(eye, c.target, [0, 1, 0]));
-  return { eye, viewProj, fovY: c.fovY, height, width, near };
+  return { eye, viewProj, fovY: c.fovY, height, width, near, far };
 }
 
 /** A close-up: target the vertex furthest towards the eye (a surface point facing the
