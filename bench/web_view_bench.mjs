@@ -11,6 +11,9 @@
 // surface point facing the camera seen from `closeup` x the model's size, as
 // web/test/page_test.js does) and single clusters raised to the finest level. Percentages
 // are of the file size; "requests" counts Range requests. See web/README.md for the table.
+// DEBUG=1 also prints, per refinement step, the clusters refined, coarsened, hidden
+// (outside the frustum) and culled (occluded or back-facing), and for each close-up its
+// final level map (level:clusters) and the bytes held per level.
 import { readFileSync } from 'node:fs';
 import { PomarStream } from '../web/pomar_stream.js';
 import { RangeFile } from '../web/range_fetch.js';
