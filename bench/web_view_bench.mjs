@@ -34,7 +34,7 @@ if (!file) {
 }
 const [width, height] = opt('size', '800x457').split('x').map(Number);
 const fetchOptions = { maxGap: 128 }; // pomar.js's default
-for (const name of ['maxGap', 'wholeBlockBytes', 'estimateMargin'])
+for (const name of ['maxGap', 'wholeBlockBytes', 'estimateMargin', 'estimateSlack'])
   if (opt(name) !== undefined) fetchOptions[name] = Number(opt(name));
 const settings = { targetPixels: Number(opt('target', 3)), backface: args.includes('--backface'),
   occlusion: !args.includes('--no-occlusion') };

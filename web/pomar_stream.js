@@ -23,7 +23,7 @@ function concat(a, b) {
 export class PomarStream {
   /** options: firstRequestBytes (16 KiB), memoryBudget (bytes of blocks held; over it the
    *  decoder is rebuilt with only what the current level map needs), tolerant (start in
-   *  tolerant mode), estimateMargin (1.25), wholeBlockBytes (1024). */
+   *  tolerant mode), estimateMargin (1.25), estimateSlack (16 bytes), wholeBlockBytes (0). */
   constructor(M, file, options = {}) {
     this.M = M;
     this.file = file;
@@ -78,7 +78,8 @@ export class PomarStream {
     if (this.tolerant || level >= finest || this.whole.has(c) || small) return size;
     const vertices = (l) => (l === 0 ? this.info.baseVertices : levels[l - 1].vertices);
     const share = (vertices(level) - vertices(base)) / (vertices(finest) - vertices(base));
-    const estimate = Math.min(size, Math.ceil(size * share * (this.options.estimateMargin || 1.25)) + 24);
+    const slack = this.options.estimateSlack ?? 16;
+    const estimate = Math.min(size, Math.ceil(size * share * (this.options.estimateMargin || 1.25)) + slack);
     return Math.max(estimate, this.have[c]);
   }
 

@@ -358,7 +358,8 @@ EMSCRIPTEN_KEEPALIVE const float *pw_cluster_bounds(Handle *h) {
     int count = 0;
     for (int k = 0; k < 3; ++k) {
       const uint32_t c = cluster(t[3 * f + k]);
-      if (std::find(clusters, clusters + count, c) == clusters + count) clusters[count++] = c;
+      if (std::find(clusters, clusters + count, c) == clusters + count)
+        clusters[count++] = c;
     }
     return count;
   };
@@ -383,13 +384,17 @@ EMSCRIPTEN_KEEPALIVE const float *pw_cluster_bounds(Handle *h) {
     uint32_t clusters[3];
     const int count = face(f, normal, clusters);
     for (int i = 0; i < count; ++i)
-      for (int k = 0; k < 3; ++k) at(clusters[i])[8 + k] += float(normal[k]);
+      for (int k = 0; k < 3; ++k)
+        at(clusters[i])[8 + k] += float(normal[k]);
   }
   for (uint32_t c = 0; c < n; ++c) {
     float *b = at(c);
-    if (b[6] == 0) b[6] = around[c];
-    const double length = std::sqrt(double(b[8]) * b[8] + double(b[9]) * b[9] + double(b[10]) * b[10]);
-    for (int k = 0; k < 3; ++k) b[8 + k] = length > 0 ? float(b[8 + k] / length) : 0.f;
+    if (b[6] == 0)
+      b[6] = around[c];
+    const double length =
+        std::sqrt(double(b[8]) * b[8] + double(b[9]) * b[9] + double(b[10]) * b[10]);
+    for (int k = 0; k < 3; ++k)
+      b[8 + k] = length > 0 ? float(b[8 + k] / length) : 0.f;
     b[11] = length > 0 ? 1.f : -1.f;
   }
   // The cone's width: the face normal furthest from the axis (zero-area faces have none).
@@ -397,8 +402,10 @@ EMSCRIPTEN_KEEPALIVE const float *pw_cluster_bounds(Handle *h) {
     double normal[3];
     uint32_t clusters[3];
     const int count = face(f, normal, clusters);
-    const double length = std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
-    if (!(length > 0)) continue;
+    const double length =
+        std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
+    if (!(length > 0))
+      continue;
     for (int i = 0; i < count; ++i) {
       float *b = at(clusters[i]);
       const double cosine = (normal[0] * b[8] + normal[1] * b[9] + normal[2] * b[10]) / length;
