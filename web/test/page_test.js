@@ -110,6 +110,10 @@ export async function run(v) {
   const result = { ok: false, log };
   try {
     $('refine').checked = false; // the test drives refinement itself (but see below)
+    // A fixed canvas size: the screenshots compared with expected images do not depend on
+    // the size the browser gives its window.
+    $('view').style.width = '800px';
+    $('view').style.height = '457px';
     const t0 = performance.now();
     const fetchOptions = params.has('maxGap') ? { maxGap: Number(params.get('maxGap')) } : {};
     const model = await within(30000, v.openSource(params.get('file'), fetchOptions), 'open');
