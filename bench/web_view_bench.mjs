@@ -63,8 +63,9 @@ async function settle(s, camera) {
     const choice = chooseLevels({ info: s.stream.info, levels: s.stream.levels, clusterBounds: s.mesh.clusterBounds,
       errorSeen: s.errorSeen, mesh: s.mesh }, v, settings);
     if (process.env.DEBUG) console.log(steps, choice.refine, choice.coarsen, choice.hidden, choice.culled);
-    if (!choice.changed || convergence.repeats(choice.levels, v)) break;
-    await s.stream.want(choice.levels);
+    const wanted = choice.changed ? convergence.next(choice.levels, s.stream.levels, v) : null;
+    if (!wanted) break;
+    await s.stream.want(wanted);
     s.mesh = s.stream.decoder.mesh();
   }
   return `, ${steps} steps, ${((performance.now() - t0) / 1000).toFixed(1)} s`;

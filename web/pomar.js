@@ -43,7 +43,7 @@ export class PomarModel {
     this.waiters = []; // {id, resolve, reject}
     this.errorSeen = new Map();
     this.lastWanted = null;
-    this.convergence = new Convergence(); // of the levels asked by wantView
+    this.convergence = new Convergence(); // damps wantView's steps for one camera
     this.worker.onmessage = (e) => this.receive(e.data);
     this.worker.onerror = (e) => this.fail(0, `the decoder worker failed: ${e.message || 'cannot load it'}`);
   }
@@ -117,8 +117,9 @@ export class PomarModel {
     }
     const choice = chooseLevels({ info: this.info, levels: this.levels, clusterBounds: this.mesh.clusterBounds,
       errorSeen: this.errorSeen, mesh: this.mesh }, view, settings);
-    if (sameLevels(choice.levels, this.lastWanted) || this.convergence.repeats(choice.levels, view)) return { ...choice, changed: false };
-    await this.want({ levels: choice.levels }, true);
+    const wanted = this.convergence.next(choice.levels, this.levels, view);
+    if (!wanted || sameLevels(wanted, this.lastWanted)) return { ...choice, changed: false };
+    await this.want({ levels: wanted }, true);
     return { ...choice, changed: true };
   }
 

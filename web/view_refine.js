@@ -260,23 +260,34 @@ export function sameLevels(a, b) {
   return !!a && !!b && a.length === b.length && a.every((l, i) => l === b[i]);
 }
 
-/** Has a view converged? True when, for the same camera, it asks again one of the last two
- *  level maps it asked: the level map rule may keep clusters above what the view wants
- *  (the same map again), and a cluster refined out of view or occluded by its own finer
- *  level flips back and forth (a cycle of two). `forget()` after any other request. */
+/** Damps a view's refinement until it converges. For one camera, it remembers the last
+ *  level maps the model had: a cluster that the choice would send back to a level it had
+ *  there keeps its current level (a cluster occluded only at its finer level, or coarsened
+ *  on an extrapolated error it does not meet, would flip back and forth, and clusters
+ *  flipping out of phase keep the whole map from ever repeating). `forget()` after any
+ *  other request. */
 export class Convergence {
-  constructor() {
-    this.recent = [];
+  constructor(depth = 4) {
+    this.depth = depth;
+    this.forget();
     this.viewProj = null;
   }
   forget() {
-    this.recent = [];
+    this.history = [];
+    this.lastAsked = null;
   }
-  repeats(levels, view) {
+  /** The level map to ask for `view` given chooseLevels' `choice` and the `current` levels,
+   *  or null when there is nothing new to ask (converged). */
+  next(choice, current, view) {
     if (!sameLevels(view.viewProj, this.viewProj)) this.forget();
     this.viewProj = Array.from(view.viewProj);
-    if (this.recent.some((r) => sameLevels(r, levels))) return true;
-    this.recent = [levels, ...this.recent].slice(0, 2);
-    return false;
+    const wanted = Int32Array.from(choice);
+    for (let c = 0; c < wanted.length; ++c)
+      if (wanted[c] !== current[c] && this.history.some((h) => h[c] === wanted[c])) wanted[c] = current[c];
+    this.history = [Int32Array.from(current), ...this.history].slice(0, this.depth);
+    // The same map again: the level map rule keeps some clusters above what the view wants.
+    if (sameLevels(wanted, this.lastAsked) || sameLevels(wanted, current)) return null;
+    this.lastAsked = wanted;
+    return wanted;
   }
 }
