@@ -5,6 +5,7 @@
 
 #include "entropy/models.h"
 #include "entropy/range_coder.h"
+#include "entropy/static_tables.h"
 
 namespace pomar {
 namespace {
@@ -180,6 +181,14 @@ TEST(RangeCoder, DominantSymbolNeverReachesFrequencyZero) {
       ASSERT_EQ(dec.decode(dm), i % 5000 == 0 ? 0 : symbols - 1) << i;
     EXPECT_FALSE(dec.overrun());
   }
+}
+
+// The static tables store each frequency as its nearest log-scale code; the fast search
+// must pick exactly the code the plain search over all 103 codes picks (the files depend
+// on it), for every frequency a model can hold.
+TEST(StaticTables, LogCodeSearchMatchesThePlainSearchForEveryFrequency) {
+  for (uint32_t f = 1; f <= FrequencyModel::kMaxTotal; ++f)
+    ASSERT_EQ(log_code(f), log_code_reference(f)) << "frequency " << f;
 }
 
 } // namespace

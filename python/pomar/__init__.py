@@ -69,7 +69,8 @@ class Mesh:
 def encode(vertices, faces=None, *, bits=12, clusters=0, cluster_ratio=0.01,
            progressive=False, memory_limit=None, progress=None, colors=None, normals=None,
            scalars=None, texcoords=None, texture_files=None, normal_bits=9, scalar_bits=16,
-           texcoord_bits=12, exact_attributes=False):
+           texcoord_bits=12, exact_attributes=False, strict=False, keep_order=False,
+           threads=0):
     """Compress a triangle mesh into .pomar bytes.
 
     vertices: float32 array (n, 3), faces: uint32 array (m, 3), both C-contiguous; or a
@@ -84,7 +85,15 @@ def encode(vertices, faces=None, *, bits=12, clusters=0, cluster_ratio=0.01,
     memory_limit: bytes or "512M" / "auto" / "none" (default: the memory available).
     progress: None or a callable(fraction, stage) called now and then (Ctrl-C interrupts
     the call in any case; an exception raised by progress stops it and propagates).
+    Messy meshes (non-manifold, inconsistently oriented, duplicate or degenerate faces,
+    unreferenced vertices) are stored losslessly; strict=True refuses them instead
+    (pomar.Error, kind "invalid_mesh") and drops unreferenced vertices. keep_order=True
+    also stores the input vertex numbering (a full decode gives the vertices back in the
+    input order). threads: for the encoder's parallel steps, 0 = every core this process
+    may use (the bytes do not depend on it).
     """
+    if isinstance(threads, bool) or not isinstance(threads, int) or threads < 0:
+        raise ValueError("threads must be an integer >= 0 (0: every core), not %r" % (threads,))
     given = {"colors": colors, "normals": normals, "scalars": scalars, "texcoords": texcoords,
              "texture_files": texture_files}
     attributes = {}
@@ -98,7 +107,8 @@ def encode(vertices, faces=None, *, bits=12, clusters=0, cluster_ratio=0.01,
     attributes.update({key: value for key, value in given.items() if value is not None})
     return _pomar.encode(vertices, faces, bits, clusters, cluster_ratio, progressive,
                          memory_limit, progress, attributes, normal_bits, scalar_bits,
-                         texcoord_bits, exact_attributes)
+                         texcoord_bits, exact_attributes, bool(strict), bool(keep_order),
+                         threads)
 
 
 def _mesh(vertices, faces, damaged, attributes):

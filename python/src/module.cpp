@@ -38,7 +38,8 @@ pomar::Mesh mesh_with_attributes(const py::handle &vertices, const py::handle &f
 py::bytes encode(const py::handle &vertices, const py::handle &faces, int bits, uint32_t clusters,
                  double cluster_ratio, bool progressive, const py::handle &max_memory,
                  const py::handle &progress, const py::dict &attributes, int normal_bits,
-                 int scalar_bits, int texcoord_bits, bool exact_attributes) {
+                 int scalar_bits, int texcoord_bits, bool exact_attributes, bool strict,
+                 bool keep_order, unsigned threads) {
   check_bits("bits", bits, 4, 24);
   check_bits("normal_bits", normal_bits, 4, 16);
   check_bits("scalar_bits", scalar_bits, 1, 24);
@@ -53,6 +54,9 @@ py::bytes encode(const py::handle &vertices, const py::handle &faces, int bits, 
   options.clusters = clusters;
   options.cluster_ratio = cluster_ratio;
   options.progressive = progressive;
+  options.strict = strict;
+  options.keep_order = keep_order;
+  options.threads = threads;
   options.memory_limit = memory_limit(max_memory);
   options.progress = python_progress(progress);
   std::vector<uint8_t> file;
@@ -143,7 +147,8 @@ PYBIND11_MODULE(_pomar, m) {
   m.def("encode", &encode, py::arg("vertices"), py::arg("faces"), py::arg("bits"),
         py::arg("clusters"), py::arg("cluster_ratio"), py::arg("progressive"),
         py::arg("memory_limit"), py::arg("progress"), py::arg("attributes"), py::arg("normal_bits"),
-        py::arg("scalar_bits"), py::arg("texcoord_bits"), py::arg("exact_attributes"));
+        py::arg("scalar_bits"), py::arg("texcoord_bits"), py::arg("exact_attributes"),
+        py::arg("strict"), py::arg("keep_order"), py::arg("threads"));
   m.def("decode", &decode, py::arg("data"), py::arg("level"), py::arg("skip_damaged"),
         py::arg("memory_limit"), py::arg("progress"), py::arg("attributes"));
   m.def("info", &info, py::arg("data"));

@@ -600,3 +600,34 @@ def test_selective_decoder_carries_attributes():
     assert part.scalars["quality"].shape == (n,)
     k = input_index(part.vertices, vertices)
     assert np.array_equal(part.colors, colors[k])
+
+
+def test_messy_meshes_strict_keep_order_and_threads():
+    """A non-manifold mesh with a duplicate face and an unreferenced vertex: stored
+    losslessly by default (the decode gives back every face and vertex), refused with
+    strict=True; keep_order gives the input numbering back; the bytes do not depend on
+    threads."""
+    vertices, faces = torus()
+    # A fin: a third face on the edge (faces[0][0], faces[0][1]) -> non-manifold edge,
+    # the same face twice, and one vertex no face uses.
+    extra = np.array([[0.0, 0.0, 2.0]], dtype=np.float32)
+    vertices = np.concatenate([vertices, extra, extra + 0.5])
+    fin = np.array([[faces[0][0], faces[0][1], len(vertices) - 2]], dtype=np.uint32)
+    faces = np.concatenate([faces, fin, fin]).astype(np.uint32)
+    data = pomar.encode(vertices, faces, bits=16)
+    mesh = pomar.decode(data)
+    assert len(mesh.vertices) == len(vertices) and len(mesh.faces) == len(faces)
+    with pytest.raises(pomar.Error) as e:
+        pomar.encode(vertices, faces, bits=16, strict=True)
+    assert e.value.kind == "invalid_mesh"
+    ordered = pomar.decode(pomar.encode(vertices, faces, bits=16, keep_order=True))
+    step = (vertices.max(0) - vertices.min(0)).max() / (2 ** 16 - 1)
+    assert np.abs(ordered.vertices - vertices).max() <= step
+
+    def oriented(f):  # each face rotated to start at its smallest index, then sorted
+        return sorted(tuple(np.roll(t, -int(np.argmin(t)))) for t in f.tolist())
+    assert oriented(ordered.faces) == oriented(faces)
+    one = pomar.encode(vertices, faces, bits=16, threads=1)
+    assert one == pomar.encode(vertices, faces, bits=16, threads=3) == data
+    with pytest.raises(ValueError, match="threads must be an integer >= 0"):
+        pomar.encode(vertices, faces, threads=-1)

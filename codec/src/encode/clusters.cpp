@@ -39,31 +39,47 @@ ClusteredLevels encode_clustered_levels(Rebuild &rb, size_t global, FileHeader &
   std::vector<Models> level_models(L - global);
   for (Models &m : level_models)
     m.attr = rb.attr_models;
+  // Level after level: record every cluster's symbols of the level, freeze the level's
+  // models on them, code them into each cluster's own range coder (which lives across
+  // levels: one stream per cluster block) and forget them. Only one level's symbols are
+  // ever held (the finest level's are the most), not every clustered level's.
+  ClusteredLevels out;
+  out.blocks.resize(clusters);
+  std::vector<RangeEncoder> block_coders;
+  block_coders.reserve(clusters);
+  for (uint32_t c = 0; c < clusters; ++c)
+    block_coders.emplace_back(&out.blocks[c]);
+  // Ideal code lengths: [0] connectivity, [1] geometry, [2 + k] attribute code k.
+  double bits[2 + kMaxAttributeCodes] = {};
   std::vector<SymbolRecorder> recordings(clusters);
+  LevelFreezer freezer;
   EncoderCodec<RecorderStream> codec(rb.q, rb.dec_to_input, rb.input_to_dec);
   codec.set_attribute_codes(rb.attr_codes, rb.attr_codes_per_vertex);
   for (size_t r = global; r < L; ++r) {
     const uint32_t level = static_cast<uint32_t>(r + 1);
-    codec.begin_level(rb.collapses(level), &level_models[r - global]);
+    Models &models = level_models[r - global];
+    codec.begin_level(rb.collapses(level), &models);
     const uint32_t older_than = lm.vertex_count(); // levels are encoded in order
+    const ModelAddresses addresses(models);
     for (uint32_t c = 0; c < clusters; ++c) {
+      recordings[c].addresses = &addresses;
       RecorderStream conn{&recordings[c], 0}, geom{&recordings[c], 1};
       codec.set_sinks(&conn, &geom);
       rb.step.cluster_level(lm, codec, {c, level, older_than}, next_local[c]);
     }
     codec.end_level();
     add_level_entry(header, lm, 0, 0);
+    freezer.freeze(models, recordings);
+    for (uint32_t c = 0; c < clusters; ++c) {
+      code_recording(recordings[c], block_coders[c], bits);
+      recordings[c].events.clear(); // keeps its capacity for the next, larger level
+    }
     if (progress)
       progress(double(r + 1) / double(L), "encode");
   }
-  freeze_on_recordings(level_models, recordings);
-  ClusteredLevels out;
+  for (RangeEncoder &rc : block_coders)
+    rc.finish();
   out.tables = write_tables(level_models);
-  // Ideal code lengths: [0] connectivity, [1] geometry, [2 + k] attribute code k.
-  double bits[2 + kMaxAttributeCodes] = {};
-  out.blocks.reserve(clusters);
-  for (const SymbolRecorder &rec : recordings)
-    out.blocks.push_back(code_recording(rec, bits));
   uint64_t cluster_bytes = 0;
   for (const auto &b : out.blocks)
     cluster_bytes += b.size();

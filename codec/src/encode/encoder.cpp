@@ -191,6 +191,7 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
   auto t2 = std::chrono::steady_clock::now();
   Rebuild rb(in.q, dec);
   const BaseMesh base = start_from_base_mesh(rb, nv);
+  rb.mesh.reserve_counts(nv, nf); // the splits append without reallocating
   // Attributes: codes of every vertex (prepared numbering); the base mesh's go to the ATTR
   // section, the others are coded with their positions by the level steps.
   AttributeTable attributes = plan_attributes(mesh, options.attributes);

@@ -1,5 +1,7 @@
 #include "entropy/static_tables.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 
@@ -14,16 +16,42 @@ constexpr int kLogCodes = 104;
 
 uint32_t log_frequency(uint32_t q) { return q == 0 ? 0 : ((8u + (q & 7)) << (q >> 3)) >> 3; }
 
-uint32_t log_code(uint32_t f) { // the code whose frequency is nearest to f (f >= 1)
+/// log_frequency of every code, built once (non-decreasing in q: the small codes repeat 1).
+const uint32_t *log_frequencies() {
+  static const auto table = [] {
+    std::array<uint32_t, kLogCodes> t{};
+    for (uint32_t q = 0; q < uint32_t(kLogCodes); ++q)
+      t[q] = log_frequency(q);
+    return t;
+  }();
+  return table.data();
+}
+
+} // namespace
+
+uint32_t log_code(uint32_t f) {
+  // The smallest code whose frequency is nearest to f: binary search instead of trying all
+  // 103 codes (the table writer and reader call this for every symbol of every model of
+  // every level). Candidates: the first code at or above f, and the first code of the
+  // value just below it (equal values: the smaller code wins, ties go to the lower value).
+  const uint32_t *F = log_frequencies();
+  const uint32_t hi = uint32_t(std::lower_bound(F + 1, F + kLogCodes, f) - F);
+  if (hi == 1)
+    return 1;
+  const uint32_t lo = uint32_t(std::lower_bound(F + 1, F + kLogCodes, F[hi - 1]) - F);
+  if (hi == uint32_t(kLogCodes))
+    return lo;
+  return f - F[lo] <= F[hi] - f ? lo : hi;
+}
+
+uint32_t log_code_reference(uint32_t f) {
   uint32_t best = 1;
-  for (uint32_t q = 1; q < kLogCodes; ++q)
+  for (uint32_t q = 1; q < uint32_t(kLogCodes); ++q)
     if (std::abs(int64_t(log_frequency(q)) - int64_t(f)) <
         std::abs(int64_t(log_frequency(best)) - int64_t(f)))
       best = q;
   return best;
 }
-
-} // namespace
 
 namespace {
 
@@ -45,22 +73,54 @@ double data_bits(const std::vector<uint32_t> &counts, const uint16_t *freq, int 
 
 } // namespace
 
-void freeze_on_recordings(std::vector<Models> &models,
-                          const std::vector<SymbolRecorder> &recordings) {
+ModelAddresses::ModelAddresses(Models &m) {
+  auto add = [&](const void *begin, size_t bytes) {
+    const uintptr_t b = reinterpret_cast<uintptr_t>(begin);
+    if (bytes)
+      ranges_.push_back({b, b + bytes});
+  };
+  auto add_vector = [&](const std::vector<FrequencyModel> &v) {
+    add(v.data(), v.size() * sizeof(FrequencyModel));
+  };
+  add(&m, sizeof(Models)); // the models held in the struct itself (sv, mantissa)
+  add_vector(m.conn.se);
+  add_vector(m.conn.faces);
+  add_vector(m.conn.sl);
+  for (const auto &kind : m.geom.magnitude)
+    add_vector(kind);
+  add(m.attr.data(), m.attr.size() * sizeof(AttributeCodeModels)); // their `top` models
+  for (const AttributeCodeModels &a : m.attr)
+    add_vector(a.classes);
+  std::sort(ranges_.begin(), ranges_.end());
+  if (ranges_.size() > 256)
+    throw Error(Error::Kind::Internal, "internal encoder error: too many model arrays");
+}
+
+uint32_t ModelAddresses::name(const void *model) const {
+  const uintptr_t p = reinterpret_cast<uintptr_t>(model);
+  auto it = std::upper_bound(ranges_.begin(), ranges_.end(), std::make_pair(p, ~uintptr_t(0)));
+  if (it == ranges_.begin() || p >= (it - 1)->second || p - (it - 1)->first > 0xFFFFFFu)
+    throw Error(Error::Kind::Internal, "internal encoder error: a model outside its level");
+  --it;
+  return uint32_t(it - ranges_.begin()) << 24 | uint32_t(p - it->first);
+}
+
+void LevelFreezer::freeze(Models &m, const std::vector<SymbolRecorder> &recordings) {
   std::unordered_map<const void *, std::vector<uint32_t>> counts;
   for (const SymbolRecorder &r : recordings)
     for (const SymbolRecorder::Event &e : r.events) {
-      if (e.kind == 2)
+      if (e.kind() == 2)
         continue;
-      auto &c = counts[e.model];
-      const size_t n = e.kind == 0 ? size_t(static_cast<FrequencyModel *>(e.model)->symbols()) : 2;
+      void *model = r.model(e);
+      auto &c = counts[model];
+      const size_t n = e.kind() == 0 ? size_t(static_cast<FrequencyModel *>(model)->symbols()) : 2;
       c.resize(n, 0);
-      ++c[e.value];
+      ++c[e.value()];
     }
-  // Level after level; a model whose previous-level table codes this level's symbols
-  // nearly as well as its own would (within what storing its own costs) reuses it.
-  std::vector<std::vector<uint16_t>> previous; // per slot: frozen frequencies (empty: unused)
-  for (Models &m : models) {
+  // A model whose previous-level table codes this level's symbols nearly as well as its
+  // own would (within what storing its own costs) reuses it.
+  std::vector<std::vector<uint16_t>> &previous = previous_;
+  {
     size_t slot = 0;
     auto prev_of = [&]() -> std::vector<uint16_t> & {
       if (previous.size() <= slot)
@@ -124,30 +184,26 @@ void freeze_on_recordings(std::vector<Models> &models,
   }
 }
 
-std::vector<uint8_t> code_recording(const SymbolRecorder &r, double bits[2]) {
-  std::vector<uint8_t> out;
-  RangeEncoder rc(&out);
+void code_recording(const SymbolRecorder &r, RangeEncoder &rc, double *bits) {
   for (const SymbolRecorder::Event &e : r.events) {
-    switch (e.kind) {
+    switch (e.kind()) {
     case 0: {
-      auto &m = *static_cast<FrequencyModel *>(e.model);
-      bits[e.stream] += cost_bits(m, int(e.value));
-      rc.encode(m, int(e.value));
+      auto &m = *static_cast<FrequencyModel *>(r.model(e));
+      bits[e.stream()] += cost_bits(m, int(e.value()));
+      rc.encode(m, int(e.value()));
       break;
     }
     case 1: {
-      auto &m = *static_cast<BitModel *>(e.model);
-      bits[e.stream] += cost_bits(m, int(e.value));
-      rc.encode_bit(m, int(e.value));
+      auto &m = *static_cast<BitModel *>(r.model(e));
+      bits[e.stream()] += cost_bits(m, int(e.value()));
+      rc.encode_bit(m, int(e.value()));
       break;
     }
     default:
-      bits[e.stream] += e.nbits;
-      rc.encode_bypass(e.value, e.nbits);
+      bits[e.stream()] += e.nbits();
+      rc.encode_bypass(e.value(), int(e.nbits()));
     }
   }
-  rc.finish();
-  return out;
 }
 
 // Table stream, level after level, each model in for_each_model order:
@@ -213,17 +269,17 @@ std::vector<uint8_t> write_tables(std::vector<Models> &models) {
         [&](FrequencyModel &f) {
           std::vector<uint32_t> &before = slot_history(history, slot);
           const size_t n = size_t(f.symbols());
-          bool uniform = true;
-          std::vector<uint32_t> q(n);
-          for (size_t s = 0; s < n; ++s) {
-            uniform = uniform && f.freq(int(s)) == 1;
-            q[s] = f.freq(int(s)) ? log_code(f.freq(int(s))) : 0;
-          }
+          bool uniform = true; // an unused model: stored as one bit, no codes needed
+          for (size_t s = 0; s < n && uniform; ++s)
+            uniform = f.freq(int(s)) == 1;
           rc.encode_bit(t.used[before.empty() ? 0 : 2], uniform ? 0 : 1);
           if (uniform) {
             before.clear();
             return;
           }
+          std::vector<uint32_t> q(n);
+          for (size_t s = 0; s < n; ++s)
+            q[s] = f.freq(int(s)) ? log_code(f.freq(int(s))) : 0;
           if (!before.empty()) {
             const bool same = q == before;
             rc.encode_bit(t.same[0], same ? 1 : 0);
@@ -292,9 +348,9 @@ std::vector<Models> read_tables(const uint8_t *data, size_t size, size_t levels,
               freq[s] = 1;
             before.clear();
           } else {
-            std::vector<uint32_t> q(n, 0);
+            uint32_t q[FrequencyModel::kMaxSymbols] = {}; // no allocation per model
             if (!before.empty() && rc.decode_bit(t.same[0])) {
-              q = before;
+              std::copy(before.begin(), before.end(), q);
             } else if (!before.empty()) {
               for (size_t s = 0; s < n; ++s)
                 q[s] = get_step(rc, t.across, before[s]);
@@ -311,7 +367,7 @@ std::vector<Models> read_tables(const uint8_t *data, size_t size, size_t levels,
                 bad();
               freq[s] = static_cast<uint16_t>(log_frequency(q[s]));
             }
-            before = q;
+            before.assign(q, q + n);
           }
           if (!f.freeze_with(freq))
             bad();

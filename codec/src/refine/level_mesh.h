@@ -52,6 +52,10 @@ struct LevelMesh {
     const uint64_t plausible = 64 * file_bytes + 1024;
     if (vertices > plausible || faces > 2 * plausible)
       return;
+    reserve_counts(vertices, faces);
+  }
+  /// Room for these counts (the encoder's rebuild: the input's own, final counts).
+  void reserve_counts(uint64_t vertices, uint64_t faces) {
     ct.V.reserve(3 * faces);
     ct.O.reserve(3 * faces);
     ct.VC.reserve(vertices);
