@@ -22,12 +22,13 @@ int64_t dist2(const int32_t *a, const int32_t *b) {
 }
 
 /// Unnormalised normal of triangle (a,b,c) in doubles (decimation decisions only; the
-/// decoder never repeats them, so they need not be bit-exact across machines).
-void normal(const int32_t *a, const int32_t *b, const int32_t *c, double n[3]) {
+/// decoder never repeats them, so they need not be bit-exact across machines). The
+/// coordinates are quantized integers converted exactly.
+inline void normal(const double a[3], const double b[3], const double c[3], double n[3]) {
   double u[3], v[3];
   for (int k = 0; k < 3; ++k) {
-    u[k] = double(b[k]) - double(a[k]);
-    v[k] = double(c[k]) - double(a[k]);
+    u[k] = b[k] - a[k];
+    v[k] = c[k] - a[k];
   }
   n[0] = u[1] * v[2] - u[2] * v[1];
   n[1] = u[2] * v[0] - u[0] * v[2];
@@ -127,12 +128,14 @@ private:
   bool normals_ok(uint32_t i);
   bool best_option(Candidate &out);
   const int32_t *at(uint32_t k) const { return &pos_[3 * size_t(k)]; } // from_.neighbour[k]
+  const double *at_d(uint32_t k) const { return &pos_d_[3 * size_t(k)]; }
 
   const CornerTable &ct_;
   const std::vector<int32_t> &q_;
   const DecimationOptions &opt_;
   uint32_t v_from_ = kNone;
   std::vector<int32_t> pos_;       // positions of from_.neighbour, gathered once
+  std::vector<double> pos_d_;      // the same as doubles, then v_from's
   std::vector<int64_t> farthest_;  // per neighbour: its largest distance^2 to a non-adjacent one
   std::vector<double> before_;     // per face of from_: its normal and the normal's length^2
   bool have_normals_ = false;      // before_ is v_from_'s
@@ -186,8 +189,15 @@ void Evaluator::collect_options() {
   if (m < 3)
     return;
   pos_.resize(3 * size_t(m));
-  for (uint32_t k = 0; k < m; ++k)
-    std::copy_n(&q_[3 * size_t(from_.neighbour[k])], 3, &pos_[3 * size_t(k)]);
+  pos_d_.resize(3 * size_t(m + 1));
+  for (uint32_t k = 0; k <= m; ++k) {
+    const int32_t *p = &q_[3 * size_t(k < m ? from_.neighbour[k] : v_from_)];
+    for (int j = 0; j < 3; ++j) {
+      if (k < m)
+        pos_[3 * size_t(k) + j] = p[j];
+      pos_d_[3 * size_t(k) + j] = double(p[j]);
+    }
+  }
   farthest_.assign(m, -1);
   for (uint32_t i = 0; i < m; ++i)
     for (uint32_t k = i + 2; k < m; ++k) {
@@ -247,24 +257,25 @@ bool Evaluator::link_ok(uint32_t i) {
 // No surviving patch face may turn its normal by more than acos(normal_cosine). The normals
 // before the collapse do not depend on v_to: computed once per v_from.
 bool Evaluator::normals_ok(uint32_t i) {
-  const uint32_t m = from_.size();
+  const uint32_t m = from_.size(), faces = from_.faces();
   if (!have_normals_) {
-    before_.resize(4 * size_t(from_.faces()));
-    for (uint32_t k = 0; k < from_.faces(); ++k) {
+    before_.resize(4 * size_t(faces));
+    for (uint32_t k = 0; k < faces; ++k) {
       double *n = &before_[4 * size_t(k)];
-      normal(&q_[3 * size_t(v_from_)], at(k), at((k + 1) % m), n);
+      normal(at_d(m), at_d(k), at_d(k + 1 == m ? 0 : k + 1), n); // at_d(m): v_from
       n[3] = dot(n, n);
     }
     have_normals_ = true;
   }
   const double c2 = opt_.normal_cosine * opt_.normal_cosine;
-  for (uint32_t k = 0; k < from_.faces(); ++k) {
+  const uint32_t gone_r = from_.closed && i == 0 ? m - 1 : i - 1; // face (v_from, v_r, v_to)
+  for (uint32_t k = 0; k < faces; ++k) {
     const double *before = &before_[4 * size_t(k)];
     const double lb = before[3];
-    if (!face_survives(k, i) || lb == 0.0)
+    if (k == i || k == gone_r || lb == 0.0)
       continue; // a zero-area face has no orientation to preserve
     double after[3];
-    normal(at(i), at(k), at((k + 1) % m), after);
+    normal(at_d(i), at_d(k), at_d(k + 1 == m ? 0 : k + 1), after);
     const double la = dot(after, after);
     if (la == 0.0)
       return false; // would create a zero-area face
