@@ -86,6 +86,12 @@ public:
   /// The candidates of the vertices [first, last) of `alive`, in that order.
   void evaluate(const uint32_t *first, const uint32_t *last, std::vector<Candidate> &out) {
     for (const uint32_t *v = first; v != last; ++v) {
+      if (last - v > 8)
+        __builtin_prefetch(&ct_.VC[v[8]]);
+      if (last - v > 4) { // alive vertices have a corner
+        __builtin_prefetch(&ct_.V[ct_.VC[v[4]]]);
+        __builtin_prefetch(&ct_.O[ct_.VC[v[4]]]);
+      }
       load(*v);
       Candidate c;
       if (best_option(c))
