@@ -35,9 +35,7 @@ inline void normal(const double a[3], const double b[3], const double c[3], doub
   n[2] = u[0] * v[1] - u[1] * v[0];
 }
 
-double dot(const double a[3], const double b[3]) {
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
+double dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 /// One halfedge of v_from's ring chosen for collapse: v_to = ring.neighbour[i].
 struct Option {
@@ -147,7 +145,7 @@ private:
   bool have_normals_ = false;      // before_ is v_from_'s
   std::vector<uint32_t> nb_stamp_; // scratch marks for the link condition
   uint32_t nb_counter_ = 0;
-  bool have_marks_ = false;        // from_'s neighbours carry nb_counter_
+  bool have_marks_ = false; // from_'s neighbours carry nb_counter_
   std::vector<Option> options_;
 };
 
@@ -171,7 +169,7 @@ private:
   std::vector<uint32_t> target_mark_; // level stamp of vertices already used as v_to
   std::vector<uint32_t> dirty_;       // level stamp of vertices whose ring changed
   uint32_t level_stamp_ = 0;
-  std::deque<Evaluator> eval_;        // eval_[0]: also the greedy pass's
+  std::deque<Evaluator> eval_; // eval_[0]: also the greedy pass's
   std::vector<Candidate> sort_scratch_;
 };
 
@@ -321,8 +319,8 @@ Collapse Decimator::collapse(uint32_t v_from, uint32_t i) {
               ir == kNone ? kNone : from_.neighbour[ir]};
   // Faces that disappear: (v_from, v_to, v_l) = face i, (v_from, v_r, v_to) = face i-1.
   const uint32_t dead_l = il != kNone ? from_.corner[i] : kNone;
-  const uint32_t dead_r = ir != kNone ? from_.corner[from_.closed ? (i + m - 1) % m : i - 1]
-                                      : kNone;
+  const uint32_t dead_r =
+      ir != kNone ? from_.corner[from_.closed ? (i + m - 1) % m : i - 1] : kNone;
   // Relabel the surviving faces of v_from (the patch).
   for (uint32_t k = 0; k < from_.faces(); ++k) {
     if (!e.face_survives(k, i))
@@ -428,9 +426,9 @@ std::vector<Collapse> Decimator::run_level(std::vector<uint32_t> &alive) {
       continue;
     done.push_back(collapse(c.v_from, static_cast<uint32_t>(i)));
   }
-  alive.erase(std::remove_if(alive.begin(), alive.end(),
-                             [&](uint32_t v) { return ct_.VC[v] == kNone; }),
-              alive.end());
+  alive.erase(
+      std::remove_if(alive.begin(), alive.end(), [&](uint32_t v) { return ct_.VC[v] == kNone; }),
+      alive.end());
   return done;
 }
 
@@ -445,8 +443,8 @@ unsigned available_cores() {
   return std::max(1u, std::thread::hardware_concurrency());
 }
 
-Decimation decimate(CornerTable ct, const std::vector<int32_t> &q,
-                    const DecimationOptions &options, const Progress &progress) {
+Decimation decimate(CornerTable ct, const std::vector<int32_t> &q, const DecimationOptions &options,
+                    const Progress &progress) {
   Decimation result;
   std::vector<uint32_t> alive;
   for (uint32_t v = 0; v < ct.vertex_count(); ++v)
