@@ -11,17 +11,22 @@ the encoder's estimate of each attribute's bytes (`info --json`). Draco runs wit
 same number of bits per coordinate); colour is 8-bit and exact in both. Draco's PLY reader
 keeps position, normal, colour and texture coordinates only: named scalars (confidence,
 intensity, quality) are "n/a" for it. Also: encode and decode time of the mesh with and
-without its attributes (fastest of --runs; decode writes a binary PLY). Markdown on stdout, progress on stderr.
+without its attributes, and the decode of the file with attributes with `--no-attributes`
+(CPU seconds, user + system, the least of --runs; decode writes a binary PLY). Besides the data folder's meshes: samples/bunny.ply
+and a generated noisy sphere (`pomar_gen_mesh`, --sphere vertices) given generated
+attributes (colour from the position, radial normals, a smooth quality, spherical UVs).
+Markdown on stdout, progress on stderr.
 """
+import math
 import argparse
 import json
 import os
+import resource
 import shutil
 import struct
 import subprocess
 import sys
 import tempfile
-import time
 
 TYPES = {'char': 'b', 'int8': 'b', 'uchar': 'B', 'uint8': 'B', 'short': 'h', 'int16': 'h',
          'ushort': 'H', 'uint16': 'H', 'int': 'i', 'int32': 'i', 'uint': 'I', 'uint32': 'I',
@@ -92,6 +97,30 @@ def write_ply(path, props, vertices, faces, keep):
     open(path, 'wb').write(bytes(out))
 
 
+def with_generated_attributes(props, vertices):
+    """Adds red green blue, nx ny nz, quality, texture_u texture_v to x y z rows."""
+    props = props + [['uchar', c] for c in ('red', 'green', 'blue')] + \
+        [['float', c] for c in ('nx', 'ny', 'nz', 'quality', 'texture_u', 'texture_v')]
+    lo = [min(v[k] for v in vertices) for k in range(3)]
+    hi = [max(v[k] for v in vertices) for k in range(3)]
+    centre = [(a + b) / 2 for a, b in zip(lo, hi)]
+    size = max(b - a for a, b in zip(lo, hi)) or 1.0
+    rows = []
+    for v in vertices:
+        d = [(v[k] - centre[k]) / size for k in range(3)]
+        r = math.sqrt(sum(x * x for x in d)) or 1.0
+        rgb = [int(127.5 + 120 * math.sin(6 * d[k] + k)) for k in range(3)]
+        rows.append(v[:3] + rgb + [d[0] / r, d[1] / r, d[2] / r, 100 * d[0] * d[1],
+                                   0.5 + math.atan2(d[1], d[0]) / (2 * math.pi), 0.5 + d[2]])
+    return props, rows
+
+
+GENERATED_GROUPS = {'colour': (['red', 'green', 'blue'], 'colour'),
+                    'normals': (['nx', 'ny', 'nz'], 'normals'),
+                    'quality': (['quality'], 'scalars'),
+                    'texcoords': (['texture_u', 'texture_v'], 'texcoords')}
+
+
 def run(cmd):
     r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     if r.returncode != 0:
@@ -100,12 +129,15 @@ def run(cmd):
 
 
 def timed(cmd, runs):
+    """CPU seconds (user + system) of the command, the smallest of `runs`: on a shared,
+    loaded machine wall-clock ratios mostly measure the other processes."""
     times = []
     for _ in range(runs):
-        t0 = time.perf_counter()
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
         run(cmd)
-        times.append(time.perf_counter() - t0)
-    return min(times) # the least disturbed run: the machine is shared
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        times.append(after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
+    return min(times)
 
 
 # (file, attribute groups: label -> (PLY properties, pomar --drop word)), extra encode flags
@@ -127,22 +159,30 @@ def main():
     ap.add_argument('--runs', type=int, default=5)
     ap.add_argument('--bits', type=int, default=12)
     ap.add_argument('--normal-bits', type=int, default=9)
+    ap.add_argument('--sphere', type=int, default=200000,
+                    help='vertices of the generated noisy sphere (0: none)')
     a = ap.parse_args()
-    if not os.path.isdir(a.data):
-        print('no data folder %s: nothing to measure' % a.data, file=sys.stderr)
-        return 0
     tmp = tempfile.mkdtemp(prefix='pomar-attr-bench.')
     pomar = os.path.join(tmp, 'pomar')
     shutil.copy(os.path.join(a.build, 'codec', 'pomar'), pomar)
+    meshes = [(os.path.join(a.data, n), n, g, f, False) for n, g, f in MESHES]
+    meshes.append((os.path.join(here, '..', 'samples', 'bunny.ply'),
+                   'samples/bunny.ply + generated', GENERATED_GROUPS, [], True))
+    if a.sphere:
+        sphere = os.path.join(tmp, 'sphere.ply')
+        run([os.path.join(a.build, 'bench', 'pomar_gen_mesh'), 'noisy_sphere', str(a.sphere),
+             sphere])
+        meshes.append((sphere, 'noisy_sphere + generated', GENERATED_GROUPS, [], True))
     rows, times = [], []
     try:
-        for name, groups, flags in MESHES:
-            src = os.path.join(a.data, name)
+        for src, name, groups, flags, generate in meshes:
             if not os.path.exists(src):
                 print('skip %s (absent)' % name, file=sys.stderr)
                 continue
             print('measuring %s' % name, file=sys.stderr)
             props, vertices, faces = read_ply(src)
+            if generate:
+                props, vertices = with_generated_attributes(props, vertices)
             all_props = [p for g in groups.values() for p in g[0]]
             full = os.path.join(tmp, 'full.ply')
             write_ply(full, props, vertices, faces, all_props)
@@ -155,17 +195,19 @@ def main():
             with_size = os.path.getsize(out)
             t_enc = timed(enc + [full, out], a.runs)
             t_dec = timed([pomar, 'decode', '-q', out, os.path.join(tmp, 'd.ply')], a.runs)
+            t_skip = timed([pomar, 'decode', '-q', '--no-attributes', out,
+                            os.path.join(tmp, 'd.ply')], a.runs)
             plain = os.path.join(tmp, 'plain.ply')
             write_ply(plain, props, vertices, faces, [])
             t_enc_no = timed(enc + [plain, out], a.runs)
             run(enc + [plain, out])
             t_dec_no = timed([pomar, 'decode', '-q', out, os.path.join(tmp, 'd.ply')], a.runs)
-            times.append((name, nv, t_enc_no, t_enc, t_dec_no, t_dec))
+            times.append((name, nv, t_enc_no, t_enc, t_dec_no, t_dec, t_skip))
             for label, (ply_props, drop) in groups.items():
                 # pomar: the file with everything minus the file without this group
                 run(enc + ['--drop', drop, full, out])
                 pomar_bpv = 8.0 * (with_size - os.path.getsize(out)) / nv
-                names = {'colour': ['colour'], 'normals': ['normal'],
+                names = {'colour': ['colour'], 'normals': ['normal'], 'texcoords': ['texcoord'],
                          'scalars': ply_props}[drop]
                 stream = sum(x['bytes'] for x in info['attributes'] if x['name'] in names)
                 precision = ', '.join(
@@ -197,11 +239,13 @@ def main():
         print('| %s | %d | %s | %s | %s | %s | %s | %s |' % (r[0], r[1], r[2], r[3], fmt(r[4]),
                                                          fmt(r[5]), fmt(r[6]), fmt(r[7])))
     print()
-    print('| mesh | vertices | encode s (no attributes) | encode s (attributes) | '
-          'decode s (no attributes) | decode s (attributes) | decode ratio |')
-    print('|:--|--:|--:|--:|--:|--:|--:|')
+    print('| mesh | vertices | encode CPU s (no attributes) | encode CPU s (attributes) | '
+          'decode CPU s (no attributes) | decode CPU s (attributes) | decode ratio | '
+          'decode CPU s (attributes, --no-attributes) | its ratio |')
+    print('|:--|--:|--:|--:|--:|--:|--:|--:|--:|')
     for t in times:
-        print('| %s | %d | %.3f | %.3f | %.3f | %.3f | %.2f |' % (t + (t[5] / t[4],)))
+        print('| %s | %d | %.3f | %.3f | %.3f | %.3f | %.2f | %.3f | %.2f |' % (
+            t[:6] + (t[5] / t[4], t[6], t[6] / t[4])))
     return 0
 
 

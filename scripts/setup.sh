@@ -46,6 +46,9 @@ for p in "${PACKAGES[@]}"; do
   st="$(dpkg-query -W -f='${db:Status-Abbrev}' "$p" 2>/dev/null || true)"
   [ "${st:0:2}" = "ii" ] || missing+=("$p")
 done
+# npm (web/build.sh installs three.js for the viewer page): Debian's nodejs has it as a
+# separate package; other builds of nodejs (e.g. NodeSource's) bring their own.
+command -v npm >/dev/null 2>&1 || missing+=(npm)
 
 has_deb_src() {
   # one-line style (sources.list, *.list) or deb822 style (*.sources)

@@ -11,8 +11,10 @@
 #include <random>
 
 #include "attributes/attribute_quantize.h"
+#include "pomar/limits.h"
 #include "pomar/pomar.h"
 #include "pomar/random_access.h"
+#include "support/mesh_attributes.h"
 #include "support/mesh_gen.h"
 
 namespace pomar {
@@ -202,62 +204,6 @@ TEST(AttributeQuantize, ValidationNamesTheProblem) {
 }
 
 // ---------------------------------------------------------------- round trips
-
-/// Which attributes with_attributes adds.
-enum Has { kColour = 1, kAlpha = 2, kNormals = 4, kScalars = 8, kTexcoords = 16, kAll = 31 };
-
-/// `m` with smooth colours (plus noise in the low bits), normals (the radial direction,
-/// plus noise), scalars "quality" (smooth) and "confidence" (random), spherical UVs.
-Mesh with_attributes(Mesh m, int has, uint32_t seed = 1) {
-  const size_t nv = m.vertex_count();
-  std::mt19937 rng(seed);
-  std::uniform_int_distribution<int> noise(-3, 3);
-  std::uniform_real_distribution<float> unit(0, 1);
-  auto p = [&](size_t v, int k) { return m.positions[3 * v + k]; };
-  auto make = [](AttributeKind kind, const char *name, uint32_t components) {
-    VertexAttribute a;
-    a.kind = kind;
-    a.name = name;
-    a.components = components;
-    return a;
-  };
-  if (has & kColour) {
-    VertexAttribute a = make(AttributeKind::Colour, "colour", (has & kAlpha) ? 4 : 3);
-    for (size_t v = 0; v < nv; ++v)
-      for (uint32_t k = 0; k < a.components; ++k) {
-        const int c = int(127.5 + 120 * std::sin(2.0 * p(v, k % 3) + k)) + noise(rng);
-        a.colour.push_back(static_cast<uint8_t>(std::max(0, std::min(255, c))));
-      }
-    m.attributes.push_back(a);
-  }
-  if (has & kNormals) {
-    VertexAttribute a = make(AttributeKind::Normal, "normal", 3);
-    for (size_t v = 0; v < nv; ++v)
-      for (int k = 0; k < 3; ++k)
-        a.values.push_back(p(v, k) + 0.05f * (unit(rng) - 0.5f));
-    m.attributes.push_back(a);
-  }
-  if (has & kScalars) {
-    VertexAttribute q = make(AttributeKind::Scalar, "quality", 1);
-    VertexAttribute c = make(AttributeKind::Scalar, "confidence", 1);
-    for (size_t v = 0; v < nv; ++v) {
-      q.values.push_back(100.0f * p(v, 0) * p(v, 1) + 3.0f * p(v, 2));
-      c.values.push_back(unit(rng));
-    }
-    m.attributes.push_back(q);
-    m.attributes.push_back(c);
-  }
-  if (has & kTexcoords) {
-    VertexAttribute a = make(AttributeKind::TexCoord, "texcoord", 2);
-    for (size_t v = 0; v < nv; ++v) {
-      a.values.push_back(0.5f + std::atan2(p(v, 1), p(v, 0)) / 6.2831853f);
-      a.values.push_back(0.5f + 0.5f * p(v, 2));
-    }
-    m.attributes.push_back(a);
-    m.texture_files = {"skin.png", "detail map.jpg"};
-  }
-  return m;
-}
 
 struct Coded {
   Mesh input;
@@ -465,6 +411,105 @@ TEST(AttributeRoundTrip, DropAndSkip) {
   EXPECT_EQ(
       inspect(encode_with(plain, false).file.data(), encode_with(plain, false).file.size()).version,
       1u);
+}
+
+// A decode that returns no attribute reads past their codes (no prediction, no storage):
+// the same positions and triangles as a full decode, at every level and in every selection.
+TEST(AttributeRoundTrip, NoAttributesDecodesTheSameMesh) {
+  const Mesh m = with_attributes(gen::noisy_sphere(2500, 12, 0.1), kAll);
+  DecodeOptions none;
+  none.attributes = AttributeMask::none();
+  for (bool clustered : {false, true}) {
+    SCOPED_TRACE(clustered ? "clustered" : "progressive");
+    const Coded c = encode_with(m, clustered);
+    const int levels = int(inspect(c.file.data(), c.file.size()).levels.size());
+    for (int level : {-1, 0, 1, levels / 2, levels - 1}) {
+      none.level = level;
+      const Mesh full = decode(c.file.data(), c.file.size(), level);
+      const Mesh plain = decode(c.file.data(), c.file.size(), none);
+      EXPECT_EQ(plain.positions, full.positions) << "level " << level;
+      EXPECT_EQ(plain.triangles, full.triangles) << "level " << level;
+      EXPECT_TRUE(plain.attributes.empty());
+      EXPECT_TRUE(plain.texture_files.empty());
+    }
+    if (!clustered)
+      continue;
+    SelectiveOptions so;
+    so.attributes = AttributeMask::none();
+    SelectiveDecoder with(std::make_unique<MemorySource>(c.file.data(), c.file.size()));
+    SelectiveDecoder without(std::make_unique<MemorySource>(c.file.data(), c.file.size()), so);
+    const float centre[3] = {1, 0, 0};
+    for (SelectiveDecoder *d : {&with, &without}) { // a region, then more of the mesh
+      d->want_sphere(centre, 0.6f, d->finest_level());
+      d->update();
+    }
+    EXPECT_EQ(without.mesh().positions, with.mesh().positions);
+    EXPECT_EQ(without.mesh().triangles, with.mesh().triangles);
+    for (SelectiveDecoder *d : {&with, &without}) {
+      d->want_cluster(0, d->finest_level());
+      d->update();
+    }
+    const Mesh region = without.mesh();
+    EXPECT_EQ(region.positions, with.mesh().positions);
+    EXPECT_EQ(region.triangles, with.mesh().triangles);
+    EXPECT_TRUE(region.attributes.empty());
+    // Only the texture coordinates asked for: the attributes are decoded and returned.
+    DecodeOptions uv;
+    uv.attributes = AttributeMask::none();
+    uv.attributes.texcoords = true;
+    const Mesh only_uv = decode(c.file.data(), c.file.size(), uv);
+    ASSERT_EQ(only_uv.attributes.size(), 1u);
+    EXPECT_EQ(only_uv.attributes[0].kind, AttributeKind::TexCoord);
+    EXPECT_EQ(only_uv.texture_files, m.texture_files);
+  }
+}
+
+// The memory checks count the attributes: a limit that fits the mesh without them refuses
+// it with them, and a decode that returns none of them needs no more than without.
+TEST(AttributeRoundTrip, MemoryLimitsCountTheAttributes) {
+  const Mesh plain = gen::noisy_sphere(3000, 13, 0.1);
+  const Mesh m = with_attributes(plain, kAll);
+  const uint64_t v = m.vertex_count(), f = m.triangle_count();
+  const uint64_t per_vertex = encode_attribute_bytes_per_vertex(m, AttributeOptions());
+  EXPECT_EQ(per_vertex, 32u + 84u * 10); // RGBA 4 + normal 2 + 2 scalars + UV 2 = 10 codes
+  EncodeOptions o;
+  o.memory_limit = encode_memory_estimate(v, f) + v * per_vertex / 2;
+  EXPECT_NO_THROW(encode(plain, o));
+  try {
+    encode(m, o);
+    ADD_FAILURE() << "the attributes do not fit";
+  } catch (const Error &e) {
+    EXPECT_EQ(e.kind(), Error::Kind::MemoryLimit) << e.what();
+  }
+  o.attributes.keep = AttributeMask::none(); // dropped: not counted
+  EXPECT_NO_THROW(encode(m, o));
+
+  const Coded c = encode_with(m, true);
+  const FileInfo info = inspect(c.file.data(), c.file.size());
+  const uint64_t decode_extra = decode_attribute_bytes_per_vertex(info, AttributeMask());
+  EXPECT_EQ(decode_extra, 16u + 8 * 10 + (4 + 12 + 8 + 8));
+  EXPECT_EQ(decode_attribute_bytes_per_vertex(info, AttributeMask::none()), 0u);
+  DecodeOptions d;
+  d.memory_limit = decode_memory_estimate(v, f, true) + v * decode_extra / 2;
+  try {
+    decode(c.file.data(), c.file.size(), d);
+    ADD_FAILURE() << "the attributes do not fit";
+  } catch (const Error &e) {
+    EXPECT_EQ(e.kind(), Error::Kind::MemoryLimit) << e.what();
+  }
+  d.attributes = AttributeMask::none();
+  EXPECT_NO_THROW(decode(c.file.data(), c.file.size(), d));
+  // The selective decoder checks the base clustered mesh (the rest is decoded on request).
+  const uint32_t gl = info.global_levels;
+  const uint64_t bv = gl ? info.levels[gl - 1].vertices : info.base_vertices;
+  const uint64_t bf = gl ? info.levels[gl - 1].faces : info.base_faces;
+  SelectiveOptions so;
+  so.memory_limit = decode_memory_estimate(bv, bf, true) + bv * decode_extra / 2;
+  EXPECT_THROW(SelectiveDecoder(std::make_unique<MemorySource>(c.file.data(), c.file.size()), so),
+               Error);
+  so.attributes = AttributeMask::none();
+  EXPECT_NO_THROW(
+      SelectiveDecoder(std::make_unique<MemorySource>(c.file.data(), c.file.size()), so));
 }
 
 TEST(AttributeRoundTrip, BadInputIsRefused) {

@@ -5,6 +5,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <string>
@@ -16,6 +17,7 @@
 #include "pomar/pomar.h"
 #include "pomar/random_access.h"
 #include "support/mesh_gen.h"
+#include "support/temp_dir.h"
 
 namespace pomar {
 namespace {
@@ -87,6 +89,46 @@ TEST(MemoryEstimate, IsAboveTheMeasuredPeaks) {
   }
 }
 
+TEST(MemoryEstimate, AttributesAreAboveTheMeasuredPeaks) {
+  // bench/README.md, "Memory", per-vertex attributes: a 1M-vertex torus (2M faces) and a
+  // 490k one with RGB colour, normal, quality and UV (8 codes), and the 1M one with quality
+  // only (1 code); peak RSS in KiB (decode: binary PLY out).
+  Mesh eight, one;
+  auto add = [](Mesh &m, AttributeKind kind, uint32_t components) {
+    VertexAttribute a;
+    a.kind = kind;
+    a.components = components;
+    m.attributes.push_back(a);
+  };
+  add(eight, AttributeKind::Colour, 3);
+  add(eight, AttributeKind::Normal, 3);
+  add(eight, AttributeKind::Scalar, 1);
+  add(eight, AttributeKind::TexCoord, 2);
+  add(one, AttributeKind::Scalar, 1);
+  FileInfo eight_info, one_info;
+  for (const VertexAttribute &a : eight.attributes)
+    eight_info.attributes.push_back({a.kind, "", a.components, a.kind == AttributeKind::Colour ? 0 : 9});
+  one_info.attributes.push_back({AttributeKind::Scalar, "", 1, 16});
+  struct Peak {
+    uint64_t v, f;
+    const Mesh *mesh;
+    const FileInfo *info;
+    uint64_t enc, dec;
+  } peaks[] = {{1000000, 2000000, &eight, &eight_info, 1062080, 242540},
+               {490000, 980000, &eight, &eight_info, 548196, 121848},
+               {1000000, 2000000, &one, &one_info, 547292, 157952}};
+  for (const Peak &p : peaks) {
+    const uint64_t enc = encode_attribute_bytes_per_vertex(*p.mesh, AttributeOptions());
+    const uint64_t dec = decode_attribute_bytes_per_vertex(*p.info, AttributeMask());
+    EXPECT_GT(encode_memory_estimate(p.v, p.f) + p.v * enc, p.enc * 1024 * 11 / 10) << p.v;
+    EXPECT_GT(decode_memory_estimate(p.v, p.f, true) + p.v * dec, p.dec * 1024 * 11 / 10) << p.v;
+  }
+  EXPECT_EQ(decode_attribute_bytes_per_vertex(eight_info, AttributeMask::none()), 0u);
+  AttributeOptions dropped;
+  dropped.keep = AttributeMask::none();
+  EXPECT_EQ(encode_attribute_bytes_per_vertex(eight, dropped), 0u);
+}
+
 TEST(MemoryEstimate, GrowsWithTheMeshAndSaturates) {
   EXPECT_LT(encode_memory_estimate(1000, 2000), encode_memory_estimate(2000, 2000));
   EXPECT_LT(encode_memory_estimate(1000, 2000), encode_memory_estimate(1000, 4000));
@@ -133,18 +175,11 @@ TEST(MemoryCheck, DecodeCheckUsesTheCountsOfTheRequestedLevel) {
 // ------------------------------------------------------------------ available memory
 
 /// A fake root with /proc and /sys files, removed afterwards.
-class FakeRoot : public ::testing::Test {
+class FakeRoot : public test::TempDirTest {
 protected:
-  void SetUp() override {
-    std::string pattern = ::testing::TempDir() + "/pomar_limits_XXXXXX";
-    ASSERT_NE(mkdtemp(&pattern[0]), nullptr);
-    root_ = pattern;
-  }
-  void TearDown() override { std::system(("rm -rf '" + root_ + "'").c_str()); }
-
   void put(const std::string &rel, const std::string &text) {
-    const std::string full = root_ + rel;
-    std::system(("mkdir -p '" + full.substr(0, full.find_last_of('/')) + "'").c_str());
+    const std::string full = dir_ + rel;
+    std::filesystem::create_directories(full.substr(0, full.find_last_of('/')));
     std::ofstream(full) << text;
   }
   /// The rlimits are the process's own: tests that expect none to bind skip if one is set.
@@ -155,13 +190,12 @@ protected:
         return true;
     return false;
   }
-  std::string root_;
 };
 
 TEST_F(FakeRoot, NothingReadableMeansUnknownAndNoRefusal) {
   if (rlimits_set())
     GTEST_SKIP() << "an address-space or data rlimit is set for this process";
-  const AvailableMemory a = available_memory(root_);
+  const AvailableMemory a = available_memory(dir_);
   EXPECT_FALSE(a.known);
 }
 
@@ -170,7 +204,7 @@ TEST_F(FakeRoot, MemAvailableAlone) {
     GTEST_SKIP() << "an address-space or data rlimit is set for this process";
   put("/proc/meminfo", "MemTotal:       16000000 kB\nMemFree:  100 kB\n"
                        "MemAvailable:    7444889 kB\nBuffers: 1 kB\n");
-  const AvailableMemory a = available_memory(root_);
+  const AvailableMemory a = available_memory(dir_);
   ASSERT_TRUE(a.known);
   EXPECT_EQ(a.bytes, 7444889ull * 1024);
   EXPECT_EQ(a.source, "MemAvailable");
@@ -188,7 +222,7 @@ TEST_F(FakeRoot, CgroupV2LimitBindsWhenSmaller) {
   put("/sys/fs/cgroup/job/memory.max", "1073741824\n");
   put("/sys/fs/cgroup/job/memory.current", "314572800\n");
   put("/sys/fs/cgroup/job/memory.stat", "anon 1\ninactive_file 104857600\nactive_file 5\n");
-  const AvailableMemory a = available_memory(root_);
+  const AvailableMemory a = available_memory(dir_);
   ASSERT_TRUE(a.known);
   EXPECT_EQ(a.bytes, (1024ull - 200) << 20);
   EXPECT_EQ(a.source, "cgroup memory.max");
@@ -204,13 +238,13 @@ TEST_F(FakeRoot, CgroupV1LimitAndUnlimitedMarker) {
   put("/sys/fs/cgroup/memory/box/memory.limit_in_bytes", "2147483648\n");
   put("/sys/fs/cgroup/memory/box/memory.usage_in_bytes", "1073741824\n");
   put("/sys/fs/cgroup/memory/box/memory.stat", "cache 9\ntotal_inactive_file 0\n");
-  AvailableMemory a = available_memory(root_);
+  AvailableMemory a = available_memory(dir_);
   ASSERT_TRUE(a.known);
   EXPECT_EQ(a.bytes, 1ull << 30);
   EXPECT_EQ(a.source, "cgroup memory.limit_in_bytes");
   // Over the limit (usage can exceed it briefly): nothing available, not a wrap-around.
   put("/sys/fs/cgroup/memory/box/memory.usage_in_bytes", "3000000000\n");
-  a = available_memory(root_);
+  a = available_memory(dir_);
   EXPECT_EQ(a.bytes, 0u);
 }
 
@@ -221,7 +255,7 @@ TEST_F(FakeRoot, MemAvailableBindsWhenSmallerThanTheCgroup) {
   put("/proc/self/cgroup", "0::/\n");
   put("/sys/fs/cgroup/memory.max", "1073741824\n");
   put("/sys/fs/cgroup/memory.current", "0\n");
-  const AvailableMemory a = available_memory(root_);
+  const AvailableMemory a = available_memory(dir_);
   EXPECT_EQ(a.bytes, 1u << 20);
   EXPECT_EQ(a.source, "MemAvailable");
 }

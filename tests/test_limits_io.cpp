@@ -12,25 +12,12 @@
 #include <vector>
 
 #include "support/mesh_gen.h"
+#include "support/temp_dir.h"
 
 namespace pomar {
 namespace {
 
-class SizeCheckTest : public ::testing::Test {
-protected:
-  void SetUp() override {
-    std::string pattern = ::testing::TempDir() + "/pomar_size_check_XXXXXX";
-    ASSERT_NE(mkdtemp(&pattern[0]), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override { std::system(("rm -rf '" + dir_ + "'").c_str()); }
-  std::string path(const std::string &name) const { return dir_ + "/" + name; }
-  std::string write(const std::string &name, const std::string &bytes) const {
-    std::ofstream(path(name), std::ios::binary) << bytes;
-    return path(name);
-  }
-  std::string dir_;
-};
+using SizeCheckTest = test::TempDirTest;
 
 /// The counts the check was called with, in order.
 struct Calls {

@@ -398,6 +398,12 @@ TEST(Lossless, AttributesOfEveryVertexComeBackWithTheMessyMesh) {
     const std::vector<uint8_t> file = encode(m, o, &again);
     const Mesh out = decode(file.data(), file.size());
     ASSERT_EQ(out.vertex_count(), nv);
+    DecodeOptions none; // the attributes read past: the same mesh, record undone
+    none.attributes = AttributeMask::none();
+    const Mesh plain = decode(file.data(), file.size(), none);
+    EXPECT_EQ(plain.positions, out.positions);
+    EXPECT_EQ(plain.triangles, out.triangles);
+    EXPECT_TRUE(plain.attributes.empty());
     const VertexAttribute *c = out.find(AttributeKind::Colour);
     const VertexAttribute *n = out.find(AttributeKind::Normal);
     const VertexAttribute *q = out.find(AttributeKind::Scalar, "quality");

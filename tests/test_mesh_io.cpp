@@ -21,6 +21,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "support/temp_dir.h"
+
 // vcglib's PLY importer never frees the index list of a tristrip (plylib allocates it);
 // keep LeakSanitizer builds of this test green.
 extern "C" const char *__lsan_default_suppressions() { return "leak:cb_read_list_\n"; }
@@ -37,40 +39,7 @@ using pomar::VertexAttribute;
 // ------------------------------------------------------------------------------------
 
 /// A fresh directory under ::testing::TempDir(), removed with its files afterwards.
-class MeshIoTest : public ::testing::Test {
-protected:
-  void SetUp() override {
-    std::string pattern = ::testing::TempDir() + "/pomar_mesh_io_XXXXXX";
-    ASSERT_NE(mkdtemp(&pattern[0]), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override {
-    for (const std::string &name : list_dir())
-      std::remove((dir_ + "/" + name).c_str());
-    rmdir(dir_.c_str());
-  }
-
-  std::string path(const std::string &name) const { return dir_ + "/" + name; }
-
-  std::string write(const std::string &name, const std::string &bytes) const {
-    std::ofstream out(path(name), std::ios::binary);
-    out << bytes;
-    return path(name);
-  }
-
-  std::vector<std::string> list_dir() const {
-    std::vector<std::string> names;
-    if (DIR *d = opendir(dir_.c_str())) {
-      while (dirent *e = readdir(d))
-        if (std::strcmp(e->d_name, ".") != 0 && std::strcmp(e->d_name, "..") != 0)
-          names.push_back(e->d_name);
-      closedir(d);
-    }
-    return names;
-  }
-
-  std::string dir_;
-};
+class MeshIoTest : public pomar::test::TempDirTest {};
 
 std::string read_text(const std::string &path) {
   std::ifstream in(path, std::ios::binary);
@@ -241,10 +210,10 @@ TEST_F(MeshIoTest, ObjRelativeIndicesSlashesGroupsAndAttributes) {
   const Mesh m = pomar::load_mesh(file, &r);
   EXPECT_EQ(m.triangles, (std::vector<uint32_t>{0, 1, 2, 1, 3, 2}));
   // Vertex colours and the one normal every corner uses are kept; the texture coordinate
-  // is missing on the second face's corners, and materials are not kept.
+  // is missing on the second face's corners, and the material library is not there.
   EXPECT_EQ(r.ignored_attributes,
             (std::vector<std::string>{"texture coordinates (not given for every corner)",
-                                      "materials"}));
+                                      "materials (material library 'x.mtl' not found)"}));
   ASSERT_EQ(m.attributes.size(), 2u);
   EXPECT_EQ(m.find(AttributeKind::Colour)->colour,
             (std::vector<uint8_t>{255, 0, 0, 255, 0, 0, 255, 0, 0, 255, 0, 0}));

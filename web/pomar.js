@@ -14,13 +14,14 @@
 // Errors (HTTP errors, servers without Range support, damaged or truncated files) reject
 // the promises with an Error whose message says what happened; damaged cluster blocks are
 // skipped (as `pomar decode --skip-damaged` does) and reported through `onWarning`.
-import { chooseLevels } from './view_refine.js';
+import { chooseLevels, Convergence, sameLevels } from './view_refine.js';
 
 /**
  * @param source URL of a .pomar file, or a File/Blob (e.g. dropped on the page)
  * @param options {onMesh(mesh, model), onWarning(message), onError(message),
- *   maxInFlight = 4, maxGap = 4 KiB (ranges this close are fetched in one request; what
- *   lies between is kept), maxRequestBytes = 1 MiB, memoryBudget = 256 MiB (block bytes
+ *   maxInFlight = 4, maxGap = 128 bytes (ranges this close are fetched in one request;
+ *   what lies between is kept: a wider gap costs more bytes than the request it saves,
+ *   see web/README.md), maxRequestBytes = 1 MiB, memoryBudget = 256 MiB (block bytes
  *   held; over it the worker rebuilds its decoder with only the blocks in use),
  *   firstRequestBytes = 16 KiB, tolerant = false (true: fetch whole blocks from the start;
  *   see pomar_stream.js)}
@@ -32,7 +33,7 @@ export function open(source, options = {}) {
 
 export class PomarModel {
   constructor(options) {
-    this.options = { memoryBudget: 256 << 20, maxGap: 4096, ...options };
+    this.options = { memoryBudget: 256 << 20, maxGap: 128, ...options };
     this.worker = new Worker(new URL('./pomar_worker.js', import.meta.url), { type: 'module' });
     this.info = null;
     this.mesh = null;
@@ -42,6 +43,7 @@ export class PomarModel {
     this.waiters = []; // {id, resolve, reject}
     this.errorSeen = new Map();
     this.lastWanted = null;
+    this.convergence = new Convergence(); // damps wantView's steps for one camera
     this.worker.onmessage = (e) => this.receive(e.data);
     this.worker.onerror = (e) => this.fail(0, `the decoder worker failed: ${e.message || 'cannot load it'}`);
   }
@@ -85,7 +87,8 @@ export class PomarModel {
 
   /** Wanted levels: {cluster, level} (that cluster at least at `level`, the others as they
    *  are), {all: level}, or {levels: per-cluster array}. Resolves with the new mesh. */
-  want(request) {
+  want(request, fromView = false) {
+    if (!fromView) this.convergence.forget();
     const n = this.info.clusters;
     let levels;
     if (request.levels) levels = Int32Array.from(request.levels);
@@ -113,11 +116,10 @@ export class PomarModel {
       return { changed: false, refine: 0, coarsen: 0, hidden: 0 };
     }
     const choice = chooseLevels({ info: this.info, levels: this.levels, clusterBounds: this.mesh.clusterBounds,
-      errorSeen: this.errorSeen }, view, settings);
-    const last = this.lastWanted;
-    const same = last && last.length === choice.levels.length && choice.levels.every((l, i) => l === last[i]);
-    if (same) return { ...choice, changed: false };
-    await this.want({ levels: choice.levels });
+      errorSeen: this.errorSeen, mesh: this.mesh }, view, settings);
+    const wanted = this.convergence.next(choice.levels, this.levels, view);
+    if (!wanted || sameLevels(wanted, this.lastWanted)) return { ...choice, changed: false };
+    await this.want({ levels: wanted }, true);
     return { ...choice, changed: true };
   }
 

@@ -2,6 +2,7 @@
 // Used by the Web Worker (pomar_worker.js) and by the Node tests; knows nothing about the
 // network: bytes come in as Uint8Arrays, meshes go out as typed arrays (copies).
 import createPomarDecoder from './dist/pomar_decoder.mjs';
+import { BOUNDS_STRIDE } from './view_refine.js';
 
 let modulePromise = null;
 /** The WebAssembly module, instantiated once (`options`: emscripten's, e.g. wasmBinary). */
@@ -123,7 +124,8 @@ export class Decoder {
   }
 
   /** The current mesh as typed arrays (copies, transferable), plus per-cluster bounds:
-   *  8 floats per cluster (bbox min, max, longest edge, face count). */
+   *  BOUNDS_STRIDE floats per cluster (bbox min, max, longest edge, face count, normal cone:
+   *  see view_refine.js). */
   mesh() {
     const M = this.M;
     if (M._pw_extract(this.h) < 0) throw new PomarError(lastError(M));
@@ -136,7 +138,7 @@ export class Decoder {
       triangles: u32(M._pw_triangles(this.h), 3 * nt),
       vertexCluster: u32(M._pw_vertex_cluster(this.h), nv),
       vertexLevel: u32(M._pw_vertex_level(this.h), nv),
-      clusterBounds: f32(M._pw_cluster_bounds(this.h), 8 * Math.max(1, this.info.clusters)),
+      clusterBounds: f32(M._pw_cluster_bounds(this.h), BOUNDS_STRIDE * Math.max(1, this.info.clusters)),
     };
   }
 }

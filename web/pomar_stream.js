@@ -23,7 +23,7 @@ function concat(a, b) {
 export class PomarStream {
   /** options: firstRequestBytes (16 KiB), memoryBudget (bytes of blocks held; over it the
    *  decoder is rebuilt with only what the current level map needs), tolerant (start in
-   *  tolerant mode), estimateMargin (1.25), wholeBlockBytes (1024). */
+   *  tolerant mode), estimateMargin (1.25), estimateSlack (16 bytes), wholeBlockBytes (0). */
   constructor(M, file, options = {}) {
     this.M = M;
     this.file = file;
@@ -67,18 +67,20 @@ export class PomarStream {
   }
 
   /** Bytes of block c to hold for decoding it to `level`: the whole block, or, for a block
-   *  larger than `wholeBlockBytes` (1 KiB) fetched for the first time for a level below the
-   *  finest, an estimate of its prefix (one request per block is worth more than a few
-   *  hundred bytes; a prefix is extended by fetching the rest of the block). */
+   *  larger than `wholeBlockBytes` (default 0) wanted below the finest level, an estimate of
+   *  its prefix (the share of the level table's vertex splits up to that level, with a
+   *  margin). A prefix that fell short once is fetched whole from then on. */
   need(c, level) {
     const { baseLevel: base, finestLevel: finest, levels } = this.info;
     const size = this.decoder.blockSize[c];
     if (level <= base) return 0;
-    const small = size <= (this.options.wholeBlockBytes ?? 1024);
-    if (this.tolerant || level >= finest || this.whole.has(c) || this.have[c] > 0 || small) return size;
+    const small = size <= (this.options.wholeBlockBytes ?? 0);
+    if (this.tolerant || level >= finest || this.whole.has(c) || small) return size;
     const vertices = (l) => (l === 0 ? this.info.baseVertices : levels[l - 1].vertices);
     const share = (vertices(level) - vertices(base)) / (vertices(finest) - vertices(base));
-    return Math.min(size, Math.ceil(size * share * (this.options.estimateMargin || 1.25)) + 24);
+    const slack = this.options.estimateSlack ?? 16;
+    const estimate = Math.min(size, Math.ceil(size * share * (this.options.estimateMargin || 1.25)) + slack);
+    return Math.max(estimate, this.have[c]);
   }
 
   /** Position in byOffset of the first block starting at or after `offset`. */

@@ -12,12 +12,30 @@
 // there, the current one scaled by sqrt(faces(l) / faces(l-1)) from the level table
 // (edges grow like 1/sqrt of the face count).
 //
-// A cluster is refined one level per step while its error projected to pixels exceeds
-// `targetPixels` (largest first, within `triangleBudget`), coarsened one level when the
+// A cluster is refined while its error projected to pixels exceeds `targetPixels` (largest
+// first, within `triangleBudget`), straight to the level where the error extrapolated with
+// the level table (as for coarsening, below) meets the target, coarsened one level when the
 // error of the coarser level is below `coarsenFraction * targetPixels`, and sent back to
 // the base clustered level when it leaves the view frustum. The decoder then completes
 // the level map (neighbouring clusters at most one level apart: no cracks), so a request
 // converges in (finest - base) steps; call again after each decode until it is stable.
+//
+// What the camera cannot see is not refined, and is coarsened one level per step:
+//  - back-facing clusters (`backface`): every face of the cluster turns away from the eye.
+//    The normal cone (axis and width, per cluster, from the current mesh) is widened by
+//    `backfaceMargin` radians for the finer levels' detail, and the cluster's bounding
+//    sphere (at least one error proxy wide) stands for its positions. Only right for closed
+//    surfaces whose faces point outwards, so it is off by default; the viewer draws both
+//    sides of every face.
+//  - occluded clusters (`occlusion`): the current mesh is rasterized into a small depth
+//    buffer (`occlusionWidth` pixels wide), each pixel keeping the nearest triangle's
+//    farthest corner plus its longest edge (a finer surface stays within about one edge of
+//    a coarser one); a cluster whose box (grown by its error proxy) lies behind every pixel
+//    of its screen rectangle is hidden. This keeps the body behind a close-up coarse.
+
+/** Floats per cluster in `clusterBounds` (pw_cluster_bounds in web/src/pomar_web.cpp):
+ *  box min xyz, max xyz, error proxy, faces, normal cone axis xyz, cosine of its width. */
+export const BOUNDS_STRIDE = 12;
 
 /** Does the box [lo, hi] lie entirely outside one plane of the frustum of `viewProj`
  *  (column-major 4x4, clip = viewProj * [x,y,z,1])? */
@@ -47,34 +65,162 @@ function distanceToBox(eye, lo, hi) {
   return Math.sqrt(d2);
 }
 
+/** Screen position (pixels, y down) and depth w of the points `xyz` (flat) for `view`;
+ *  w < near: in front of the near plane or behind the eye. */
+function project(view, xyz, width, height) {
+  const m = view.viewProj;
+  const n = xyz.length / 3;
+  const out = new Float32Array(3 * n);
+  for (let i = 0; i < n; ++i) {
+    const x = xyz[3 * i];
+    const y = xyz[3 * i + 1];
+    const z = xyz[3 * i + 2];
+    const w = m[3] * x + m[7] * y + m[11] * z + m[15];
+    const cx = m[0] * x + m[4] * y + m[8] * z + m[12];
+    const cy = m[1] * x + m[5] * y + m[9] * z + m[13];
+    out[3 * i] = (cx / w * 0.5 + 0.5) * width;
+    out[3 * i + 1] = (0.5 - cy / w * 0.5) * height;
+    out[3 * i + 2] = w;
+  }
+  return out;
+}
+
+/** A conservative depth buffer of `mesh` for `view`: per pixel, the smallest over the
+ *  triangles covering its centre of (farthest corner depth + longest edge); Infinity where
+ *  nothing is drawn. Triangles crossing the near plane are left out. */
+export function occlusionBuffer(mesh, view, width) {
+  const height = Math.max(1, Math.round(width * view.height / (view.width || view.height)));
+  const depth = new Float32Array(width * height).fill(Infinity);
+  const p = mesh.positions;
+  const t = mesh.triangles;
+  const s = project(view, p, width, height);
+  for (let f = 0; f < t.length; f += 3) {
+    const a = 3 * t[f];
+    const b = 3 * t[f + 1];
+    const c = 3 * t[f + 2];
+    const wa = s[a + 2];
+    const wb = s[b + 2];
+    const wc = s[c + 2];
+    if (wa < view.near || wb < view.near || wc < view.near) continue;
+    const x0 = Math.max(0, Math.ceil(Math.min(s[a], s[b], s[c]) - 0.5));
+    const x1 = Math.min(width - 1, Math.floor(Math.max(s[a], s[b], s[c]) - 0.5));
+    const y0 = Math.max(0, Math.ceil(Math.min(s[a + 1], s[b + 1], s[c + 1]) - 0.5));
+    const y1 = Math.min(height - 1, Math.floor(Math.max(s[a + 1], s[b + 1], s[c + 1]) - 0.5));
+    if (x0 > x1 || y0 > y1) continue;
+    const edge = Math.max(Math.hypot(p[a] - p[b], p[a + 1] - p[b + 1], p[a + 2] - p[b + 2]),
+      Math.hypot(p[b] - p[c], p[b + 1] - p[c + 1], p[b + 2] - p[c + 2]),
+      Math.hypot(p[c] - p[a], p[c + 1] - p[a + 1], p[c + 2] - p[a + 2]));
+    const d = Math.max(wa, wb, wc) + edge;
+    // Edge functions; the sign of the area makes the test independent of the winding.
+    const area = (s[b] - s[a]) * (s[c + 1] - s[a + 1]) - (s[b + 1] - s[a + 1]) * (s[c] - s[a]);
+    if (area === 0) continue;
+    const sign = area > 0 ? 1 : -1;
+    for (let y = y0; y <= y1; ++y) {
+      const py = y + 0.5;
+      for (let x = x0; x <= x1; ++x) {
+        const px = x + 0.5;
+        const e0 = ((s[b] - s[a]) * (py - s[a + 1]) - (s[b + 1] - s[a + 1]) * (px - s[a])) * sign;
+        const e1 = ((s[c] - s[b]) * (py - s[b + 1]) - (s[c + 1] - s[b + 1]) * (px - s[b])) * sign;
+        const e2 = ((s[a] - s[c]) * (py - s[c + 1]) - (s[a + 1] - s[c + 1]) * (px - s[c])) * sign;
+        if (e0 >= 0 && e1 >= 0 && e2 >= 0 && d < depth[y * width + x]) depth[y * width + x] = d;
+      }
+    }
+  }
+  return { width, height, depth };
+}
+
+/** Is the box [lo, hi] behind the depth buffer everywhere it could appear? */
+function occluded(buffer, view, lo, hi) {
+  const corners = [];
+  for (let k = 0; k < 8; ++k) corners.push(k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1], k & 4 ? hi[2] : lo[2]);
+  const s = project(view, corners, buffer.width, buffer.height);
+  let nearest = Infinity;
+  let x0 = Infinity;
+  let x1 = -Infinity;
+  let y0 = Infinity;
+  let y1 = -Infinity;
+  for (let k = 0; k < 8; ++k) {
+    if (s[3 * k + 2] < view.near) return false;
+    nearest = Math.min(nearest, s[3 * k + 2]);
+    x0 = Math.min(x0, s[3 * k]);
+    x1 = Math.max(x1, s[3 * k]);
+    y0 = Math.min(y0, s[3 * k + 1]);
+    y1 = Math.max(y1, s[3 * k + 1]);
+  }
+  // Every pixel the box may touch, one more on each side.
+  const i0 = Math.max(0, Math.floor(x0) - 1);
+  const i1 = Math.min(buffer.width - 1, Math.floor(x1) + 1);
+  const j0 = Math.max(0, Math.floor(y0) - 1);
+  const j1 = Math.min(buffer.height - 1, Math.floor(y1) + 1);
+  if (i0 > i1 || j0 > j1) return false;
+  for (let j = j0; j <= j1; ++j)
+    for (let i = i0; i <= i1; ++i) if (!(buffer.depth[j * buffer.width + i] < nearest)) return false;
+  return true;
+}
+
+/** Do all faces of the cluster (normal cone `axis`, `cosWidth`; bounding sphere `centre`,
+ *  `radius`) turn away from `eye`, with `margin` radians to spare? */
+function backFacing(eye, centre, radius, axis, cosWidth, margin) {
+  if (cosWidth <= -1) return false;
+  const d = [centre[0] - eye[0], centre[1] - eye[1], centre[2] - eye[2]];
+  const distance = Math.hypot(d[0], d[1], d[2]);
+  if (distance <= radius) return false;
+  const cosAngle = (d[0] * axis[0] + d[1] * axis[1] + d[2] * axis[2]) / distance;
+  const angle = Math.acos(Math.max(-1, Math.min(1, cosAngle)));
+  return angle + Math.acos(Math.min(1, cosWidth)) + margin + Math.asin(radius / distance) < Math.PI / 2;
+}
+
 /**
  * @param state {info, levels (Int32Array, current level per cluster), clusterBounds
- *   (Float32Array, 8 per cluster), errorSeen (Map "c:l" -> error, updated here)}
- * @param view {eye [3], viewProj (16, column-major), fovY (radians), height (pixels), near}
- * @returns {levels: Int32Array wanted, changed: boolean, refine, coarsen, hidden}
+ *   (Float32Array, BOUNDS_STRIDE per cluster), errorSeen (Map "c:l" -> error, updated
+ *   here), mesh (positions, triangles: the occluders; optional)}
+ * @param view {eye [3], viewProj (16, column-major), fovY (radians), height, width (pixels),
+ *   near}
+ * @returns {levels: Int32Array wanted, changed: boolean, refine, coarsen, hidden (clusters
+ *   above the base level outside the frustum), culled (back-facing or occluded)}
  */
-export function chooseLevels(state, view, { targetPixels = 3, coarsenFraction = 0.5, triangleBudget = 2e6 } = {}) {
+export function chooseLevels(state, view, {
+  targetPixels = 3, coarsenFraction = 0.5, triangleBudget = 2e6, backface = false, backfaceMargin = 0.3,
+  occlusion = true, occlusionWidth = 128,
+} = {}) {
   const { info, levels, clusterBounds: b, errorSeen } = state;
+  const S = BOUNDS_STRIDE;
   const n = info.clusters;
   const base = info.baseLevel;
   const finest = info.finestLevel;
   const faces = (l) => (l === 0 ? info.baseFaces : info.levels[l - 1].faces);
   const pixelsPerUnit = view.height / (2 * Math.tan(view.fovY / 2));
+  const buffer = occlusion && state.mesh && view.width ? occlusionBuffer(state.mesh, view, occlusionWidth) : null;
   const wanted = Int32Array.from(levels);
   let triangles = 0;
-  for (let c = 0; c < n; ++c) triangles += b[8 * c + 7];
+  for (let c = 0; c < n; ++c) triangles += b[S * c + 7];
   const candidates = [];
   let coarsen = 0;
   let hidden = 0;
+  let culled = 0;
   for (let c = 0; c < n; ++c) {
     const l = levels[c];
-    const lo = [b[8 * c], b[8 * c + 1], b[8 * c + 2]];
-    const hi = [b[8 * c + 3], b[8 * c + 4], b[8 * c + 5]];
-    const error = l >= finest ? 0 : b[8 * c + 6];
+    const lo = [b[S * c], b[S * c + 1], b[S * c + 2]];
+    const hi = [b[S * c + 3], b[S * c + 4], b[S * c + 5]];
+    const error = l >= finest ? 0 : b[S * c + 6];
     errorSeen.set(`${c}:${l}`, error);
     if (outsideFrustum(view.viewProj, lo, hi)) {
       if (l > base) ++hidden;
       wanted[c] = base;
+      continue;
+    }
+    // Hidden from the eye: not refined, coarsened one level per step. The box grows by the
+    // error proxy: a coarse cluster (one vertex at the base level) stands for more surface.
+    const grow = b[S * c + 6];
+    const centre = [0, 1, 2].map((k) => (lo[k] + hi[k]) / 2);
+    const radius = Math.max(grow, Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) / 2);
+    if ((backface && backFacing(view.eye, centre, radius, [b[S * c + 8], b[S * c + 9], b[S * c + 10]], b[S * c + 11],
+      backfaceMargin)) || (buffer && occluded(buffer, view, lo.map((x) => x - grow), hi.map((x) => x + grow)))) {
+      ++culled;
+      if (l > base) {
+        wanted[c] = l - 1;
+        ++coarsen;
+      }
       continue;
     }
     const toPixels = pixelsPerUnit / Math.max(view.near, distanceToBox(view.eye, lo, hi));
@@ -82,7 +228,7 @@ export function chooseLevels(state, view, { targetPixels = 3, coarsenFraction = 
       candidates.push({ c, pixels: error * toPixels });
     } else if (l > base) {
       const coarser = errorSeen.get(`${c}:${l - 1}`) ??
-        (l >= finest ? b[8 * c + 6] : error) * Math.sqrt(faces(l) / faces(l - 1));
+        (l >= finest ? b[S * c + 6] : error) * Math.sqrt(faces(l) / faces(l - 1));
       if (coarser * toPixels < coarsenFraction * targetPixels) {
         wanted[c] = l - 1;
         ++coarsen;
@@ -90,16 +236,58 @@ export function chooseLevels(state, view, { targetPixels = 3, coarsenFraction = 
     }
   }
   // Largest projected error first, while the estimated triangle count fits the budget.
+  // A cluster goes at once to the level whose error, extrapolated from the current one with
+  // the level table's face counts, is under the target (all its bytes in one request, not
+  // one level per step); the next step measures it again and goes on if that fell short.
   candidates.sort((x, y) => y.pixels - x.pixels);
   let refine = 0;
-  for (const { c } of candidates) {
+  for (const { c, pixels } of candidates) {
     const l = levels[c];
-    const more = b[8 * c + 7] * (faces(l + 1) / faces(l) - 1);
-    if (triangles + more > triangleBudget) break;
-    triangles += more;
-    wanted[c] = l + 1;
+    let to = l + 1;
+    while (to < finest && pixels * Math.sqrt(faces(l) / faces(to)) > targetPixels) ++to;
+    const more = (level) => b[S * c + 7] * (faces(level) / faces(l) - 1);
+    while (to > l + 1 && triangles + more(to) > triangleBudget) --to; // as far as the budget goes
+    if (triangles + more(to) > triangleBudget) break;
+    triangles += more(to);
+    wanted[c] = to;
     ++refine;
   }
   const changed = refine > 0 || coarsen > 0 || hidden > 0;
-  return { levels: wanted, changed, refine, coarsen, hidden };
+  return { levels: wanted, changed, refine, coarsen, hidden, culled };
+}
+
+export function sameLevels(a, b) {
+  return !!a && !!b && a.length === b.length && a.every((l, i) => l === b[i]);
+}
+
+/** Damps a view's refinement until it converges. For one camera, it remembers the last
+ *  level maps the model had: a cluster that the choice would send back to a level it had
+ *  there keeps its current level (a cluster occluded only at its finer level, or coarsened
+ *  on an extrapolated error it does not meet, would flip back and forth, and clusters
+ *  flipping out of phase keep the whole map from ever repeating). `forget()` after any
+ *  other request. */
+export class Convergence {
+  constructor(depth = 4) {
+    this.depth = depth;
+    this.forget();
+    this.viewProj = null;
+  }
+  forget() {
+    this.history = [];
+    this.lastAsked = null;
+  }
+  /** The level map to ask for `view` given chooseLevels' `choice` and the `current` levels,
+   *  or null when there is nothing new to ask (converged). */
+  next(choice, current, view) {
+    if (!sameLevels(view.viewProj, this.viewProj)) this.forget();
+    this.viewProj = Array.from(view.viewProj);
+    const wanted = Int32Array.from(choice);
+    for (let c = 0; c < wanted.length; ++c)
+      if (wanted[c] !== current[c] && this.history.some((h) => h[c] === wanted[c])) wanted[c] = current[c];
+    this.history = [Int32Array.from(current), ...this.history].slice(0, this.depth);
+    // The same map again: the level map rule keeps some clusters above what the view wants.
+    if (sameLevels(wanted, this.lastAsked) || sameLevels(wanted, current)) return null;
+    this.lastAsked = wanted;
+    return wanted;
+  }
 }

@@ -1,43 +1,24 @@
-// The pomar web viewer: WebGL2, orbit camera, view-dependent refinement through pomar.js.
+// The pomar web viewer: three.js (WebGL2; web/dist/three.module.js, vendored from npm by
+// web/build.sh), orbit camera, view-dependent refinement through pomar.js.
 // URL parameters: ?file=URL opens a file; &test=1 runs the scripted browser test
 // (web/test/browser_test.py) and reports to the test server.
 import { open } from './pomar.js';
+import { frameMesh, orbitCamera, viewOf } from './camera.js';
+import * as THREE from './dist/three.module.js';
 
 const $ = (id) => document.getElementById(id);
 const canvas = $('view');
-const gl = canvas.getContext('webgl2', { antialias: true, preserveDrawingBuffer: true });
 const params = new URLSearchParams(location.search);
 
-// ------------------------------------------------------------------ small matrix helpers
-function perspective(fovY, aspect, near, far) {
-  const f = 1 / Math.tan(fovY / 2);
-  const nf = 1 / (near - far);
-  return [f / aspect, 0, 0, 0, 0, f, 0, 0, 0, 0, (far + near) * nf, -1, 0, 0, 2 * far * near * nf, 0];
-}
-function lookAt(eye, target, up) {
-  const sub = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-  const norm = (a) => { const l = Math.hypot(...a) || 1; return a.map((x) => x / l); };
-  const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
-  const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-  const z = norm(sub(eye, target));
-  const x = norm(cross(up, z));
-  const y = cross(z, x);
-  return [x[0], y[0], z[0], 0, x[1], y[1], z[1], 0, x[2], y[2], z[2], 0, -dot(x, eye), -dot(y, eye), -dot(z, eye), 1];
-}
-function multiply(a, b) {
-  const out = new Array(16).fill(0);
-  for (let c = 0; c < 4; ++c)
-    for (let r = 0; r < 4; ++r)
-      for (let k = 0; k < 4; ++k) out[4 * c + r] += a[4 * k + r] * b[4 * c + k];
-  return out;
-}
-
 // ------------------------------------------------------------------ renderer
-const VS = `#version 300 es
-layout(location=0) in vec3 position;
-layout(location=1) in uint cluster;
-layout(location=2) in uint level;
-uniform mat4 viewProj;
+// One three.js mesh drawn with a small shader: flat shading from screen-space derivatives
+// (the decoded mesh has no normals), colour by cluster or by level.
+const VS = `precision highp float;
+in vec3 position;
+in float cluster;
+in float level;
+uniform mat4 projectionMatrix;
+uniform mat4 modelViewMatrix;
 uniform int colourMode;
 uniform float finest;
 uniform float base;
@@ -46,13 +27,12 @@ flat out vec3 vColour;
 vec3 hue(float h) { return clamp(abs(mod(h * 6.0 + vec3(0, 4, 2), 6.0) - 3.0) - 1.0, 0.0, 1.0); }
 void main() {
   vPosition = position;
-  if (colourMode == 1) vColour = 0.35 + 0.65 * hue(fract(float(cluster) * 0.61803));
-  else if (colourMode == 2) vColour = 0.3 + 0.7 * hue(0.66 * (1.0 - (float(level) - base) / max(1.0, finest - base)));
+  if (colourMode == 1) vColour = 0.35 + 0.65 * hue(fract(cluster * 0.61803));
+  else if (colourMode == 2) vColour = 0.3 + 0.7 * hue(0.66 * (1.0 - (level - base) / max(1.0, finest - base)));
   else vColour = vec3(0.82, 0.80, 0.76);
-  gl_Position = viewProj * vec4(position, 1.0);
+  gl_Position = projectionMatrix * modelViewMatrix * vec4(position, 1.0);
 }`;
-const FS = `#version 300 es
-precision highp float;
+const FS = `precision highp float;
 in vec3 vPosition;
 flat in vec3 vColour;
 uniform vec3 eye;
@@ -64,58 +44,40 @@ void main() {
   colour = vec4(vColour * (0.25 + 0.75 * d), 1.0);
 }`;
 
-function compile(type, source) {
-  const s = gl.createShader(type);
-  gl.shaderSource(s, source);
-  gl.compileShader(s);
-  if (!gl.getShaderParameter(s, gl.COMPILE_STATUS)) throw new Error(gl.getShaderInfoLog(s));
-  return s;
-}
-let program = null;
-let vao = null;
-const buffers = {};
-let indexCount = 0;
+let renderer = null;
+let scene = null;
+let shown = null; // the THREE.Mesh
+const camera3 = new THREE.PerspectiveCamera();
 function initGL() {
-  program = gl.createProgram();
-  gl.attachShader(program, compile(gl.VERTEX_SHADER, VS));
-  gl.attachShader(program, compile(gl.FRAGMENT_SHADER, FS));
-  gl.linkProgram(program);
-  if (!gl.getProgramParameter(program, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(program));
-  vao = gl.createVertexArray();
-  gl.bindVertexArray(vao);
-  for (const name of ['position', 'cluster', 'level', 'index']) buffers[name] = gl.createBuffer();
-  gl.bindBuffer(gl.ARRAY_BUFFER, buffers.position);
-  gl.enableVertexAttribArray(0);
-  gl.vertexAttribPointer(0, 3, gl.FLOAT, false, 0, 0);
-  gl.bindBuffer(gl.ARRAY_BUFFER, buffers.cluster);
-  gl.enableVertexAttribArray(1);
-  gl.vertexAttribIPointer(1, 1, gl.UNSIGNED_INT, 0, 0);
-  gl.bindBuffer(gl.ARRAY_BUFFER, buffers.level);
-  gl.enableVertexAttribArray(2);
-  gl.vertexAttribIPointer(2, 1, gl.UNSIGNED_INT, 0, 0);
-  gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, buffers.index);
-  gl.enable(gl.DEPTH_TEST);
+  THREE.ColorManagement.enabled = false; // colours as given, no sRGB conversions
+  renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
+  renderer.setClearColor(new THREE.Color(0x20242a), 1);
+  scene = new THREE.Scene();
+  const material = new THREE.RawShaderMaterial({
+    glslVersion: THREE.GLSL3, vertexShader: VS, fragmentShader: FS, side: THREE.DoubleSide,
+    uniforms: { colourMode: { value: 0 }, finest: { value: 1 }, base: { value: 0 }, eye: { value: new THREE.Vector3() } },
+  });
+  shown = new THREE.Mesh(new THREE.BufferGeometry(), material);
+  shown.frustumCulled = false; // the geometry changes with every decode
+  scene.add(shown);
 }
 function upload(mesh, model) {
-  gl.bindVertexArray(vao);
-  gl.bindBuffer(gl.ARRAY_BUFFER, buffers.position);
-  gl.bufferData(gl.ARRAY_BUFFER, mesh.positions, gl.DYNAMIC_DRAW);
-  gl.bindBuffer(gl.ARRAY_BUFFER, buffers.cluster);
-  gl.bufferData(gl.ARRAY_BUFFER, mesh.vertexCluster, gl.DYNAMIC_DRAW);
+  const g = new THREE.BufferGeometry();
+  g.setAttribute('position', new THREE.BufferAttribute(mesh.positions, 3));
+  g.setAttribute('cluster', new THREE.BufferAttribute(Float32Array.from(mesh.vertexCluster), 1));
   // Colour by level: the level of the vertex's cluster (the level map), not the level
   // that created the vertex (which mixes all levels up to it in every region).
   const levels = model ? model.levels : null;
-  const level = new Uint32Array(mesh.vertexCluster.length);
+  const level = new Float32Array(mesh.vertexCluster.length);
   for (let v = 0; v < level.length; ++v) level[v] = levels && levels.length ? levels[mesh.vertexCluster[v]] : mesh.vertexLevel[v];
-  gl.bindBuffer(gl.ARRAY_BUFFER, buffers.level);
-  gl.bufferData(gl.ARRAY_BUFFER, level, gl.DYNAMIC_DRAW);
-  gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, buffers.index);
-  gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, mesh.triangles, gl.DYNAMIC_DRAW);
-  indexCount = mesh.triangles.length;
+  g.setAttribute('level', new THREE.BufferAttribute(level, 1));
+  g.setIndex(new THREE.BufferAttribute(mesh.triangles, 1));
+  shown.geometry.dispose();
+  shown.geometry = g;
 }
 
 // ------------------------------------------------------------------ camera
-const camera = { target: [0, 0, 0], distance: 1, yaw: 0.6, pitch: 0.3, fovY: Math.PI / 4, extent: 1 };
+const camera = orbitCamera();
 let cameraVersion = 0;
 function view() {
   const dpr = window.devicePixelRatio || 1;
@@ -125,30 +87,27 @@ function view() {
     canvas.width = w;
     canvas.height = h;
   }
-  const c = camera;
-  const eye = [c.target[0] + c.distance * Math.cos(c.pitch) * Math.sin(c.yaw),
-    c.target[1] + c.distance * Math.sin(c.pitch),
-    c.target[2] + c.distance * Math.cos(c.pitch) * Math.cos(c.yaw)];
-  const near = Math.max(c.distance * 0.01, c.extent * 1e-4);
-  const far = c.distance + 4 * c.extent;
-  const viewProj = multiply(perspective(c.fovY, w / h, near, far), lookAt(eye, c.target, [0, 1, 0]));
-  return { eye, viewProj, fovY: c.fovY, height: h, near };
+  return viewOf(camera, w, h);
 }
 function frame(model) {
-  if (!program) return;
+  if (!renderer) return;
   const v = view();
-  gl.viewport(0, 0, canvas.width, canvas.height);
-  gl.clearColor(0.125, 0.14, 0.165, 1);
-  gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
-  if (!indexCount) return;
-  gl.useProgram(program);
-  gl.uniformMatrix4fv(gl.getUniformLocation(program, 'viewProj'), false, v.viewProj);
-  gl.uniform3fv(gl.getUniformLocation(program, 'eye'), v.eye);
-  gl.uniform1i(gl.getUniformLocation(program, 'colourMode'), Number($('colour').value));
-  gl.uniform1f(gl.getUniformLocation(program, 'finest'), model ? model.info.finestLevel : 1);
-  gl.uniform1f(gl.getUniformLocation(program, 'base'), model ? model.info.baseLevel : 0);
-  gl.bindVertexArray(vao);
-  gl.drawElements(gl.TRIANGLES, indexCount, gl.UNSIGNED_INT, 0);
+  renderer.setSize(canvas.width, canvas.height, false);
+  const c = camera3;
+  c.fov = (v.fovY * 180) / Math.PI;
+  c.aspect = v.width / v.height;
+  c.near = v.near;
+  c.far = v.far;
+  c.position.set(...v.eye);
+  c.up.set(0, 1, 0);
+  c.lookAt(...camera.target);
+  c.updateProjectionMatrix();
+  const u = shown.material.uniforms;
+  u.eye.value.set(...v.eye);
+  u.colourMode.value = Number($('colour').value);
+  u.finest.value = model ? model.info.finestLevel : 1;
+  u.base.value = model ? model.info.baseLevel : 0;
+  renderer.render(scene, c);
 }
 
 // ------------------------------------------------------------------ the model
@@ -196,7 +155,7 @@ async function openSource(source, extraOptions = {}) {
   $('warning').textContent = '';
   if (model) model.close();
   model = null;
-  indexCount = 0;
+  upload({ positions: new Float32Array(0), triangles: new Uint32Array(0), vertexCluster: new Uint32Array(0), vertexLevel: new Uint32Array(0) });
   frame(null);
   const m = await open(source, {
     ...extraOptions,
@@ -205,16 +164,7 @@ async function openSource(source, extraOptions = {}) {
   });
   model = m;
   // The header's box is the quantization cube; frame the base mesh's own box instead.
-  const p = m.mesh.positions;
-  const lo = [Infinity, Infinity, Infinity];
-  const hi = [-Infinity, -Infinity, -Infinity];
-  for (let i = 0; i < p.length; ++i) {
-    lo[i % 3] = Math.min(lo[i % 3], p[i]);
-    hi[i % 3] = Math.max(hi[i % 3], p[i]);
-  }
-  camera.target = [0, 1, 2].map((k) => (lo[k] + hi[k]) / 2);
-  camera.extent = Math.max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
-  camera.distance = 1.6 * camera.extent;
+  frameMesh(camera, m.mesh.positions);
   ++cameraVersion;
   onMesh(m.mesh, m);
   if (m.info.clusters === 0) await m.want({ all: m.info.finestLevel }); // progressive: no regions
@@ -271,7 +221,6 @@ window.addEventListener('drop', (e) => {
 
 // ------------------------------------------------------------------ start
 try {
-  if (!gl) throw new Error('this browser has no WebGL2');
   initGL();
   frame(null);
   if (params.get('test')) {

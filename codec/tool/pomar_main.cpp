@@ -139,6 +139,17 @@ void print_attributes(const pomar::FileInfo &i) {
     std::printf("  texture file %s\n", t.c_str());
 }
 
+/// One stderr warning naming what is lost: `what` is the list, `why` ends the line.
+void warn_dropped(const std::string &file, const std::vector<std::string> &what, const char *verb,
+                  const char *why) {
+  if (what.empty())
+    return;
+  std::string list;
+  for (const auto &s : what)
+    list += (list.empty() ? "" : ", ") + s;
+  std::fprintf(stderr, "pomar: warning: %s %s %s%s\n", file.c_str(), verb, list.c_str(), why);
+}
+
 int run_encode(const EncodeArgs &a) {
   const auto t0 = Clock::now();
   const uint64_t memory_limit = pomar::parse_memory_size(a.max_memory);
@@ -146,15 +157,10 @@ int run_encode(const EncodeArgs &a) {
   // Refused as soon as the file's header tells the mesh size, before it is read.
   pomar::Mesh mesh = pomar::load_mesh(
       a.in, &load, [&](uint64_t v, uint64_t f) { pomar::check_encode_memory(v, f, memory_limit); });
-  if (!load.ignored_attributes.empty() && !a.quiet) {
-    std::string list;
-    for (const auto &s : load.ignored_attributes)
-      list += (list.empty() ? "" : ", ") + s;
-    std::fprintf(stderr,
-                 "pomar: warning: %s has %s, not kept (.pomar keeps positions, triangles and "
-                 "per-vertex colour, normals, scalars and texture coordinates)\n",
-                 a.in.c_str(), list.c_str());
-  }
+  if (!a.quiet)
+    warn_dropped(a.in, load.ignored_attributes, "has",
+                 ", not kept (.pomar keeps positions, triangles and per-vertex colour, normals, "
+                 "scalars and texture coordinates)");
   const double t_load = since(t0);
   const double t_repair = a.repair ? repair_and_report(mesh, a.quiet) : 0.0;
   pomar::EncodeOptions opt;
@@ -396,6 +402,9 @@ int run_selective_decode(const DecodeArgs &a) {
   const pomar::Mesh mesh = d.exact_mesh(); // every region at its finest: the input exactly
   const double t_decode = since(t0);
   pomar::save_mesh(a.out, mesh, !a.ascii);
+  if (!a.quiet)
+    warn_dropped(a.out, pomar::attributes_not_saved(a.out, mesh), "cannot hold",
+                 ": not written (.ply keeps every attribute)");
   if (a.stats || !a.quiet) {
     const uint64_t file_size = d.info().total_bytes;
     std::printf("%s: %zu vertices, %zu faces; %u of %u clusters refined (levels %d..%d), %u "
@@ -431,6 +440,9 @@ int run_decode(const DecodeArgs &a) {
   }
   const double t_decode = since(t0);
   pomar::save_mesh(a.out, mesh, !a.ascii);
+  if (!a.quiet)
+    warn_dropped(a.out, pomar::attributes_not_saved(a.out, mesh), "cannot hold",
+                 ": not written (.ply keeps every attribute)");
   if (!a.quiet || a.stats)
     std::printf("%s: %zu vertices, %zu faces (decoded in %.3f s, %zu bytes read)\n", a.out.c_str(),
                 mesh.vertex_count(), mesh.triangle_count(), t_decode, data.size());
@@ -867,7 +879,9 @@ int main(int argc, char **argv) {
   auto *dec = app.add_subcommand("decode", "Decompress a .pomar file into a mesh file");
   dec->add_option("input", da.in, "Input .pomar file")->required();
   dec->add_option("output", da.out,
-                  "Output mesh; the format follows the extension (.ply .obj .off .stl)")
+                  "Output mesh; the format follows the extension (.ply .obj .off .stl). PLY keeps "
+                  "every attribute; OBJ colour, normals, UVs and texture names (OUT.mtl beside "
+                  "it); OFF colour and normals; STL none (a warning names what is not written)")
       ->required();
   dec->add_option("-l,--level", da.level,
                   "Stop after L refinement levels (0 = base mesh; default: full resolution). With "
@@ -903,8 +917,8 @@ int main(int argc, char **argv) {
       ->capture_default_str();
   dec->add_flag("--no-attributes", da.no_attributes,
                 "Write positions and triangles only: leave out colour, normals, scalars and "
-                "texture coordinates (their codes are interleaved with the positions and are "
-                "read anyway)");
+                "texture coordinates (their codes, interleaved with the positions, are read "
+                "past without being decoded into values: less memory, a little less time)");
   dec->add_option("--max-memory", da.max_memory,
                   "Refuse (exit 1, no output file) a file whose decoding would need more than "
                   "SIZE of memory, checked from its header (with --cluster/--sphere/--box: for "

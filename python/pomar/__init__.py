@@ -14,6 +14,7 @@ read, write and SelectiveDecoder.update release the GIL while they work.
 """
 
 import os
+import warnings
 
 from . import _pomar
 from ._pomar import Error, info
@@ -152,15 +153,20 @@ def read(path, level=None):
 
 def write(path, mesh, *, binary=True, **encode_options):
     """Write a Mesh, replacing `path` atomically: .ply .stl (binary unless binary=False),
-    .obj .off, or .pomar (encode_options as for encode(), e.g. bits=14). The attributes
-    go to PLY and OBJ files (OFF and STL keep positions and faces)."""
+    .obj .off, or .pomar (encode_options as for encode(), e.g. bits=14). PLY and .pomar
+    keep every attribute; OBJ colour (RGB), normals, texture coordinates and texture
+    files (a .mtl beside the file); OFF colour and normals; STL none. What a format cannot
+    hold is named in one UserWarning."""
     path = os.fspath(path)
     if path.lower().endswith(".pomar"):
         _pomar.write_bytes(path, encode(mesh, **encode_options))
         return
     if encode_options:
         raise TypeError(f"options {sorted(encode_options)} apply to .pomar files only")
-    _pomar.write_mesh(path, mesh.vertices, mesh.faces, binary, Mesh._attributes(mesh))
+    lost = _pomar.write_mesh(path, mesh.vertices, mesh.faces, binary, Mesh._attributes(mesh))
+    if lost:
+        warnings.warn(f"{path} cannot hold {', '.join(lost)}: not written (.ply keeps every "
+                      "attribute)", stacklevel=2)
 
 
 class SelectiveDecoder(_pomar.SelectiveDecoder):

@@ -124,11 +124,14 @@ py::tuple read_mesh(const std::string &path) {
   return py::make_tuple(arrays[0], arrays[1], r, arrays[2]);
 }
 
-void write_mesh(const std::string &path, const py::handle &vertices, const py::handle &faces,
-                bool binary, const py::dict &attributes) {
+/// Writes the mesh; returns what the format cannot hold of its attributes (for a warning).
+std::vector<std::string> write_mesh(const std::string &path, const py::handle &vertices,
+                                    const py::handle &faces, bool binary,
+                                    const py::dict &attributes) {
   const pomar::Mesh mesh = mesh_with_attributes(vertices, faces, attributes);
   py::gil_scoped_release unlocked;
   call_library("io", [&] { pomar::save_mesh(path, mesh, binary); });
+  return pomar::attributes_not_saved(path, mesh);
 }
 
 void write_bytes(const std::string &path, const py::handle &data) {

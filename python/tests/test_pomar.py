@@ -3,6 +3,7 @@ errors for bad input, the GIL released, no growth in memory under repeated calls
 import gc
 import json
 import os
+import warnings
 import subprocess
 import sys
 import threading
@@ -527,6 +528,21 @@ def test_files_with_attributes(tmp_path):
     rgb = pomar.Mesh(vertices, faces, colors=colors[:, :3].copy())
     pomar.write(tmp_path / "rgb.ply", rgb)
     assert np.array_equal(pomar.read(tmp_path / "rgb.ply").colors, colors[:, :3])
+    # Formats that cannot hold an attribute say so in one warning; OFF keeps the colours.
+    with pytest.warns(UserWarning, match="cannot hold colours, normals, scalars 'quality'"):
+        pomar.write(tmp_path / "t.stl", mesh)
+    with pytest.warns(UserWarning, match="t.off cannot hold scalars 'quality', texture coord"):
+        pomar.write(tmp_path / "t.off", mesh)
+    assert np.array_equal(pomar.read(tmp_path / "t.off").colors, colors)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        pomar.write(tmp_path / "plain.stl", pomar.Mesh(vertices, faces))
+    # OBJ: texture coordinates and the texture file names (a .mtl beside it).
+    with pytest.warns(UserWarning, match="the alpha of the colours, scalars 'quality'"):
+        pomar.write(tmp_path / "t.obj", mesh)
+    back = pomar.read(tmp_path / "t.obj")
+    assert np.array_equal(back.texcoords, texcoords) and back.texture_files == ["skin.png"]
+    assert (tmp_path / "t.mtl").exists()
     # .pomar files carry them too.
     pomar.write(tmp_path / "t.pomar", mesh, bits=16)
     back = pomar.read(tmp_path / "t.pomar")

@@ -686,6 +686,17 @@ expect_contains "$ERR" "missing from the decoded mesh" "verify of a mesh without
 run decode --level 3 "$WORK/attr/c.pomar" "$WORK/attr/l3.ply"
 expect_rc 0
 grep -q "property uchar red" "$WORK/attr/l3.ply" || fail "an intermediate level has colours"; pass
+run decode "$WORK/attr/c.pomar" "$WORK/attr/back.stl"
+expect_rc 0
+expect_contains "$ERR" "back.stl cannot hold colours, normals, scalars 'quality', texture file names: not written" "STL warning"
+[ "$(printf '%s\n' "$ERR" | grep -c warning)" = 1 ] || fail "one warning line for STL"; pass
+run decode "$WORK/attr/c.pomar" "$WORK/attr/back.off"
+expect_rc 0
+expect_contains "$ERR" "back.off cannot hold scalars 'quality', texture file names: not written" "OFF warning"
+head -1 "$WORK/attr/back.off" | grep -qx "CNOFF" || fail "OFF with colour and normals is CNOFF"; pass
+run decode --no-attributes "$WORK/attr/c.pomar" "$WORK/attr/plain.stl"
+expect_rc 0
+[ -z "$ERR" ] || fail "no warning when there is nothing to drop"; pass
 
 section "attributes: --drop, --exact-attributes, NaN in quantized mode"
 run encode --drop colour,normals "$WORK/attr/c.ply" "$WORK/attr/d.pomar"

@@ -313,22 +313,29 @@ EMSCRIPTEN_KEEPALIVE const uint32_t *pw_vertex_cluster(Handle *h) {
 }
 EMSCRIPTEN_KEEPALIVE const uint32_t *pw_vertex_level(Handle *h) { return h->vertex_level.data(); }
 
-/// Per cluster of the extracted mesh, 8 floats: bounding box min xyz, max xyz, the longest
-/// edge between two of its vertices (or, if it has none, touching it: the screen-space
-/// error proxy, see web/view_refine.js), and its face count (faces are counted in the
-/// cluster of their first vertex).
+/// Per cluster of the extracted mesh, kBoundsStride floats (web/view_refine.js reads them):
+///  0-5  bounding box min xyz, max xyz;
+///  6    the longest edge between two of its vertices (or, if it has none, touching it: the
+///       screen-space error proxy, see web/view_refine.js);
+///  7    its face count (faces are counted in the cluster of their first vertex);
+///  8-11 its normal cone: the unit axis (the area-weighted mean normal of the faces touching
+///       the cluster) and the cosine of the widest angle between it and one of those faces'
+///       normals (-1, a cone of every direction, when the axis is undefined).
+constexpr size_t kBoundsStride = 12;
+
 EMSCRIPTEN_KEEPALIVE const float *pw_cluster_bounds(Handle *h) {
   const uint32_t n = std::max<uint32_t>(1, h->decoder->cluster_count());
-  h->bounds.assign(size_t(n) * 8, 0.f);
+  h->bounds.assign(size_t(n) * kBoundsStride, 0.f);
+  auto at = [&](uint32_t c) { return &h->bounds[kBoundsStride * size_t(c)]; };
   for (uint32_t c = 0; c < n; ++c)
     for (int k = 0; k < 3; ++k) {
-      h->bounds[8 * c + k] = 3.4e38f;
-      h->bounds[8 * c + 3 + k] = -3.4e38f;
+      at(c)[k] = 3.4e38f;
+      at(c)[3 + k] = -3.4e38f;
     }
   const std::vector<float> &p = h->mesh.positions;
   auto cluster = [&](uint32_t v) { return h->vertex_cluster.empty() ? 0u : h->vertex_cluster[v]; };
   for (uint32_t v = 0; v < h->mesh.vertex_count(); ++v) {
-    float *b = &h->bounds[8 * size_t(cluster(v))];
+    float *b = at(cluster(v));
     for (int k = 0; k < 3; ++k) {
       b[k] = std::min(b[k], p[3 * v + k]);
       b[3 + k] = std::max(b[3 + k], p[3 * v + k]);
@@ -339,8 +346,25 @@ EMSCRIPTEN_KEEPALIVE const float *pw_cluster_bounds(Handle *h) {
   // a cluster has inner edges: they belong to the coarser neighbour as much as to it.
   const std::vector<uint32_t> &t = h->mesh.triangles;
   std::vector<float> around(n, 0.f);
+  // The face's normal times twice its area, and the distinct clusters of its corners.
+  auto face = [&](size_t f, double normal[3], uint32_t clusters[3]) {
+    double e[2][3];
+    for (int k = 0; k < 2; ++k)
+      for (int j = 0; j < 3; ++j)
+        e[k][j] = double(p[3 * t[3 * f + k + 1] + j]) - p[3 * t[3 * f] + j];
+    normal[0] = e[0][1] * e[1][2] - e[0][2] * e[1][1];
+    normal[1] = e[0][2] * e[1][0] - e[0][0] * e[1][2];
+    normal[2] = e[0][0] * e[1][1] - e[0][1] * e[1][0];
+    int count = 0;
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t c = cluster(t[3 * f + k]);
+      if (std::find(clusters, clusters + count, c) == clusters + count)
+        clusters[count++] = c;
+    }
+    return count;
+  };
   for (size_t f = 0; f < h->mesh.triangle_count(); ++f) {
-    h->bounds[8 * size_t(cluster(t[3 * f])) + 7] += 1;
+    at(cluster(t[3 * f]))[7] += 1;
     for (int k = 0; k < 3; ++k) {
       const uint32_t a = t[3 * f + k], b = t[3 * f + (k + 1) % 3];
       double d2 = 0;
@@ -350,17 +374,44 @@ EMSCRIPTEN_KEEPALIVE const float *pw_cluster_bounds(Handle *h) {
       }
       const float len = float(std::sqrt(d2));
       if (cluster(a) == cluster(b)) {
-        float &e = h->bounds[8 * size_t(cluster(a)) + 6];
-        e = std::max(e, len);
+        at(cluster(a))[6] = std::max(at(cluster(a))[6], len);
       } else {
         around[cluster(a)] = std::max(around[cluster(a)], len);
         around[cluster(b)] = std::max(around[cluster(b)], len);
       }
     }
+    double normal[3];
+    uint32_t clusters[3];
+    const int count = face(f, normal, clusters);
+    for (int i = 0; i < count; ++i)
+      for (int k = 0; k < 3; ++k)
+        at(clusters[i])[8 + k] += float(normal[k]);
   }
-  for (uint32_t c = 0; c < n; ++c)
-    if (h->bounds[8 * size_t(c) + 6] == 0)
-      h->bounds[8 * size_t(c) + 6] = around[c];
+  for (uint32_t c = 0; c < n; ++c) {
+    float *b = at(c);
+    if (b[6] == 0)
+      b[6] = around[c];
+    const double length =
+        std::sqrt(double(b[8]) * b[8] + double(b[9]) * b[9] + double(b[10]) * b[10]);
+    for (int k = 0; k < 3; ++k)
+      b[8 + k] = length > 0 ? float(b[8 + k] / length) : 0.f;
+    b[11] = length > 0 ? 1.f : -1.f;
+  }
+  // The cone's width: the face normal furthest from the axis (zero-area faces have none).
+  for (size_t f = 0; f < h->mesh.triangle_count(); ++f) {
+    double normal[3];
+    uint32_t clusters[3];
+    const int count = face(f, normal, clusters);
+    const double length =
+        std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
+    if (!(length > 0))
+      continue;
+    for (int i = 0; i < count; ++i) {
+      float *b = at(clusters[i]);
+      const double cosine = (normal[0] * b[8] + normal[1] * b[9] + normal[2] * b[10]) / length;
+      b[11] = std::min(b[11], float(cosine));
+    }
+  }
   return h->bounds.data();
 }
 

@@ -12,6 +12,12 @@ mesh is drawn at once, a close-up refines and fetches a fraction of the file, zo
 coarsens, a full-resolution view fetches every byte of the file exactly once (checked in
 the server's log), and 404 / no Range support / truncated / damaged files show a message
 in the page. --images DIR keeps the screenshots (base, overview, closeup, zoomout, full).
+Screenshots (scaled to 320 pixels wide) are compared with the expected images in
+docs/images/web_test/ (made from samples/bunny.ply encoded with --cluster-ratio 0.05, as
+web/test/run.sh does): at most --max-differing of their pixels may differ by more than a
+small colour threshold (see page_test.js). --update-references writes the new screenshots
+there instead (after a deliberate change to the encoder, the camera or the rendering; look
+at them). --no-compare skips the comparison (another file than the sample).
 Exit status 0 = pass, 1 = a check failed, 77 = Chromium or the WebAssembly build missing.
 """
 import argparse
@@ -27,6 +33,7 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 WEB = os.path.dirname(HERE)
 sys.path.insert(0, WEB)
+REFERENCES = os.path.join(os.path.dirname(WEB), 'docs', 'images', 'web_test')
 import serve  # noqa: E402
 
 
@@ -38,7 +45,11 @@ def main():
     ap.add_argument('--timeout', type=float, default=240)
     ap.add_argument('--target', type=float, default=3, help='target screen-space error in pixels')
     ap.add_argument('--closeup', type=float, default=0.3, help='close-up distance / model size')
-    ap.add_argument('--max-gap', type=int, default=4096, help='pomar.js maxGap for the session (bytes)')
+    ap.add_argument('--max-differing', type=float, default=0.005,
+                    help='largest fraction of differing pixels per compared screenshot')
+    ap.add_argument('--update-references', action='store_true', help='write docs/images/web_test/*.png')
+    ap.add_argument('--no-compare', action='store_true', help='do not compare screenshots')
+    ap.add_argument('--max-gap', type=int, help="pomar.js maxGap for the session (bytes; default: pomar.js's)")
     args = ap.parse_args()
     if not args.chromium:
         print('browser_test: SKIP: chromium not installed')
@@ -62,6 +73,7 @@ def main():
         data = os.path.join(root, 'data')
         os.makedirs(data)
         os.symlink(WEB, os.path.join(root, 'web'))
+        os.symlink(REFERENCES, os.path.join(root, 'ref'))
         with open(args.pomar, 'rb') as f:
             blob = f.read()
         with open(os.path.join(data, 'model.pomar'), 'wb') as f:
@@ -81,7 +93,10 @@ def main():
         server = serve.make_server(root, 0, test=True, report_dir=reports)
         threading.Thread(target=server.serve_forever, daemon=True).start()
         base = f'http://127.0.0.1:{server.server_address[1]}'
-        url = (f'{base}/web/index.html?test=1&file=/data/model.pomar&maxGap={args.max_gap}'
+        gap = '' if args.max_gap is None else f'&maxGap={args.max_gap}'
+        if not (args.no_compare or args.update_references):
+            gap += '&ref=/ref/'
+        url = (f'{base}/web/index.html?test=1&file=/data/model.pomar{gap}'
                f'&target={args.target}&closeup={args.closeup}&missing=/data/missing.pomar'
                '&noRange=/no-range/data/model.pomar&truncatedGlobal=/data/truncated_global.pomar'
                '&truncatedBlocks=/data/truncated_blocks.pomar&damagedBlocks=/data/damaged_blocks.pomar')
@@ -147,7 +162,7 @@ def main():
         check(full['triangles'] > cu['triangles'] and full['minLevel'] == r['info']['finestLevel'], 'full resolution everywhere')
         check(full['bytesFetched'] == size, f"full resolution fetched {full['bytesFetched']} bytes of {size}")
         check(full['maxInFlightSeen'] <= 4, 'at most 4 requests in flight')
-        if args.max_gap >= 1024:
+        if args.max_gap is not None and args.max_gap >= 1024:
             check(full['requests'] < r['info']['clusters'] / 4,
                   f"{full['requests']} requests for {r['info']['clusters']} blocks (coalesced)")
         # The server's view: the intact file's bytes, each served once.
@@ -165,6 +180,22 @@ def main():
               if e['truncatedBlocks']['warning'] else 'a file cut in its cluster blocks: no warning')
         check(not e['damagedBlocks']['error'] and 'damaged' in e['damagedBlocks']['warning'],
               'a damaged cluster block is skipped with a warning')
+        compared = r.get('comparisons', {})
+        for name, c in sorted(compared.items()):
+            if 'missing' in c:
+                check(False, f'screenshot {name}: no expected image ({c["missing"]}; --update-references makes them)')
+            else:
+                check(c['fraction'] <= args.max_differing,
+                      f"screenshot {name}: {c['differing']} of {c['width']}x{c['height']} pixels differ from "
+                      f"docs/images/web_test/{name}.png ({100 * c['fraction']:.2f}%, at most {100 * args.max_differing:.1f}%)")
+        if not (args.no_compare or args.update_references):
+            check(len(compared) == 6, f'{len(compared)} screenshots compared with expected images')
+        if args.update_references:
+            os.makedirs(REFERENCES, exist_ok=True)
+            names = [n[:-len('_small.png')] for n in os.listdir(reports) if n.endswith('_small.png')]
+            for name in names:
+                shutil.copy(os.path.join(reports, name + '_small.png'), os.path.join(REFERENCES, name + '.png'))
+            print(f'expected images written: {REFERENCES}/ ({", ".join(sorted(names))})')
         if args.images:
             os.makedirs(args.images, exist_ok=True)
             for name in ('base', 'closeup', 'closeup_levels', 'overview', 'overview_levels', 'zoomout', 'full'):

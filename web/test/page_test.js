@@ -2,6 +2,8 @@
 // the server and headless Chromium, then checks what this posts to /report/).
 // ?file=URL of an intact file; &missing=, &truncatedGlobal=, &truncatedBlocks=,
 // &damagedBlocks=, &noRange= URLs of the error cases.
+import { closeUp } from '../camera.js';
+
 const params = new URLSearchParams(location.search);
 const targetPixels = Number(params.get('target') || 3);
 const closeup = Number(params.get('closeup') || 0.3);
@@ -16,10 +18,56 @@ function note(...args) {
 async function post(name, body) {
   await fetch('/report/' + name, { method: 'POST', body });
 }
+// Screenshots compared with expected images (docs/images/web_test/NAME.png, given as
+// &ref=URL_PREFIX): both scaled to COMPARE_WIDTH pixels wide in a 2D canvas, a pixel
+// differs when its |dR|+|dG|+|dB| exceeds PIXEL_THRESHOLD; web/test/browser_test.py checks
+// the fraction of differing pixels. The scaled screenshot is posted as NAME_small.png
+// (browser_test.py --update-references keeps it as the new expected image).
+const COMPARED = ['base', 'closeup', 'closeup_levels', 'overview', 'zoomout', 'full'];
+const COMPARE_WIDTH = 320;
+const PIXEL_THRESHOLD = 32;
+const comparisons = {};
+function pixelsOf(source, w, h) {
+  const c = document.createElement('canvas');
+  c.width = w;
+  c.height = h;
+  const ctx = c.getContext('2d');
+  ctx.drawImage(source, 0, 0, w, h);
+  return { canvas: c, data: ctx.getImageData(0, 0, w, h).data };
+}
+async function compareWithExpected(name) {
+  const view = document.getElementById('view');
+  const w = COMPARE_WIDTH;
+  const h = Math.round((COMPARE_WIDTH * view.height) / view.width);
+  const got = pixelsOf(view, w, h);
+  await post(name + '_small.png', await new Promise((resolve) => got.canvas.toBlob(resolve, 'image/png')));
+  const ref = params.get('ref');
+  if (!ref) return;
+  const response = await fetch(ref + name + '.png');
+  if (!response.ok) {
+    comparisons[name] = { missing: `${ref}${name}.png: HTTP ${response.status}` };
+    return;
+  }
+  const image = await createImageBitmap(await response.blob());
+  if (image.width !== w || image.height !== h) {
+    comparisons[name] = { missing: `${name}.png is ${image.width}x${image.height}, the screenshot ${w}x${h}` };
+    return;
+  }
+  const expected = pixelsOf(image, w, h).data;
+  let differing = 0;
+  for (let i = 0; i < expected.length; i += 4) {
+    const d = Math.abs(expected[i] - got.data[i]) + Math.abs(expected[i + 1] - got.data[i + 1]) +
+      Math.abs(expected[i + 2] - got.data[i + 2]);
+    if (d > PIXEL_THRESHOLD) ++differing;
+  }
+  comparisons[name] = { fraction: differing / (w * h), differing, width: w, height: h };
+}
+
 async function screenshot(name, v) {
   v.frame();
   const blob = await new Promise((resolve) => document.getElementById('view').toBlob(resolve, 'image/png'));
   await post(name + '.png', blob);
+  if (COMPARED.includes(name)) await compareWithExpected(name);
   // Fraction of pixels that are not the background: the mesh is drawn.
   const gl = document.getElementById('view').getContext('webgl2');
   if (gl.isContextLost()) {
@@ -62,6 +110,10 @@ export async function run(v) {
   const result = { ok: false, log };
   try {
     $('refine').checked = false; // the test drives refinement itself (but see below)
+    // A fixed canvas size: the screenshots compared with expected images do not depend on
+    // the size the browser gives its window.
+    $('view').style.width = '800px';
+    $('view').style.height = '457px';
     const t0 = performance.now();
     const fetchOptions = params.has('maxGap') ? { maxGap: Number(params.get('maxGap')) } : {};
     const model = await within(30000, v.openSource(params.get('file'), fetchOptions), 'open');
@@ -73,18 +125,7 @@ export async function run(v) {
 
     // Close-up: the surface point facing the camera, seen from `closeup` x the model's size.
     const center = v.camera.target.slice();
-    const eye = v.view().eye;
-    const p = model.mesh.positions;
-    let best = 0;
-    let bestDot = -Infinity;
-    const dir = [0, 1, 2].map((k) => eye[k] - v.camera.target[k]);
-    for (let i = 0; i < p.length / 3; ++i) {
-      const d = (p[3 * i] - v.camera.target[0]) * dir[0] + (p[3 * i + 1] - v.camera.target[1]) * dir[1] +
-        (p[3 * i + 2] - v.camera.target[2]) * dir[2];
-      if (d > bestDot) { bestDot = d; best = i; }
-    }
-    v.camera.target = [p[3 * best], p[3 * best + 1], p[3 * best + 2]];
-    v.camera.distance = closeup * v.camera.extent;
+    closeUp(v.camera, model.mesh.positions, closeup);
     const before = model.stats.bytesFetched;
     result.closeupSteps = await settle(v, 'close-up');
     result.closeup = snapshot(model, await screenshot('closeup', v), { bytesForCloseup: model.stats.bytesFetched - before });
@@ -144,5 +185,6 @@ export async function run(v) {
     result.exception = String(e && e.stack ? e.stack : e);
     note('exception', result.exception);
   }
+  result.comparisons = comparisons;
   await post('result.json', JSON.stringify(result));
 }

@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # The web tests (called by scripts/test.sh):  bash web/test/run.sh BUILD_DIR POMAR_TOOL
-#  1. builds the WebAssembly decoder (web/build.sh, in BUILD_DIR);
+#  1. builds the WebAssembly decoder (web/build.sh, in BUILD_DIR; it also vendors three.js
+#     from npm into web/dist/ for the page);
 #  2. encodes samples/bunny.ply three ways with the native tool and checks that the WASM
 #     decoder decodes them bit for bit like the native one, and that damaged/truncated
 #     copies give messages (web/test/wasm_decode_test.mjs, Node.js);
-#  3. runs the viewer in headless Chromium (web/test/browser_test.py).
+#  3. runs the viewer in headless Chromium (web/test/browser_test.py), screenshots compared
+#     with docs/images/web_test/.
 # (Plus web/test/unit_test.mjs: request coalescing and the choice of levels for a view.)
 # Each step is skipped with a message when emscripten, Node.js or Chromium is missing.
 set -euo pipefail

@@ -1,7 +1,7 @@
 // Unit tests of the pure parts of web/: request coalescing (range_fetch.js) and the choice
 // of levels for a view (view_refine.js).   node web/test/unit_test.mjs
 import { coalesce } from '../range_fetch.js';
-import { chooseLevels } from '../view_refine.js';
+import { BOUNDS_STRIDE, Convergence, chooseLevels } from '../view_refine.js';
 import { checker } from './node_support.mjs';
 
 const result = checker();
@@ -36,13 +36,13 @@ function lookAlongMinusZ(eye) {
   for (let c = 0; c < 4; ++c)
     for (let row = 0; row < 4; ++row)
       for (let k = 0; k < 4; ++k) m[4 * c + row] += p[4 * k + row] * v[4 * c + k];
-  return { eye, viewProj: m, fovY: Math.PI / 2, height: 1000, near: n };
+  return { eye, viewProj: m, fovY: Math.PI / 2, height: 1000, width: 1000, near: n };
 }
 const info = { clusters: 3, baseLevel: 2, finestLevel: 5, baseFaces: 10,
   levels: [{ faces: 20 }, { faces: 40 }, { faces: 80 }, { faces: 160 }, { faces: 320 }] };
 function bounds(boxes) {
-  const b = new Float32Array(8 * boxes.length);
-  boxes.forEach(([lo, hi, edge, faces], c) => b.set([...lo, ...hi, edge, faces], 8 * c));
+  const b = new Float32Array(BOUNDS_STRIDE * boxes.length);
+  boxes.forEach(([lo, hi, edge, faces, cone = [0, 0, 0, -1]], c) => b.set([...lo, ...hi, edge, faces, ...cone], BOUNDS_STRIDE * c));
   return b;
 }
 const view = lookAlongMinusZ([0, 0, 0]);
@@ -51,8 +51,13 @@ const far = [[-0.1, -0.1, -50.1], [0.1, 0.1, -50], 0.05, 10];  // 50 units ahead
 const behind = [[-0.1, -0.1, 1], [0.1, 0.1, 1.1], 0.05, 10];   // behind the eye
 let state = { info, levels: Int32Array.of(2, 2, 3), clusterBounds: bounds([near, far, behind]), errorSeen: new Map() };
 let choice = chooseLevels(state, view, { targetPixels: 3 });
-// near: 0.05 units at distance 1 with 500 px per unit = 25 px > 3: refine. far: 0.5 px: keep.
-check(same(Array.from(choice.levels), [3, 2, 2]), `near refines, far stays, behind goes to the base: ${choice.levels}`);
+// near: 0.05 units at distance 1 with 500 px per unit = 25 px > 3: refine, at once to the
+// finest level (25 px / sqrt(8) at level 5 is still over 3). far: 0.5 px: keep.
+check(same(Array.from(choice.levels), [5, 2, 2]), `near refines, far stays, behind goes to the base: ${choice.levels}`);
+// 5 px at level 2: level 3 has 5 / sqrt(2) = 3.5 px, level 4 2.5 px: straight to level 4.
+const five = [near[0], near[1], 0.01, 10];
+choice = chooseLevels({ ...state, clusterBounds: bounds([five, far, behind]) }, view, { targetPixels: 3 });
+check(choice.levels[0] === 4, `refines straight to the level meeting the target: ${choice.levels}`);
 check(choice.refine === 1 && choice.hidden === 1, 'counts of refined and hidden clusters');
 // Coarsening: the far cluster at level 4 whose error at level 3 was seen small.
 state = { info, levels: Int32Array.of(2, 4, 2), clusterBounds: bounds([near, far, behind]), errorSeen: new Map([['1:3', 0.01]]) };
@@ -62,9 +67,45 @@ check(choice.levels[1] === 3 && choice.coarsen === 1, `a far cluster coarsens on
 state = { info, levels: Int32Array.of(2, 2, 2), clusterBounds: bounds([near, far, behind]), errorSeen: new Map() };
 choice = chooseLevels(state, view, { targetPixels: 3, triangleBudget: 35 });
 check(choice.levels[0] === 2 && choice.refine === 0, `over the triangle budget nothing refines: ${choice.levels}`);
+choice = chooseLevels(state, view, { targetPixels: 3, triangleBudget: 45 });
+check(choice.levels[0] === 3, `refines as far as the triangle budget goes: ${choice.levels}`);
 // The finest level has no error: never refined further.
 state = { info, levels: Int32Array.of(5, 2, 2), clusterBounds: bounds([near, far, behind]), errorSeen: new Map() };
 choice = chooseLevels(state, view, { targetPixels: 3 });
 check(choice.levels[0] === 5, 'the finest level stays');
+
+
+// Back-face culling: a cluster ahead whose normals all point away from the eye (-z) is not
+// refined, and is coarsened; facing the eye (+z) it refines. Off by default.
+const away = [near[0], near[1], near[2], near[3], [0, 0, -1, 0.9]];
+const towards = [near[0], near[1], near[2], near[3], [0, 0, 1, 0.9]];
+state = { info, levels: Int32Array.of(3, 2, 2), clusterBounds: bounds([away, towards, far]), errorSeen: new Map() };
+choice = chooseLevels(state, view, { targetPixels: 3, backface: true, occlusion: false });
+check(same(Array.from(choice.levels), [2, 5, 2]) && choice.culled === 1, `back-facing coarsens, facing refines: ${choice.levels}`);
+choice = chooseLevels(state, view, { targetPixels: 3, occlusion: false });
+check(same(Array.from(choice.levels), [5, 5, 2]), `without back-face culling both refine: ${choice.levels}`);
+// Occlusion: a wall (two triangles) at z = -5 hides the far cluster, not the near one.
+const wall = { positions: Float32Array.of(-10, -10, -5, 10, -10, -5, 10, 10, -5, -10, 10, -5),
+  triangles: Uint32Array.of(0, 1, 2, 0, 2, 3) };
+const farButBig = [[-0.1, -0.1, -50.1], [0.1, 0.1, -50], 1, 10]; // 1-unit error: 10 px
+state = { info, levels: Int32Array.of(2, 3, 2), clusterBounds: bounds([near, farButBig, behind]), errorSeen: new Map(), mesh: wall };
+choice = chooseLevels(state, view, { targetPixels: 3 });
+check(same(Array.from(choice.levels), [5, 2, 2]) && choice.culled === 1, `behind a wall: coarsens, in front: refines: ${choice.levels}`);
+choice = chooseLevels(state, view, { targetPixels: 3, occlusion: false });
+check(choice.levels[1] === 5, `without occlusion culling the far cluster refines: ${choice.levels}`);
+const hole = { positions: wall.positions, triangles: Uint32Array.of(0, 1, 2) }; // half the wall
+choice = chooseLevels({ ...state, mesh: hole }, view, { targetPixels: 3 });
+check(choice.levels[1] === 5, `a cluster seen past the edge of an occluder refines: ${choice.levels}`);
+
+// Convergence: a cluster sent back to a level it had for this camera keeps its level; the
+// same map asked again is converged; another camera starts afresh.
+const conv = new Convergence();
+const A = Int32Array.of(1, 2, 5);
+const B = Int32Array.of(1, 3, 5);
+check(same(Array.from(conv.next(B, A, view)), [1, 3, 5]), 'a first step is asked as chosen');
+check(conv.next(A, B, view) === null, 'back to a map it had: damped, nothing new to ask');
+check(same(Array.from(conv.next(Int32Array.of(2, 2, 4), B, view)), [2, 3, 4]),
+  'only the clusters flipping back are damped');
+check(same(Array.from(conv.next(A, B, lookAlongMinusZ([0, 0, 1]))), [1, 2, 5]), 'another camera starts afresh');
 
 result.done('unit tests');

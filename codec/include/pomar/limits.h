@@ -30,6 +30,19 @@ uint64_t encode_memory_estimate(uint64_t vertices, uint64_t faces);
 /// decode`); `clustered` files (random access) need a little more than progressive ones.
 uint64_t decode_memory_estimate(uint64_t vertices, uint64_t faces, bool clustered);
 
+/// What per-vertex attributes add to the encode peak, per vertex, for the attributes
+/// `options` keeps of `mesh` (0 without): their integer codes (docs/format.md: colour 3-4,
+/// quantized normal 2, exact normal 3, scalar 1, texcoord 2) in the encoder's copies, and
+/// the reader's path for files with attributes. Measured, rounded up (bench/README.md,
+/// "Memory").
+uint64_t encode_attribute_bytes_per_vertex(const Mesh &mesh, const AttributeOptions &options);
+
+/// What per-vertex attributes add to the decode peak, per vertex, for the file's attributes
+/// (`info.attributes`, filled by inspect() or from the ATTR section) of which the decoder
+/// returns those `keep` keeps: their codes (not stored at all when `keep` keeps none of
+/// them) and the returned values.
+uint64_t decode_attribute_bytes_per_vertex(const FileInfo &info, const AttributeMask &keep);
+
 /// Memory this process may still use, and which bound gave it.
 struct AvailableMemory {
   bool known = false; ///< false: nothing could be read (then nothing is refused)
@@ -60,19 +73,20 @@ std::string format_memory_size(uint64_t bytes);
 void check_memory(const char *action, uint64_t vertices, uint64_t faces, uint64_t needed,
                   uint64_t held, uint64_t limit);
 
-/// check_memory with encode_memory_estimate (action "encode").
-void check_encode_memory(uint64_t vertices, uint64_t faces, uint64_t limit, uint64_t held = 0);
-
-/// check_memory with decode_memory_estimate for the mesh of `level` (-1 = full resolution)
-/// of the file `info` describes (action "decode").
-void check_decode_memory(const FileInfo &info, int level, uint64_t limit);
+/// check_memory with encode_memory_estimate plus `attribute_bytes` per vertex
+/// (encode_attribute_bytes_per_vertex) (action "encode").
+void check_encode_memory(uint64_t vertices, uint64_t faces, uint64_t limit, uint64_t held = 0,
+                         uint64_t attribute_bytes = 0);
 
 /// What each decoding thread past the first adds to decode_memory_estimate for a clustered
 /// file: its traversal marks, 8 bytes per vertex and 4 per face.
 uint64_t decode_thread_memory(uint64_t vertices, uint64_t faces);
 
-/// check_decode_memory for a decode on `threads` threads (DecodeOptions::threads resolved:
-/// a clustered file's clusters decode on all of them).
-void check_decode_memory(const FileInfo &info, int level, uint64_t limit, unsigned threads);
+/// check_memory with decode_memory_estimate for the mesh of `level` (-1 = full resolution)
+/// of the file `info` describes, plus decode_attribute_bytes_per_vertex(info, keep) per
+/// vertex, plus decode_thread_memory per thread past the first of a clustered file's decode
+/// on `threads` threads (DecodeOptions::threads resolved) (action "decode").
+void check_decode_memory(const FileInfo &info, int level, uint64_t limit,
+                         const AttributeMask &keep = AttributeMask(), unsigned threads = 1);
 
 } // namespace pomar

@@ -4,9 +4,11 @@
 // Positions, triangles and per-vertex attributes (Mesh::attributes) are kept: PLY vertex
 // colour (8-bit), normals, texture coordinates, every other scalar property by its name and
 // "comment TextureFile" names; OBJ vertex colours (rounded to 8 bits) and the normals and
-// texture coordinates that are per vertex; OFF vertex colours and normals. Everything else a
-// file may carry (face data, per-corner attributes, materials, ...) is dropped and named in
-// LoadReport::ignored_attributes. save_mesh writes the attributes to PLY and OBJ.
+// texture coordinates that are per vertex and the texture files of its materials (`mtllib`,
+// `map_Kd`); OFF vertex colours and normals. Everything else a file may carry (face data,
+// per-corner attributes, other material properties, ...) is dropped and named in
+// LoadReport::ignored_attributes. save_mesh writes what each format holds of the attributes
+// (attributes_not_saved names the rest).
 // PLY, OFF and ASCII STL are read through vcglib's importers (so a file loads as it does
 // in MeshLab), binary STL directly, OBJ through tinyobjloader. Every failure throws
 // pomar::Error with a one-line message that starts with the file's path.
@@ -67,7 +69,18 @@ Mesh load_mesh(const std::string &path, LoadReport *report = nullptr,
 /// STL has its vertices in order of first use and loses unreferenced ones. Throws
 /// pomar::Error on an unknown extension, an invalid mesh (index out of range, NaN/Inf
 /// coordinate) or an I/O failure; the destination is then left untouched.
+///
+/// Attributes: PLY holds them all (vertex properties, "comment TextureFile"); OBJ vertex
+/// colour (RGB), normals and texture coordinates ("vt") and, when the mesh names texture
+/// files, a material library beside the file ("<name>.mtl", replaced atomically like the
+/// file, one material with map_Kd per texture file; the images are not copied); OFF vertex
+/// colour (RGB or RGBA) and normals; STL none.
 void save_mesh(const std::string &path, const Mesh &mesh, bool binary = true);
+
+/// What save_mesh(path, mesh) cannot write of the mesh's attributes in `path`'s format, one
+/// entry per kind ("scalars 'quality', 'confidence'", "texture coordinates", "alpha of the
+/// colours", ...); empty when it writes them all. For a warning naming what is not written.
+std::vector<std::string> attributes_not_saved(const std::string &path, const Mesh &mesh);
 
 /// Write `size` bytes to `path` atomically: they go to a temporary file in the same
 /// directory (".<name>.tmp.<pid>.<n>"), which is fsync'ed and renamed over `path`. On

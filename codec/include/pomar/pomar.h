@@ -311,7 +311,8 @@ struct DecodeOptions {
   /// UINT64_MAX = do not check; see pomar/limits.h).
   uint64_t memory_limit = 0;
   /// Which stored attributes the returned mesh carries (AttributeMask::none(): positions
-  /// and triangles only; the codes are interleaved with the positions and decoded anyway).
+  /// and triangles only; the codes, interleaved with the positions, are then read past
+  /// without being stored or predicted: less memory and time).
   AttributeMask attributes;
   /// Threads for the clustered levels of a random-access file (their clusters are decoded
   /// in parallel); 0 = the cores this process may run on; at most 8 (each one holds 8 bytes

@@ -76,7 +76,8 @@ struct SelectiveOptions {
   /// pomar/limits.h). Later refinement is not checked: it decodes what is asked for.
   uint64_t memory_limit = 0;
   /// Which stored attributes mesh() returns (AttributeMask::none(): none). Their codes
-  /// are decoded with the positions, block by block, whatever this says.
+  /// come with the positions, block by block: with none kept they are read past (no
+  /// storage, no prediction), otherwise decoded and stored.
   AttributeMask attributes;
   /// Threads update() decodes the clusters of a level on (0 = the cores this process may
   /// run on; at most 8, as DecodeOptions::threads); the mesh is the same for any number.

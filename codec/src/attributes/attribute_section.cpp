@@ -86,7 +86,20 @@ std::vector<AttributeCodeModels> attribute_models(const AttributeTable &table) {
   return models;
 }
 
-void init_attributes(const AttributeTable &table, LevelMesh &lm) {
+bool keeps_any(const AttributeTable &table, const AttributeMask &mask) {
+  for (const StoredAttribute &s : table.stored)
+    if (mask.keeps(s.kind))
+      return true;
+  return false;
+}
+
+void init_attributes(const AttributeTable &table, LevelMesh &lm, const AttributeMask &mask) {
+  if (!keeps_any(table, mask)) { // read past the codes: no prediction, no storage
+    lm.attr_codes = 0;
+    lm.attr_skipped = table.codes;
+    return;
+  }
+  lm.attr_skipped = 0;
   lm.attr_codes = table.codes;
   lm.attr = table.base;
   lm.attr_lo.clear();
@@ -246,8 +259,10 @@ void attach_attributes(const AttributeTable &t, const LevelMesh &lm, const Attri
                        Mesh &out) {
   if (mask.texcoords)
     out.texture_files = t.texture_files;
+  if (!keeps_any(t, mask))
+    return;
   const uint32_t nv = lm.vertex_count(), n = t.codes;
-  if (lm.attr.size() != size_t(nv) * n)
+  if (lm.attr_codes != n || lm.attr.size() != size_t(nv) * n)
     throw Error("internal error: the decoded mesh lacks attribute codes");
   for (size_t i = 0, first = 0; i < t.stored.size(); first += t.stored[i].codes(), ++i) {
     const StoredAttribute &s = t.stored[i];

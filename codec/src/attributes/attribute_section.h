@@ -45,8 +45,15 @@ std::vector<int64_t> attribute_codes(const Mesh &mesh, const AttributeTable &tab
                                      const std::vector<uint32_t> &to_input);
 /// The models of the attribute codes (Models::attr) for a table.
 std::vector<AttributeCodeModels> attribute_models(const AttributeTable &table);
-/// Give `lm` (the base mesh) its attribute codes and ranges from the table.
-void init_attributes(const AttributeTable &table, LevelMesh &lm);
+/// Whether `mask` keeps any attribute of the table.
+bool keeps_any(const AttributeTable &table, const AttributeMask &mask);
+/// Give `lm` (the base mesh) its attribute codes and ranges from the table. A decoder whose
+/// `mask` keeps none of the attributes only reads past their codes (LevelMesh::attr_skipped):
+/// the residuals are interleaved with the positions in the same range-coded streams and
+/// their models' contexts depend on the residuals alone, so they are decoded as symbols,
+/// without prediction, range checks or storage.
+void init_attributes(const AttributeTable &table, LevelMesh &lm,
+                     const AttributeMask &mask = AttributeMask());
 
 /// The ATTR section body of `table` (table.base holds the base vertices' codes).
 std::vector<uint8_t> write_attributes(const AttributeTable &table);

@@ -12,42 +12,66 @@ namespace {
 
 using Corner = CornerTable;
 
-int64_t dist2(const std::vector<int32_t> &q, uint32_t a, uint32_t b) {
-  const int64_t dx = q[3 * a] - q[3 * b], dy = q[3 * a + 1] - q[3 * b + 1],
-                dz = q[3 * a + 2] - q[3 * b + 2];
+int64_t dist2(const int32_t *a, const int32_t *b) {
+  const int64_t dx = int64_t(a[0]) - b[0], dy = int64_t(a[1]) - b[1], dz = int64_t(a[2]) - b[2];
   return dx * dx + dy * dy + dz * dz;
 }
 
 /// Unnormalised normal of triangle (a,b,c) in doubles (decimation decisions only; the
-/// decoder never repeats them, so they need not be bit-exact across machines).
-void normal(const std::vector<int32_t> &q, uint32_t a, uint32_t b, uint32_t c, double n[3]) {
+/// decoder never repeats them, so they need not be bit-exact across machines). The
+/// coordinates are quantized integers converted exactly.
+inline void normal(const double a[3], const double b[3], const double c[3], double n[3]) {
   double u[3], v[3];
   for (int k = 0; k < 3; ++k) {
-    u[k] = double(q[3 * b + k]) - double(q[3 * a + k]);
-    v[k] = double(q[3 * c + k]) - double(q[3 * a + k]);
+    u[k] = b[k] - a[k];
+    v[k] = c[k] - a[k];
   }
   n[0] = u[1] * v[2] - u[2] * v[1];
   n[1] = u[2] * v[0] - u[0] * v[2];
   n[2] = u[0] * v[1] - u[1] * v[0];
 }
 
+double dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
 /// One halfedge of v_from's ring chosen for collapse: v_to = ring.neighbour[i].
 struct Option {
   int64_t metric;
   uint32_t i;
+  bool operator<(const Option &o) const { return metric != o.metric ? metric < o.metric : i < o.i; }
 };
 
 struct Candidate {
   int64_t metric;
   uint32_t v_from, v_to;
-  bool operator<(const Candidate &o) const {
-    return metric != o.metric ? metric < o.metric : v_from < o.v_from;
-  }
 };
 
-/// What evaluating a collapse reads and its scratch (rings, options, link marks): one per
-/// thread while the candidates of a level are evaluated, the first one also for the
-/// greedy pass. Evaluation only reads the mesh.
+/// Sort a level's candidates by (metric, v_from). They arrive by increasing v_from (`alive`
+/// stays sorted and the threads' slices are joined in order), so a stable sort on the metric
+/// alone gives that order: a least-significant-digit radix sort (metrics are >= 0), 11 bits
+/// a pass, as many passes as the largest metric needs.
+void sort_candidates(std::vector<Candidate> &c, std::vector<Candidate> &scratch) {
+  constexpr int kBits = 11;
+  constexpr uint64_t kMask = (uint64_t(1) << kBits) - 1;
+  uint64_t largest = 0;
+  for (const Candidate &x : c)
+    largest = std::max(largest, uint64_t(x.metric));
+  scratch.resize(c.size());
+  std::vector<size_t> start(kMask + 2);
+  for (int shift = 0; shift < 64 && (largest >> shift) != 0; shift += kBits) {
+    std::fill(start.begin(), start.end(), 0);
+    for (const Candidate &x : c)
+      ++start[((uint64_t(x.metric) >> shift) & kMask) + 1];
+    for (size_t d = 1; d < start.size(); ++d)
+      start[d] += start[d - 1];
+    for (const Candidate &x : c)
+      scratch[start[(uint64_t(x.metric) >> shift) & kMask]++] = x;
+    c.swap(scratch);
+  }
+}
+
+/// What evaluating a collapse reads and its scratch (ring of v_from, its positions and face
+/// normals, options, link marks): one per thread while the candidates of a level are
+/// evaluated, the first one also for the greedy pass. Evaluation only reads the mesh.
 class Evaluator {
 public:
   Evaluator(const CornerTable &ct, const std::vector<int32_t> &q, const DecimationOptions &opt)
@@ -56,11 +80,26 @@ public:
   /// The candidates of the vertices [first, last) of `alive`, in that order.
   void evaluate(const uint32_t *first, const uint32_t *last, std::vector<Candidate> &out) {
     for (const uint32_t *v = first; v != last; ++v) {
-      get_ring(ct_, *v, from_);
+      if (last - v > 8)
+        __builtin_prefetch(&ct_.VC[v[8]]);
+      if (last - v > 4) { // alive vertices have a corner
+        __builtin_prefetch(&ct_.V[ct_.VC[v[4]]]);
+        __builtin_prefetch(&ct_.O[ct_.VC[v[4]]]);
+      }
+      load(*v);
       Candidate c;
-      if (best_option(*v, c))
+      if (best_option(c))
         out.push_back(c);
     }
+  }
+
+  /// Make v_from the vertex under evaluation: fill from_ and forget what was derived from
+  /// the previous one (positions, face normals and link marks are computed when needed).
+  void load(uint32_t v_from) {
+    get_ring(ct_, v_from, from_);
+    v_from_ = v_from;
+    have_normals_ = false;
+    have_marks_ = false;
   }
 
   uint32_t v_l_index(uint32_t i) const { // index of v_l in ring_from_, or kNone
@@ -79,21 +118,30 @@ public:
     const uint32_t m = from_.size();
     return k != i && k != (from_.closed ? (i + m - 1) % m : i - 1);
   }
-  bool link_ok(uint32_t v_from, uint32_t i);
+  bool link_ok(uint32_t i);
 
-  Ring from_, to_;
+  Ring from_;
 
 private:
   bool allowed_direction(uint32_t i) const;
-  int64_t metric(uint32_t i) const;
-  bool normals_ok(uint32_t v_from, uint32_t i) const;
-  bool best_option(uint32_t v_from, Candidate &out);
+  void collect_options();
+  bool normals_ok(uint32_t i);
+  bool best_option(Candidate &out);
+  const int32_t *at(uint32_t k) const { return &pos_[3 * size_t(k)]; } // from_.neighbour[k]
+  const double *at_d(uint32_t k) const { return &pos_d_[3 * size_t(k)]; }
 
   const CornerTable &ct_;
   const std::vector<int32_t> &q_;
   const DecimationOptions &opt_;
+  uint32_t v_from_ = kNone;
+  std::vector<int32_t> pos_;       // positions of from_.neighbour, gathered once
+  std::vector<double> pos_d_;      // the same as doubles, then v_from's
+  std::vector<int64_t> farthest_;  // per neighbour: its largest distance^2 to a non-adjacent one
+  std::vector<double> before_;     // per face of from_: its normal and the normal's length^2
+  bool have_normals_ = false;      // before_ is v_from_'s
   std::vector<uint32_t> nb_stamp_; // scratch marks for the link condition
   uint32_t nb_counter_ = 0;
+  bool have_marks_ = false; // from_'s neighbours carry nb_counter_
   std::vector<Option> options_;
 };
 
@@ -117,7 +165,8 @@ private:
   std::vector<uint32_t> target_mark_; // level stamp of vertices already used as v_to
   std::vector<uint32_t> dirty_;       // level stamp of vertices whose ring changed
   uint32_t level_stamp_ = 0;
-  std::deque<Evaluator> eval_;        // eval_[0]: also the greedy pass's
+  std::deque<Evaluator> eval_; // eval_[0]: also the greedy pass's
+  std::vector<Candidate> sort_scratch_;
 };
 
 // Boundary rule: a boundary vertex may only slide along its boundary (onto the first or
@@ -129,80 +178,128 @@ bool Evaluator::allowed_direction(uint32_t i) const {
   return from_.closed || i == 0 || i == m - 1;
 }
 
-// Length^2 of v_to-v_ref, v_ref being the farthest vertex that gets a new edge to v_to.
-// With no new edge (v_from of valence 3), v_ref is v_l (or v_r on a boundary).
-int64_t Evaluator::metric(uint32_t i) const {
-  const uint32_t v_to = from_.neighbour[i];
-  const uint32_t il = v_l_index(i), ir = v_r_index(i);
-  int64_t best = -1;
-  for (uint32_t k = 0; k < from_.size(); ++k)
-    if (k != i && k != il && k != ir)
-      best = std::max(best, dist2(q_, v_to, from_.neighbour[k]));
-  if (best < 0)
-    best = dist2(q_, v_to, from_.neighbour[il != kNone ? il : ir]);
-  return best;
+// The allowed options with their metric: length^2 of v_to-v_ref, v_ref being the farthest
+// vertex that gets a new edge to v_to, i.e. any neighbour but v_to, v_l and v_r (its ring
+// neighbours). With no new edge (v_from of valence 3), v_ref is v_l (or v_r on a boundary).
+// Distances are symmetric, so each pair of non-adjacent neighbours is measured once, for
+// both ends.
+void Evaluator::collect_options() {
+  options_.clear();
+  const uint32_t m = from_.size();
+  if (m < 3)
+    return;
+  pos_.resize(3 * size_t(m));
+  pos_d_.resize(3 * size_t(m + 1));
+  for (uint32_t k = 0; k <= m; ++k) {
+    const int32_t *p = &q_[3 * size_t(k < m ? from_.neighbour[k] : v_from_)];
+    for (int j = 0; j < 3; ++j) {
+      if (k < m)
+        pos_[3 * size_t(k) + j] = p[j];
+      pos_d_[3 * size_t(k) + j] = double(p[j]);
+    }
+  }
+  farthest_.assign(m, -1);
+  for (uint32_t i = 0; i < m; ++i)
+    for (uint32_t k = i + 2; k < m; ++k) {
+      if (from_.closed && i == 0 && k == m - 1)
+        continue; // adjacent across the start of a closed ring
+      const int64_t d = dist2(at(i), at(k));
+      farthest_[i] = std::max(farthest_[i], d);
+      farthest_[k] = std::max(farthest_[k], d);
+    }
+  for (uint32_t i = 0; i < m; ++i) {
+    if (!allowed_direction(i))
+      continue;
+    const uint32_t il = v_l_index(i);
+    const int64_t metric =
+        farthest_[i] >= 0 ? farthest_[i] : dist2(at(i), at(il != kNone ? il : v_r_index(i)));
+    options_.push_back({metric, i});
+  }
 }
 
 // Link condition: v_from and v_to may share no neighbour but v_l and v_r. Also refuse to
-// collapse an edge of a tetrahedron (two closed valence-3 vertices).
-bool Evaluator::link_ok(uint32_t v_from, uint32_t i) {
-  const uint32_t v_to = from_.neighbour[i];
-  get_ring(ct_, v_to, to_);
-  if (from_.closed && to_.closed && from_.size() == 3 && to_.size() == 3)
-    return false;
-  if (++nb_counter_ == 0) { // stamp wrap-around: reset
-    std::fill(nb_stamp_.begin(), nb_stamp_.end(), 0);
-    nb_counter_ = 1;
+// collapse an edge of a tetrahedron (two closed valence-3 vertices). v_to's fan is walked
+// as get_ring does, counting instead of storing.
+bool Evaluator::link_ok(uint32_t i) {
+  if (!have_marks_) {
+    if (++nb_counter_ == 0) { // stamp wrap-around: reset
+      std::fill(nb_stamp_.begin(), nb_stamp_.end(), 0);
+      nb_counter_ = 1;
+    }
+    for (uint32_t n : from_.neighbour)
+      nb_stamp_[n] = nb_counter_;
+    have_marks_ = true;
   }
-  for (uint32_t n : from_.neighbour)
-    nb_stamp_[n] = nb_counter_;
-  uint32_t shared = 0;
-  for (uint32_t n : to_.neighbour)
-    if (n != v_from && nb_stamp_[n] == nb_counter_)
-      ++shared;
+  uint32_t shared = 0, size = 0;
+  const auto visit = [&](uint32_t n) {
+    ++size;
+    shared += n != v_from_ && nb_stamp_[n] == nb_counter_;
+  };
+  const uint32_t start = ct_.VC[from_.neighbour[i]]; // v_to has faces: it is in a face of v_from
+  uint32_t c = start, last = start;
+  do {
+    visit(ct_.V[Corner::next(c)]);
+    last = c;
+    c = ct_.swing_ccw(c);
+  } while (c != kNone && c != start);
+  const bool to_closed = c == start;
+  if (!to_closed) { // the far end of the last face, then the faces clockwise of start
+    visit(ct_.V[Corner::prev(last)]);
+    for (uint32_t b = ct_.swing_cw(start); b != kNone; b = ct_.swing_cw(b))
+      visit(ct_.V[Corner::next(b)]);
+  }
+  if (from_.closed && to_closed && from_.size() == 3 && size == 3)
+    return false;
   const uint32_t expected = (v_l_index(i) != kNone) + (v_r_index(i) != kNone);
   return shared == expected;
 }
 
-// No surviving patch face may turn its normal by more than acos(normal_cosine).
-bool Evaluator::normals_ok(uint32_t v_from, uint32_t i) const {
-  (void)v_from;
-  const uint32_t v_to = from_.neighbour[i];
+// No surviving patch face may turn its normal by more than acos(normal_cosine). The normals
+// before the collapse do not depend on v_to: computed once per v_from.
+bool Evaluator::normals_ok(uint32_t i) {
+  const uint32_t m = from_.size(), faces = from_.faces();
+  if (!have_normals_) {
+    before_.resize(4 * size_t(faces));
+    for (uint32_t k = 0; k < faces; ++k) {
+      double *n = &before_[4 * size_t(k)];
+      normal(at_d(m), at_d(k), at_d(k + 1 == m ? 0 : k + 1), n); // at_d(m): v_from
+      n[3] = dot(n, n);
+    }
+    have_normals_ = true;
+  }
   const double c2 = opt_.normal_cosine * opt_.normal_cosine;
-  for (uint32_t k = 0; k < from_.faces(); ++k) {
-    if (!face_survives(k, i))
-      continue;
-    const uint32_t a = from_.neighbour[k], b = from_.neighbour[(k + 1) % from_.size()];
-    double before[3], after[3];
-    normal(q_, v_from, a, b, before);
-    normal(q_, v_to, a, b, after);
-    const double lb = before[0] * before[0] + before[1] * before[1] + before[2] * before[2];
-    const double la = after[0] * after[0] + after[1] * after[1] + after[2] * after[2];
-    if (lb == 0.0)
+  const uint32_t gone_r = from_.closed && i == 0 ? m - 1 : i - 1; // face (v_from, v_r, v_to)
+  for (uint32_t k = 0; k < faces; ++k) {
+    const double *before = &before_[4 * size_t(k)];
+    const double lb = before[3];
+    if (k == i || k == gone_r || lb == 0.0)
       continue; // a zero-area face has no orientation to preserve
+    double after[3];
+    normal(at_d(i), at_d(k), at_d(k + 1 == m ? 0 : k + 1), after);
+    const double la = dot(after, after);
     if (la == 0.0)
       return false; // would create a zero-area face
-    const double dot = before[0] * after[0] + before[1] * after[1] + before[2] * after[2];
-    if (dot <= 0.0 || dot * dot < c2 * la * lb)
+    const double d = dot(before, after);
+    if (d <= 0.0 || d * d < c2 * la * lb)
       return false;
   }
   return true;
 }
 
-// The admissible halfedge of v_from with the smallest metric (ring from_ is filled).
-bool Evaluator::best_option(uint32_t v_from, Candidate &out) {
-  options_.clear();
-  for (uint32_t i = 0; i < from_.size(); ++i)
-    if (allowed_direction(i))
-      options_.push_back({metric(i), i});
-  std::sort(options_.begin(), options_.end(), [](const Option &a, const Option &b) {
-    return a.metric != b.metric ? a.metric < b.metric : a.i < b.i;
-  });
-  for (const Option &o : options_) {
-    if (normals_ok(v_from, o.i) && link_ok(v_from, o.i)) {
-      out = {o.metric, v_from, from_.neighbour[o.i]};
+// The admissible halfedge of v_from with the smallest (metric, index). The options are
+// tried smallest first, picking the smallest left each time: usually the first or second
+// one is admissible, so this is cheaper than sorting them.
+bool Evaluator::best_option(Candidate &out) {
+  collect_options();
+  while (!options_.empty()) {
+    auto best = std::min_element(options_.begin(), options_.end());
+    const Option o = *best;
+    if (normals_ok(o.i) && link_ok(o.i)) {
+      out = {o.metric, v_from_, from_.neighbour[o.i]};
       return true;
     }
+    *best = options_.back();
+    options_.pop_back();
   }
   return false;
 }
@@ -218,8 +315,8 @@ Collapse Decimator::collapse(uint32_t v_from, uint32_t i) {
               ir == kNone ? kNone : from_.neighbour[ir]};
   // Faces that disappear: (v_from, v_to, v_l) = face i, (v_from, v_r, v_to) = face i-1.
   const uint32_t dead_l = il != kNone ? from_.corner[i] : kNone;
-  const uint32_t dead_r = ir != kNone ? from_.corner[from_.closed ? (i + m - 1) % m : i - 1]
-                                      : kNone;
+  const uint32_t dead_r =
+      ir != kNone ? from_.corner[from_.closed ? (i + m - 1) % m : i - 1] : kNone;
   // Relabel the surviving faces of v_from (the patch).
   for (uint32_t k = 0; k < from_.faces(); ++k) {
     if (!e.face_survives(k, i))
@@ -293,32 +390,48 @@ std::vector<Candidate> Decimator::candidates(const std::vector<uint32_t> &alive)
 std::vector<Collapse> Decimator::run_level(std::vector<uint32_t> &alive) {
   ++level_stamp_;
   std::vector<Candidate> candidates = this->candidates(alive);
-  std::sort(candidates.begin(), candidates.end());
+  sort_candidates(candidates, sort_scratch_);
   Evaluator &e = eval_[0];
   Ring &from_ = e.from_;
   // Greedy pass, shortest first. A candidate whose v_from has an unchanged ring still has
   // untouched faces (a collapse touching one of them would have changed that ring) and an
   // unchanged metric and normal test; only the link condition depends on v_to's ring.
+  // The candidates are in metric order, scattered over the mesh: fetch the marks and the
+  // first corner of v_from 16 candidates ahead, that corner's face 8 ahead.
   std::vector<Collapse> done;
-  for (const Candidate &c : candidates) {
+  for (size_t j = 0; j < candidates.size(); ++j) {
+    if (j + 16 < candidates.size()) {
+      const Candidate &f = candidates[j + 16];
+      __builtin_prefetch(&dirty_[f.v_from]);
+      __builtin_prefetch(&target_mark_[f.v_to]);
+      __builtin_prefetch(&ct_.VC[f.v_from]);
+    }
+    if (j + 8 < candidates.size()) {
+      const uint32_t corner = ct_.VC[candidates[j + 8].v_from];
+      if (corner != kNone) {
+        __builtin_prefetch(&ct_.V[corner]);
+        __builtin_prefetch(&ct_.O[corner]);
+      }
+    }
+    const Candidate &c = candidates[j];
     if (dirty_[c.v_from] == level_stamp_ || target_mark_[c.v_to] == level_stamp_)
       continue;
-    get_ring(ct_, c.v_from, from_);
+    e.load(c.v_from);
     const int i = from_.index_of(c.v_to);
-    if (i < 0 || (dirty_[c.v_to] == level_stamp_ && !e.link_ok(c.v_from, static_cast<uint32_t>(i))))
+    if (i < 0 || (dirty_[c.v_to] == level_stamp_ && !e.link_ok(static_cast<uint32_t>(i))))
       continue;
     done.push_back(collapse(c.v_from, static_cast<uint32_t>(i)));
   }
-  alive.erase(std::remove_if(alive.begin(), alive.end(),
-                             [&](uint32_t v) { return ct_.VC[v] == kNone; }),
-              alive.end());
+  alive.erase(
+      std::remove_if(alive.begin(), alive.end(), [&](uint32_t v) { return ct_.VC[v] == kNone; }),
+      alive.end());
   return done;
 }
 
 } // namespace
 
-Decimation decimate(CornerTable ct, const std::vector<int32_t> &q,
-                    const DecimationOptions &options, const Progress &progress) {
+Decimation decimate(CornerTable ct, const std::vector<int32_t> &q, const DecimationOptions &options,
+                    const Progress &progress) {
   Decimation result;
   std::vector<uint32_t> alive;
   for (uint32_t v = 0; v < ct.vertex_count(); ++v)

@@ -112,8 +112,13 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
   const size_t levels = h.levels.size();
   if (options.level != -1) // -1: full resolution
     check_level_exists(options.level, static_cast<int>(levels));
+  // The ATTR section (descriptors, base mesh codes) first: the attributes count in the check.
+  const std::unique_ptr<AttributeTable> attributes = load_attribute_table(data, layout);
+  FileInfo info = file_info(layout, size);
+  if (attributes)
+    describe_attributes(*attributes, info);
   const unsigned threads = decode_threads(options.threads);
-  check_decode_memory(file_info(layout, size), options.level, options.memory_limit, threads);
+  check_decode_memory(info, options.level, options.memory_limit, options.attributes, threads);
   const size_t target = options.level < 0 ? levels : static_cast<size_t>(options.level);
   const size_t global = h.clustered() ? h.global_levels : levels;
   // Clustered levels go through the selective decoder, unless a global level they build
@@ -152,26 +157,21 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
     }
   }
   LevelMesh lm = base_level_mesh(data, layout);
+  Models models;
+  if (attributes) {
+    init_attributes(*attributes, lm, options.attributes);
+    models.attr = attribute_models(*attributes);
+  }
   const size_t reach = std::min(target, global);
   if (reach > 0)
     lm.reserve(h.levels[reach - 1].vertices, h.levels[reach - 1].faces, size);
-  Models models;
-  // Attribute codes come with the positions: decoded whatever the mask says.
-  const std::unique_ptr<AttributeTable> attributes = load_attribute_table(data, layout);
-  if (attributes) {
-    init_attributes(*attributes, lm);
-    models.attr = attribute_models(*attributes);
-  }
   r.level = static_cast<int>(decode_global_levels(data, layout, 0, std::min(target, global), lm,
                                                   models, options.progress,
                                                   options.skip_damaged ? &r.damaged : nullptr));
-  Mesh mesh;
-  if (attributes) {
-    mesh = to_mesh(lm, h.grid);
+  // Hands over the triangles (no copy); the vertex count and the attribute codes stay.
+  Mesh mesh = to_mesh(std::move(lm), h.grid);
+  if (attributes)
     attach_attributes(*attributes, lm, options.attributes, mesh);
-  } else {
-    mesh = to_mesh(std::move(lm), h.grid); // hands over the triangles: no copy
-  }
   if (r.level == static_cast<int>(levels)) {
     try {
       undo_cut(data, layout, mesh); // the full mesh: as it was input (attributes follow)

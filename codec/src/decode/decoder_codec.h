@@ -58,13 +58,19 @@ public:
   void attributes(const LevelMesh &mesh, const int64_t *pred, int64_t *codes) {
     const uint32_t n = mesh.attr_codes;
     int64_t r[kMaxAttributeCodes];
+    residuals(n, r);
     for (uint32_t k = 0; k < n; ++k) {
-      AttributeCodeModels &m = m_->attr[k];
-      r[k] = get_signed(*geom_, m.classes[attribute_context(m, r, k)], m.top);
       codes[k] = pred[k] + r[k];
       if (codes[k] < mesh.attr_lo[k] || codes[k] > mesh.attr_hi[k])
         corrupt("a decoded attribute lies outside its range");
     }
+  }
+
+  /// Reads past a split vertex's n attribute codes (a decode that returns none of them):
+  /// their models' contexts come from the residuals alone, so no prediction is needed.
+  void skip_attributes(uint32_t n) {
+    int64_t r[kMaxAttributeCodes];
+    residuals(n, r);
   }
 
   [[noreturn]] void corrupt(const char *what) {
@@ -77,6 +83,13 @@ public:
   }
 
 private:
+  void residuals(uint32_t n, int64_t *r) {
+    for (uint32_t k = 0; k < n; ++k) {
+      AttributeCodeModels &m = m_->attr[k];
+      r[k] = get_signed(*geom_, m.classes[attribute_context(m, r, k)], m.top);
+    }
+  }
+
   Models *m_ = nullptr;
   RangeDecoder *conn_ = nullptr, *geom_ = nullptr;
   int64_t top_;

@@ -236,7 +236,7 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   // mesh). Further refinement is what the caller asks for, region by region.
   check_decode_memory(file_info(s.layout, file_size),
                       s.layout.header.clustered() ? int(s.layout.header.global_levels) : 0,
-                      options.memory_limit, s.threads);
+                      options.memory_limit, AttributeMask(), s.threads);
   // The global part (a truncated progressive file: what is there of it).
   s.global.resize(std::min<uint64_t>(s.layout.global_bytes, file_size));
   s.source->read(hsize, s.global.size() - hsize, s.global.data() + hsize);
@@ -247,7 +247,11 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   s.mesh = base_level_mesh(s.global.data(), s.layout);
   s.attributes = load_attribute_table(s.global.data(), s.layout);
   if (s.attributes) { // attribute codes come with the positions, whatever the mask says
-    init_attributes(*s.attributes, s.mesh);
+    describe_attributes(*s.attributes, s.info);
+    // Checked again with the attributes, which only the global part describes.
+    check_decode_memory(s.info, s.clustered() ? int(h.global_levels) : 0, options.memory_limit,
+                        options.attributes, s.threads);
+    init_attributes(*s.attributes, s.mesh, options.attributes);
     s.global_models.attr = attribute_models(*s.attributes);
   }
   if (!s.clustered()) {

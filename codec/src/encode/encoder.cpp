@@ -83,9 +83,11 @@ PreparedInput prepare_input(const Mesh &mesh, const EncodeOptions &options,
   check_input(mesh, options);
   validate_attributes(mesh, !options.attributes.exact, options.attributes.keep);
   // The caller already holds the input mesh: an automatic check counts only the rest.
-  const uint64_t held =
-      mesh.positions.size() * sizeof(float) + mesh.triangles.size() * sizeof(uint32_t);
-  check_encode_memory(mesh.vertex_count(), mesh.triangle_count(), options.memory_limit, held);
+  uint64_t held = mesh.positions.size() * sizeof(float) + mesh.triangles.size() * sizeof(uint32_t);
+  for (const VertexAttribute &a : mesh.attributes)
+    held += a.colour.size() + a.values.size() * sizeof(float);
+  check_encode_memory(mesh.vertex_count(), mesh.triangle_count(), options.memory_limit, held,
+                      encode_attribute_bytes_per_vertex(mesh, options.attributes));
   PreparedInput in;
   std::vector<uint32_t> triangles, compact_to_input;
   const std::vector<float> positions = compact_vertices(mesh, triangles, compact_to_input);

@@ -49,7 +49,7 @@ public:
   int split_flag(uint32_t v, int context) {
     current_ = collapse_at_[dec_to_input_[v]];
     const int flag = current_ != kNone;
-    bits.s_v += cost_bits(m_->conn.sv[context], flag);
+    bits.s_v += bits_for<Sink>(m_->conn.sv[context], flag);
     conn_->encode_bit(m_->conn.sv[context], flag);
     emitted_ += flag;
     return flag;
@@ -126,7 +126,7 @@ public:
     attr_bits.assign(n, 0.0);
   }
 
-  SymbolBits bits;               // ideal code lengths per symbol kind
+  SymbolBits bits; // ideal code lengths per symbol kind (global levels: a recorder has none)
   std::vector<double> attr_bits; // ideal code lengths per attribute code (global levels)
 
   [[noreturn]] void corrupt(const char *what) {

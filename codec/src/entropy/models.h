@@ -14,18 +14,19 @@
 #pragma once
 
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 #include "entropy/range_coder.h"
 
 namespace pomar {
 
-constexpr int kSvContexts = 48; // 12 (held faces x split neighbours) x 4 valence classes
-constexpr int kSmallSymbols = 16;         // values 0..15 coded directly, 16 = escape
-constexpr int kValenceContexts = 16;      // ring sizes 0..14, 15+
+constexpr int kSvContexts = 48;      // 12 (held faces x split neighbours) x 4 valence classes
+constexpr int kSmallSymbols = 16;    // values 0..15 coded directly, 16 = escape
+constexpr int kValenceContexts = 16; // ring sizes 0..14, 15+
 constexpr int kSlContexts = 12;
-constexpr int kGeomContexts = 26;         // edge-length classes (octaves)
-constexpr int kMagnitudeSymbols = 40;     // bit length of a residual component (<= 39)
+constexpr int kGeomContexts = 26;     // edge-length classes (octaves)
+constexpr int kMagnitudeSymbols = 40; // bit length of a residual component (<= 39)
 
 inline int bit_length(uint64_t x) { return x ? 64 - __builtin_clzll(x) : 0; }
 
@@ -121,15 +122,31 @@ inline int geometry_context(int64_t edge_length2) {
 
 // ---------------------------------------------------------------- encoding side
 
-/// Each put_* returns the ideal number of bits it spent (statistics only).
+/// Whether an encoder wants the ideal code lengths of what it is given. A symbol recorder
+/// (Encoder::kRecorder) does not: its models are not frozen yet, so the lengths would mean
+/// nothing; code_recording measures them when it codes the recording.
+template <class Encoder, class = void> struct WantsBits : std::true_type {};
+template <class Encoder>
+struct WantsBits<Encoder, std::void_t<decltype(Encoder::kRecorder)>> : std::false_type {};
+
+/// cost_bits(m, s) for an encoder that wants it, else 0 (no log2 per recorded symbol).
+template <class Encoder, class Model> double bits_for(const Model &m, int s) {
+  if constexpr (WantsBits<Encoder>::value)
+    return cost_bits(m, s);
+  else
+    return 0.0;
+}
+
+/// Each put_* returns the ideal number of bits it spent (statistics only; 0 for the models
+/// of a recorder, see WantsBits).
 template <class Encoder> double put_small(Encoder &rc, FrequencyModel &m, uint32_t v) {
   double bits;
   if (v < kSmallSymbols) {
-    bits = cost_bits(m, static_cast<int>(v));
+    bits = bits_for<Encoder>(m, static_cast<int>(v));
     rc.encode(m, static_cast<int>(v));
     return bits;
   }
-  bits = cost_bits(m, kSmallSymbols);
+  bits = bits_for<Encoder>(m, kSmallSymbols);
   rc.encode(m, kSmallSymbols);
   const uint32_t x = v - kSmallSymbols + 1; // >= 1
   const int n = bit_length(x);
@@ -150,7 +167,7 @@ template <class Encoder>
 double put_signed(Encoder &rc, FrequencyModel &classes, BitModel *top, int64_t v) {
   const uint64_t a = static_cast<uint64_t>(v < 0 ? -v : v);
   const int n = bit_length(a);
-  double bits = cost_bits(classes, n);
+  double bits = bits_for<Encoder>(classes, n);
   rc.encode(classes, n);
   if (n == 0)
     return bits;
@@ -159,7 +176,7 @@ double put_signed(Encoder &rc, FrequencyModel &classes, BitModel *top, int64_t v
   int rest = n - 1;
   if (top && n >= 2) {
     const int bit = static_cast<int>((a >> (n - 2)) & 1);
-    bits += cost_bits(top[n], bit);
+    bits += bits_for<Encoder>(top[n], bit);
     rc.encode_bit(top[n], bit);
     --rest;
   }

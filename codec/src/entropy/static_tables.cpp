@@ -269,17 +269,17 @@ std::vector<uint8_t> write_tables(std::vector<Models> &models) {
         [&](FrequencyModel &f) {
           std::vector<uint32_t> &before = slot_history(history, slot);
           const size_t n = size_t(f.symbols());
-          bool uniform = true;
-          std::vector<uint32_t> q(n);
-          for (size_t s = 0; s < n; ++s) {
-            uniform = uniform && f.freq(int(s)) == 1;
-            q[s] = f.freq(int(s)) ? log_code(f.freq(int(s))) : 0;
-          }
+          bool uniform = true; // an unused model: stored as one bit, no codes needed
+          for (size_t s = 0; s < n && uniform; ++s)
+            uniform = f.freq(int(s)) == 1;
           rc.encode_bit(t.used[before.empty() ? 0 : 2], uniform ? 0 : 1);
           if (uniform) {
             before.clear();
             return;
           }
+          std::vector<uint32_t> q(n);
+          for (size_t s = 0; s < n; ++s)
+            q[s] = f.freq(int(s)) ? log_code(f.freq(int(s))) : 0;
           if (!before.empty()) {
             const bool same = q == before;
             rc.encode_bit(t.same[0], same ? 1 : 0);

@@ -62,6 +62,7 @@ private:
 
 /// A view of a recorder that tags its events with a stream (what EncoderCodec writes to).
 struct RecorderStream {
+  static constexpr bool kRecorder = true; // no ideal code lengths wanted (WantsBits)
   SymbolRecorder *recorder;
   uint8_t stream;
   void encode(FrequencyModel &m, int s) {

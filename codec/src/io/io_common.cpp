@@ -248,6 +248,13 @@ void append_triangles(std::string &out, const Mesh &mesh, const char *prefix, ui
   }
 }
 
+size_t count_unreferenced(const Mesh &mesh) {
+  std::vector<uint8_t> used(mesh.vertex_count(), 0);
+  for (uint32_t t : mesh.triangles)
+    used[t] = 1;
+  return static_cast<size_t>(std::count(used.begin(), used.end(), uint8_t(0)));
+}
+
 void append_vertices(std::string &out, const Mesh &mesh, const char *prefix) {
   for (size_t v = 0; v < mesh.vertex_count(); ++v) {
     out += prefix;

@@ -351,6 +351,8 @@ void append_point(std::string &out, const float *p);
 /// Appends the triangles as "<prefix>a b c\n" lines, indices offset by `base`.
 void append_triangles(std::string &out, const Mesh &mesh, const char *prefix, uint64_t base);
 void append_vertices(std::string &out, const Mesh &mesh, const char *prefix);
+/// Vertices no triangle uses.
+size_t count_unreferenced(const Mesh &mesh);
 /// Checks that a file written by a vcglib exporter has the expected size: the exporters
 /// do not report failed writes (full disk), so a short file would otherwise go unnoticed.
 void check_written_size(const std::string &file, uint64_t expected, const std::string &target);
@@ -371,6 +373,8 @@ void save_ply_binary_vcg(const std::string &path, const Mesh &mesh);
 std::string ply_with_attributes(const Mesh &mesh, bool binary, const std::string &path);
 // off_io.cpp
 Mesh load_off(const std::string &path, LoadReport &report, const SizeCheck &check);
+/// OFF text; per-vertex normals and colour (8-bit integers, RGB or RGBA) when the mesh has
+/// them ("[C][N]OFF": what vcglib's importer reads back exactly).
 std::string off_text(const Mesh &mesh);
 // stl_io.cpp
 Mesh load_stl(const std::string &path, LoadReport &report, const SizeCheck &check);
@@ -380,6 +384,10 @@ std::string stl_ascii_text(const Mesh &mesh);
 void save_stl_binary(const std::string &path, const Mesh &mesh);
 // obj_io.cpp
 Mesh load_obj(const std::string &path, LoadReport &report, const SizeCheck &check);
-std::string obj_text(const Mesh &mesh);
+/// The OBJ text; `mtllib` (if not empty) is the material library it names, whose material
+/// "texture_0" its faces use (mtl_text writes one material per texture file).
+std::string obj_text(const Mesh &mesh, const std::string &mtllib);
+/// A material library with one material "texture_<i>" per texture file (map_Kd).
+std::string mtl_text(const Mesh &mesh);
 
 } // namespace pomar::io

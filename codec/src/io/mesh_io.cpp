@@ -80,6 +80,19 @@ void check_mesh_for_save(const Mesh &mesh, const std::string &path) {
       fail(path, "cannot save: vertex " + num(v) + " has a non-finite coordinate " +
                      point_text(p[0], p[1], p[2]));
   }
+  for (const std::string &name : mesh.texture_files) // one line of a header or .mtl file
+    if (name.empty() || name.find_first_of("\r\n") != std::string::npos)
+      fail(path, "cannot save: texture file name '" + name + "' is empty or has a line break");
+}
+
+/// The material library written beside an OBJ file: its name with the extension .mtl.
+std::string material_library_path(const std::string &obj_path) {
+  return obj_path.substr(0, obj_path.find_last_of('.')) + ".mtl";
+}
+
+std::string file_name(const std::string &path) {
+  const size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
 }
 
 } // namespace
@@ -179,9 +192,53 @@ void save_mesh(const std::string &path, const Mesh &mesh, bool binary) {
     text = stl_ascii_text(mesh);
     break;
   case Format::Off: text = off_text(mesh); break;
-  case Format::Obj: text = obj_text(mesh); break;
+  case Format::Obj:
+    if (!mesh.texture_files.empty()) { // the library first: the OBJ names it
+      const std::string mtl = material_library_path(path), lib = mtl_text(mesh);
+      write_file_atomic(mtl, lib.data(), lib.size());
+      text = obj_text(mesh, file_name(mtl));
+    } else {
+      text = obj_text(mesh, "");
+    }
+    break;
   }
   write_file_atomic(path, text.data(), text.size());
+}
+
+std::vector<std::string> attributes_not_saved(const std::string &path, const Mesh &mesh) {
+  const Format format = format_of(path);
+  std::vector<std::string> out;
+  if (format == Format::Ply)
+    return out;
+  std::string scalars;
+  bool alpha = false;
+  for (const VertexAttribute &a : mesh.attributes) {
+    if (a.kind == AttributeKind::Scalar)
+      scalars += (scalars.empty() ? "scalars '" : ", '") + a.name + "'";
+    alpha |= a.kind == AttributeKind::Colour && a.components == 4;
+  }
+  const bool stl = format == Format::Stl, off = format == Format::Off;
+  const bool uv = mesh.find(AttributeKind::TexCoord) != nullptr;
+  if (stl && mesh.find(AttributeKind::Colour))
+    out.push_back("colours");
+  if (alpha && format == Format::Obj)
+    out.push_back("the alpha of the colours");
+  if (stl && mesh.find(AttributeKind::Normal))
+    out.push_back("normals");
+  if (!scalars.empty())
+    out.push_back(scalars);
+  if ((stl || off) && uv)
+    out.push_back("texture coordinates");
+  if ((stl || off) && !mesh.texture_files.empty())
+    out.push_back("texture file names");
+  if (format == Format::Obj && (uv || mesh.find(AttributeKind::Normal))) {
+    // OBJ gives normals and texture coordinates to face corners: a vertex no face uses
+    // has none when read back.
+    if (const size_t unused = count_unreferenced(mesh))
+      out.push_back("the normals and texture coordinates of " + num(unused) +
+                    " vertices no face uses");
+  }
+  return out;
 }
 
 } // namespace pomar

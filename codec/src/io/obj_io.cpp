@@ -1,6 +1,8 @@
 // OBJ: a line scan with tinyobjloader's rules (it silently skips short faces and does not
-// range-check indices), then tinyobjloader itself (vcglib's OBJ importer drops faces);
-// writing formatted here (vcglib's exporter needs material code).
+// range-check indices), then tinyobjloader itself (vcglib's OBJ importer drops faces), with
+// the material libraries (`mtllib`) beside the file for their texture names (`map_Kd`);
+// writing formatted here (vcglib's exporter needs material code), with a `.mtl` beside
+// the file when the mesh names texture files.
 #include "io/io_common.h"
 
 #include <cmath>
@@ -9,7 +11,9 @@
 
 #include <algorithm>
 #include <climits>
+#include <fstream>
 #include <istream>
+#include <map>
 #include <streambuf>
 
 namespace pomar::io {
@@ -18,7 +22,8 @@ namespace {
 /// What a line scan of an OBJ file finds, using tinyobjloader's line rules.
 struct ObjScan {
   size_t vertices = 0, faces = 0, triangles = 0, polygons = 0;
-  bool normals = false, texcoords = false, colors = false, materials = false;
+  bool normals = false, texcoords = false, colors = false;
+  bool mtllib = false, usemtl = false;
 };
 
 /// Splits at spaces and tabs (tinyobjloader's separators within a line).
@@ -89,8 +94,10 @@ ObjScan scan_obj(const std::vector<uint8_t> &bytes, const std::string &path) {
       s.normals = true;
     else if (key == "vt")
       s.texcoords = true;
-    else if (key == "mtllib" || key == "usemtl")
-      s.materials = true;
+    else if (key == "mtllib")
+      s.mtllib = true;
+    else if (key == "usemtl")
+      s.usemtl = true;
   }
   return s;
 }
@@ -135,14 +142,6 @@ std::vector<uint32_t> fan_triangles(const std::vector<tinyobj::shape_t> &shapes,
     }
   }
   return tris;
-}
-
-/// Vertices no triangle uses (they are kept).
-size_t count_unreferenced(const Mesh &mesh) {
-  std::vector<uint8_t> used(mesh.vertex_count(), 0);
-  for (uint32_t t : mesh.triangles)
-    used[t] = 1;
-  return static_cast<size_t>(std::count(used.begin(), used.end(), uint8_t(0)));
 }
 
 /// Per-vertex normals or texture coordinates from OBJ's per-corner indices (`which`: the
@@ -218,6 +217,106 @@ void take_obj_attributes(const tinyobj::attrib_t &attrib,
   }
 }
 
+/// Reads the material libraries an OBJ file names (`mtllib`), relative to the OBJ file's
+/// directory (or absolute), with tinyobjloader's MTL parser; records the ones it did not
+/// read and why. Only regular files of 1 byte to 64 MiB are read: a FIFO, a device, a
+/// directory or a /proc file (size 0; /proc/kmsg would block) is not, nor a huge file that
+/// cannot be a material library.
+class MaterialLibraries : public tinyobj::MaterialReader {
+public:
+  explicit MaterialLibraries(const std::string &obj_path) {
+    const size_t slash = obj_path.find_last_of('/');
+    dir_ = slash == std::string::npos ? "" : obj_path.substr(0, slash + 1);
+  }
+  bool operator()(const std::string &name, std::vector<tinyobj::material_t> *materials,
+                  std::map<std::string, int> *names, std::string *warn,
+                  std::string *err) override {
+    const std::string path = !name.empty() && name[0] == '/' ? name : dir_ + name;
+    struct stat st;
+    const char *why = nullptr;
+    std::ifstream in;
+    if (::stat(path.c_str(), &st) != 0)
+      why = "not found";
+    else if (!S_ISREG(st.st_mode) || st.st_size == 0 || st.st_size > (64 << 20))
+      why = "not a regular file of 1 byte to 64 MiB";
+    else if (in.open(path, std::ios::binary), !in.is_open())
+      why = "cannot be read";
+    if (why) {
+      missing.push_back("material library '" + name + "' " + why);
+      return false;
+    }
+    tinyobj::LoadMtl(names, materials, &in, warn, err);
+    return true;
+  }
+  std::vector<std::string> missing; ///< "material library 'NAME' not found", ...
+
+private:
+  std::string dir_;
+};
+
+/// Adds to `keys` the MTL keywords of what a material holds besides its name and diffuse
+/// texture (map_Kd). A diffuse colour of 1 1 1 (white: the texture as it is, what save_mesh
+/// writes) counts as nothing else.
+void other_material_properties(const tinyobj::material_t &m, std::vector<std::string> &keys) {
+  auto note = [&](bool differs, const char *key) {
+    if (differs)
+      add_unique(keys, key);
+  };
+  auto zero = [](const tinyobj::real_t *c) { return c[0] == 0 && c[1] == 0 && c[2] == 0; };
+  auto white = [](const tinyobj::real_t *c) { return c[0] == 1 && c[1] == 1 && c[2] == 1; };
+  note(!zero(m.ambient), "Ka");
+  note(!zero(m.diffuse) && !white(m.diffuse), "Kd");
+  note(!zero(m.specular), "Ks");
+  note(!zero(m.transmittance), "Tf");
+  note(!zero(m.emission), "Ke");
+  note(m.shininess != 1, "Ns");
+  note(m.ior != 1, "Ni");
+  note(m.dissolve != 1, "d");
+  note(m.illum != 0, "illum");
+  note(!(m.ambient_texname + m.specular_texname + m.specular_highlight_texname + m.bump_texname +
+         m.displacement_texname + m.alpha_texname + m.reflection_texname + m.roughness_texname +
+         m.metallic_texname + m.sheen_texname + m.emissive_texname + m.normal_texname)
+            .empty(),
+       "other maps");
+  note(!m.unknown_parameter.empty(), "other keywords");
+}
+
+/// The texture files of the materials (`map_Kd`, in material order, each once) go to the
+/// mesh's texture list; what else the materials say is named in `ignored`: libraries that
+/// could not be read, other material properties, which material each face uses.
+void take_obj_materials(const std::vector<tinyobj::material_t> &materials,
+                        const std::vector<tinyobj::shape_t> &shapes, const ObjScan &scan,
+                        const MaterialLibraries &libraries, Mesh &mesh,
+                        std::vector<std::string> &ignored) {
+  for (const tinyobj::material_t &m : materials)
+    if (!m.diffuse_texname.empty() &&
+        std::find(mesh.texture_files.begin(), mesh.texture_files.end(), m.diffuse_texname) ==
+            mesh.texture_files.end())
+      mesh.texture_files.push_back(m.diffuse_texname);
+  for (const std::string &why : libraries.missing)
+    add_unique(ignored, ("materials (" + why + ")").c_str());
+  std::vector<std::string> keys;
+  for (const tinyobj::material_t &m : materials)
+    other_material_properties(m, keys);
+  if (!keys.empty()) {
+    std::string list;
+    for (const std::string &k : keys)
+      list += (list.empty() ? "" : " ") + k;
+    add_unique(ignored, ("material properties other than texture names (" + list + ")").c_str());
+  }
+  std::vector<int> used;
+  for (const auto &shape : shapes)
+    for (const int id : shape.mesh.material_ids)
+      if (id >= 0 && std::find(used.begin(), used.end(), id) == used.end())
+        used.push_back(id);
+  if (used.size() > 1)
+    add_unique(ignored, ("which material each face uses (" + num(used.size()) +
+                         " materials; their texture names are kept)")
+                            .c_str());
+  if (scan.usemtl && !scan.mtllib)
+    add_unique(ignored, "materials (usemtl without a material library)");
+}
+
 } // namespace
 
 Mesh load_obj(const std::string &path, LoadReport &report, const SizeCheck &check) {
@@ -231,10 +330,12 @@ Mesh load_obj(const std::string &path, LoadReport &report, const SizeCheck &chec
   std::vector<tinyobj::shape_t> shapes;
   std::vector<tinyobj::material_t> materials;
   std::string warn, err;
-  // No material reader (mtllib is ignored), no triangulation (tinyobjloader's own picks a
-  // quad diagonal by geometry), no default vertex colors.
+  // Material libraries beside the file (for texture names), no triangulation
+  // (tinyobjloader's own picks a quad diagonal by geometry), no default vertex colors.
+  MaterialLibraries libraries(path);
   const bool ok = guarded(path, [&] {
-    return tinyobj::LoadObj(&attrib, &shapes, &materials, &warn, &err, &stream, nullptr, false, false);
+    return tinyobj::LoadObj(&attrib, &shapes, &materials, &warn, &err, &stream, &libraries, false,
+                            false);
   });
   if (!ok)
     fail(path, "OBJ parse error: " + first_line(err));
@@ -254,20 +355,33 @@ Mesh load_obj(const std::string &path, LoadReport &report, const SizeCheck &chec
                    num(scan.triangles));
   mesh.positions.assign(attrib.vertices.begin(), attrib.vertices.end());
   take_obj_attributes(attrib, shapes, scan, scan.vertices, mesh, report.ignored_attributes);
+  take_obj_materials(materials, shapes, scan, libraries, mesh, report.ignored_attributes);
 
   report.file_vertices = scan.vertices;
   report.file_faces = scan.faces;
   report.polygons_triangulated = scan.polygons;
   report.unreferenced_vertices = count_unreferenced(mesh);
-  if (scan.materials) add_unique(report.ignored_attributes, "materials");
   return mesh;
 }
 
-std::string obj_text(const Mesh &mesh) {
+std::string mtl_text(const Mesh &mesh) {
+  std::string s = "# pomar: the mesh's texture files\n";
+  for (size_t i = 0; i < mesh.texture_files.size(); ++i)
+    s += "newmtl texture_" + num(i) + "\nKd 1 1 1\nmap_Kd " + mesh.texture_files[i] + "\n";
+  return s;
+}
+
+std::string obj_text(const Mesh &mesh, const std::string &mtllib) {
   const VertexAttribute *colour = mesh.find(AttributeKind::Colour);
   const VertexAttribute *normal = mesh.find(AttributeKind::Normal);
   const VertexAttribute *uv = mesh.find(AttributeKind::TexCoord);
   std::string s = "# pomar\n";
+  if (!mtllib.empty()) { // tinyobjloader splits the names at spaces unless escaped
+    s += "mtllib ";
+    for (const char c : mtllib)
+      s += c == ' ' ? std::string("\\ ") : std::string(1, c);
+    s += '\n';
+  }
   for (size_t v = 0; v < mesh.vertex_count(); ++v) {
     s += "v ";
     append_point(s, &mesh.positions[3 * v]);
@@ -292,6 +406,8 @@ std::string obj_text(const Mesh &mesh) {
     return true;
   };
   const bool vt = table(uv, "vt"), vn = table(normal, "vn");
+  if (!mtllib.empty())
+    s += "usemtl texture_0\n";
   for (size_t t = 0; t < mesh.triangle_count(); ++t) {
     s += 'f';
     for (int k = 0; k < 3; ++k) {

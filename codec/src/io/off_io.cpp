@@ -207,8 +207,31 @@ Mesh load_off(const std::string &path, LoadReport &report, const SizeCheck &chec
 }
 
 std::string off_text(const Mesh &mesh) {
-  std::string s = "OFF\n" + num(mesh.vertex_count()) + " " + num(mesh.triangle_count()) + " 0\n";
-  append_vertices(s, mesh, "");
+  const size_t n = mesh.vertex_count();
+  const VertexAttribute *colour = mesh.find(AttributeKind::Colour);
+  const VertexAttribute *normal = mesh.find(AttributeKind::Normal);
+  if (colour && colour->vertex_count() != n)
+    colour = nullptr;
+  if (normal && normal->vertex_count() != n)
+    normal = nullptr;
+  std::string s = std::string(colour ? "C" : "") + (normal ? "N" : "") + "OFF\n" + num(n) + " " +
+                  num(mesh.triangle_count()) + " 0\n";
+  if (!colour && !normal) {
+    append_vertices(s, mesh, "");
+  } else { // one vertex a line: x y z [nx ny nz] [r g b [a]] (vcglib's importer needs it)
+    for (size_t v = 0; v < n; ++v) {
+      append_point(s, &mesh.positions[3 * v]);
+      if (normal) {
+        s += ' ';
+        append_point(s, &normal->values[3 * v]);
+      }
+      for (uint32_t k = 0; colour && k < colour->components; ++k) {
+        s += ' ';
+        append_uint(s, colour->colour[v * colour->components + k]);
+      }
+      s += '\n';
+    }
+  }
   append_triangles(s, mesh, "3 ", 0);
   return s;
 }

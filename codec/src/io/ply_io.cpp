@@ -20,9 +20,9 @@ enum class PlyType { I8, U8, I16, U16, I32, U32, F32, F64 };
 
 struct PlyProperty {
   std::string name;
-  PlyType type = PlyType::F32;       // list items for a list
+  PlyType type = PlyType::F32; // list items for a list
   bool is_list = false;
-  PlyType count_type = PlyType::U8;  // lists only
+  PlyType count_type = PlyType::U8; // lists only
 };
 
 struct PlyElement {
@@ -55,21 +55,31 @@ struct PlyHeader {
 
 size_t type_size(PlyType t) {
   switch (t) {
-  case PlyType::I8: case PlyType::U8: return 1;
-  case PlyType::I16: case PlyType::U16: return 2;
-  case PlyType::I32: case PlyType::U32: case PlyType::F32: return 4;
-  case PlyType::F64: return 8;
+  case PlyType::I8:
+  case PlyType::U8:
+    return 1;
+  case PlyType::I16:
+  case PlyType::U16:
+    return 2;
+  case PlyType::I32:
+  case PlyType::U32:
+  case PlyType::F32:
+    return 4;
+  case PlyType::F64:
+    return 8;
   }
   return 0;
 }
 
 /// The type names plylib accepts (classic and sized spellings).
 bool parse_ply_type(const std::string &s, PlyType &t) {
-  static const struct { const char *a, *b; PlyType t; } names[] = {
-      {"char", "int8", PlyType::I8},     {"uchar", "uint8", PlyType::U8},
-      {"short", "int16", PlyType::I16},  {"ushort", "uint16", PlyType::U16},
-      {"int", "int32", PlyType::I32},    {"uint", "uint32", PlyType::U32},
-      {"float", "float32", PlyType::F32}, {"double", "float64", PlyType::F64}};
+  static const struct {
+    const char *a, *b;
+    PlyType t;
+  } names[] = {{"char", "int8", PlyType::I8},      {"uchar", "uint8", PlyType::U8},
+               {"short", "int16", PlyType::I16},   {"ushort", "uint16", PlyType::U16},
+               {"int", "int32", PlyType::I32},     {"uint", "uint32", PlyType::U32},
+               {"float", "float32", PlyType::F32}, {"double", "float64", PlyType::F64}};
   for (const auto &n : names)
     if (s == n.a || s == n.b) {
       t = n.t;
@@ -177,9 +187,9 @@ PlyHeader read_ply_header(FileReader &in, const std::string &path) {
 /// What the walk found; the triangle count is what vcglib's importer will build.
 struct PlyLayout {
   size_t vertices = 0;
-  size_t faces = 0;     // polygons of the face element, or triangles of the strips
+  size_t faces = 0; // polygons of the face element, or triangles of the strips
   size_t triangles = 0;
-  size_t polygons = 0;  // faces with more than 3 corners
+  size_t polygons = 0; // faces with more than 3 corners
   bool edges = false, camera = false;
 };
 
@@ -293,10 +303,14 @@ private:
   static int64_t decode(PlyType t, const unsigned char *b) {
     const uint32_t u = b[0] | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24;
     switch (t) {
-    case PlyType::I8: return static_cast<int8_t>(u);
-    case PlyType::I16: return static_cast<int16_t>(u);
-    case PlyType::I32: return static_cast<int32_t>(u);
-    default: return u; // U8, U16, U32
+    case PlyType::I8:
+      return static_cast<int8_t>(u);
+    case PlyType::I16:
+      return static_cast<int16_t>(u);
+    case PlyType::I32:
+      return static_cast<int32_t>(u);
+    default:
+      return u; // U8, U16, U32
     }
   }
 
@@ -370,9 +384,8 @@ PlyVertexPlan plan_vertex_attributes(const PlyElement *vertex, std::vector<std::
   const int nx = index("nx"), ny = index("ny"), nz = index("nz");
   if (nx >= 0 && ny >= 0 && nz >= 0 && is_float(nx) && is_float(ny) && is_float(nz))
     add(AttributeKind::Normal, "normal", {nx, ny, nz});
-  for (const auto &uv : {std::pair<const char *, const char *>{"texture_u", "texture_v"},
-                         {"u", "v"},
-                         {"s", "t"}}) {
+  for (const auto &uv :
+       {std::pair<const char *, const char *>{"texture_u", "texture_v"}, {"u", "v"}, {"s", "t"}}) {
     const int u = index(uv.first), v = index(uv.second);
     if (u >= 0 && v >= 0 && !taken[u] && !taken[v] && is_float(u) && is_float(v)) {
       add(AttributeKind::TexCoord, "texcoord", {u, v});
@@ -439,20 +452,24 @@ private:
       conn_ = nullptr;
     for (const PlyElement *e : {face, strips})
       if (e && e->count > 0 && e != conn_)
-        fail(path_, "PLY " + e->name + " element without a vertex index list of a type vcglib reads");
+        fail(path_,
+             "PLY " + e->name + " element without a vertex index list of a type vcglib reads");
     // plylib cannot byte-swap doubles (SwapDouble() is an assert(0)); these it would store.
     for (const char *name : {"x", "y", "z", "nx", "ny", "nz"})
-      if (h_.encoding == PlyHeader::BinaryBig && vertex && is_scalar_of(vertex->find(name), PlyType::F64))
+      if (h_.encoding == PlyHeader::BinaryBig && vertex &&
+          is_scalar_of(vertex->find(name), PlyType::F64))
         fail(path_, "big-endian PLY with double vertex data, which vcglib cannot read");
     // plylib reads binary index lists with a one-byte count unless the items are int.
     if (conn_prop_ && h_.encoding != PlyHeader::Ascii && conn_prop_->type != PlyType::I32 &&
         type_size(conn_prop_->count_type) != 1)
-      fail(path_, "PLY " + conn_->name + " list with a count wider than a byte and non-int indices, "
-                  "which vcglib misreads in binary files");
+      fail(path_, "PLY " + conn_->name +
+                      " list with a count wider than a byte and non-int indices, "
+                      "which vcglib misreads in binary files");
     if (conn_ && conn_->count > 0 && (!vertex || conn_ < vertex))
       fail(path_, "PLY " + conn_->name + " element comes before the vertex element");
     if (edge && edge->count > 0 &&
-        !(is_scalar_of(edge->find("vertex1"), PlyType::I32) && is_scalar_of(edge->find("vertex2"), PlyType::I32)))
+        !(is_scalar_of(edge->find("vertex1"), PlyType::I32) &&
+          is_scalar_of(edge->find("vertex2"), PlyType::I32)))
       fail(path_, "PLY edge element without int vertex1/vertex2 properties");
   }
 
@@ -472,14 +489,16 @@ private:
   /// The face's index list if its types are among those vcglib reads (FaceDesc 0, 13-24).
   static const PlyProperty *face_index_list(const PlyElement &face) {
     using T = PlyType;
-    static const struct { const char *name; T item, count; } kinds[] = {
-        {"vertex_indices", T::I32, T::U8},  {"vertex_index", T::I32, T::U8},
-        {"vertex_index", T::I32, T::I8},    {"vertex_index", T::I32, T::I32},
-        {"vertex_indices", T::I32, T::I8},  {"vertex_indices", T::I32, T::I32},
-        {"vertex_indices", T::U32, T::U8},  {"vertex_indices", T::U32, T::I8},
-        {"vertex_indices", T::U32, T::I32}, {"vertex_indices", T::U32, T::U16},
-        {"vertex_indices", T::I16, T::I8},  {"vertex_indices", T::I16, T::U8},
-        {"vertex_indices", T::I16, T::I32}};
+    static const struct {
+      const char *name;
+      T item, count;
+    } kinds[] = {{"vertex_indices", T::I32, T::U8},  {"vertex_index", T::I32, T::U8},
+                 {"vertex_index", T::I32, T::I8},    {"vertex_index", T::I32, T::I32},
+                 {"vertex_indices", T::I32, T::I8},  {"vertex_indices", T::I32, T::I32},
+                 {"vertex_indices", T::U32, T::U8},  {"vertex_indices", T::U32, T::I8},
+                 {"vertex_indices", T::U32, T::I32}, {"vertex_indices", T::U32, T::U16},
+                 {"vertex_indices", T::I16, T::I8},  {"vertex_indices", T::I16, T::U8},
+                 {"vertex_indices", T::I16, T::I32}};
     for (const auto &k : kinds)
       if (is_list_of(face.find(k.name), k.item, k.count))
         return face.find(k.name);
@@ -515,12 +534,14 @@ private:
     if (!p.is_list || h_.encoding == PlyHeader::Ascii)
       return values_.skip(p);
     if (type_size(p.count_type) != 1)
-      fail(path_, "PLY list '" + p.name + "' has a count wider than a byte, which vcglib misreads in binary files");
+      fail(path_, "PLY list '" + p.name +
+                      "' has a count wider than a byte, which vcglib misreads in binary files");
     int64_t n = 0;
     if (!values_.integer(p.count_type, n))
       return false;
     if (n < 0 || static_cast<uint64_t>(n) * type_size(p.type) > 512)
-      fail(path_, "PLY list '" + p.name + "' of " + std::to_string(n) + " items is too long for vcglib");
+      fail(path_,
+           "PLY list '" + p.name + "' of " + std::to_string(n) + " items is too long for vcglib");
     if (n == 0)
       fail(path_, "PLY list '" + p.name + "' is empty, which vcglib cannot skip in binary files");
     return values_.skip(p.type, static_cast<uint64_t>(n));
@@ -679,8 +700,8 @@ bool read_simple_ply(FileReader &in, const PlyHeader &h, Mesh &out, size_t &unre
       (list.type != PlyType::I32 && list.type != PlyType::U32))
     return false;
   const uint64_t nv = ve.count, nf = fe.count;
-  if (nv == 0 || nf == 0 || nv >= UINT32_MAX || nf > UINT32_MAX / 3 ||
-      in.remaining() / 13 < nf || in.remaining() - 13 * nf < 12 * nv)
+  if (nv == 0 || nf == 0 || nv >= UINT32_MAX || nf > UINT32_MAX / 3 || in.remaining() / 13 < nf ||
+      in.remaining() - 13 * nf < 12 * nv)
     return false;
   std::vector<float> positions(3 * nv);
   if (!in.read(positions.data(), 12 * nv))
@@ -763,8 +784,8 @@ Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &chec
   PlyImporter::LoadMask(path.c_str(), file_mask);
   {
     using M = vcg::tri::io::Mask; // per-vertex data is read by the walk (plan)
-    file_mask &= ~(M::IOM_VERTCOLOR | M::IOM_VERTNORMAL | M::IOM_VERTQUALITY |
-                   M::IOM_VERTTEXCOORD | M::IOM_VERTRADIUS | M::IOM_VERTFLAGS);
+    file_mask &= ~(M::IOM_VERTCOLOR | M::IOM_VERTNORMAL | M::IOM_VERTQUALITY | M::IOM_VERTTEXCOORD |
+                   M::IOM_VERTRADIUS | M::IOM_VERTFLAGS);
   }
   add_ignored_from_mask(file_mask, report.ignored_attributes);
   if (layout.edges)
@@ -796,23 +817,52 @@ Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &chec
 }
 
 std::string ply_ascii_text(const Mesh &mesh) {
-  std::string s = "ply\nformat ascii 1.0\ncomment pomar\nelement vertex " + num(mesh.vertex_count()) +
-                  "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
-                  num(mesh.triangle_count()) + "\nproperty list uchar int vertex_indices\nend_header\n";
+  std::string s =
+      "ply\nformat ascii 1.0\ncomment pomar\nelement vertex " + num(mesh.vertex_count()) +
+      "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
+      num(mesh.triangle_count()) + "\nproperty list uchar int vertex_indices\nend_header\n";
   append_vertices(s, mesh, "");
   append_triangles(s, mesh, "3 ", 0);
   return s;
 }
 
 namespace {
-void put_le(std::string &out, uint32_t v, int bytes) {
-  for (int i = 0; i < bytes; ++i)
-    out += static_cast<char>((v >> (8 * i)) & 0xFF);
-}
-void put_float(std::string &out, float f) {
-  uint32_t v;
-  std::memcpy(&v, &f, 4);
-  put_le(out, v, 4);
+/// The binary little-endian body of ply_with_attributes: every vertex record (x y z, then
+/// each attribute's components in the header's order) and every face, written into a
+/// buffer sized once (a byte at a time through std::string::operator+= was 10x slower).
+void append_binary_body(std::string &s, const Mesh &mesh) {
+  const size_t nv = mesh.vertex_count(), nt = mesh.triangle_count();
+  size_t record = 12;
+  for (const VertexAttribute &a : mesh.attributes)
+    record += a.kind == AttributeKind::Colour ? a.components : 4 * size_t(a.components);
+  const size_t start = s.size();
+  s.resize(start + nv * record + 13 * nt);
+  char *p = &s[start];
+  auto put32 = [&p](uint32_t v) {
+    for (int i = 0; i < 4; ++i)
+      *p++ = static_cast<char>((v >> (8 * i)) & 0xFF);
+  };
+  auto put_float32 = [&put32](float f) {
+    uint32_t v;
+    std::memcpy(&v, &f, 4);
+    put32(v);
+  };
+  for (size_t v = 0; v < nv; ++v) {
+    for (int k = 0; k < 3; ++k)
+      put_float32(mesh.positions[3 * v + k]);
+    for (const VertexAttribute &a : mesh.attributes)
+      for (uint32_t k = 0; k < a.components; ++k) {
+        if (a.kind == AttributeKind::Colour)
+          *p++ = static_cast<char>(a.colour[v * a.components + k]);
+        else
+          put_float32(a.values[v * a.components + k]);
+      }
+  }
+  for (size_t t = 0; t < nt; ++t) {
+    *p++ = static_cast<char>(3);
+    for (int k = 0; k < 3; ++k)
+      put32(mesh.triangles[3 * t + k]);
+  }
 }
 } // namespace
 
@@ -858,42 +908,28 @@ std::string ply_with_attributes(const Mesh &mesh, bool binary, const std::string
   }
   s += "element face " + num(mesh.triangle_count()) +
        "\nproperty list uchar int vertex_indices\nend_header\n";
-  for (size_t v = 0; v < nv; ++v) {
+  if (binary) {
+    append_binary_body(s, mesh);
+    return s;
+  }
+  for (size_t v = 0; v < nv; ++v) { // ASCII
     for (int k = 0; k < 3; ++k) {
-      if (binary) {
-        put_float(s, mesh.positions[3 * v + k]);
-      } else {
-        if (k)
-          s += ' ';
-        append_float(s, mesh.positions[3 * v + k]);
-      }
+      if (k)
+        s += ' ';
+      append_float(s, mesh.positions[3 * v + k]);
     }
     for (const VertexAttribute &a : mesh.attributes)
       for (uint32_t k = 0; k < a.components; ++k) {
         if (a.kind == AttributeKind::Colour) {
-          if (binary)
-            s += static_cast<char>(a.colour[v * a.components + k]);
-          else
-            s += ' ' + std::to_string(a.colour[v * a.components + k]);
-        } else if (binary) {
-          put_float(s, a.values[v * a.components + k]);
+          s += ' ' + std::to_string(a.colour[v * a.components + k]);
         } else {
           s += ' ';
           append_float(s, a.values[v * a.components + k]);
         }
       }
-    if (!binary)
-      s += '\n';
+    s += '\n';
   }
-  if (!binary) {
-    append_triangles(s, mesh, "3 ", 0);
-    return s;
-  }
-  for (size_t t = 0; t < mesh.triangle_count(); ++t) {
-    s += static_cast<char>(3);
-    for (int k = 0; k < 3; ++k)
-      put_le(s, mesh.triangles[3 * t + k], 4);
-  }
+  append_triangles(s, mesh, "3 ", 0);
   return s;
 }
 
@@ -904,10 +940,11 @@ void save_ply_binary(const std::string &path, const Mesh &mesh) {
   // of through a vcglib copy and one fwrite per value.
   const uint64_t nv = mesh.vertex_count(), nf = mesh.triangle_count();
   const std::string header = "ply\nformat binary_little_endian 1.0\ncomment VCGLIB generated\n"
-                             "element vertex " + num(nv) +
+                             "element vertex " +
+                             num(nv) +
                              "\nproperty float x\nproperty float y\nproperty float z\n"
-                             "element face " + num(nf) +
-                             "\nproperty list uchar int vertex_indices\nend_header\n";
+                             "element face " +
+                             num(nf) + "\nproperty list uchar int vertex_indices\nend_header\n";
   ChunkedFileWriter out(path);
   out.put(header.data(), header.size());
   out.put(mesh.positions.data(), 12 * nv);

@@ -2,6 +2,8 @@
 // the process, and the check that refuses a mesh before the large allocations.
 #include "pomar/limits.h"
 
+#include "attributes/attribute_quantize.h"
+
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
@@ -37,6 +39,25 @@ constexpr uint64_t kClusteredDecodePerVertex = 64;
 constexpr uint64_t kClusteredDecodePerFace = 60;
 constexpr uint64_t kProgressiveDecodePerVertex = 86;
 constexpr uint64_t kProgressiveDecodePerFace = 40;
+
+// Per-vertex attributes (bench/README.md, "Memory", attributes): a 1M-vertex torus (2M
+// faces) with 8 codes per vertex (RGB, normal, quality, UV) peaked 611 B/vertex above the
+// same mesh without attributes when encoding, with 1 code (quality) 96 B/vertex: about
+// 22 + 74 B per code, rounded up. Decoding: 97 B/vertex (8 codes, 27 bytes of values) and
+// 12 B/vertex (1 code, 4 bytes): the codes (8 B each) plus the values, plus slack.
+constexpr uint64_t kEncodeAttributeFixed = 32;
+constexpr uint64_t kEncodePerAttributeCode = 84;
+constexpr uint64_t kDecodePerAttributeCode = 8;
+constexpr uint64_t kDecodeAttributeFixed = 16;
+
+/// Integer codes per vertex of one stored attribute (StoredAttribute::codes).
+uint32_t code_count(AttributeKind kind, uint32_t components, int bits) {
+  StoredAttribute s;
+  s.kind = kind;
+  s.components = components;
+  s.bits = bits;
+  return s.codes();
+}
 
 /// a + b * c, saturating at UINT64_MAX (counts come from untrusted headers).
 uint64_t add_mul(uint64_t a, uint64_t b, uint64_t c) {
@@ -201,6 +222,26 @@ uint64_t decode_memory_estimate(uint64_t vertices, uint64_t faces, bool clustere
   return add_mul(add_mul(kDecodeFixed, vertices, per_vertex), faces, per_face);
 }
 
+uint64_t encode_attribute_bytes_per_vertex(const Mesh &mesh, const AttributeOptions &options) {
+  uint64_t codes = 0;
+  for (const VertexAttribute &a : mesh.attributes)
+    if (options.keep.keeps(a.kind))
+      codes += code_count(a.kind, a.components, options.exact ? 0 : 1);
+  return codes ? kEncodeAttributeFixed + kEncodePerAttributeCode * codes : 0;
+}
+
+uint64_t decode_attribute_bytes_per_vertex(const FileInfo &info, const AttributeMask &keep) {
+  uint64_t codes = 0, values = 0;
+  for (const AttributeInfo &a : info.attributes) {
+    codes += code_count(a.kind, a.components, a.bits);
+    if (keep.keeps(a.kind))
+      values += a.components * (a.kind == AttributeKind::Colour ? 1 : sizeof(float));
+  }
+  if (values == 0) // nothing returned: the decoder reads past the codes without storing them
+    return 0;
+  return kDecodeAttributeFixed + kDecodePerAttributeCode * codes + values;
+}
+
 AvailableMemory available_memory(const std::string &root) {
   AvailableMemory best;
   uint64_t bytes = 0;
@@ -290,26 +331,27 @@ void check_memory(const char *action, uint64_t vertices, uint64_t faces, uint64_
                                             "; use --max-memory to change the limit");
 }
 
-void check_encode_memory(uint64_t vertices, uint64_t faces, uint64_t limit, uint64_t held) {
-  check_memory("encode", vertices, faces, encode_memory_estimate(vertices, faces), held, limit);
-}
-
-void check_decode_memory(const FileInfo &info, int level, uint64_t limit) {
-  check_decode_memory(info, level, limit, 1);
+void check_encode_memory(uint64_t vertices, uint64_t faces, uint64_t limit, uint64_t held,
+                         uint64_t attribute_bytes) {
+  check_memory("encode", vertices, faces,
+               add_mul(encode_memory_estimate(vertices, faces), vertices, attribute_bytes), held,
+               limit);
 }
 
 uint64_t decode_thread_memory(uint64_t vertices, uint64_t faces) {
   return add_mul(add_mul(0, vertices, 8), faces, 4);
 }
 
-void check_decode_memory(const FileInfo &info, int level, uint64_t limit, unsigned threads) {
+void check_decode_memory(const FileInfo &info, int level, uint64_t limit, const AttributeMask &keep,
+                         unsigned threads) {
   uint64_t v = info.vertices, f = info.faces;
   if (level == 0) {
     v = info.base_vertices, f = info.base_faces;
   } else if (level > 0 && static_cast<size_t>(level) <= info.levels.size()) {
     v = info.levels[size_t(level) - 1].vertices, f = info.levels[size_t(level) - 1].faces;
   }
-  uint64_t needed = decode_memory_estimate(v, f, info.clustered());
+  uint64_t needed = add_mul(decode_memory_estimate(v, f, info.clustered()), v,
+                           decode_attribute_bytes_per_vertex(info, keep));
   if (info.clustered() && threads > 1)
     needed = add_mul(needed, threads - 1, decode_thread_memory(v, f));
   check_memory("decode", v, f, needed, 0, limit);

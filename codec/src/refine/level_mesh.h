@@ -29,6 +29,9 @@ struct LevelMesh {
   // [attr_lo[k], attr_hi[k]]; a split vertex's codes are coded after its position.
   uint32_t attr_codes = 0;
   std::vector<int64_t> attr, attr_lo, attr_hi;
+  // A decode that returns no attribute: the codes per split vertex read and dropped (the
+  // residuals share the streams of the positions), with attr_codes = 0 and attr empty.
+  uint32_t attr_skipped = 0;
   int normal_code = -1; // first code of a quantized normal attribute (-1: none)
   int normal_bits = 0;  // its octahedral bits
   uint32_t vertex_count() const { return ct.vertex_count(); }
@@ -57,6 +60,7 @@ struct LevelMesh {
     ct.O.reserve(3 * faces);
     ct.VC.reserve(vertices);
     q.reserve(3 * vertices);
+    attr.reserve(attr_codes * vertices);
     tag.reserve(vertices);
     parent.reserve(vertices);
     if (!local.empty())

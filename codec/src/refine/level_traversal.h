@@ -16,12 +16,15 @@
 //   void geometry(uint32_t v_to, const Prediction& prediction, int32_t position[3]);
 //                                     // prediction: geometry/predict.h
 //   void attributes(const LevelMesh& mesh, const int64_t* prediction, int64_t* codes); // if any
+//   void skip_attributes(uint32_t n);  // optional (decoder): read past n codes (attr_skipped)
 //   [[noreturn]] void corrupt(const char* what);
 #pragma once
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "attributes/attribute_quantize.h"
@@ -216,6 +219,13 @@ inline void predict_attributes(const LevelMesh &mesh, uint32_t v_to, const Ring 
 /// What a stream whose patches overlap is told.
 constexpr const char *kSharedFace = "two vertex splits of one level share a face";
 
+/// Whether a Codec can read past attribute codes (the decoder's skip_attributes).
+template <class Codec, class = void> struct SkipsAttributes : std::false_type {};
+template <class Codec>
+struct SkipsAttributes<Codec,
+                       std::void_t<decltype(std::declval<Codec &>().skip_attributes(0u))>>
+    : std::true_type {};
+
 /// Code (or decode) s_v at v and, for a split vertex, the split: symbols, patch, claim of
 /// its faces, prediction and position. `ring` is v's ring as the level sees it.
 template <class Codec, class Key>
@@ -259,6 +269,9 @@ void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v,
     int64_t pred[kMaxAttributeCodes];
     predict_attributes(mesh, v, ring, p, ps.v_from.position, pred);
     codec.attributes(mesh, pred, ps.v_from.attr);
+  } else if constexpr (SkipsAttributes<Codec>::value) {
+    if (mesh.attr_skipped)
+      codec.skip_attributes(mesh.attr_skipped);
   }
   splits.push_back(ps);
 }

@@ -1,0 +1,122 @@
+// Bytes fetched for views of a .pomar file through the web viewer's own streaming code
+// (web/pomar_stream.js over web/range_fetch.js, view_refine.js for the views), in Node.js
+// with the file as a Blob: the same requests the browser would make, counted.
+//
+//   node bench/web_view_bench.mjs FILE.pomar [--closeup 0.1] [--target 3] [--size 800x457]
+//        [--clusters 1000,2000] [--maxGap B] [--wholeBlockBytes B] [--estimateMargin F]
+//        [--backface] [--no-occlusion]
+//
+// Reports, each from a fresh stream: the base clustered mesh (open), the overview (whole
+// model framed as the viewer frames it, refined to `target` pixels), a close-up (the
+// surface point facing the camera seen from `closeup` x the model's size, as
+// web/test/page_test.js does) and single clusters raised to the finest level. Percentages
+// are of the file size; "requests" counts Range requests. See web/README.md for the table.
+// DEBUG=1 also prints, per refinement step, the clusters refined, coarsened, hidden
+// (outside the frustum) and culled (occluded or back-facing), and for each close-up its
+// final level map (level:clusters) and the bytes held per level.
+import { readFileSync } from 'node:fs';
+import { PomarStream } from '../web/pomar_stream.js';
+import { RangeFile } from '../web/range_fetch.js';
+import { chooseLevels, Convergence } from '../web/view_refine.js';
+import { closeUp, frameMesh, orbitCamera, viewOf } from '../web/camera.js';
+import { loadModuleInNode } from '../web/test/node_support.mjs';
+
+const args = process.argv.slice(2);
+const file = args[0] && !args[0].startsWith('--') ? args[0] : null;
+const opt = (name, fallback) => {
+  const k = args.indexOf('--' + name);
+  return k >= 0 ? args[k + 1] : fallback;
+};
+if (!file) {
+  console.error('usage: node bench/web_view_bench.mjs FILE.pomar [--closeup F] [--target PX] [--size WxH] ' +
+    '[--clusters C,C] [--maxGap B] [--wholeBlockBytes B] [--estimateMargin F] [--backface] [--no-occlusion]');
+  process.exit(2);
+}
+const [width, height] = opt('size', '800x457').split('x').map(Number);
+const fetchOptions = { maxGap: 128 }; // pomar.js's default
+for (const name of ['maxGap', 'wholeBlockBytes', 'estimateMargin', 'estimateSlack'])
+  if (opt(name) !== undefined) fetchOptions[name] = Number(opt(name));
+const settings = { targetPixels: Number(opt('target', 3)), backface: args.includes('--backface'),
+  occlusion: !args.includes('--no-occlusion') };
+const M = await loadModuleInNode();
+const blob = new Blob([readFileSync(file)]);
+
+async function fresh() {
+  const stream = await new PomarStream(M, new RangeFile(blob, fetchOptions), fetchOptions).open();
+  return { stream, mesh: stream.decoder.mesh(), errorSeen: new Map() };
+}
+const pct = (s, b) => `${(100 * b / s.file.size).toFixed(2)}%`;
+function line(what, s, extra = '') {
+  const f = s.stream.file.stats;
+  const raised = s.stream.levels.filter((l) => l > s.stream.info.baseLevel).length;
+  console.log(`${what.padEnd(22)} ${pct(s.stream, f.bytesFetched).padStart(7)} ${String(f.bytesFetched).padStart(8)} B ` +
+    `${String(f.requests).padStart(5)} requests ${String(s.mesh.triangles.length / 3).padStart(7)} triangles ` +
+    `${String(raised).padStart(5)} clusters raised, ${s.stream.retries} short prefixes${extra}`);
+}
+/** Refine for the camera until stable, as the viewer's loop does. */
+async function settle(s, camera) {
+  let steps = 0;
+  const convergence = new Convergence();
+  const t0 = performance.now();
+  for (; steps < 64; ++steps) {
+    const v = viewOf(camera, width, height);
+    const choice = chooseLevels({ info: s.stream.info, levels: s.stream.levels, clusterBounds: s.mesh.clusterBounds,
+      errorSeen: s.errorSeen, mesh: s.mesh }, v, settings);
+    if (process.env.DEBUG) console.log(steps, choice.refine, choice.coarsen, choice.hidden, choice.culled);
+    const wanted = choice.changed ? convergence.next(choice.levels, s.stream.levels, v) : null;
+    if (!wanted) break;
+    await s.stream.want(wanted);
+    s.mesh = s.stream.decoder.mesh();
+  }
+  return `, ${steps} steps, ${((performance.now() - t0) / 1000).toFixed(1)} s`;
+}
+
+let s = await fresh();
+const info = s.stream.info;
+console.log(`${file}: ${info.vertices} vertices, ${info.fileBytes} bytes, ${info.clusters} clusters, levels ` +
+  `${info.baseLevel}..${info.finestLevel}, global part ${info.globalBytes} B (${pct(s.stream, info.globalBytes)}); ` +
+  `view ${width}x${height}, target ${settings.targetPixels} px, backface ${settings.backface}, occlusion ` +
+  `${settings.occlusion}, fetch ${JSON.stringify(fetchOptions)}`);
+line('open (base mesh)', s);
+if (info.clusters) {
+  const camera = orbitCamera();
+  frameMesh(camera, s.mesh.positions);
+  line('overview', s, await settle(s, camera));
+  s.stream.close();
+  for (const fraction of opt('closeup', '0.1').split(',').map(Number)) {
+    s = await fresh();
+    const c = orbitCamera();
+    frameMesh(c, s.mesh.positions);
+    closeUp(c, s.mesh.positions, fraction);
+    line(`close-up ${fraction}`, s, await settle(s, c));
+    // The level map it converged to, asked at once from a fresh stream: the bytes the
+    // fetch policy alone costs, without the steps of refinement.
+    const final = s.stream.levels;
+    if (process.env.DEBUG) {
+      const histogram = new Map();
+      for (const l of final) histogram.set(l, (histogram.get(l) || 0) + 1);
+      console.log([...histogram.entries()].sort((a, b) => a[0] - b[0]).map(([l, k]) => `${l}:${k}`).join(' '));
+    }
+    s.stream.close();
+    s = await fresh();
+    await s.stream.want(final);
+    s.mesh = s.stream.decoder.mesh();
+    line(`  its map at once`, s);
+    if (process.env.DEBUG) {
+      const byLevel = new Map();
+      for (let c = 0; c < final.length; ++c) byLevel.set(final[c], (byLevel.get(final[c]) || 0) + s.stream.have[c]);
+      console.log([...byLevel.entries()].sort((a, b) => a[0] - b[0]).map(([l, k]) => `${l}:${k}`).join(' '));
+    }
+    s.stream.close();
+  }
+  const clusters = opt('clusters', [1, 2, 3, 4].map((k) => Math.floor(k * info.clusters / 4.5)).join(','));
+  for (const c of clusters.split(',').map(Number)) {
+    s = await fresh();
+    const levels = s.stream.baseLevels;
+    levels[c] = info.finestLevel;
+    await s.stream.want(levels);
+    s.mesh = s.stream.decoder.mesh();
+    line(`cluster ${c} finest`, s);
+    s.stream.close();
+  }
+}

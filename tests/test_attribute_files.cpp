@@ -1,0 +1,209 @@
+// Attributes in mesh files: OBJ texture names (mtllib + map_Kd) and UVs through .pomar,
+// OFF colour and normals written back exactly, and what each writer cannot hold named.
+#include <pomar/mesh_io.h>
+#include <pomar/pomar.h>
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include <dirent.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "support/mesh_attributes.h"
+#include "support/mesh_gen.h"
+#include "support/temp_dir.h"
+
+namespace pomar {
+namespace {
+
+using AttributeFiles = test::TempDirTest;
+
+std::string read_text(const std::string &path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+std::string joined(const std::vector<std::string> &list) {
+  std::string out;
+  for (const std::string &s : list)
+    out += (out.empty() ? "" : " | ") + s;
+  return out;
+}
+
+/// An n x n grid in the OBJ format with a texture coordinate per vertex ("f a/a b/b c/c"),
+/// naming the material library `mtllib` and using material `material`.
+std::string uv_grid_obj(int n, const std::string &mtllib, const std::string &material) {
+  std::string s = "mtllib " + mtllib + "\n";
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i)
+      s += "v " + std::to_string(i) + " " + std::to_string(j) + " " +
+           std::to_string(0.1 * ((i * 7 + j * 3) % 5)) + "\n";
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i)
+      s += "vt " + std::to_string(i / double(n - 1)) + " " + std::to_string(j / double(n - 1)) +
+           "\n";
+  s += "usemtl " + material + "\n";
+  for (int j = 0; j + 1 < n; ++j)
+    for (int i = 0; i + 1 < n; ++i) {
+      const std::string a = std::to_string(j * n + i + 1), b = std::to_string(j * n + i + 2),
+                        c = std::to_string((j + 1) * n + i + 1),
+                        d = std::to_string((j + 1) * n + i + 2);
+      s += "f " + a + "/" + a + " " + b + "/" + b + " " + d + "/" + d + "\n";
+      s += "f " + a + "/" + a + " " + d + "/" + d + " " + c + "/" + c + "\n";
+    }
+  return s;
+}
+
+TEST_F(AttributeFiles, ObjTextureNamesAndUvsRoundTripThroughPomar) {
+  write("tex.mtl", "newmtl skin\nKd 1 1 1\nmap_Kd my skin.png\n");
+  const std::string in = write("in.obj", uv_grid_obj(12, "tex.mtl", "skin"));
+  LoadReport r;
+  const Mesh original = load_mesh(in, &r);
+  EXPECT_TRUE(r.ignored_attributes.empty()) << joined(r.ignored_attributes);
+  EXPECT_EQ(original.texture_files, std::vector<std::string>{"my skin.png"});
+  ASSERT_NE(original.find(AttributeKind::TexCoord), nullptr);
+
+  EncodeOptions exact;
+  exact.attributes.exact = true; // UVs bit for bit: the OBJ written back has the input's
+  const std::vector<uint8_t> file = encode(original, exact);
+  const Mesh decoded = decode(file.data(), file.size());
+  EXPECT_EQ(decoded.texture_files, original.texture_files);
+  const std::string out = path("out dir.obj"); // a space: the mtllib name is escaped
+  save_mesh(out, decoded);
+  EXPECT_TRUE(attributes_not_saved(out, decoded).empty());
+  const std::string mtl = read_text(path("out dir.mtl"));
+  EXPECT_NE(mtl.find("map_Kd my skin.png\n"), std::string::npos) << mtl;
+  const std::string obj = read_text(out);
+  EXPECT_NE(obj.find("mtllib out\\ dir.mtl\n"), std::string::npos);
+  EXPECT_NE(obj.find("\nusemtl texture_0\n"), std::string::npos);
+  EXPECT_NE(obj.find("\nvt "), std::string::npos);
+
+  LoadReport back_report;
+  const Mesh back = load_mesh(out, &back_report);
+  EXPECT_TRUE(back_report.ignored_attributes.empty()) << joined(back_report.ignored_attributes);
+  EXPECT_EQ(back.texture_files, original.texture_files);
+  EXPECT_EQ(back.positions, decoded.positions);
+  EXPECT_EQ(back.triangles, decoded.triangles);
+  ASSERT_NE(back.find(AttributeKind::TexCoord), nullptr);
+  EXPECT_EQ(back.find(AttributeKind::TexCoord)->values,
+            decoded.find(AttributeKind::TexCoord)->values);
+  // The decoded mesh is the input (up to the 12-bit grid): same UVs per input vertex.
+  const std::vector<uint8_t> again = encode(back, exact);
+  EXPECT_EQ(decode(again.data(), again.size()).texture_files, original.texture_files);
+}
+
+TEST_F(AttributeFiles, ObjMaterialsNotKeptAreNamed) {
+  // Missing library: the names are lost, and said so.
+  LoadReport r;
+  load_mesh(write("a.obj", uv_grid_obj(4, "nowhere.mtl", "m")), &r);
+  EXPECT_NE(joined(r.ignored_attributes).find("material library 'nowhere.mtl' not found"),
+            std::string::npos)
+      << joined(r.ignored_attributes);
+  // Other properties and two materials: the texture names are kept, the rest named.
+  write("two.mtl", "newmtl m\nKa 0.2 0.2 0.2\nKd 1 1 1\nillum 2\nmap_Kd a.png\n"
+                   "newmtl n\nmap_Kd b.png\n");
+  std::string text = uv_grid_obj(4, "two.mtl", "m");
+  text.insert(text.rfind("f "), "usemtl n\n");
+  const Mesh m = load_mesh(write("b.obj", text), &r);
+  EXPECT_EQ(m.texture_files, (std::vector<std::string>{"a.png", "b.png"}));
+  const std::string ignored = joined(r.ignored_attributes);
+  EXPECT_NE(ignored.find("material properties other than texture names (Ka illum)"),
+            std::string::npos)
+      << ignored;
+  EXPECT_NE(ignored.find("which material each face uses (2 materials"), std::string::npos)
+      << ignored;
+  // A library that is a directory, a device or a /proc file (which could block) is not read.
+  ASSERT_EQ(mkdir(path("dir.mtl").c_str(), 0700), 0);
+  for (const char *name : {"dir.mtl", "/dev/zero", "/proc/self/status"}) {
+    load_mesh(write("c.obj", uv_grid_obj(4, name, "m")), &r);
+    EXPECT_NE(joined(r.ignored_attributes)
+                  .find("'" + std::string(name) + "' not a regular file of 1 byte to 64 MiB"),
+              std::string::npos)
+        << joined(r.ignored_attributes);
+  }
+}
+
+TEST_F(AttributeFiles, TextureNamesWithLineBreaksAreRefused) {
+  Mesh m = gen::noisy_sphere(50, 1, 0.1);
+  m.texture_files = {"a\nb.png"};
+  EXPECT_THROW(save_mesh(path("x.obj"), m), Error);
+  EXPECT_THROW(save_mesh(path("x.ply"), m), Error);
+}
+
+TEST_F(AttributeFiles, OffColourAndNormalsAreWrittenAndReadBackExactly) {
+  for (const int has : {int(kColour), kColour | kAlpha, int(kNormals), kColour | kNormals}) {
+    const Mesh m = with_attributes(gen::noisy_sphere(300, 2, 0.1), has);
+    const std::string out = path("m.off");
+    save_mesh(out, m);
+    EXPECT_TRUE(attributes_not_saved(out, m).empty());
+    const std::string head = read_text(out).substr(0, 6);
+    EXPECT_EQ(head.substr(0, head.find('\n')),
+              std::string(has & kColour ? "C" : "") + (has & kNormals ? "N" : "") + "OFF");
+    LoadReport r;
+    const Mesh back = load_mesh(out, &r);
+    EXPECT_TRUE(r.ignored_attributes.empty()) << joined(r.ignored_attributes);
+    EXPECT_EQ(back.positions, m.positions);
+    EXPECT_EQ(back.triangles, m.triangles);
+    ASSERT_EQ(back.attributes.size(), m.attributes.size()) << has;
+    for (size_t i = 0; i < m.attributes.size(); ++i) {
+      EXPECT_EQ(back.attributes[i].kind, m.attributes[i].kind);
+      EXPECT_EQ(back.attributes[i].components, m.attributes[i].components);
+      EXPECT_EQ(back.attributes[i].colour, m.attributes[i].colour);
+      EXPECT_EQ(back.attributes[i].values, m.attributes[i].values);
+    }
+  }
+}
+
+TEST_F(AttributeFiles, OffColourSurvivesOffPomarOffPomar) {
+  // A COFF file as a user has it, through pomar twice: the colours never change.
+  std::string text = "COFF\n";
+  const Mesh sphere = gen::noisy_sphere(400, 3, 0.1);
+  text += std::to_string(sphere.vertex_count()) + " " + std::to_string(sphere.triangle_count()) +
+          " 0\n";
+  for (size_t v = 0; v < sphere.vertex_count(); ++v)
+    text += std::to_string(sphere.positions[3 * v]) + " " +
+            std::to_string(sphere.positions[3 * v + 1]) + " " +
+            std::to_string(sphere.positions[3 * v + 2]) + " " + std::to_string(v * 7 % 256) + " " +
+            std::to_string(v * 13 % 256) + " " + std::to_string(v * 31 % 256) + "\n";
+  for (size_t t = 0; t < sphere.triangle_count(); ++t)
+    text += "3 " + std::to_string(sphere.triangles[3 * t]) + " " +
+            std::to_string(sphere.triangles[3 * t + 1]) + " " +
+            std::to_string(sphere.triangles[3 * t + 2]) + "\n";
+  const Mesh input = load_mesh(write("in.off", text));
+  ASSERT_NE(input.find(AttributeKind::Colour), nullptr);
+  EncodeOptions in_order;
+  in_order.keep_order = true; // the input's vertex numbering: colours compare vertex by vertex
+  const std::vector<uint8_t> a = encode(input, in_order);
+  save_mesh(path("mid.off"), decode(a.data(), a.size()));
+  const Mesh mid = load_mesh(path("mid.off"));
+  const std::vector<uint8_t> b = encode(mid, in_order);
+  const Mesh last = decode(b.data(), b.size());
+  ASSERT_NE(last.find(AttributeKind::Colour), nullptr);
+  EXPECT_EQ(last.find(AttributeKind::Colour)->colour, input.find(AttributeKind::Colour)->colour);
+  EXPECT_EQ(last.positions, mid.positions); // on the grid since the first encode
+}
+
+TEST_F(AttributeFiles, WritersNameWhatTheyCannotHold) {
+  const Mesh m = with_attributes(gen::noisy_sphere(100, 4, 0.1), kAll);
+  EXPECT_TRUE(attributes_not_saved("x.ply", m).empty());
+  EXPECT_EQ(joined(attributes_not_saved("x.stl", m)),
+            "colours | normals | scalars 'quality', 'confidence' | texture coordinates | texture "
+            "file names");
+  EXPECT_EQ(joined(attributes_not_saved("x.off", m)),
+            "scalars 'quality', 'confidence' | texture coordinates | texture file names");
+  EXPECT_EQ(joined(attributes_not_saved("x.obj", m)),
+            "the alpha of the colours | scalars 'quality', 'confidence'");
+  Mesh plain = gen::noisy_sphere(100, 4, 0.1);
+  for (const char *ext : {".ply", ".obj", ".off", ".stl"})
+    EXPECT_TRUE(attributes_not_saved(std::string("x") + ext, plain).empty());
+}
+
+} // namespace
+} // namespace pomar
