@@ -7,6 +7,7 @@
 #include "geometry/quantize.h"
 #include "mesh/corner_table.h"
 #include "pomar/pomar.h"
+#include "support/mesh_attributes.h"
 #include "support/mesh_gen.h"
 
 namespace pomar {
@@ -42,8 +43,8 @@ void expect_lossless(const Mesh &input, int bits) {
   }
   std::vector<Tri> a, b;
   for (size_t f = 0; f < input.triangle_count(); ++f)
-    a.push_back(canonical(input.triangles[3 * f], input.triangles[3 * f + 1],
-                          input.triangles[3 * f + 2]));
+    a.push_back(
+        canonical(input.triangles[3 * f], input.triangles[3 * f + 1], input.triangles[3 * f + 2]));
   for (size_t f = 0; f < out.triangle_count(); ++f) {
     const uint32_t *t = &out.triangles[3 * f];
     b.push_back(canonical(report.decoded_to_input[t[0]], report.decoded_to_input[t[1]],
@@ -65,7 +66,8 @@ void expect_valid_levels(const Mesh &input) {
     ASSERT_EQ(m.vertex_count(), nv) << "level " << level;
     ASSERT_EQ(m.triangle_count(), nf) << "level " << level;
     CornerTable ct;
-    EXPECT_NO_THROW(build_corner_table(m.triangles.data(), m.triangle_count(), m.vertex_count(), ct))
+    EXPECT_NO_THROW(
+        build_corner_table(m.triangles.data(), m.triangle_count(), m.vertex_count(), ct))
         << "level " << level;
     const gen::TopologyReport t = gen::analyze(m);
     EXPECT_TRUE(t.manifold && t.oriented) << "level " << level;
@@ -179,19 +181,28 @@ TEST(Codec, LevelOutOfRangeIsAnError) {
   EXPECT_THROW(decode(file.data(), file.size(), -2), Error);
 }
 
-// Decimation evaluates its candidates on several threads: the file must not depend on how
-// many (the mesh is large enough for every thread to get a slice).
+// Decimation evaluates its candidates on several threads, and the clusters of a level are
+// recorded on several threads (encode/clusters.cpp, more than one batch of clusters here):
+// the file must not depend on how many (the mesh is large enough for every thread to get a
+// slice), with attributes too.
 TEST(Codec, FileDoesNotDependOnThreadCount) {
-  const Mesh mesh = gen::noisy_sphere(70000, 7);
-  std::vector<uint8_t> files[3];
-  const unsigned threads[3] = {1, 2, 7};
-  for (int i = 0; i < 3; ++i) {
-    EncodeOptions options;
-    options.threads = threads[i];
-    files[i] = encode(mesh, options);
+  const Mesh plain = gen::noisy_sphere(70000, 7);
+  const Mesh coloured = with_attributes(gen::noisy_sphere(20000, 3), kColour | kNormals | kScalars);
+  for (const Mesh *mesh : {&plain, &coloured}) {
+    for (uint32_t clusters : {0u, 2500u}) {
+      std::vector<uint8_t> files[3];
+      const unsigned threads[3] = {1, 2, 7};
+      for (int i = 0; i < 3; ++i) {
+        EncodeOptions options;
+        options.threads = threads[i];
+        options.clusters = clusters;
+        files[i] = encode(*mesh, options);
+      }
+      ASSERT_GT(inspect(files[0].data(), files[0].size()).clusters, 64u);
+      EXPECT_EQ(files[0], files[1]) << "clusters " << clusters;
+      EXPECT_EQ(files[0], files[2]) << "clusters " << clusters;
+    }
   }
-  EXPECT_EQ(files[0], files[1]);
-  EXPECT_EQ(files[0], files[2]);
 }
 
 } // namespace

@@ -1,9 +1,13 @@
 // The clusters (paper section 5.2); see clusters.h.
 #include "encode/clusters.h"
 
+#include <algorithm>
 #include <cmath>
+#include <deque>
+#include <memory>
 
 #include "entropy/static_tables.h"
+#include "parallel/thread_pool.h"
 
 namespace pomar {
 
@@ -27,8 +31,74 @@ size_t choose_global_levels(const Decimation &dec, uint32_t base_vertices, uint3
   return best;
 }
 
+namespace {
+
+/// The clusters of a level recorded on several threads, in two phases per batch (the
+/// decoder's, refine/level_step.h): every cluster of the batch traversed at once without
+/// touching the mesh, each thread with its own step and a codec working for the level's
+/// (which defers numbering the split vertices), then, in cluster order, the split vertices
+/// numbered and the splits applied. The symbols, the mesh and the vertex numbering are
+/// those of the clusters recorded one after the other, for any thread count.
+class ParallelClusters {
+public:
+  ParallelClusters(Rebuild &rb, uint32_t clusters, unsigned threads) : rb_(rb) {
+    if (threads < 2 || clusters < kMinClusters)
+      return;
+    pool_ = std::make_unique<ThreadPool>(threads);
+    steps_.resize(pool_->size());
+    for (unsigned t = 0; t < pool_->size(); ++t) {
+      workers_.emplace_back(rb.q, rb.dec_to_input, rb.input_to_dec);
+      workers_.back().set_attribute_codes(rb.attr_codes, rb.attr_codes_per_vertex);
+    }
+    traversed_.resize(kBatch);
+    numbered_.resize(kBatch);
+  }
+  bool on() const { return pool_ != nullptr; }
+
+  /// Record every cluster's splits of `where.level` (where.cluster is ignored).
+  void level(EncoderCodec<RecorderStream> &codec, std::vector<SymbolRecorder> &recordings,
+             ClusterLevel where, std::vector<uint32_t> &next_local) {
+    for (auto &w : workers_)
+      w.work_for(codec);
+    const uint32_t clusters = static_cast<uint32_t>(recordings.size());
+    for (uint32_t first = 0; first < clusters; first += kBatch) {
+      const uint32_t n = std::min(kBatch, clusters - first);
+      pool_->run(n, [&](size_t i, unsigned t) {
+        ClusterLevel at = where;
+        at.cluster = first + static_cast<uint32_t>(i);
+        RecorderStream conn{&recordings[at.cluster], 0}, geom{&recordings[at.cluster], 1};
+        workers_[t].set_sinks(&conn, &geom);
+        steps_[t].traverse_cluster_level(rb_.mesh, workers_[t], at, NoCheck{}, traversed_[i]);
+        workers_[t].take_deferred(numbered_[i]);
+      });
+      for (uint32_t i = 0; i < n; ++i) {
+        ClusterLevel at = where;
+        at.cluster = first + i;
+        if (!traversed_[i].error)
+          for (uint32_t v_from : numbered_[i])
+            codec.number_split(v_from);
+        rb_.step.apply_cluster_level(rb_.mesh, codec, at, next_local[at.cluster], traversed_[i]);
+      }
+    }
+    for (auto &w : workers_)
+      codec.add_emitted(w);
+  }
+
+private:
+  static constexpr uint32_t kBatch = 1024;     // clusters whose traversals are held at once
+  static constexpr uint32_t kMinClusters = 64; // fewer: the threads cost more than they save
+  Rebuild &rb_;
+  std::unique_ptr<ThreadPool> pool_;
+  std::vector<LevelStep> steps_;
+  std::deque<EncoderCodec<RecorderStream>> workers_; // (their addresses must not move)
+  std::vector<TraversedCluster> traversed_;
+  std::vector<std::vector<uint32_t>> numbered_; // per batch cluster: its v_from, in order
+};
+
+} // namespace
+
 ClusteredLevels encode_clustered_levels(Rebuild &rb, size_t global, FileHeader &header,
-                                        const Progress &progress) {
+                                        unsigned threads, const Progress &progress) {
   const size_t L = rb.levels();
   LevelMesh &lm = rb.mesh;
   header.flags |= kFlagClustered;
@@ -55,17 +125,23 @@ ClusteredLevels encode_clustered_levels(Rebuild &rb, size_t global, FileHeader &
   LevelFreezer freezer;
   EncoderCodec<RecorderStream> codec(rb.q, rb.dec_to_input, rb.input_to_dec);
   codec.set_attribute_codes(rb.attr_codes, rb.attr_codes_per_vertex);
+  ParallelClusters parallel(rb, clusters, threads);
   for (size_t r = global; r < L; ++r) {
     const uint32_t level = static_cast<uint32_t>(r + 1);
     Models &models = level_models[r - global];
     codec.begin_level(rb.collapses(level), &models);
     const uint32_t older_than = lm.vertex_count(); // levels are encoded in order
     const ModelAddresses addresses(models);
-    for (uint32_t c = 0; c < clusters; ++c) {
-      recordings[c].addresses = &addresses;
-      RecorderStream conn{&recordings[c], 0}, geom{&recordings[c], 1};
-      codec.set_sinks(&conn, &geom);
-      rb.step.cluster_level(lm, codec, {c, level, older_than}, next_local[c]);
+    for (SymbolRecorder &recording : recordings)
+      recording.addresses = &addresses;
+    if (parallel.on()) {
+      parallel.level(codec, recordings, {0, level, older_than}, next_local);
+    } else {
+      for (uint32_t c = 0; c < clusters; ++c) {
+        RecorderStream conn{&recordings[c], 0}, geom{&recordings[c], 1};
+        codec.set_sinks(&conn, &geom);
+        rb.step.cluster_level(lm, codec, {c, level, older_than}, next_local[c]);
+      }
     }
     codec.end_level();
     add_level_entry(header, lm, 0, 0);

@@ -25,7 +25,9 @@ struct ClusteredLevels {
 /// mesh: every vertex roots a cluster) and fill the clustered fields and level entries of
 /// `header`. Each cluster's splits of every clustered level are recorded, the level models
 /// frozen on all clusters' symbols, then every cluster is coded into its own block.
+/// The clusters of a level are recorded on `threads` threads (1: one after the other); the
+/// file does not depend on it.
 ClusteredLevels encode_clustered_levels(Rebuild &rebuild, size_t global, FileHeader &header,
-                                        const Progress &progress);
+                                        unsigned threads, const Progress &progress);
 
 } // namespace pomar

@@ -220,7 +220,7 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
       encode_global_levels(rb, global, header, bits, options.progress);
   ClusteredLevels clustered;
   if (global < rb.levels())
-    clustered = encode_clustered_levels(rb, global, header, options.progress);
+    clustered = encode_clustered_levels(rb, global, header, decimation.threads, options.progress);
   if (rb.mesh.vertex_count() != nv || rb.mesh.ct.face_count() != nf)
     throw Error(Error::Kind::Internal,
                 "internal encoder error: the refined mesh does not match the input");

@@ -25,12 +25,13 @@ template <class Sink> class EncoderCodec {
 public:
   EncoderCodec(const std::vector<int32_t> &input_q, std::vector<uint32_t> &dec_to_input,
                std::vector<uint32_t> &input_to_dec)
-      : input_q_(input_q), dec_to_input_(dec_to_input), input_to_dec_(input_to_dec),
-        collapse_at_(input_to_dec.size(), kNone) {}
+      : input_q_(input_q), dec_to_input_(dec_to_input), input_to_dec_(input_to_dec) {}
 
   void begin_level(const std::vector<Collapse> &level, Models *models) {
     level_ = &level;
     m_ = models;
+    if (collapse_at_.empty())
+      collapse_at_.assign(input_to_dec_.size(), kNone);
     for (uint32_t i = 0; i < level.size(); ++i)
       collapse_at_[level[i].v_to] = i;
     emitted_ = 0;
@@ -46,8 +47,36 @@ public:
       corrupt("a collapse of the level was not reached by the traversal");
   }
 
+  /// A codec for another thread of the same level (clustered levels in parallel): it reads
+  /// `owner`'s level (collapses, index, models) and defers the numbering of the vertices it
+  /// splits (take_deferred), which the owner's thread applies in cluster order.
+  void work_for(EncoderCodec &owner) {
+    index_ = &owner.collapse_at_;
+    level_ = owner.level_;
+    m_ = owner.m_;
+    attr_codes_ = owner.attr_codes_;
+    defer_ids_ = true;
+    emitted_ = 0;
+  }
+  /// The input ids of the v_from this codec coded since the last call, in coding order
+  /// (work_for codecs): number them with number_split in the same order as the splits.
+  void take_deferred(std::vector<uint32_t> &out) {
+    out.swap(deferred_);
+    deferred_.clear();
+  }
+  /// Give input vertex v_from the next id of the decoder's numbering.
+  void number_split(uint32_t v_from) {
+    input_to_dec_[v_from] = static_cast<uint32_t>(dec_to_input_.size());
+    dec_to_input_.push_back(v_from);
+  }
+  /// Splits coded by a work_for codec count for the owner's end_level check.
+  void add_emitted(EncoderCodec &worker) {
+    emitted_ += worker.emitted_;
+    worker.emitted_ = 0;
+  }
+
   int split_flag(uint32_t v, int context) {
-    current_ = collapse_at_[dec_to_input_[v]];
+    current_ = (index_ ? *index_ : collapse_at_)[dec_to_input_[v]];
     const int flag = current_ != kNone;
     bits.s_v += bits_for<Sink>(m_->conn.sv[context], flag);
     conn_->encode_bit(m_->conn.sv[context], flag);
@@ -96,9 +125,12 @@ public:
     bits.tangential += put_residual(*geom_, m_->geom, 0, p.context, r[0] - p.offset[0]);
     bits.tangential += put_residual(*geom_, m_->geom, 0, p.context, r[1] - p.offset[1]);
     bits.normal += put_residual(*geom_, m_->geom, 1, p.context, r[2] - p.offset[2]);
-    // The step applies the splits in the order they are coded: v_from gets the next id.
-    input_to_dec_[v_from] = static_cast<uint32_t>(dec_to_input_.size());
-    dec_to_input_.push_back(v_from);
+    // The step applies the splits in the order they are coded: v_from gets the next id
+    // (a work_for codec's splits are applied later, in cluster order: numbered then).
+    if (defer_ids_)
+      deferred_.push_back(v_from);
+    else
+      number_split(v_from);
   }
 
   /// The split vertex's attribute codes (from the input), coded against the prediction.
@@ -146,7 +178,10 @@ private:
   Models *m_ = nullptr;
   const std::vector<int32_t> &input_q_;
   std::vector<uint32_t> &dec_to_input_, &input_to_dec_;
-  std::vector<uint32_t> collapse_at_; // input vertex -> index of its collapse as v_to
+  std::vector<uint32_t> collapse_at_;            // input vertex -> index of its collapse as v_to
+  const std::vector<uint32_t> *index_ = nullptr; // the owner's collapse_at_ (work_for codecs)
+  bool defer_ids_ = false;
+  std::vector<uint32_t> deferred_; // v_from coded, numbered later (work_for codecs)
   const std::vector<Collapse> *level_ = nullptr;
   Sink *conn_ = nullptr, *geom_ = nullptr;
   const std::vector<int64_t> *attr_codes_ = nullptr;
