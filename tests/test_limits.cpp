@@ -156,6 +156,17 @@ TEST(MemoryCheck, ExplicitLimitRefusesWithCountsAndSizes) {
   EXPECT_NO_THROW(check_memory("decode", 1, 1, UINT64_MAX, 0, kNoMemoryLimit));
 }
 
+// The encoder records the clustered levels on several threads, each with traversal marks.
+TEST(MemoryCheck, EncodeCheckCountsEachThreadPastTheFirst) {
+  const uint64_t v = 1000000, f = 2000000;
+  const uint64_t one = encode_memory_estimate(v, f), extra = decode_thread_memory(v, f);
+  EXPECT_EQ(extra, 8 * v + 4 * f);
+  EXPECT_NO_THROW(check_encode_memory(v, f, one, 0, 0, 1));
+  EXPECT_THROW(check_encode_memory(v, f, one, 0, 0, 2), Error);
+  EXPECT_NO_THROW(check_encode_memory(v, f, one + 2 * extra, 0, 0, 3));
+  EXPECT_THROW(check_encode_memory(v, f, one + 2 * extra - 1, 0, 0, 3), Error);
+}
+
 TEST(MemoryCheck, DecodeCheckUsesTheCountsOfTheRequestedLevel) {
   FileInfo info;
   info.vertices = 1000000, info.faces = 2000000;
@@ -280,7 +291,11 @@ TEST(MemoryCheck, EncodeRefusesBeforeWorkingAndHonoursNone) {
   opt.memory_limit = kNoMemoryLimit;
   EXPECT_FALSE(encode(mesh, opt).empty());
   opt.memory_limit = encode_memory_estimate(mesh.vertex_count(), mesh.triangle_count());
+  opt.threads = 1;
   EXPECT_FALSE(encode(mesh, opt).empty());
+  opt.threads = 2; // a second thread's traversal marks do not fit
+  EXPECT_NE(error_of([&] { encode(mesh, opt); }).find("not enough memory to encode"),
+            std::string::npos);
 }
 
 TEST(MemoryCheck, DecodeAndSelectiveDecoderRefuseAfterTheHeader) {

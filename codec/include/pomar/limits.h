@@ -74,12 +74,15 @@ void check_memory(const char *action, uint64_t vertices, uint64_t faces, uint64_
                   uint64_t held, uint64_t limit);
 
 /// check_memory with encode_memory_estimate plus `attribute_bytes` per vertex
-/// (encode_attribute_bytes_per_vertex) (action "encode").
+/// (encode_attribute_bytes_per_vertex), plus decode_thread_memory per thread past the first
+/// recording the clustered levels (`threads`: EncodeOptions::threads resolved and capped
+/// like the decoder's, decode_threads) (action "encode").
 void check_encode_memory(uint64_t vertices, uint64_t faces, uint64_t limit, uint64_t held = 0,
-                         uint64_t attribute_bytes = 0);
+                         uint64_t attribute_bytes = 0, unsigned threads = 1);
 
 /// What each decoding thread past the first adds to decode_memory_estimate for a clustered
-/// file: its traversal marks, 8 bytes per vertex and 4 per face.
+/// file (and each encoding thread to encode_memory_estimate): its traversal marks, 8 bytes
+/// per vertex and 4 per face.
 uint64_t decode_thread_memory(uint64_t vertices, uint64_t faces);
 
 /// check_memory with decode_memory_estimate for the mesh of `level` (-1 = full resolution)

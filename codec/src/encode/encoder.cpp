@@ -87,7 +87,8 @@ PreparedInput prepare_input(const Mesh &mesh, const EncodeOptions &options,
   for (const VertexAttribute &a : mesh.attributes)
     held += a.colour.size() + a.values.size() * sizeof(float);
   check_encode_memory(mesh.vertex_count(), mesh.triangle_count(), options.memory_limit, held,
-                      encode_attribute_bytes_per_vertex(mesh, options.attributes));
+                      encode_attribute_bytes_per_vertex(mesh, options.attributes),
+                      decode_threads(options.threads));
   PreparedInput in;
   std::vector<uint32_t> triangles, compact_to_input;
   const std::vector<float> positions = compact_vertices(mesh, triangles, compact_to_input);
@@ -220,7 +221,8 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
       encode_global_levels(rb, global, header, bits, options.progress);
   ClusteredLevels clustered;
   if (global < rb.levels())
-    clustered = encode_clustered_levels(rb, global, header, decimation.threads, options.progress);
+    clustered = encode_clustered_levels(rb, global, header, decode_threads(options.threads),
+                                        options.progress);
   if (rb.mesh.vertex_count() != nv || rb.mesh.ct.face_count() != nf)
     throw Error(Error::Kind::Internal,
                 "internal encoder error: the refined mesh does not match the input");

@@ -332,10 +332,11 @@ void check_memory(const char *action, uint64_t vertices, uint64_t faces, uint64_
 }
 
 void check_encode_memory(uint64_t vertices, uint64_t faces, uint64_t limit, uint64_t held,
-                         uint64_t attribute_bytes) {
-  check_memory("encode", vertices, faces,
-               add_mul(encode_memory_estimate(vertices, faces), vertices, attribute_bytes), held,
-               limit);
+                         uint64_t attribute_bytes, unsigned threads) {
+  uint64_t needed = add_mul(encode_memory_estimate(vertices, faces), vertices, attribute_bytes);
+  if (threads > 1)
+    needed = add_mul(needed, threads - 1, decode_thread_memory(vertices, faces));
+  check_memory("encode", vertices, faces, needed, held, limit);
 }
 
 uint64_t decode_thread_memory(uint64_t vertices, uint64_t faces) {
@@ -351,7 +352,7 @@ void check_decode_memory(const FileInfo &info, int level, uint64_t limit, const 
     v = info.levels[size_t(level) - 1].vertices, f = info.levels[size_t(level) - 1].faces;
   }
   uint64_t needed = add_mul(decode_memory_estimate(v, f, info.clustered()), v,
-                           decode_attribute_bytes_per_vertex(info, keep));
+                            decode_attribute_bytes_per_vertex(info, keep));
   if (info.clustered() && threads > 1)
     needed = add_mul(needed, threads - 1, decode_thread_memory(v, f));
   check_memory("decode", v, f, needed, 0, limit);
