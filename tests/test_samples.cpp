@@ -74,6 +74,43 @@ TEST(Samples, BunnyCompressesLikeAProgressiveCoder) {
   EXPECT_GT(bpv, 8.0);  // far below would mean something is not being stored
 }
 
+// A real coloured scan (MeshLab's sample, samples/README.md): colour (RGBA in the file, its
+// alpha 255 everywhere: read as RGB) and MeshLab's quality per vertex, holes and
+// non-manifold vertices. Geometry lossless, colour exact, the
+// quality within half a step of its 16-bit grid, at every level as the full decode has it.
+TEST(Samples, ColouredScanKeepsItsColoursExactly) {
+  const std::string path = POMAR_SAMPLES_DIR "/many_small_holes.ply";
+  expect_lossless_file(path, 12);
+  const Mesh input = load_mesh(path);
+  ASSERT_EQ(input.attributes.size(), 2u);
+  const VertexAttribute &colour = input.attributes[0], &quality = input.attributes[1];
+  ASSERT_EQ(colour.kind, AttributeKind::Colour);
+  ASSERT_EQ(colour.components, 3u);
+  ASSERT_EQ(quality.kind, AttributeKind::Scalar);
+  EncodeReport r;
+  const std::vector<uint8_t> file = encode(input, EncodeOptions(), &r);
+  const Mesh out = decode(file.data(), file.size());
+  ASSERT_EQ(out.vertex_count(), input.vertex_count());
+  ASSERT_EQ(out.attributes.size(), 2u);
+  const float lo = *std::min_element(quality.values.begin(), quality.values.end());
+  const float hi = *std::max_element(quality.values.begin(), quality.values.end());
+  const double bound = 0.5 * (double(hi) - double(lo)) / 65535.0 * (1 + 1e-6) + 1e-7;
+  size_t changed_colours = 0;
+  for (size_t i = 0; i < out.vertex_count(); ++i) {
+    const uint32_t v = r.decoded_to_input[i];
+    for (uint32_t k = 0; k < 3; ++k)
+      changed_colours += out.attributes[0].colour[3 * i + k] != colour.colour[3 * v + k];
+    ASSERT_LE(std::abs(double(out.attributes[1].values[i]) - double(quality.values[v])), bound)
+        << "vertex " << v;
+  }
+  EXPECT_EQ(changed_colours, 0u);
+  // The colours are not all alike (a sample that tests something).
+  EXPECT_GT(std::count(colour.colour.begin(), colour.colour.end(), colour.colour[0]),
+            ptrdiff_t(0));
+  EXPECT_LT(std::count(colour.colour.begin(), colour.colour.end(), colour.colour[0]),
+            ptrdiff_t(colour.colour.size() / 2));
+}
+
 fs::path shared_data() {
   const char *env = std::getenv("POMAR_SHARED_DATA");
   return env ? fs::path(env) : fs::path(POMAR_SOURCE_DIR) / ".." / "shared" / "data";
