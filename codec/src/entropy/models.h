@@ -137,6 +137,25 @@ template <class Encoder, class Model> double bits_for(const Model &m, int s) {
     return 0.0;
 }
 
+/// `nbits` (0..48) raw, equiprobable bits of `value` (which has no higher bits set): the
+/// range coder's bypass takes at most 24 at a time. get_raw reads them back.
+template <class Encoder> void put_raw(Encoder &rc, uint64_t value, int nbits) {
+  if (nbits > 24) {
+    rc.encode_bypass(static_cast<uint32_t>(value >> 24), nbits - 24);
+    rc.encode_bypass(static_cast<uint32_t>(value & 0xFFFFFF), 24);
+  } else if (nbits > 0) {
+    rc.encode_bypass(static_cast<uint32_t>(value), nbits);
+  }
+}
+
+inline uint64_t get_raw(RangeDecoder &rc, int nbits) {
+  if (nbits > 24) {
+    const uint64_t high = rc.decode_bypass(nbits - 24);
+    return (high << 24) | rc.decode_bypass(24);
+  }
+  return nbits > 0 ? rc.decode_bypass(nbits) : 0;
+}
+
 /// Each put_* returns the ideal number of bits it spent (statistics only; 0 for the models
 /// of a recorder, see WantsBits).
 template <class Encoder> double put_small(Encoder &rc, FrequencyModel &m, uint32_t v) {
@@ -152,12 +171,7 @@ template <class Encoder> double put_small(Encoder &rc, FrequencyModel &m, uint32
   const int n = bit_length(x);
   bits += 6 + n;
   rc.encode_bypass(static_cast<uint32_t>(n), 6);
-  if (n > 24) {
-    rc.encode_bypass(x >> 24, n - 24);
-    rc.encode_bypass(x & 0xFFFFFF, 24);
-  } else {
-    rc.encode_bypass(x, n);
-  }
+  put_raw(rc, x, n);
   return bits;
 }
 
@@ -181,13 +195,7 @@ double put_signed(Encoder &rc, FrequencyModel &classes, BitModel *top, int64_t v
     --rest;
   }
   bits += rest;
-  const uint64_t low = a & ((uint64_t(1) << rest) - 1);
-  if (rest > 24) {
-    rc.encode_bypass(static_cast<uint32_t>(low >> 24), rest - 24);
-    rc.encode_bypass(static_cast<uint32_t>(low & 0xFFFFFF), 24);
-  } else if (rest > 0) {
-    rc.encode_bypass(static_cast<uint32_t>(low), rest);
-  }
+  put_raw(rc, a & ((uint64_t(1) << rest) - 1), rest);
   return bits;
 }
 
@@ -205,14 +213,7 @@ inline uint32_t get_small(RangeDecoder &rc, FrequencyModel &m) {
   const int n = static_cast<int>(rc.decode_bypass(6));
   if (n < 1 || n > 32)
     return 0xFFFFFFFFu; // corrupt; callers range-check every symbol
-  uint32_t x;
-  if (n > 24) {
-    x = rc.decode_bypass(n - 24) << 24;
-    x |= rc.decode_bypass(24);
-  } else {
-    x = rc.decode_bypass(n);
-  }
-  const uint64_t v = uint64_t(x) + kSmallSymbols - 1;
+  const uint64_t v = get_raw(rc, n) + kSmallSymbols - 1;
   return v > 0xFFFFFFFEu ? 0xFFFFFFFFu : static_cast<uint32_t>(v);
 }
 
@@ -227,12 +228,7 @@ inline int64_t get_signed(RangeDecoder &rc, FrequencyModel &classes, BitModel *t
     a = (a << 1) | static_cast<uint64_t>(rc.decode_bit(top[n]));
     --rest;
   }
-  if (rest > 24) {
-    a = (a << (rest - 24)) | rc.decode_bypass(rest - 24);
-    a = (a << 24) | rc.decode_bypass(24);
-  } else if (rest > 0) {
-    a = (a << rest) | rc.decode_bypass(rest);
-  }
+  a = (a << rest) | get_raw(rc, rest);
   return negative ? -static_cast<int64_t>(a) : static_cast<int64_t>(a);
 }
 

@@ -10,6 +10,7 @@
 #include <cstring>
 #include <string>
 
+#include "attributes/vertex_rows.h"
 #include "entropy/models.h"
 #include "entropy/range_coder.h"
 #include "mesh/corner_table.h"
@@ -20,7 +21,7 @@ namespace {
 
 constexpr uint8_t kHasOrder = 1;
 constexpr uint8_t kHasAttributes = 2; // the extra vertices' attributes end the stream
-constexpr int kUintClasses = 34; // bit lengths 0..33
+constexpr int kUintClasses = 34;      // bit lengths 0..33
 
 /// An unsigned number as its bit length (adaptive) and the bits below the leading one.
 struct UintModel {
@@ -36,13 +37,7 @@ void put_u(RangeEncoder &rc, UintModel &m, uint64_t v) {
   int rest = n - 1;
   rc.encode_bit(m.top[n], static_cast<int>((v >> (rest - 1)) & 1));
   --rest;
-  const uint64_t low = v & ((uint64_t(1) << rest) - 1);
-  if (rest > 24) {
-    rc.encode_bypass(static_cast<uint32_t>(low >> 24), rest - 24);
-    rc.encode_bypass(static_cast<uint32_t>(low & 0xFFFFFF), 24);
-  } else if (rest > 0) {
-    rc.encode_bypass(static_cast<uint32_t>(low), rest);
-  }
+  put_raw(rc, v & ((uint64_t(1) << rest) - 1), rest);
 }
 
 uint64_t get_u(RangeDecoder &rc, UintModel &m) {
@@ -52,13 +47,7 @@ uint64_t get_u(RangeDecoder &rc, UintModel &m) {
   int rest = n - 1;
   uint64_t v = 2 | static_cast<uint64_t>(rc.decode_bit(m.top[n]));
   --rest;
-  if (rest > 24) {
-    v = (v << (rest - 24)) | rc.decode_bypass(rest - 24);
-    v = (v << 24) | rc.decode_bypass(24);
-  } else if (rest > 0) {
-    v = (v << rest) | rc.decode_bypass(rest);
-  }
-  return v;
+  return (v << rest) | get_raw(rc, rest);
 }
 
 /// Position groups: group[v] numbers the distinct positions of `mesh` (exact float bits).
@@ -329,8 +318,7 @@ void write_extra_attributes(RangeEncoder &rc, const std::vector<VertexAttribute>
   }
 }
 
-std::vector<VertexAttribute> read_extra_attributes(RangeDecoder &rc, uint64_t extra,
-                                                   size_t size) {
+std::vector<VertexAttribute> read_extra_attributes(RangeDecoder &rc, uint64_t extra, size_t size) {
   const uint32_t count = rc.decode_bypass(8);
   if (count == 0)
     damaged("attribute flag without attributes");
@@ -668,23 +656,14 @@ Mesh apply_lossless_record(const Mesh &decoded, const LosslessRecord &r, const Q
               "' for the vertices no face uses");
     if (a.vertex_count() != nv)
       damaged("attribute '" + a.name + "' does not fit the decoded mesh");
-    const size_t n = a.components;
-    auto keep_representatives = [&](auto &values) {
-      size_t at = 0;
-      for (uint32_t v = 0, c = 0; v < nv; ++v) {
-        if (c < r.copies.size() && r.copies[c].first == v) {
-          ++c;
-          continue;
-        }
-        for (size_t k = 0; k < n; ++k)
-          values[at++] = values[v * n + k];
+    size_t c = 0; // the copies, in increasing vertex order, are dropped
+    keep_vertex_rows(b, nv, [&](size_t v) {
+      if (c < r.copies.size() && r.copies[c].first == v) {
+        ++c;
+        return false;
       }
-      values.resize(at);
-    };
-    if (a.kind == AttributeKind::Colour)
-      keep_representatives(b.colour);
-    else
-      keep_representatives(b.values);
+      return true;
+    });
     if (x != nullptr && extra != 0) {
       b.colour.insert(b.colour.end(), x->colour.begin(), x->colour.end());
       b.values.insert(b.values.end(), x->values.begin(), x->values.end());

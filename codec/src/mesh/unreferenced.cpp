@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "attributes/vertex_rows.h"
 #include "mesh/corner_table.h"
 #include "pomar/pomar.h"
 
@@ -26,21 +27,10 @@ size_t drop_unreferenced_vertices(Mesh &mesh) {
       v = index[v];
   mesh.positions.swap(kept);
   for (VertexAttribute &a : mesh.attributes) { // the attributes of the kept vertices
-    const size_t n = a.components;
-    auto compact = [&](auto &values) {
-      if (values.size() != nv * n)
-        return; // not one value per vertex: left for validation to name
-      size_t out = 0;
-      for (size_t v = 0; v < nv; ++v)
-        if (index[v] != kNone)
-          for (size_t k = 0; k < n; ++k)
-            values[out++] = values[v * n + k];
-      values.resize(out);
-    };
-    if (a.kind == AttributeKind::Colour)
-      compact(a.colour);
-    else
-      compact(a.values);
+    const size_t size = a.kind == AttributeKind::Colour ? a.colour.size() : a.values.size();
+    if (size != nv * a.components)
+      continue; // not one value per vertex: left for validation to name
+    keep_vertex_rows(a, nv, [&](size_t v) { return index[v] != kNone; });
   }
   return nv - next;
 }
