@@ -6,7 +6,8 @@
 #     decoder decodes them bit for bit like the native one, and that damaged/truncated
 #     copies give messages (web/test/wasm_decode_test.mjs, Node.js);
 #  3. runs the viewer in headless Chromium (web/test/browser_test.py), screenshots compared
-#     with docs/images/web_test/.
+#     with docs/images/web_test/, then on an emulated phone with touch input
+#     (web/test/mobile_test.py).
 # (Plus web/test/unit_test.mjs: request coalescing and the choice of levels for a view.)
 # Each step is skipped with a message when emscripten, Node.js or Chromium is missing.
 set -euo pipefail
@@ -37,6 +38,14 @@ status=0
 python3 "$REPO/web/test/browser_test.py" "$samples/bunny_c5.pomar" || status=$?
 if [ "$status" = 77 ]; then
   echo "web tests: browser test SKIPPED"
+elif [ "$status" != 0 ]; then
+  exit "$status"
+fi
+echo "web tests: the viewer on an emulated phone, touch input (web/test/mobile_test.py)"
+status=0
+python3 "$REPO/web/test/mobile_test.py" "$samples/bunny_c5.pomar" || status=$?
+if [ "$status" = 77 ]; then
+  echo "web tests: mobile test SKIPPED"
 elif [ "$status" != 0 ]; then
   exit "$status"
 fi
