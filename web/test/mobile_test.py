@@ -20,6 +20,7 @@ import argparse
 import base64
 import fcntl
 import json
+import math
 import os
 import shutil
 import subprocess
@@ -125,7 +126,7 @@ STATE = r'''(() => {
     bytesFetched: m.stats.bytesFetched, requests: m.stats.requests, fileBytes: m.stats.fileBytes,
     minLevel: Math.min(...m.levels), maxLevel: Math.max(...m.levels), finestClusters: finest,
     baseLevel: m.info.baseLevel, finestLevel: m.info.finestLevel, covered: covered / (px.length / 4),
-    distance: v.camera.distance, yaw: v.camera.yaw });
+    distance: v.camera.distance, yaw: v.camera.yaw, target: v.camera.target.slice() });
 })()'''
 
 
@@ -265,6 +266,18 @@ def main():
               f"the pinch refined: {orbit['finestClusters']} -> {pinch['finestClusters']} clusters at the finest level "
               f"({pinch['bytesFetched'] - orbit['bytesFetched']} more bytes)")
         check(pinch['covered'] > first['covered'], 'the model fills more of the screen')
+
+        # Two fingers moving together: pan (the target follows their midpoint).
+        touch('touchStart', [(0, (cx - 40, cy)), (1, (cx + 40, cy))])
+        for k in range(1, 9):
+            touch('touchMove', [(0, (cx - 40 + 8 * k, cy)), (1, (cx + 40 + 8 * k, cy))])
+        touch('touchEnd', [])
+        panned = settled('pan')
+        moved = sum((a - b) ** 2 for a, b in zip(panned['target'], pinch['target'])) ** 0.5
+        # 64 CSS pixels at the target's distance (vertical field of view 45 degrees).
+        expected = 64 * 2 * pinch['distance'] * math.tan(math.pi / 8) / HEIGHT
+        check(0.5 * expected < moved < 1.5 * expected and abs(panned['distance'] - pinch['distance']) < 0.01 * pinch['distance'],
+              f"two fingers moving together pan: the target moved {moved:.3g} ({expected:.3g} expected), no zoom")
         check(not pinch['error'], 'no error in the page: ' + (pinch['error'] or 'none'))
         with devtools.cond:
             thrown = [e for e in devtools.events if e.get('method') == 'Runtime.exceptionThrown']
