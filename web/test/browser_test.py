@@ -35,13 +35,13 @@ WEB = os.path.dirname(HERE)
 sys.path.insert(0, WEB)
 REFERENCES = os.path.join(os.path.dirname(WEB), 'docs', 'images', 'web_test')
 import serve  # noqa: E402
+from browser_support import Checks, parse  # noqa: E402
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     ap.add_argument('pomar', help='a clustered .pomar file')
     ap.add_argument('--images', help='copy the screenshots into this directory (prefix web_)')
-    ap.add_argument('--chromium', default=shutil.which('chromium') or shutil.which('chromium-browser'))
     ap.add_argument('--timeout', type=float, default=240)
     ap.add_argument('--target', type=float, default=3, help='target screen-space error in pixels')
     ap.add_argument('--closeup', type=float, default=0.3, help='close-up distance / model size')
@@ -50,20 +50,11 @@ def main():
     ap.add_argument('--update-references', action='store_true', help='write docs/images/web_test/*.png')
     ap.add_argument('--no-compare', action='store_true', help='do not compare screenshots')
     ap.add_argument('--max-gap', type=int, help="pomar.js maxGap for the session (bytes; default: pomar.js's)")
-    args = ap.parse_args()
-    if not args.chromium:
-        print('browser_test: SKIP: chromium not installed')
+    args = parse(ap, 'browser_test')
+    if args is None:
         return 77
-    if not os.path.exists(os.path.join(WEB, 'dist', 'pomar_decoder.wasm')):
-        print('browser_test: SKIP: web/dist/pomar_decoder.wasm not built (bash web/build.sh)')
-        return 77
-
-    failures = []
-
-    def check(ok, what):
-        print(('ok   ' if ok else 'FAIL ') + what)
-        if not ok:
-            failures.append(what)
+    check = Checks()
+    failures = check.failures
 
     work = tempfile.mkdtemp(prefix='pomar-browser-')
     proc = None

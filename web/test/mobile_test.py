@@ -33,6 +33,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 WEB = os.path.dirname(HERE)
 sys.path.insert(0, WEB)
 import serve  # noqa: E402
+from browser_support import Checks, parse  # noqa: E402
 
 WIDTH, HEIGHT, DPR = 390, 844, 3
 
@@ -134,25 +135,14 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     ap.add_argument('pomar', help='a clustered .pomar file')
     ap.add_argument('--images', help='keep the screenshots here (mobile_base.png, mobile_pinch.png)')
-    ap.add_argument('--chromium', default=shutil.which('chromium') or shutil.which('chromium-browser'))
     ap.add_argument('--timeout', type=float, default=120, help='seconds for each stage')
     ap.add_argument('--target', type=float, default=12, help="the viewer's target error in pixels")
-    args = ap.parse_args()
-    if not args.chromium:
-        print('mobile_test: SKIP: chromium not installed')
+    args = parse(ap, 'mobile_test')
+    if args is None:
         return 77
-    if not os.path.exists(os.path.join(WEB, 'dist', 'pomar_decoder.wasm')):
-        print('mobile_test: SKIP: web/dist/pomar_decoder.wasm not built (bash web/build.sh)')
-        return 77
-    failures = []
-
-    def check(ok, what):
-        print(('ok   ' if ok else 'FAIL ') + what)
-        if not ok:
-            failures.append(what)
-
     work = tempfile.mkdtemp(prefix='pomar-mobile-')
     server = devtools = None
+    check = Checks()
     try:
         root = os.path.join(work, 'root')
         os.makedirs(os.path.join(root, 'data'))
@@ -294,8 +284,8 @@ def main():
         if server is not None:
             server.shutdown()
         shutil.rmtree(work, ignore_errors=True)
-    print('mobile_test: ' + ('PASS' if not failures else f'{len(failures)} checks FAILED'))
-    return 1 if failures else 0
+    print('mobile_test: ' + ('PASS' if not check.failures else f'{len(check.failures)} checks FAILED'))
+    return 1 if check.failures else 0
 
 
 if __name__ == '__main__':

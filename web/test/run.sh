@@ -33,20 +33,17 @@ if ! command -v chromium >/dev/null 2>&1; then
   echo "web tests: browser test SKIPPED: chromium not installed"
   exit 0
 fi
-echo "web tests: the viewer in headless Chromium (web/test/browser_test.py)"
-status=0
-python3 "$REPO/web/test/browser_test.py" "$samples/bunny_c5.pomar" || status=$?
-if [ "$status" = 77 ]; then
-  echo "web tests: browser test SKIPPED"
-elif [ "$status" != 0 ]; then
-  exit "$status"
-fi
-echo "web tests: the viewer on an emulated phone, touch input (web/test/mobile_test.py)"
-status=0
-python3 "$REPO/web/test/mobile_test.py" "$samples/bunny_c5.pomar" || status=$?
-if [ "$status" = 77 ]; then
-  echo "web tests: mobile test SKIPPED"
-elif [ "$status" != 0 ]; then
-  exit "$status"
-fi
+# A browser test: exit status 77 = skipped (Chromium or the build missing).
+in_browser() {
+  echo "web tests: $1 (web/test/$2)"
+  local status=0
+  python3 "$REPO/web/test/$2" "$samples/bunny_c5.pomar" || status=$?
+  if [ "$status" = 77 ]; then
+    echo "web tests: $2 SKIPPED"
+  elif [ "$status" != 0 ]; then
+    exit "$status"
+  fi
+}
+in_browser "the viewer in headless Chromium" browser_test.py
+in_browser "the viewer on an emulated phone, touch input" mobile_test.py
 echo "web tests: passed"
