@@ -155,7 +155,7 @@ def main():
         policy = r['fetchPolicy']
         check(full['maxInFlightSeen'] <= policy['maxInFlight'], f"at most {policy['maxInFlight']} requests in flight")
         # The bound of the fetch policy: the ranges still missing are at most one per
-        # cluster block (every held stretch starts at a block), grouped by up to maxRanges
+        # cluster block (a block is held as a prefix), grouped by up to maxRanges
         # ranges and maxRequestBytes bytes a request (a group closed by its size holds, with
         # the next range, more than maxRequestBytes).
         bound = (-(-r['info']['clusters'] // policy['maxRanges']) + 2 * -(-size // policy['maxRequestBytes']) + 1)
