@@ -198,7 +198,9 @@ def main():
         def shot(name):
             if args.images:
                 os.makedirs(args.images, exist_ok=True)
-                png = base64.b64decode(page('Page.captureScreenshot', {'format': 'png'})['data'])
+                # In CSS pixels (390x844), not the device's 1170x2532.
+                clip = {'x': 0, 'y': 0, 'width': WIDTH, 'height': HEIGHT, 'scale': 1 / DPR}
+                png = base64.b64decode(page('Page.captureScreenshot', {'format': 'png', 'clip': clip})['data'])
                 with open(os.path.join(args.images, name), 'wb') as f:
                     f.write(png)
 
