@@ -144,7 +144,10 @@ async function refineLoop() {
   try {
     for (let step = 0; step < 64; ++step) {
       const version = cameraVersion;
-      const r = await model.wantView(view(), { targetPixels: Number($('target').value) || 3 });
+      // The target is in CSS pixels (what one sees), the view in drawn pixels.
+      const v = view();
+      const targetPixels = (Number($('target').value) || 3) * (v.width / Math.max(1, canvas.clientWidth));
+      const r = await model.wantView(v, { targetPixels });
       if (!r.changed && version === cameraVersion) break;
     }
   } catch (e) {
