@@ -79,6 +79,7 @@ export class RangeFile {
     this.stats = { requests: 0, ranges: 0, bytesFetched: 0, inFlight: 0, maxInFlightSeen: 0 };
     this.waiting = [];
   }
+
   async slot() {
     if (this.stats.inFlight >= this.maxInFlight)
       await new Promise((resolve) => this.waiting.push(resolve));
