@@ -606,6 +606,46 @@ TEST_F(MeshIoTest, PlyTruncatedIsError) {
 // OFF
 // ------------------------------------------------------------------------------------
 
+// A plain OFF file ("OFF", counts, x y z lines, "3 a b c" lines) is read without vcglib
+// (io/off_io.cpp, read_simple_off): the same floats as vcglib's atof-then-float, the same
+// faces and report as the general path, taken here for the same data by a comment line.
+TEST_F(MeshIoTest, OffFastPathReadsWhatVcglibReads) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> mantissa(-1.0, 1.0);
+  std::uniform_int_distribution<int> exponent(-60, 60);
+  const char *formats[] = {"%.17g", "%.3f", "%e", "%.9g", "%.1e", "%g"};
+  const size_t nv = 204, nf = 200; // vertices 202 and 203 unreferenced
+  std::string body;
+  char buf[64];
+  for (size_t i = 0; i < nv; ++i)
+    for (int k = 0; k < 3; ++k) {
+      std::snprintf(buf, sizeof buf, formats[(i + k) % 6], std::ldexp(mantissa(rng), exponent(rng) / 3));
+      body += buf;
+      body += k < 2 ? (i % 3 ? " " : " \t") : "\n";
+    }
+  for (size_t f = 0; f < nf; ++f)
+    body += "3 " + std::to_string(f) + " " + std::to_string(f + 2) + " " + std::to_string(f + 1) + "\n";
+  const std::string counts = std::to_string(nv) + " " + std::to_string(nf) + " 0\n";
+  LoadReport fast_report, general_report;
+  const Mesh fast = pomar::load_mesh(write("fast.off", "OFF\n" + counts + body), &fast_report);
+  const Mesh general =
+      pomar::load_mesh(write("general.off", "OFF\n# a comment\n" + counts + body), &general_report);
+  EXPECT_TRUE(same_bits(fast.positions, general.positions));
+  EXPECT_EQ(fast.triangles, general.triangles);
+  EXPECT_EQ(fast_report.unreferenced_vertices, 2u);
+  EXPECT_EQ(fast_report.unreferenced_vertices, general_report.unreferenced_vertices);
+  EXPECT_EQ(fast_report.file_vertices, general_report.file_vertices);
+  EXPECT_EQ(fast_report.file_faces, general_report.file_faces);
+  EXPECT_EQ(fast_report.ignored_attributes, general_report.ignored_attributes);
+  // Doubles that round differently straight to float and through double (vcglib's way).
+  const std::string tricky = "OFF\n3 1 0\n1.00000005960464477539062500000001 0 0\n"
+                             "0 0.100000001490116119384765625000001 0\n0 0 1e-44\n3 0 1 2\n";
+  const Mesh t_fast = pomar::load_mesh(write("t_fast.off", tricky));
+  const Mesh t_general =
+      pomar::load_mesh(write("t_general.off", "OFF\n#\n" + tricky.substr(4)));
+  EXPECT_TRUE(same_bits(t_fast.positions, t_general.positions));
+}
+
 TEST_F(MeshIoTest, OffQuadAndPolygon) {
   const std::string file = write("poly.off", "OFF\n# comment\n6 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n"
                                              "2 0 0\n2 1 0\n4 0 1 2 3\n5 1 4 5 2 0\n");

@@ -801,33 +801,6 @@ private:
   size_t pos_ = 0, end_ = 0;
 };
 
-/// A plain decimal number ([-]digits[.digits][e[+-]digits]): what the ASCII fast path
-/// takes. fscanf("%f") (vcglib) and from_chars both round such a number correctly, so they
-/// give the same float; anything else (a '+', hex, inf, nan, ...) is left to the general
-/// path.
-bool plain_decimal(const char *b, const char *e) {
-  if (b != e && *b == '-')
-    ++b;
-  bool digits = false;
-  while (b != e && *b >= '0' && *b <= '9')
-    ++b, digits = true;
-  if (b != e && *b == '.')
-    for (++b; b != e && *b >= '0' && *b <= '9'; ++b)
-      digits = true;
-  if (!digits)
-    return false;
-  if (b != e && (*b == 'e' || *b == 'E')) {
-    ++b;
-    if (b != e && (*b == '-' || *b == '+'))
-      ++b;
-    if (b == e)
-      return false;
-    while (b != e && *b >= '0' && *b <= '9')
-      ++b;
-  }
-  return b == e;
-}
-
 /// ASCII data of the simple shape, as vcglib reads it: plain decimal coordinates (finite),
 /// faces "3 a b c" with indices in range, nothing after the last face.
 bool read_simple_ascii(FileReader &in, uint64_t nv, uint64_t nf, Mesh &out,
