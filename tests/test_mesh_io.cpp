@@ -494,6 +494,19 @@ TEST_F(MeshIoTest, PlyBinaryBigEndianAndIndexTypes) {
   EXPECT_NE(msg.find("misreads"), std::string::npos) << msg;
 }
 
+/// A fast reading path gave what the general one gives: the same floats bit for bit, the
+/// same faces and the same report (two unreferenced vertices in the tests' files).
+void expect_same_load(const Mesh &fast, const LoadReport &fast_report, const Mesh &general,
+                      const LoadReport &general_report) {
+  EXPECT_TRUE(same_bits(fast.positions, general.positions));
+  EXPECT_EQ(fast.triangles, general.triangles);
+  EXPECT_EQ(fast_report.unreferenced_vertices, 2u);
+  EXPECT_EQ(fast_report.unreferenced_vertices, general_report.unreferenced_vertices);
+  EXPECT_EQ(fast_report.file_vertices, general_report.file_vertices);
+  EXPECT_EQ(fast_report.file_faces, general_report.file_faces);
+  EXPECT_EQ(fast_report.ignored_attributes, general_report.ignored_attributes);
+}
+
 // ASCII PLY of float x, y, z and uchar-counted int faces is read without vcglib (io/ply_io.cpp,
 // read_simple_ascii): it must give the floats fscanf gives (vcglib's general path, taken
 // here for the same data by an extra empty element) for every way of writing a number,
@@ -529,12 +542,7 @@ TEST_F(MeshIoTest, PlyAsciiFastPathReadsWhatVcglibReads) {
   const Mesh general = pomar::load_mesh(
       write("general.ply", header("element material 0\nproperty float shine\n") + vertices + faces),
       &general_report);
-  EXPECT_TRUE(same_bits(fast.positions, general.positions));
-  EXPECT_EQ(fast.triangles, general.triangles);
-  EXPECT_EQ(fast_report.unreferenced_vertices, 2u);
-  EXPECT_EQ(fast_report.unreferenced_vertices, general_report.unreferenced_vertices);
-  EXPECT_EQ(fast_report.file_vertices, general_report.file_vertices);
-  EXPECT_EQ(fast_report.file_faces, general_report.file_faces);
+  expect_same_load(fast, fast_report, general, general_report);
   // Odd numbers, first coordinate of the file: read as the general path reads them; what the
   // fast path declines fails as the general path fails.
   for (const std::string &odd :
@@ -630,13 +638,7 @@ TEST_F(MeshIoTest, OffFastPathReadsWhatVcglibReads) {
   const Mesh fast = pomar::load_mesh(write("fast.off", "OFF\n" + counts + body), &fast_report);
   const Mesh general =
       pomar::load_mesh(write("general.off", "OFF\n# a comment\n" + counts + body), &general_report);
-  EXPECT_TRUE(same_bits(fast.positions, general.positions));
-  EXPECT_EQ(fast.triangles, general.triangles);
-  EXPECT_EQ(fast_report.unreferenced_vertices, 2u);
-  EXPECT_EQ(fast_report.unreferenced_vertices, general_report.unreferenced_vertices);
-  EXPECT_EQ(fast_report.file_vertices, general_report.file_vertices);
-  EXPECT_EQ(fast_report.file_faces, general_report.file_faces);
-  EXPECT_EQ(fast_report.ignored_attributes, general_report.ignored_attributes);
+  expect_same_load(fast, fast_report, general, general_report);
   // Doubles that round differently straight to float and through double (vcglib's way).
   const std::string tricky = "OFF\n3 1 0\n1.00000005960464477539062500000001 0 0\n"
                              "0 0.100000001490116119384765625000001 0\n0 0 1e-44\n3 0 1 2\n";
