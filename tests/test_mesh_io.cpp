@@ -531,14 +531,17 @@ TEST_F(MeshIoTest, PlyAsciiFastPathReadsWhatVcglibReads) {
   std::string faces;
   const size_t nf = 299; // vertices 301 and 302 unreferenced
   for (size_t f = 0; f < nf; ++f)
-    faces += "3 " + std::to_string(f) + " " + std::to_string(f + 1) + " " + std::to_string(f + 2) + "\n";
+    faces +=
+        "3 " + std::to_string(f) + " " + std::to_string(f + 1) + " " + std::to_string(f + 2) + "\n";
   auto header = [&](const std::string &extra) {
     return "ply\nformat ascii 1.0\nelement vertex " + std::to_string(nv) +
            "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
-           std::to_string(nf) + "\nproperty list uchar int vertex_indices\n" + extra + "end_header\n";
+           std::to_string(nf) + "\nproperty list uchar int vertex_indices\n" + extra +
+           "end_header\n";
   };
   LoadReport fast_report, general_report;
-  const Mesh fast = pomar::load_mesh(write("fast.ply", header("") + vertices + faces), &fast_report);
+  const Mesh fast =
+      pomar::load_mesh(write("fast.ply", header("") + vertices + faces), &fast_report);
   const Mesh general = pomar::load_mesh(
       write("general.ply", header("element material 0\nproperty float shine\n") + vertices + faces),
       &general_report);
@@ -547,12 +550,14 @@ TEST_F(MeshIoTest, PlyAsciiFastPathReadsWhatVcglibReads) {
   // fast path declines fails as the general path fails.
   for (const std::string &odd :
        {std::string("-0"), std::string(".5"), std::string("5."), std::string("1e-40"),
-        std::string("-3.4028234e38"), std::string("-2.50E+1"), std::string("0.") + std::string(44, '0') + "1",
+        std::string("-3.4028234e38"), std::string("-2.50E+1"),
+        std::string("0.") + std::string(44, '0') + "1",
         std::string("123456789012345678901234567890"), std::string("+1"), std::string("0x1p3"),
         std::string("1e39"), std::string("1.5f"), std::string("nan")}) {
     const std::string v = odd + vertices.substr(vertices.find(' '));
     const std::string a = write("odd_fast.ply", header("") + v + faces);
-    const std::string b = write("odd_general.ply", header("element material 0\nproperty float shine\n") + v + faces);
+    const std::string b =
+        write("odd_general.ply", header("element material 0\nproperty float shine\n") + v + faces);
     std::string error_a, error_b;
     Mesh ma, mb;
     try {
@@ -627,12 +632,14 @@ TEST_F(MeshIoTest, OffFastPathReadsWhatVcglibReads) {
   char buf[64];
   for (size_t i = 0; i < nv; ++i)
     for (int k = 0; k < 3; ++k) {
-      std::snprintf(buf, sizeof buf, formats[(i + k) % 6], std::ldexp(mantissa(rng), exponent(rng) / 3));
+      std::snprintf(buf, sizeof buf, formats[(i + k) % 6],
+                    std::ldexp(mantissa(rng), exponent(rng) / 3));
       body += buf;
       body += k < 2 ? (i % 3 ? " " : " \t") : "\n";
     }
   for (size_t f = 0; f < nf; ++f)
-    body += "3 " + std::to_string(f) + " " + std::to_string(f + 2) + " " + std::to_string(f + 1) + "\n";
+    body +=
+        "3 " + std::to_string(f) + " " + std::to_string(f + 2) + " " + std::to_string(f + 1) + "\n";
   const std::string counts = std::to_string(nv) + " " + std::to_string(nf) + " 0\n";
   LoadReport fast_report, general_report;
   const Mesh fast = pomar::load_mesh(write("fast.off", "OFF\n" + counts + body), &fast_report);
@@ -643,8 +650,7 @@ TEST_F(MeshIoTest, OffFastPathReadsWhatVcglibReads) {
   const std::string tricky = "OFF\n3 1 0\n1.00000005960464477539062500000001 0 0\n"
                              "0 0.100000001490116119384765625000001 0\n0 0 1e-44\n3 0 1 2\n";
   const Mesh t_fast = pomar::load_mesh(write("t_fast.off", tricky));
-  const Mesh t_general =
-      pomar::load_mesh(write("t_general.off", "OFF\n#\n" + tricky.substr(4)));
+  const Mesh t_general = pomar::load_mesh(write("t_general.off", "OFF\n#\n" + tricky.substr(4)));
   EXPECT_TRUE(same_bits(t_fast.positions, t_general.positions));
 }
 

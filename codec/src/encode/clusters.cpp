@@ -88,9 +88,8 @@ public:
   /// spread over the threads (the models are frozen: coding only reads them).
   void code(const std::vector<SymbolRecorder> &recordings, const ModelSlots &slots,
             std::vector<RangeEncoder> &coders) {
-    pool_->run(recordings.size(), [&](size_t c, unsigned) {
-      code_recording(recordings[c], slots, coders[c]);
-    });
+    pool_->run(recordings.size(),
+               [&](size_t c, unsigned) { code_recording(recordings[c], slots, coders[c]); });
   }
 
 private:

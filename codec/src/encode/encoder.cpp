@@ -4,8 +4,8 @@
 // The levels are coded by the traversal the decoder runs (encode/encoder_codec.h).
 #include <algorithm>
 #include <chrono>
-#include <functional>
 #include <cmath>
+#include <functional>
 #include <string>
 
 #include "attributes/attribute_section.h"
@@ -54,7 +54,8 @@ std::vector<uint32_t> compact_triangles(const Mesh &mesh, std::vector<uint32_t> 
 }
 
 /// The positions of the vertices compact_to_input names, in that order (xyz floats).
-std::vector<float> gather_positions(const Mesh &mesh, const std::vector<uint32_t> &compact_to_input) {
+std::vector<float> gather_positions(const Mesh &mesh,
+                                    const std::vector<uint32_t> &compact_to_input) {
   std::vector<float> positions(3 * compact_to_input.size());
   for (size_t i = 0; i < compact_to_input.size(); ++i)
     std::copy_n(&mesh.positions[3 * size_t(compact_to_input[i])], 3, &positions[3 * i]);

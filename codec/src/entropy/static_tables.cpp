@@ -76,8 +76,7 @@ double data_bits(const uint32_t *counts, const uint16_t *freq, int n) {
 ModelSlots::ModelSlots(Models &m) {
   // for_each_model visits each array's models one after the other: a model that does not
   // follow the previous one of its type starts a new array.
-  auto add = [&](std::vector<Array> &arrays, void *model, size_t size, uint32_t symbols,
-                 bool bit) {
+  auto add = [&](std::vector<Array> &arrays, void *model, size_t size, uint32_t symbols, bool bit) {
     const uintptr_t p = reinterpret_cast<uintptr_t>(model);
     const uint32_t slot = static_cast<uint32_t>(models_.size());
     Array *last = arrays.empty() ? nullptr : &arrays.back();
@@ -194,7 +193,8 @@ std::vector<double> symbol_costs(const ModelSlots &slots) {
 void add_recording_bits(const SymbolRecorder &r, const ModelSlots &slots,
                         const std::vector<double> &costs, double *bits) {
   for (const SymbolRecorder::Event &e : r.events)
-    bits[e.stream()] += e.kind() == 2 ? double(e.nbits()) : costs[slots.first_symbol(e.model) + e.value()];
+    bits[e.stream()] +=
+        e.kind() == 2 ? double(e.nbits()) : costs[slots.first_symbol(e.model) + e.value()];
 }
 
 void code_recording(const SymbolRecorder &r, const ModelSlots &slots, RangeEncoder &rc) {

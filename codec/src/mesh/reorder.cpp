@@ -55,9 +55,9 @@ std::vector<uint32_t> face_order(const std::vector<uint32_t> &t,
   const size_t nf = t.size() / 3;
   std::vector<Face> faces(nf);
   for (size_t f = 0; f < nf; ++f)
-    faces[f] = {std::min({old_to_new[t[3 * f]], old_to_new[t[3 * f + 1]],
-                          old_to_new[t[3 * f + 2]]}),
-                static_cast<uint32_t>(f)};
+    faces[f] = {
+        std::min({old_to_new[t[3 * f]], old_to_new[t[3 * f + 1]], old_to_new[t[3 * f + 2]]}),
+        static_cast<uint32_t>(f)};
   std::sort(faces.begin(), faces.end(),
             [](const Face &a, const Face &b) { return a.lowest < b.lowest; });
   std::vector<uint32_t> order(nf);
