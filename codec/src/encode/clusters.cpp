@@ -156,7 +156,7 @@ ClusteredLevels encode_clustered_levels(Rebuild &rb, size_t global, FileHeader &
     freezer.freeze(models, slots, recordings);
     // The ideal code lengths summed in cluster order (the same sums for any thread count),
     // then each cluster's symbols coded into its own coder.
-    const std::vector<double> costs = symbol_costs(slots);
+    const std::vector<double> costs = symbol_costs(slots, freezer.counts());
     for (const SymbolRecorder &recording : recordings)
       add_recording_bits(recording, slots, costs, bits);
     if (parallel.on())

@@ -105,7 +105,8 @@ void ModelSlots::outside_level() {
 void LevelFreezer::freeze(Models &m, const ModelSlots &slots,
                           const std::vector<SymbolRecorder> &recordings) {
   // How often each symbol of each model was recorded, and which models were used at all.
-  std::vector<uint32_t> counts(slots.symbols(), 0);
+  std::vector<uint32_t> &counts = counts_;
+  counts.assign(slots.symbols(), 0);
   std::vector<uint8_t> used(slots.slots(), 0);
   for (const SymbolRecorder &r : recordings)
     for (const SymbolRecorder::Event &e : r.events) {
@@ -174,17 +175,17 @@ void LevelFreezer::freeze(Models &m, const ModelSlots &slots,
       });
 }
 
-std::vector<double> symbol_costs(const ModelSlots &slots) {
-  std::vector<double> costs(slots.symbols());
+std::vector<double> symbol_costs(const ModelSlots &slots, const std::vector<uint32_t> &counts) {
+  std::vector<double> costs(slots.symbols(), 0.0);
   for (uint32_t slot = 0; slot < slots.slots(); ++slot) {
-    double *c = &costs[slots.first_symbol(slot)];
-    if (slots.is_bit(slot)) {
-      for (int bit = 0; bit < 2; ++bit)
-        c[bit] = cost_bits(*static_cast<const BitModel *>(slots.model(slot)), bit);
-    } else {
-      const auto &f = *static_cast<const FrequencyModel *>(slots.model(slot));
-      for (uint32_t s = 0; s < slots.symbols(slot); ++s) // 0: never recorded
-        c[s] = f.freq(int(s)) ? cost_bits(f, int(s)) : 0.0;
+    const uint32_t first = slots.first_symbol(slot);
+    for (uint32_t s = 0; s < slots.symbols(slot); ++s) {
+      if (!counts[first + s])
+        continue; // never looked up
+      costs[first + s] =
+          slots.is_bit(slot)
+              ? cost_bits(*static_cast<const BitModel *>(slots.model(slot)), int(s))
+              : cost_bits(*static_cast<const FrequencyModel *>(slots.model(slot)), int(s));
     }
   }
   return costs;

@@ -117,15 +117,19 @@ class LevelFreezer {
 public:
   void freeze(Models &level, const ModelSlots &slots,
               const std::vector<SymbolRecorder> &recordings);
+  /// How often each symbol was recorded in the level last frozen (at first_symbol + symbol).
+  const std::vector<uint32_t> &counts() const { return counts_; }
 
 private:
+  std::vector<uint32_t> counts_;
   std::vector<std::vector<uint16_t>>
       previous_; // per model slot: frozen frequencies (empty: unused)
 };
 
-/// The ideal code length (cost_bits) of every symbol of every model of a frozen level, at
-/// ModelSlots::first_symbol(slot) + symbol: computed once per level, not once per event.
-std::vector<double> symbol_costs(const ModelSlots &slots);
+/// The ideal code length (cost_bits) of every symbol of a frozen level that was recorded
+/// (`counts`, LevelFreezer::counts), at ModelSlots::first_symbol(slot) + symbol (0 for the
+/// others): computed once per level and symbol, not once per event.
+std::vector<double> symbol_costs(const ModelSlots &slots, const std::vector<uint32_t> &counts);
 
 /// Add the ideal code lengths of a recording's events (`costs` of its frozen level) to
 /// bits[stream]: 0 connectivity, 1 geometry, 2 + k attribute code k (the array must have
