@@ -473,6 +473,7 @@ TEST(AttributeRoundTrip, MemoryLimitsCountTheAttributes) {
   const uint64_t per_vertex = encode_attribute_bytes_per_vertex(m, AttributeOptions());
   EXPECT_EQ(per_vertex, 32u + 84u * 10); // RGBA 4 + normal 2 + 2 scalars + UV 2 = 10 codes
   EncodeOptions o;
+  o.threads = 1; // (each further thread adds decode_thread_memory: not what this tests)
   o.memory_limit = encode_memory_estimate(v, f) + v * per_vertex / 2;
   EXPECT_NO_THROW(encode(plain, o));
   try {
@@ -490,6 +491,7 @@ TEST(AttributeRoundTrip, MemoryLimitsCountTheAttributes) {
   EXPECT_EQ(decode_extra, 16u + 8 * 10 + (4 + 12 + 8 + 8));
   EXPECT_EQ(decode_attribute_bytes_per_vertex(info, AttributeMask::none()), 0u);
   DecodeOptions d;
+  d.threads = 1;
   d.memory_limit = decode_memory_estimate(v, f, true) + v * decode_extra / 2;
   try {
     decode(c.file.data(), c.file.size(), d);
@@ -504,6 +506,7 @@ TEST(AttributeRoundTrip, MemoryLimitsCountTheAttributes) {
   const uint64_t bv = gl ? info.levels[gl - 1].vertices : info.base_vertices;
   const uint64_t bf = gl ? info.levels[gl - 1].faces : info.base_faces;
   SelectiveOptions so;
+  so.threads = 1;
   so.memory_limit = decode_memory_estimate(bv, bf, true) + bv * decode_extra / 2;
   EXPECT_THROW(SelectiveDecoder(std::make_unique<MemorySource>(c.file.data(), c.file.size()), so),
                Error);
