@@ -123,54 +123,18 @@ inline uint32_t view_of(const LevelMesh &mesh, uint32_t v, const LevelView &view
   return v;
 }
 
-/// Like get_ring, mapping neighbours through view_of and skipping the faces that collapse
-/// in the view. One walk round the fan collects its corners (counter-clockwise from the
-/// fan's clockwise end); one pass over them maps the neighbours and keeps, in place, the
-/// corners of the faces the view does not skip.
+/// Like get_ring, naming the neighbours through view_of: the faces that collapse in the
+/// view (two neighbours with one name) are left out.
 inline void get_view_ring(const LevelMesh &mesh, uint32_t v, const LevelView &level, Ring &view) {
-  const CornerTable &ct = mesh.ct;
-  std::vector<uint32_t> &corner = view.corner;
-  view.neighbour.clear();
-  corner.clear();
-  view.closed = true;
-  const uint32_t start = ct.VC[v];
-  if (start == kNone)
-    return;
-  uint32_t c = start;
-  do {
-    corner.push_back(c);
-    const uint32_t o = ct.O[CornerTable::next(c)];
-    if (o == kNone) {
-      view.closed = false;
-      break;
-    }
-    c = CornerTable::next(o);
-  } while (c != start);
-  if (!view.closed) { // open fan: the corners clockwise of `start` go first
-    const size_t after = corner.size();
-    for (uint32_t b = ct.swing_cw(start); b != kNone; b = ct.swing_cw(b))
-      corner.push_back(b);
-    if (corner.size() > after) {
-      std::rotate(corner.begin(), corner.begin() + after, corner.end());
-      std::reverse(corner.begin(), corner.begin() + (corner.size() - after));
-    }
-  }
-  const size_t n = corner.size();
-  uint32_t prev = view_of(mesh, ct.V[CornerTable::next(corner[0])], level);
-  view.neighbour.push_back(prev);
-  size_t kept = 0;
-  for (size_t i = 0; i < n; ++i) {
-    const uint32_t ci = corner[i];
-    const uint32_t next = view_of(mesh, ct.V[CornerTable::prev(ci)], level);
-    if (next != prev) {
-      corner[kept++] = ci;
-      view.neighbour.push_back(next);
-    }
-    prev = next;
-  }
-  corner.resize(kept);
-  if (view.closed && view.neighbour.size() > 1)
-    view.neighbour.pop_back(); // the wrap-around repeats the first neighbour
+  // view_of with what it reads in locals (kept in registers through the walk).
+  const auto name = [tag = mesh.tag.data(), parent = mesh.parent.data(), level](uint32_t n) {
+    if (n < level.older_than)
+      return n;
+    while (tag[n].level >= level.level && parent[n] != n)
+      n = parent[n];
+    return n;
+  };
+  get_named_ring(mesh.ct, v, name, view);
 }
 
 /// Prediction of v_from's attribute codes: v_to's codes, except a quantized normal, which is
