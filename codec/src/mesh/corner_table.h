@@ -112,7 +112,7 @@ bool walk_fan(const CornerTable &ct, uint32_t first, const Name &name, Ring &rin
   const uint32_t *V = ct.V.data(), *O = ct.O.data(); // (locals: the stores below are
   uint32_t *corner = ring.corner.grow_to(32);        //  uint32_t too and could alias)
   uint32_t *neighbour = ring.neighbour.grow_to(ring.corner.capacity() + 1);
-  uint32_t room = static_cast<uint32_t>(ring.corner.capacity());
+  const uint32_t room = static_cast<uint32_t>(ring.corner.capacity());
   uint32_t before = name(V[CornerTable::next(first)]);
   neighbour[0] = before;
   uint32_t kept = 0; // faces kept; neighbour[0..kept] are named
@@ -120,10 +120,9 @@ bool walk_fan(const CornerTable &ct, uint32_t first, const Name &name, Ring &rin
   // c = 3 * face + k; k is carried along so that each step takes one `% 3` (of the
   // opposite corner o: the next corner of the fan is next(o), and prev(next(o)) = o).
   for (uint32_t c = first, k = first % 3;;) {
-    if (kept == room) { // a fan larger than any seen so far
-      corner = ring.corner.grow_to(room + 1);
-      neighbour = ring.neighbour.grow_to(ring.corner.capacity() + 1);
-      room = static_cast<uint32_t>(ring.corner.capacity());
+    if (kept == room) { // a fan larger than any seen so far: walk it again with room
+      ring.corner.grow_to(room + 1);
+      return walk_fan(ct, first, name, ring);
     }
     const uint32_t after = name(V[k == 0 ? c + 2 : c - 1]); // V[prev(c)]
     if (after != before) {

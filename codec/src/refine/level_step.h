@@ -25,6 +25,7 @@
 // the vertex numbering and the errors of cluster_level called in cluster order.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <exception>
 #include <vector>
@@ -146,21 +147,39 @@ private:
         mesh.face_claim[f] = static_cast<uint16_t>(level - 1);
   }
 
-  /// Apply the splits in traversal order; new vertices get consecutive ids. A cluster's
-  /// new vertices are numbered inside the cluster by `next_local`.
+  /// Apply the splits in traversal order; new vertices get consecutive ids, new faces
+  /// too. A cluster's new vertices are numbered inside the cluster by `next_local`. The
+  /// arrays are sized once for the whole step, each split writes its entries in place.
   static void apply_splits(LevelMesh &mesh, const std::vector<PendingSplit> &splits, uint32_t level,
                            uint32_t cluster, uint32_t *next_local) {
-    for (const PendingSplit &ps : splits) {
-      const uint32_t v_from = mesh.vertex_count();
-      apply_split(mesh.ct, ps.op, v_from);
-      mesh.q.insert(mesh.q.end(), ps.v_from.position, ps.v_from.position + 3);
-      mesh.attr.insert(mesh.attr.end(), ps.v_from.attr, ps.v_from.attr + mesh.attr_codes);
-      mesh.tag.push_back({cluster, static_cast<uint16_t>(level)});
-      mesh.parent.push_back(ps.op.v_to);
+    CornerTable &ct = mesh.ct;
+    const uint32_t v0 = mesh.vertex_count(), n = static_cast<uint32_t>(splits.size());
+    uint32_t face = ct.face_count(), new_faces = 0;
+    for (const PendingSplit &ps : splits)
+      new_faces += uint32_t(ps.op.has_l) + uint32_t(ps.op.has_r);
+    const size_t vertices = size_t(v0) + n, faces = size_t(face) + new_faces;
+    ct.V.resize(3 * faces);
+    ct.O.resize(3 * faces);
+    ct.VC.resize(vertices);
+    mesh.q.resize(3 * vertices);
+    mesh.attr.resize(mesh.attr_codes * vertices);
+    mesh.tag.resize(vertices);
+    mesh.parent.resize(vertices);
+    if (next_local)
+      mesh.local.resize(vertices);
+    mesh.face_claim.resize(faces, 0);
+    const uint32_t codes = mesh.attr_codes;
+    for (uint32_t i = 0; i < n; ++i) {
+      const PendingSplit &ps = splits[i];
+      const uint32_t v_from = v0 + i;
+      face += apply_split(ct, ps.op, v_from, face);
+      std::copy(ps.v_from.position, ps.v_from.position + 3, &mesh.q[3 * size_t(v_from)]);
+      std::copy(ps.v_from.attr, ps.v_from.attr + codes, mesh.attr.data() + size_t(v_from) * codes);
+      mesh.tag[v_from] = {cluster, static_cast<uint16_t>(level)};
+      mesh.parent[v_from] = ps.op.v_to;
       if (next_local)
-        mesh.local.push_back((*next_local)++);
+        mesh.local[v_from] = (*next_local)++;
     }
-    mesh.face_claim.resize(mesh.ct.face_count(), 0);
   }
 
   TraversalScratch scratch_;

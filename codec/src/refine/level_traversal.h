@@ -66,8 +66,8 @@ struct TraversalScratch {
   bool defer_claims = false;
   std::vector<std::pair<uint32_t, uint32_t>> queue; // (vertex, came from)
   Ring ring;
-  std::vector<uint32_t> ranked;
-  std::vector<int64_t> len2;
+  std::vector<Spoke> spokes;    // of the split vertex being coded
+  std::vector<uint32_t> ranked; // its ring's edges, longest first
   void begin(uint32_t vertices, uint32_t faces) {
     if (marks.size() < vertices)
       marks.resize(vertices);
@@ -199,7 +199,8 @@ void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v,
   if (context < 0 || !codec.split_flag(v, context))
     return;
   s.marks[v].split = s.stamp;
-  rank_edges(mesh, v, ring, s.ranked, s.len2, key);
+  load_spokes(mesh.q, v, ring, s.spokes);
+  rank_edges(ring, s.spokes.data(), s.ranked, key);
   SplitSymbols sym;
   codec.split_symbols(v, ring, s.ranked.data(), sym);
   PatchRange p;
@@ -207,8 +208,9 @@ void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v,
     codec.corrupt("split symbols do not fit the vertex's neighbourhood");
   // Patches of one level must not share faces (that is what makes the splits
   // independent); a stream that says otherwise is damaged.
-  for (uint32_t t = 0; t < p.faces; ++t) {
-    const uint32_t f = ring.corner[(p.first_face + t) % ring.size()] / 3;
+  const uint32_t m = ring.size();
+  for (uint32_t t = 0, i = p.first_face; t < p.faces; ++t, i = i + 1 == m ? 0 : i + 1) {
+    const uint32_t f = ring.corner[i] / 3;
     if (mesh.face_claim[f] == level || s.claimed[f] == s.stamp)
       codec.corrupt(kSharedFace);
     if (!s.defer_claims)
@@ -219,15 +221,16 @@ void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v,
   // The split walks the patch faces counter-clockwise in the actual mesh: they must be the
   // ring's faces (true for valid data; a damaged stream could point across a boundary or a
   // face the view skipped).
-  for (uint32_t t = 0, c = ring.corner[p.first_face]; t < p.faces; ++t) {
-    if (c != ring.corner[(p.first_face + t) % ring.size()])
+  for (uint32_t t = 0, i = p.first_face, c = ring.corner[i]; t < p.faces;
+       ++t, i = i + 1 == m ? 0 : i + 1) {
+    if (c != ring.corner[i])
       codec.corrupt("a vertex split does not match the mesh");
     c = mesh.ct.swing_ccw(c);
   }
   PendingSplit ps;
   ps.op = {v, ring.corner[p.first_face], p.faces, p.il != kNone, p.ir != kNone};
   Prediction prediction;
-  predict(mesh.q, v, ring, p, prediction);
+  predict(&mesh.q[3 * size_t(v)], ring, s.spokes.data(), p, prediction);
   codec.geometry(v, prediction, ps.v_from.position);
   if (mesh.attr_codes) {
     int64_t pred[kMaxAttributeCodes];
@@ -245,11 +248,9 @@ template <class Accept>
 void queue_neighbours(TraversalScratch &s, uint32_t v, uint32_t from, const Ring &ring,
                       const Accept &accept) {
   const uint32_t m = ring.size();
-  int start = ring.index_of(from);
-  if (start < 0)
-    start = 0;
-  for (uint32_t t = 0; t < m; ++t) {
-    const uint32_t n = ring.neighbour[(uint32_t(start) + m - t) % m];
+  const int start = ring.index_of(from);
+  for (uint32_t t = 0, i = start < 0 ? 0 : uint32_t(start); t < m; ++t, i = i ? i - 1 : m - 1) {
+    const uint32_t n = ring.neighbour[i];
     if (!s.queued(n) && accept(n)) {
       s.marks[n].queued = s.stamp;
       s.queue.emplace_back(n, v);
