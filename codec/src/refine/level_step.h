@@ -163,10 +163,7 @@ private:
     ct.VC.resize(vertices);
     mesh.q.resize(3 * vertices);
     mesh.attr.resize(mesh.attr_codes * vertices);
-    mesh.tag.resize(vertices);
-    mesh.parent.resize(vertices);
-    if (next_local)
-      mesh.local.resize(vertices);
+    mesh.lineage.resize(vertices);
     mesh.face_claim.resize(faces, 0);
     const uint32_t codes = mesh.attr_codes;
     for (uint32_t i = 0; i < n; ++i) {
@@ -175,10 +172,8 @@ private:
       face += apply_split(ct, ps.op, v_from, face);
       std::copy(ps.v_from.position, ps.v_from.position + 3, &mesh.q[3 * size_t(v_from)]);
       std::copy(ps.v_from.attr, ps.v_from.attr + codes, mesh.attr.data() + size_t(v_from) * codes);
-      mesh.tag[v_from] = {cluster, static_cast<uint16_t>(level)};
-      mesh.parent[v_from] = ps.op.v_to;
-      if (next_local)
-        mesh.local[v_from] = (*next_local)++;
+      mesh.lineage[v_from] = {cluster, ps.op.v_to, next_local ? (*next_local)++ : 0,
+                              static_cast<uint16_t>(level)};
     }
   }
 

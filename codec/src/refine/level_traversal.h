@@ -115,24 +115,20 @@ struct LevelView {
 /// their parents, and the faces those splits added (degenerate in the view) are skipped.
 /// The view is the same whatever clusters were decoded before, which is what makes
 /// selective and incremental decoding equal to a full decode.
-inline uint32_t view_of(const LevelMesh &mesh, uint32_t v, const LevelView &view) {
+inline uint32_t view_of(const LevelMesh::Lineage *lineage, uint32_t v, const LevelView &view) {
   if (v < view.older_than)
     return v;
-  while (mesh.tag[v].level >= view.level && mesh.parent[v] != v)
-    v = mesh.parent[v];
+  while (lineage[v].level >= view.level && lineage[v].parent != v)
+    v = lineage[v].parent;
   return v;
 }
 
 /// Like get_ring, naming the neighbours through view_of: the faces that collapse in the
 /// view (two neighbours with one name) are left out.
 inline void get_view_ring(const LevelMesh &mesh, uint32_t v, const LevelView &level, Ring &view) {
-  // view_of with what it reads in locals (kept in registers through the walk).
-  const auto name = [tag = mesh.tag.data(), parent = mesh.parent.data(), level](uint32_t n) {
-    if (n < level.older_than)
-      return n;
-    while (tag[n].level >= level.level && parent[n] != n)
-      n = parent[n];
-    return n;
+  // (What view_of reads, copied: kept in registers through the walk.)
+  const auto name = [lineage = mesh.lineage.data(), level](uint32_t n) {
+    return view_of(lineage, n, level);
   };
   get_named_ring(mesh.ct, v, name, view);
 }
@@ -306,7 +302,7 @@ void traverse_cluster(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32
                       const LevelView &level, std::vector<PendingSplit> &splits) {
   const uint32_t cluster = mesh.cluster_of(root);
   const auto key = [&](uint32_t v) { return mesh.key(v); };
-  const auto mine = [&](uint32_t v) { return mesh.tag[v].cluster == cluster; };
+  const auto mine = [&](uint32_t v) { return mesh.lineage[v].cluster == cluster; };
   get_view_ring(mesh, root, level, s.ring);
   if (s.ring.neighbour.empty())
     return;
