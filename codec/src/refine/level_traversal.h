@@ -38,18 +38,29 @@
 namespace pomar {
 
 /// What is coded per split vertex besides the split itself: the data of the new vertex
-/// v_from. code_vertex codes it (Codec::geometry), apply_splits (level_step.h) stores it
-/// with the new vertex. A per-vertex attribute adds its field here, its coding next to
-/// Codec::geometry and its storage next to LevelMesh::q.
+/// v_from. code_vertex codes it (Codec::geometry, Codec::attributes), apply_splits
+/// (level_step.h) stores it with the new vertex: the position in PendingSplit, the
+/// attribute codes (LevelMesh::attr_codes per split, often none) beside, in
+/// SplitList::attr, so that a split takes 28 bytes whatever the attributes.
 constexpr uint32_t kMaxAttributeCodes = 16; // integer codes of all attributes of a vertex
-struct NewVertex {
-  int32_t position[3];               // quantized xyz
-  int64_t attr[kMaxAttributeCodes]; // attribute codes (LevelMesh::attr_codes of them)
-};
-
 struct PendingSplit {
   SplitOp op;
-  NewVertex v_from;
+  int32_t position[3]; // v_from's, quantized
+};
+
+/// The splits of one step, in the order they were coded.
+struct SplitList {
+  std::vector<PendingSplit> split;
+  std::vector<int64_t> attr; // split i's attribute codes: [i * attr_codes, (i + 1) * attr_codes)
+  size_t size() const { return split.size(); }
+  void clear() {
+    split.clear();
+    attr.clear();
+  }
+  void swap(SplitList &other) {
+    split.swap(other.split);
+    attr.swap(other.attr);
+  }
 };
 
 /// Per-vertex and per-face marks of one traversal (level stamps, reused across levels).
@@ -190,7 +201,7 @@ struct SkipsAttributes<Codec,
 /// its faces, prediction and position. `ring` is v's ring as the level sees it.
 template <class Codec, class Key>
 void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v, const Ring &ring,
-                 uint32_t level, const Key &key, std::vector<PendingSplit> &splits) {
+                 uint32_t level, const Key &key, SplitList &splits) {
   const int context = sv_context(s, ring);
   if (context < 0 || !codec.split_flag(v, context))
     return;
@@ -227,16 +238,17 @@ void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v,
   ps.op = {v, ring.corner[p.first_face], p.faces, p.il != kNone, p.ir != kNone};
   Prediction prediction;
   predict(&mesh.q[3 * size_t(v)], ring, s.spokes.data(), p, prediction);
-  codec.geometry(v, prediction, ps.v_from.position);
+  codec.geometry(v, prediction, ps.position);
   if (mesh.attr_codes) {
-    int64_t pred[kMaxAttributeCodes];
-    predict_attributes(mesh, v, ring, p, ps.v_from.position, pred);
-    codec.attributes(mesh, pred, ps.v_from.attr);
+    int64_t pred[kMaxAttributeCodes], codes[kMaxAttributeCodes];
+    predict_attributes(mesh, v, ring, p, ps.position, pred);
+    codec.attributes(mesh, pred, codes);
+    splits.attr.insert(splits.attr.end(), codes, codes + mesh.attr_codes);
   } else if constexpr (SkipsAttributes<Codec>::value) {
     if (mesh.attr_skipped)
       codec.skip_attributes(mesh.attr_skipped);
   }
-  splits.push_back(ps);
+  splits.split.push_back(ps);
 }
 
 /// Queue v's neighbours clockwise, starting with the one back to `from`.
@@ -272,7 +284,7 @@ inline void prefetch_ahead(const LevelMesh &mesh, const TraversalScratch &s, siz
 /// base faces in order), appending the splits to `splits`. `s` is begun by the caller.
 template <class Codec>
 void traverse_level(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t level,
-                    std::vector<PendingSplit> &splits) {
+                    SplitList &splits) {
   const auto id = [](uint32_t v) { return uint64_t(v); };
   const auto all = [](uint32_t) { return true; };
   size_t head = 0;
@@ -299,7 +311,7 @@ void traverse_level(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t
 /// caller.
 template <class Codec>
 void traverse_cluster(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t root,
-                      const LevelView &level, std::vector<PendingSplit> &splits) {
+                      const LevelView &level, SplitList &splits) {
   const uint32_t cluster = mesh.cluster_of(root);
   const auto key = [&](uint32_t v) { return mesh.key(v); };
   const auto mine = [&](uint32_t v) { return mesh.lineage[v].cluster == cluster; };
