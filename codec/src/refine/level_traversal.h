@@ -89,17 +89,15 @@ struct TraversalScratch {
     claims.clear();
   }
   bool queued(uint32_t v) const { return marks[v].queued == stamp; }
-  bool split(uint32_t v) const { return marks[v].split == stamp; }
 };
 
 /// s_v context from what the decoder already knows at v: how many of v's faces earlier
 /// patches of this level hold (0..3+), how many neighbours were split (0..2+), and v's
 /// valence (<=5, 6, 7, 8+: a v_to gained the valence of the vertex it absorbed).
 /// Returns -1 when every face is held: v cannot be split, s_v is not coded at all.
-inline int sv_context(const TraversalScratch &s, const Ring &ring) {
-  uint32_t split_neighbours = 0;
-  for (uint32_t n : ring.neighbour)
-    split_neighbours += s.split(n);
+/// `split_neighbours` counts the ring's entries split earlier in this traversal
+/// (queue_neighbours counts them).
+inline int sv_context(const TraversalScratch &s, const Ring &ring, uint32_t split_neighbours) {
   // Every patch face contains its v_to: without a split neighbour no face is held.
   uint32_t claimed = 0;
   if (split_neighbours) {
@@ -201,8 +199,8 @@ struct SkipsAttributes<Codec,
 /// its faces, prediction and position. `ring` is v's ring as the level sees it.
 template <class Codec, class Key>
 void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v, const Ring &ring,
-                 uint32_t level, const Key &key, SplitList &splits) {
-  const int context = sv_context(s, ring);
+                 uint32_t level, const Key &key, uint32_t split_neighbours, SplitList &splits) {
+  const int context = sv_context(s, ring, split_neighbours);
   if (context < 0 || !codec.split_flag(v, context))
     return;
   s.marks[v].split = s.stamp;
@@ -251,19 +249,25 @@ void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v,
   splits.split.push_back(ps);
 }
 
-/// Queue v's neighbours clockwise, starting with the one back to `from`.
+/// Queue v's neighbours clockwise, starting with the one back to `from`; returns how many
+/// of them were split earlier in this traversal (for sv_context: one pass over the ring's
+/// marks; v's own coding, which follows, changes neither the queue nor those marks).
 template <class Accept>
-void queue_neighbours(TraversalScratch &s, uint32_t v, uint32_t from, const Ring &ring,
-                      const Accept &accept) {
+uint32_t queue_neighbours(TraversalScratch &s, uint32_t v, uint32_t from, const Ring &ring,
+                          const Accept &accept) {
   const uint32_t m = ring.size();
   const int start = ring.index_of(from);
+  uint32_t split = 0;
   for (uint32_t t = 0, i = start < 0 ? 0 : uint32_t(start); t < m; ++t, i = i ? i - 1 : m - 1) {
     const uint32_t n = ring.neighbour[i];
-    if (!s.queued(n) && accept(n)) {
+    const TraversalScratch::VertexMarks marks = s.marks[n];
+    split += marks.split == s.stamp;
+    if (marks.queued != s.stamp && accept(n)) {
       s.marks[n].queued = s.stamp;
       s.queue.emplace_back(n, v);
     }
   }
+  return split;
 }
 
 /// The walks are memory bound: fetch the corners of the vertex 8 places ahead in the
@@ -298,8 +302,8 @@ void traverse_level(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t
       prefetch_ahead(mesh, s, head);
       const auto [v, from] = s.queue[head++];
       get_ring(mesh.ct, v, s.ring);
-      code_vertex(mesh, codec, s, v, s.ring, level, id, splits);
-      queue_neighbours(s, v, from, s.ring, all);
+      const uint32_t split = queue_neighbours(s, v, from, s.ring, all);
+      code_vertex(mesh, codec, s, v, s.ring, level, id, split, splits);
     }
   }
 }
@@ -328,8 +332,8 @@ void traverse_cluster(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32
     prefetch_ahead(mesh, s, head);
     const auto [v, came_from] = s.queue[head++];
     get_view_ring(mesh, v, level, s.ring);
-    code_vertex(mesh, codec, s, v, s.ring, level.level, key, splits);
-    queue_neighbours(s, v, came_from, s.ring, mine);
+    const uint32_t split = queue_neighbours(s, v, came_from, s.ring, mine);
+    code_vertex(mesh, codec, s, v, s.ring, level.level, key, split, splits);
   }
 }
 
