@@ -117,29 +117,31 @@ bool walk_fan(const CornerTable &ct, uint32_t first, const Name &name, Ring &rin
   neighbour[0] = before;
   uint32_t kept = 0; // faces kept; neighbour[0..kept] are named
   bool closed = true;
-  // c = 3 * face + k; k is carried along so that each step takes one `% 3` (of the
-  // opposite corner o: the next corner of the fan is next(o), and prev(next(o)) = o).
-  for (uint32_t c = first, k = first % 3;;) {
+  // Face c = (v, a, b) of the fan gives corner c and neighbour b; the next face is the one
+  // across edge (v, b): corner next(o) for o = O[next(c)], and its b is V[prev(next(o))]
+  // = V[o]. So each step takes one `% 3`, of o.
+  uint32_t c = first, b = V[CornerTable::prev(first)], o = O[CornerTable::next(first)];
+  for (;;) {
     if (kept == room) { // a fan larger than any seen so far: walk it again with room
       ring.corner.grow_to(room + 1);
       return walk_fan(ct, first, name, ring);
     }
-    const uint32_t after = name(V[k == 0 ? c + 2 : c - 1]); // V[prev(c)]
+    const uint32_t after = name(b);
     if (after != before) {
       corner[kept++] = c;
       neighbour[kept] = after;
     }
     before = after;
-    const uint32_t o = O[k == 2 ? c - 2 : c + 1]; // O[next(c)]
     if (o == kNone) {
       closed = false;
       break;
     }
-    const uint32_t ko = o % 3;
-    c = ko == 2 ? o - 2 : o + 1; // next(o)
-    k = ko == 2 ? 0 : ko + 1;
+    const uint32_t k = o % 3;
+    c = k == 2 ? o - 2 : o + 1; // next(o)
     if (c == first)
       break;
+    b = V[o];
+    o = O[k == 0 ? o + 2 : o - 1]; // O[next(c)] = O[prev(o)]
   }
   ring.corner.resize(kept);
   // (a closed fan's wrap-around repeats the first neighbour)

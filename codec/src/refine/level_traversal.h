@@ -13,6 +13,7 @@
 //   int  split_flag(uint32_t v, int context);
 //   void split_symbols(uint32_t v, const Ring& ring, const uint32_t* ranked,
 //                      SplitSymbols& s);      // ranked = ring indices, longest edge first
+//                                     (nullptr if Codec::kSelectsSplitEdge: see code_vertex)
 //   void geometry(uint32_t v_to, const Prediction& prediction, int32_t position[3]);
 //                                     // prediction: geometry/predict.h
 //   void attributes(const LevelMesh& mesh, const int64_t* prediction, int64_t* codes); // if any
@@ -195,6 +196,12 @@ struct SkipsAttributes<Codec,
                        std::void_t<decltype(std::declval<Codec &>().skip_attributes(0u))>>
     : std::true_type {};
 
+/// Whether a Codec's split_symbols ignores the ranked edges (the decoder: it reads s_e and
+/// code_vertex then looks up that one edge, ranked_edge, instead of sorting them all).
+template <class Codec, class = void> struct SelectsSplitEdge : std::false_type {};
+template <class Codec>
+struct SelectsSplitEdge<Codec, std::enable_if_t<Codec::kSelectsSplitEdge>> : std::true_type {};
+
 /// Code (or decode) s_v at v and, for a split vertex, the split: symbols, patch, claim of
 /// its faces, prediction and position. `ring` is v's ring as the level sees it.
 template <class Codec, class Key>
@@ -205,11 +212,24 @@ void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v,
     return;
   s.marks[v].split = s.stamp;
   load_spokes(mesh.q, v, ring, s.spokes);
-  rank_edges(ring, s.spokes.data(), s.ranked, key);
   SplitSymbols sym;
-  codec.split_symbols(v, ring, s.ranked.data(), sym);
+  uint32_t j = kNone; // the ring index of edge v_to-v_ref (rank s_e)
+  if constexpr (SelectsSplitEdge<Codec>::value) {
+    codec.split_symbols(v, ring, nullptr, sym);
+    if (sym.s_e < ring.size() && ring.size() <= 16)
+      j = ranked_edge(ring, s.spokes.data(), sym.s_e, key);
+    else if (sym.s_e < ring.size()) {
+      rank_edges(ring, s.spokes.data(), s.ranked, key);
+      j = s.ranked[sym.s_e];
+    }
+  } else {
+    rank_edges(ring, s.spokes.data(), s.ranked, key);
+    codec.split_symbols(v, ring, s.ranked.data(), sym);
+    if (sym.s_e < ring.size())
+      j = s.ranked[sym.s_e];
+  }
   PatchRange p;
-  if (!resolve_patch(ring, s.ranked.data(), sym, p))
+  if (!resolve_patch(ring, j, sym, p))
     codec.corrupt("split symbols do not fit the vertex's neighbourhood");
   // Patches of one level must not share faces (that is what makes the splits
   // independent); a stream that says otherwise is damaged.
