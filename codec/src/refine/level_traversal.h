@@ -275,18 +275,25 @@ void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v,
 template <class Accept>
 uint32_t queue_neighbours(TraversalScratch &s, uint32_t v, uint32_t from, const Ring &ring,
                           const Accept &accept) {
-  const uint32_t m = ring.size();
-  const int start = ring.index_of(from);
+  const uint32_t m = ring.size(), stamp = s.stamp; // (a local: the mark stores could alias it)
+  if (m == 0)
+    return 0;
+  const int at = ring.index_of(from);
+  const uint32_t start = at < 0 ? 0 : uint32_t(at);
   uint32_t split = 0;
-  for (uint32_t t = 0, i = start < 0 ? 0 : uint32_t(start); t < m; ++t, i = i ? i - 1 : m - 1) {
-    const uint32_t n = ring.neighbour[i];
-    const TraversalScratch::VertexMarks marks = s.marks[n];
-    split += marks.split == s.stamp;
-    if (marks.queued != s.stamp && accept(n)) {
-      s.marks[n].queued = s.stamp;
+  const auto visit = [&](uint32_t n) {
+    TraversalScratch::VertexMarks &marks = s.marks[n];
+    split += marks.split == stamp;
+    if (marks.queued != stamp && accept(n)) {
+      marks.queued = stamp;
       s.queue.emplace_back(n, v);
     }
-  }
+  };
+  // Clockwise: start, start - 1, ..., 0, then m - 1, ..., start + 1.
+  for (uint32_t i = start + 1; i-- > 0;)
+    visit(ring.neighbour[i]);
+  for (uint32_t i = m; i-- > start + 1;)
+    visit(ring.neighbour[i]);
   return split;
 }
 
