@@ -297,18 +297,35 @@ uint32_t queue_neighbours(TraversalScratch &s, uint32_t v, uint32_t from, const 
   return split;
 }
 
-/// The walks are memory bound: fetch the corners of the vertex 8 places ahead in the
-/// queue, and the corner reference of the one 16 places ahead.
+/// The walks are memory bound: fetch the corner reference of the vertex 16 places ahead in
+/// the queue, the corners of its first face 8 places ahead, and 4 places ahead the two
+/// faces next to that one in its fan (their O entries have arrived by then).
 inline void prefetch_ahead(const LevelMesh &mesh, const TraversalScratch &s, size_t head) {
-  if (head + 8 < s.queue.size()) {
-    const uint32_t ahead = mesh.ct.VC[s.queue[head + 8].first];
-    if (ahead != kNone) {
-      __builtin_prefetch(&mesh.ct.O[ahead]);
-      __builtin_prefetch(&mesh.ct.V[ahead]);
+  const CornerTable &ct = mesh.ct;
+  const size_t n = s.queue.size();
+  if (head + 4 < n) {
+    const uint32_t c = ct.VC[s.queue[head + 4].first];
+    if (c != kNone) {
+      const uint32_t a = ct.O[CornerTable::next(c)], b = ct.O[CornerTable::prev(c)];
+      if (a != kNone) {
+        __builtin_prefetch(&ct.O[a]);
+        __builtin_prefetch(&ct.V[a]);
+      }
+      if (b != kNone) {
+        __builtin_prefetch(&ct.O[b]);
+        __builtin_prefetch(&ct.V[b]);
+      }
     }
   }
-  if (head + 16 < s.queue.size())
-    __builtin_prefetch(&mesh.ct.VC[s.queue[head + 16].first]);
+  if (head + 8 < n) {
+    const uint32_t ahead = ct.VC[s.queue[head + 8].first];
+    if (ahead != kNone) {
+      __builtin_prefetch(&ct.O[ahead]);
+      __builtin_prefetch(&ct.V[ahead]);
+    }
+  }
+  if (head + 16 < n)
+    __builtin_prefetch(&ct.VC[s.queue[head + 16].first]);
 }
 
 /// Traverse the whole mesh once for global level `level` (all components, seeded by the
