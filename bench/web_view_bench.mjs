@@ -10,7 +10,8 @@
 // model framed as the viewer frames it, refined to `target` pixels), a close-up (the
 // surface point facing the camera seen from `closeup` x the model's size, as
 // web/test/page_test.js does) and single clusters raised to the finest level. Percentages
-// are of the file size; "requests" counts Range requests. See web/README.md for the table.
+// are of the file size; "requests" counts Range requests (a server answering several ranges
+// in one request assumed), "ranges" the byte ranges they asked for. See web/README.md for the table.
 // DEBUG=1 also prints, per refinement step, the clusters refined, coarsened, hidden
 // (outside the frustum) and culled (occluded or back-facing), and for each close-up its
 // final level map (level:clusters) and the bytes held per level.
@@ -34,7 +35,7 @@ if (!file) {
 }
 const [width, height] = opt('size', '800x457').split('x').map(Number);
 const fetchOptions = { maxGap: 128 }; // pomar.js's default
-for (const name of ['maxGap', 'wholeBlockBytes', 'estimateMargin', 'estimateSlack'])
+for (const name of ['maxGap', 'maxRanges', 'wholeBlockBytes', 'estimateMargin', 'estimateSlack'])
   if (opt(name) !== undefined) fetchOptions[name] = Number(opt(name));
 const settings = { targetPixels: Number(opt('target', 3)), backface: args.includes('--backface'),
   occlusion: !args.includes('--no-occlusion') };
@@ -50,7 +51,7 @@ function line(what, s, extra = '') {
   const f = s.stream.file.stats;
   const raised = s.stream.levels.filter((l) => l > s.stream.info.baseLevel).length;
   console.log(`${what.padEnd(22)} ${pct(s.stream, f.bytesFetched).padStart(7)} ${String(f.bytesFetched).padStart(8)} B ` +
-    `${String(f.requests).padStart(5)} requests ${String(s.mesh.triangles.length / 3).padStart(7)} triangles ` +
+    `${String(f.requests).padStart(5)} requests (${f.ranges} ranges) ${String(s.mesh.triangles.length / 3).padStart(7)} triangles ` +
     `${String(raised).padStart(5)} clusters raised, ${s.stream.retries} short prefixes${extra}`);
 }
 /** Refine for the camera until stable, as the viewer's loop does. */

@@ -9,8 +9,8 @@
 #include "mesh/corner_table.h"
 #include "pomar/pomar.h"
 #include "pomar/random_access.h"
-#include "support/mesh_gen.h"
 #include "support/mesh_compare.h"
+#include "support/mesh_gen.h"
 
 namespace pomar {
 namespace {
@@ -61,7 +61,8 @@ void check_state(const Encoded &e, const SelectiveDecoder &d) {
   std::set<std::array<float, 3>> full;
   const Mesh finest = decode(e.file.data(), e.file.size());
   for (size_t v = 0; v < finest.vertex_count(); ++v)
-    full.insert({finest.positions[3 * v], finest.positions[3 * v + 1], finest.positions[3 * v + 2]});
+    full.insert(
+        {finest.positions[3 * v], finest.positions[3 * v + 1], finest.positions[3 * v + 2]});
   for (size_t v = 0; v < m.vertex_count(); ++v) {
     EXPECT_LE(int(vl[v]), levels[vc[v]]);
     EXPECT_TRUE(full.count({m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]}));
@@ -219,9 +220,78 @@ TEST(RandomAccess, LevelMapCompletion) {
   const std::vector<uint32_t> adj = {1, 0, 2, 1, 3, 2, 4, 3};
   EXPECT_EQ(complete_level_map({10, 0, 0, 0, 0}, start, adj, 6),
             (std::vector<int>{10, 9, 8, 7, 6}));
-  EXPECT_EQ(complete_level_map({0, 0, 9, 0, 0}, start, adj, 6),
-            (std::vector<int>{7, 8, 9, 8, 7}));
+  EXPECT_EQ(complete_level_map({0, 0, 9, 0, 0}, start, adj, 6), (std::vector<int>{7, 8, 9, 8, 7}));
   EXPECT_EQ(complete_level_map({0, 0, 0, 0, 0}, start, adj, 6), (std::vector<int>(5, 6)));
+}
+
+/// A colour per vertex from its position, so that take_mesh() has attributes to hand over.
+Mesh coloured(Mesh m) {
+  VertexAttribute c;
+  c.kind = AttributeKind::Colour;
+  c.name = "colour";
+  c.components = 3;
+  for (float x : m.positions)
+    c.colour.push_back(static_cast<uint8_t>(int(std::abs(x) * 977.0f) & 255));
+  m.attributes.push_back(std::move(c));
+  return m;
+}
+
+/// take_mesh() gives what mesh() gives, leaves the decoder at the base (clustered) mesh with
+/// the requests kept, and the next update() brings the same mesh back.
+void expect_take_mesh_round_trip(SelectiveDecoder &d, const Mesh &base) {
+  const Mesh before = d.mesh();
+  const Mesh taken = d.take_mesh();
+  EXPECT_EQ(taken.positions, before.positions);
+  EXPECT_EQ(taken.triangles, before.triangles);
+  ASSERT_EQ(taken.attributes.size(), before.attributes.size());
+  for (size_t i = 0; i < taken.attributes.size(); ++i)
+    EXPECT_EQ(taken.attributes[i].colour, before.attributes[i].colour);
+  const Mesh after = d.mesh();
+  EXPECT_EQ(after.positions, base.positions);
+  EXPECT_EQ(after.triangles, base.triangles);
+  d.update();
+  const Mesh again = d.mesh();
+  EXPECT_EQ(again.positions, before.positions);
+  EXPECT_EQ(again.triangles, before.triangles);
+  ASSERT_EQ(again.attributes.size(), before.attributes.size());
+  for (size_t i = 0; i < again.attributes.size(); ++i)
+    EXPECT_EQ(again.attributes[i].colour, before.attributes[i].colour);
+}
+
+TEST(RandomAccess, TakeMeshHandsTheMeshOverAndGoesBackToTheBase) {
+  const Encoded e = encode_clustered(coloured(gen::torus(60, 30)), 0.04);
+  ASSERT_GT(e.info.clusters, 10u);
+  auto d = open(e);
+  const Mesh base = d->mesh();
+  ASSERT_FALSE(base.attributes.empty());
+  for (uint32_t c = 0; c < d->cluster_count(); c += 3)
+    d->want_cluster(c, d->finest_level());
+  d->update();
+  EXPECT_FALSE(d->complete());
+  expect_take_mesh_round_trip(*d, base);
+  auto fresh = open(e);
+  for (uint32_t c = 0; c < fresh->cluster_count(); c += 3)
+    fresh->want_cluster(c, fresh->finest_level());
+  fresh->update();
+  EXPECT_EQ(d->levels(), fresh->levels());
+  // (a fresh decoder: one refined in two steps numbers its vertices in another order)
+  auto full = open(e);
+  full->want_all(full->finest_level());
+  full->update();
+  EXPECT_TRUE(full->complete());
+  expect_take_mesh_round_trip(*full, base);
+}
+
+TEST(RandomAccess, TakeMeshOfAProgressiveFile) {
+  EncodeOptions o;
+  o.progressive = true;
+  const Mesh m = coloured(gen::icosphere(4));
+  const std::vector<uint8_t> file = encode(m, o);
+  SelectiveDecoder d(std::make_unique<MemorySource>(file.data(), file.size()));
+  const Mesh base = d.mesh();
+  d.want_all(3);
+  d.update();
+  expect_take_mesh_round_trip(d, base);
 }
 
 TEST(RandomAccess, ProgressiveModeStaysAvailable) {

@@ -33,8 +33,9 @@ export function orbitCamera() {
   return { target: [0, 0, 0], distance: 1, yaw: 0.6, pitch: 0.3, fovY: Math.PI / 4, extent: 1 };
 }
 
-/** Frame the mesh (positions, xyz): target its box centre, from 1.6 x its size. */
-export function frameMesh(camera, positions) {
+/** Frame the mesh (positions, xyz): target its box centre, from 1.6 x its size (divided by
+ *  `aspect`, width / height, on a portrait screen: the model's width fits too). */
+export function frameMesh(camera, positions, aspect = 1) {
   const lo = [Infinity, Infinity, Infinity];
   const hi = [-Infinity, -Infinity, -Infinity];
   for (let i = 0; i < positions.length; ++i) {
@@ -43,13 +44,20 @@ export function frameMesh(camera, positions) {
   }
   camera.target = [0, 1, 2].map((k) => (lo[k] + hi[k]) / 2);
   camera.extent = Math.max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
-  camera.distance = 1.6 * camera.extent;
+  camera.distance = (1.6 * camera.extent) / Math.min(1, aspect);
 }
 
 export function eyeOf(c) {
   return [c.target[0] + c.distance * Math.cos(c.pitch) * Math.sin(c.yaw),
     c.target[1] + c.distance * Math.sin(c.pitch),
     c.target[2] + c.distance * Math.cos(c.pitch) * Math.cos(c.yaw)];
+}
+
+/** Move the target by (dx, dy) in the camera's screen plane (right, up), in model units. */
+export function pan(c, dx, dy) {
+  const right = [Math.cos(c.yaw), 0, -Math.sin(c.yaw)];
+  const up = [-Math.sin(c.pitch) * Math.sin(c.yaw), Math.cos(c.pitch), -Math.sin(c.pitch) * Math.cos(c.yaw)];
+  c.target = c.target.map((t, k) => t + dx * right[k] + dy * up[k]);
 }
 
 /** The view of view_refine.js / PomarModel.wantView for a `width` x `height` viewport. */

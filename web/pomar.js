@@ -8,7 +8,8 @@
 //
 // open() reads the header, global part and cluster index with one or two Range requests
 // and decodes the base clustered mesh; want*() fetch only the cluster blocks still missing
-// (adjacent blocks in one request, at most `maxInFlight` requests at once) and decode them
+// (adjacent blocks in one range, up to `maxRanges` ranges in one request, at most
+// `maxInFlight` requests at once) and decode them
 // on top of the current mesh. Meshes arrive as typed arrays: positions (Float32Array, xyz),
 // triangles (Uint32Array), vertexCluster, vertexLevel (Uint32Array), clusterBounds.
 // Errors (HTTP errors, servers without Range support, damaged or truncated files) reject
@@ -21,7 +22,9 @@ import { chooseLevels, Convergence, sameLevels } from './view_refine.js';
  * @param options {onMesh(mesh, model), onWarning(message), onError(message),
  *   maxInFlight = 4, maxGap = 128 bytes (ranges this close are fetched in one request;
  *   what lies between is kept: a wider gap costs more bytes than the request it saves,
- *   see web/README.md), maxRequestBytes = 1 MiB, memoryBudget = 256 MiB (block bytes
+ *   see web/README.md), maxRanges = 100 (ranges in one request: `Range: bytes=a-b,c-d,...`
+ *   answered multipart/byteranges; a server that answers otherwise gets one range a
+ *   request), maxRequestBytes = 1 MiB, memoryBudget = 256 MiB (block bytes
  *   held; over it the worker rebuilds its decoder with only the blocks in use),
  *   firstRequestBytes = 16 KiB, tolerant = false (true: fetch whole blocks from the start;
  *   see pomar_stream.js)}
@@ -33,7 +36,7 @@ export function open(source, options = {}) {
 
 export class PomarModel {
   constructor(options) {
-    this.options = { memoryBudget: 256 << 20, maxGap: 128, ...options };
+    this.options = { memoryBudget: 256 << 20, maxGap: 128, maxRanges: 100, maxRequestBytes: 1 << 20, maxInFlight: 4, ...options };
     this.worker = new Worker(new URL('./pomar_worker.js', import.meta.url), { type: 'module' });
     this.info = null;
     this.mesh = null;

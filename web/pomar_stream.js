@@ -233,8 +233,8 @@ export class PomarStream {
     const f = this.file.stats;
     let blocksHeld = 0;
     for (let c = 0; c < this.info.clusters; ++c) blocksHeld += this.have[c] > 0;
-    return { fileBytes: this.file.size, bytesFetched: f.bytesFetched, requests: f.requests,
-      maxInFlightSeen: f.maxInFlightSeen, blocksHeld, heldBytes: this.heldBytes, rebuilds: this.rebuilds,
+    return { fileBytes: this.file.size, bytesFetched: f.bytesFetched, requests: f.requests, ranges: f.ranges,
+      multiRange: this.file.multiRange, maxInFlightSeen: f.maxInFlightSeen, blocksHeld, heldBytes: this.heldBytes, rebuilds: this.rebuilds,
       retries: this.retries, tolerant: this.tolerant, damaged: this.decoder.damaged().count };
   }
 

@@ -1,6 +1,8 @@
 // Byte ranges of a remote file (HTTP Range requests) or of a local File/Blob: adjacent
-// ranges are coalesced into one request, at most `maxInFlight` requests run at once, and
-// every failure is an Error whose message names the URL and the problem.
+// ranges are coalesced into one range, up to `maxRanges` ranges go in one request
+// (`Range: bytes=a-b,c-d`, answered multipart/byteranges; one range a request from servers
+// that do not answer so), at most `maxInFlight` requests run at once, and every failure is
+// an Error whose message names the URL and the problem.
 
 export class RangeError_ extends Error {}
 
@@ -25,16 +27,56 @@ export function coalesce(ranges, maxGap = 0, maxBytes = 1 << 20, skipGap = () =>
   return out;
 }
 
+/** Index of `pattern` (bytes) in `bytes` from `from`, or -1. */
+function indexOf(bytes, pattern, from) {
+  const last = bytes.length - pattern.length;
+  for (let i = Math.max(0, from); i <= last; ++i) {
+    let k = 0;
+    while (k < pattern.length && bytes[i + k] === pattern[k]) ++k;
+    if (k === pattern.length) return i;
+  }
+  return -1;
+}
+
+/** The parts [{offset, bytes, total}] of a multipart/byteranges body (RFC 9110 14.6). The
+ *  boundary is looked for only between parts: each part's bytes are skipped by length. */
+export function parseByteranges(body, boundary, name = 'the file') {
+  const delimiter = new TextEncoder().encode('--' + boundary);
+  const blank = new TextEncoder().encode('\r\n\r\n');
+  const bad = (what) => new RangeError_(`the server of ${name} sent a broken multipart/byteranges answer: ${what}`);
+  const parts = [];
+  for (let p = indexOf(body, delimiter, 0); ; ) {
+    if (p < 0) throw bad('a delimiter is missing');
+    p += delimiter.length;
+    if (body[p] === 45 && body[p + 1] === 45) return parts; // "--": the closing delimiter
+    const end = indexOf(body, blank, p);
+    if (end < 0) throw bad('a part has no header end');
+    const headers = new TextDecoder().decode(body.subarray(p, end));
+    const m = /content-range:\s*bytes (\d+)-(\d+)\/(\d+|\*)/i.exec(headers);
+    if (!m) throw bad('a part has no Content-Range');
+    const from = end + blank.length;
+    const length = Number(m[2]) - Number(m[1]) + 1;
+    if (from + length > body.length) throw bad(`a part of ${length} bytes is cut short`);
+    parts.push({ offset: Number(m[1]), bytes: body.subarray(from, from + length), total: m[3] });
+    p = indexOf(body, delimiter, from + length);
+  }
+}
+
 export class RangeFile {
   /** `source`: a URL (string) or a File/Blob. */
-  constructor(source, { maxInFlight = 4, maxGap = 0, maxRequestBytes = 1 << 20 } = {}) {
+  constructor(source, { maxInFlight = 4, maxGap = 0, maxRequestBytes = 1 << 20, maxRanges = 100 } = {}) {
     this.source = source;
     this.name = typeof source === 'string' ? source : source.name || 'local file';
     this.maxInFlight = maxInFlight;
     this.maxGap = maxGap;
     this.maxRequestBytes = maxRequestBytes;
+    this.maxRanges = maxRanges;
+    // Does the server answer several ranges in one request? null: not asked yet (the
+    // first such request is a probe: the others wait for it).
+    this.multiRange = maxRanges > 1 ? null : false;
+    this.probe = null;
     this.size = typeof source === 'string' ? -1 : source.size;
-    this.stats = { requests: 0, bytesFetched: 0, inFlight: 0, maxInFlightSeen: 0 };
+    this.stats = { requests: 0, ranges: 0, bytesFetched: 0, inFlight: 0, maxInFlightSeen: 0 };
     this.waiting = [];
   }
 
@@ -63,6 +105,7 @@ export class RangeFile {
 
   async readNow(offset, size) {
     ++this.stats.requests;
+    ++this.stats.ranges;
     if (typeof this.source !== 'string') {
       const end = Math.min(this.size, offset + size);
       const bytes = new Uint8Array(await this.source.slice(offset, end).arrayBuffer());
@@ -109,26 +152,135 @@ export class RangeFile {
     return bytes;
   }
 
-  /** Fetch ranges [{key, offset, size}], coalesced, at most maxInFlight requests at once.
-   *  Returns {parts: Map key -> Uint8Array (shorter than asked at the end of a truncated
-   *  file) or Error (that request failed), chunks: [{offset, bytes}] (every response, gaps
-   *  between coalesced ranges included)}. */
+  /** Several ranges [{offset, size}] in one request: the chunks [{offset, bytes}] the server
+   *  sent ([] when it does not answer several ranges in one request: then
+   *  this.multiRange = false and the caller asks them one by one). */
+  async readRanges(batch) {
+    if (this.multiRange === null && this.probe) await this.probe;
+    if (this.multiRange === false) return [];
+    const request = (async () => {
+      await this.slot();
+      try {
+        return await this.readRangesNow(batch);
+      } finally {
+        this.release();
+      }
+    })();
+    if (this.multiRange === null) this.probe = request.catch(() => {});
+    return request;
+  }
+
+  async readRangesNow(batch) {
+    ++this.stats.requests;
+    this.stats.ranges += batch.length;
+    if (typeof this.source !== 'string') {
+      // A local file: each range sliced, counted as the one request a server would get.
+      const chunks = [];
+      for (const r of batch) {
+        const bytes = new Uint8Array(await this.source.slice(r.offset, r.offset + r.size).arrayBuffer());
+        this.stats.bytesFetched += bytes.length;
+        chunks.push({ offset: r.offset, bytes });
+      }
+      this.multiRange = true;
+      return chunks;
+    }
+    const spec = batch.map((r) => `${r.offset}-${r.offset + r.size - 1}`).join(',');
+    let response;
+    try {
+      response = await fetch(this.source, { headers: { Range: `bytes=${spec}` } });
+    } catch (e) {
+      // Cross-origin, such a Range header needs a CORS preflight the server may refuse.
+      if (this.multiRange !== null) throw new RangeError_(`cannot fetch ${this.name}: ${e.message || e}`);
+      this.multiRange = false;
+      return [];
+    }
+    const boundary = /multipart\/byteranges;\s*boundary="?([^";]+)"?/i.exec(response.headers.get('Content-Type') || '');
+    if (response.status === 206 && boundary) {
+      let body;
+      try {
+        body = new Uint8Array(await response.arrayBuffer());
+      } catch (e) {
+        throw new RangeError_(`the download of ${this.name} broke off: ${e.message || e}`);
+      }
+      const chunks = parseByteranges(body, boundary[1], this.name);
+      for (const c of chunks) {
+        this.stats.bytesFetched += c.bytes.length;
+        if (c.total !== '*') this.size = Number(c.total);
+      }
+      this.multiRange = true;
+      return chunks;
+    }
+    // Anything else (200 with the whole file, as Amazon S3 answers; one range only): one
+    // range a request from now on, this answer dropped unread.
+    await response.body?.cancel();
+    this.multiRange = false;
+    return [];
+  }
+
+  /** Coalesced requests grouped by consecutive runs of up to maxRanges ranges and
+   *  maxRequestBytes bytes (each group one request when the server answers several ranges). */
+  batches(requests) {
+    const out = [];
+    for (const req of requests) {
+      const last = out[out.length - 1];
+      if (last && this.multiRange !== false && last.length < this.maxRanges && last.bytes + req.size <= this.maxRequestBytes) {
+        last.push(req);
+        last.bytes += req.size;
+      } else {
+        out.push(Object.assign([req], { bytes: req.size }));
+      }
+    }
+    return out;
+  }
+
+  /** Fetch ranges [{key, offset, size}], coalesced and batched, at most maxInFlight
+   *  requests at once. Returns {parts: Map key -> Uint8Array (shorter than asked at the end
+   *  of a truncated file) or Error (that request failed), chunks: [{offset, bytes}] (every
+   *  range received, gaps between coalesced ranges included)}. */
   async readMany(ranges, skipGap = undefined) {
     const parts = new Map();
     const chunks = [];
-    const requests = coalesce(ranges, this.maxGap, this.maxRequestBytes, skipGap);
-    await Promise.all(requests.map(async (req) => {
-      try {
-        const end = this.size >= 0 ? Math.min(this.size, req.offset + req.size) : req.offset + req.size;
-        const bytes = end > req.offset ? await this.read(req.offset, end - req.offset) : new Uint8Array(0);
-        chunks.push({ offset: req.offset, bytes });
-        for (const p of req.parts) {
-          const a = Math.min(bytes.length, p.offset - req.offset);
-          parts.set(p.key, bytes.subarray(a, Math.min(bytes.length, a + p.size)));
+    const fill = (req, chunk) => {
+      for (const p of req.parts) {
+        if (chunk instanceof Error) {
+          parts.set(p.key, chunk);
+          continue;
         }
-      } catch (e) {
-        for (const p of req.parts) parts.set(p.key, e);
+        const a = Math.min(chunk.bytes.length, p.offset - chunk.offset);
+        parts.set(p.key, chunk.bytes.subarray(a, Math.min(chunk.bytes.length, a + p.size)));
       }
+    };
+    const requests = [];
+    for (const req of coalesce(ranges, this.maxGap, this.maxRequestBytes, skipGap)) {
+      if (this.size >= 0) req.size = Math.max(0, Math.min(this.size, req.offset + req.size) - req.offset);
+      if (req.size > 0) requests.push(req);
+      else fill(req, { offset: req.offset, bytes: new Uint8Array(0) });
+    }
+    const covers = (c, req) => c.offset <= req.offset && c.offset + c.bytes.length >= req.offset + req.size;
+    await Promise.all(this.batches(requests).map(async (batch) => {
+      let got = [];
+      if (batch.length > 1) {
+        try {
+          got = await this.readRanges(batch);
+        } catch (e) {
+          batch.forEach((req) => fill(req, e));
+          return;
+        }
+        chunks.push(...got);
+      }
+      await Promise.all(batch.map(async (req) => {
+        let chunk = got.find((c) => covers(c, req));
+        if (!chunk) {
+          try {
+            chunk = { offset: req.offset, bytes: await this.read(req.offset, req.size) };
+          } catch (e) {
+            fill(req, e);
+            return;
+          }
+          chunks.push(chunk);
+        }
+        fill(req, chunk);
+      }));
     }));
     return { parts, chunks };
   }

@@ -1,9 +1,10 @@
 // The pomar web viewer: three.js (WebGL2; web/dist/three.module.js, vendored from npm by
 // web/build.sh), orbit camera, view-dependent refinement through pomar.js.
-// URL parameters: ?file=URL opens a file; &test=1 runs the scripted browser test
+// URL parameters: ?file=URL opens a file, &target=PX sets the target error, &refine=0 starts
+// with refinement off (the base clustered mesh only); &test=1 runs the scripted browser test
 // (web/test/browser_test.py) and reports to the test server.
 import { open } from './pomar.js';
-import { frameMesh, orbitCamera, viewOf } from './camera.js';
+import { frameMesh, orbitCamera, pan, viewOf } from './camera.js';
 import * as THREE from './dist/three.module.js';
 
 const $ = (id) => document.getElementById(id);
@@ -79,8 +80,11 @@ function upload(mesh, model) {
 // ------------------------------------------------------------------ camera
 const camera = orbitCamera();
 let cameraVersion = 0;
+// Pixels drawn per CSS pixel: the device's, at most 2 (a phone at 3 would draw 2.25x the
+// pixels for little to see, and the target error is in drawn pixels).
+const MAX_PIXEL_RATIO = 2;
 function view() {
-  const dpr = window.devicePixelRatio || 1;
+  const dpr = Math.min(window.devicePixelRatio || 1, MAX_PIXEL_RATIO);
   const w = Math.max(1, Math.round(canvas.clientWidth * dpr));
   const h = Math.max(1, Math.round(canvas.clientHeight * dpr));
   if (canvas.width !== w || canvas.height !== h) {
@@ -140,7 +144,10 @@ async function refineLoop() {
   try {
     for (let step = 0; step < 64; ++step) {
       const version = cameraVersion;
-      const r = await model.wantView(view(), { targetPixels: Number($('target').value) || 3 });
+      // The target is in CSS pixels (what one sees), the view in drawn pixels.
+      const v = view();
+      const targetPixels = (Number($('target').value) || 3) * (v.width / Math.max(1, canvas.clientWidth));
+      const r = await model.wantView(v, { targetPixels });
       if (!r.changed && version === cameraVersion) break;
     }
   } catch (e) {
@@ -164,7 +171,7 @@ async function openSource(source, extraOptions = {}) {
   });
   model = m;
   // The header's box is the quantization cube; frame the base mesh's own box instead.
-  frameMesh(camera, m.mesh.positions);
+  frameMesh(camera, m.mesh.positions, canvas.clientWidth / Math.max(1, canvas.clientHeight));
   ++cameraVersion;
   onMesh(m.mesh, m);
   if (m.info.clusters === 0) await m.want({ all: m.info.finestLevel }); // progressive: no regions
@@ -177,6 +184,9 @@ function moved() {
   frame(model);
   refineLoop();
 }
+// Mouse and touch through pointer events (the canvas has `touch-action: none`): one pointer
+// orbits; two (a pinch) zoom by the change of the distance between them and pan the target
+// with their midpoint.
 const pointers = new Map();
 canvas.addEventListener('pointerdown', (e) => { canvas.setPointerCapture(e.pointerId); pointers.set(e.pointerId, [e.clientX, e.clientY]); });
 canvas.addEventListener('pointerup', (e) => pointers.delete(e.pointerId));
@@ -184,12 +194,15 @@ canvas.addEventListener('pointercancel', (e) => pointers.delete(e.pointerId));
 canvas.addEventListener('pointermove', (e) => {
   if (!pointers.has(e.pointerId)) return;
   const [x, y] = pointers.get(e.pointerId);
-  if (pointers.size === 2) { // pinch: zoom by the change of the distance between fingers
+  if (pointers.size === 2) {
     const other = [...pointers.entries()].find(([id]) => id !== e.pointerId)[1];
     const before = Math.hypot(x - other[0], y - other[1]);
     const after = Math.hypot(e.clientX - other[0], e.clientY - other[1]);
     if (before > 0 && after > 0) camera.distance *= before / after;
-  } else {
+    // The midpoint moves by half this pointer's move: the target follows it on screen.
+    const perPixel = (2 * camera.distance * Math.tan(camera.fovY / 2)) / Math.max(1, canvas.clientHeight);
+    pan(camera, (-(e.clientX - x) / 2) * perPixel, ((e.clientY - y) / 2) * perPixel);
+  } else if (pointers.size === 1) {
     camera.yaw -= (e.clientX - x) * 0.01;
     camera.pitch = Math.max(-1.5, Math.min(1.5, camera.pitch + (e.clientY - y) * 0.01));
   }
@@ -220,6 +233,8 @@ window.addEventListener('drop', (e) => {
 });
 
 // ------------------------------------------------------------------ start
+// For the console and the browser tests (web/test/mobile_test.py): the viewer's state.
+window.pomarViewer = { model: () => model, camera, refining: () => refining };
 try {
   initGL();
   frame(null);
@@ -227,6 +242,8 @@ try {
     import('./test/page_test.js').then((t) => t.run({ openSource, camera, moved, view, frame: () => frame(model),
       model: () => model, showError, refineLoop }));
   } else if (params.get('file')) {
+    if (params.get('target')) $('target').value = params.get('target');
+    if (params.get('refine') === '0') $('refine').checked = false;
     $('url').value = params.get('file');
     openSource(params.get('file')).then(() => refineLoop(), (err) => showError(err.message));
   }

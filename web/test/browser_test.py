@@ -35,13 +35,13 @@ WEB = os.path.dirname(HERE)
 sys.path.insert(0, WEB)
 REFERENCES = os.path.join(os.path.dirname(WEB), 'docs', 'images', 'web_test')
 import serve  # noqa: E402
+from browser_support import Checks, parse  # noqa: E402
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     ap.add_argument('pomar', help='a clustered .pomar file')
     ap.add_argument('--images', help='copy the screenshots into this directory (prefix web_)')
-    ap.add_argument('--chromium', default=shutil.which('chromium') or shutil.which('chromium-browser'))
     ap.add_argument('--timeout', type=float, default=240)
     ap.add_argument('--target', type=float, default=3, help='target screen-space error in pixels')
     ap.add_argument('--closeup', type=float, default=0.3, help='close-up distance / model size')
@@ -50,20 +50,11 @@ def main():
     ap.add_argument('--update-references', action='store_true', help='write docs/images/web_test/*.png')
     ap.add_argument('--no-compare', action='store_true', help='do not compare screenshots')
     ap.add_argument('--max-gap', type=int, help="pomar.js maxGap for the session (bytes; default: pomar.js's)")
-    args = ap.parse_args()
-    if not args.chromium:
-        print('browser_test: SKIP: chromium not installed')
+    args = parse(ap, 'browser_test')
+    if args is None:
         return 77
-    if not os.path.exists(os.path.join(WEB, 'dist', 'pomar_decoder.wasm')):
-        print('browser_test: SKIP: web/dist/pomar_decoder.wasm not built (bash web/build.sh)')
-        return 77
-
-    failures = []
-
-    def check(ok, what):
-        print(('ok   ' if ok else 'FAIL ') + what)
-        if not ok:
-            failures.append(what)
+    check = Checks()
+    failures = check.failures
 
     work = tempfile.mkdtemp(prefix='pomar-browser-')
     proc = None
@@ -98,7 +89,7 @@ def main():
             gap += '&ref=/ref/'
         url = (f'{base}/web/index.html?test=1&file=/data/model.pomar{gap}'
                f'&target={args.target}&closeup={args.closeup}&missing=/data/missing.pomar'
-               '&noRange=/no-range/data/model.pomar&truncatedGlobal=/data/truncated_global.pomar'
+               '&noRange=/no-range/data/model.pomar&singleRange=/single-range/data/model.pomar&truncatedGlobal=/data/truncated_global.pomar'
                '&truncatedBlocks=/data/truncated_blocks.pomar&damagedBlocks=/data/damaged_blocks.pomar')
         profile = os.path.join(work, 'profile')
         cmd = [args.chromium, '--headless=new', '--no-sandbox', '--use-angle=swiftshader',
@@ -161,10 +152,21 @@ def main():
               "the viewer's own refinement loop refines the overview again")
         check(full['triangles'] > cu['triangles'] and full['minLevel'] == r['info']['finestLevel'], 'full resolution everywhere')
         check(full['bytesFetched'] == size, f"full resolution fetched {full['bytesFetched']} bytes of {size}")
-        check(full['maxInFlightSeen'] <= 4, 'at most 4 requests in flight')
-        if args.max_gap is not None and args.max_gap >= 1024:
-            check(full['requests'] < r['info']['clusters'] / 4,
-                  f"{full['requests']} requests for {r['info']['clusters']} blocks (coalesced)")
+        policy = r['fetchPolicy']
+        check(full['maxInFlightSeen'] <= policy['maxInFlight'], f"at most {policy['maxInFlight']} requests in flight")
+        # The bound of the fetch policy: the ranges still missing are at most one per
+        # cluster block (a block is held as a prefix), grouped by up to maxRanges
+        # ranges and maxRequestBytes bytes a request (a group closed by its size holds, with
+        # the next range, more than maxRequestBytes).
+        bound = (-(-r['info']['clusters'] // policy['maxRanges']) + 2 * -(-size // policy['maxRequestBytes']) + 1)
+        check(full['requestsForFull'] <= bound,
+              f"full resolution after the session: {full['requestsForFull']} requests (at most {bound}: "
+              f"{r['info']['clusters']} blocks / {policy['maxRanges']} ranges a request + 2 x {size} bytes / "
+              f"{policy['maxRequestBytes']} + 1); {full['requests']} requests for {full['ranges']} ranges in the whole session")
+        sr = r['singleRange']
+        check(sr['multiRange'] is False and sr['triangles'] == full['triangles'] and sr['minLevel'] == r['info']['finestLevel'],
+              f"a server answering several ranges with the whole file: one range a request, same mesh "
+              f"({sr['requests']} requests, {sr['bytesFetched']} bytes)")
         # The server's view: the intact file's bytes, each served once.
         served = sorted((e['start'], e['start'] + e['bytes']) for e in log
                         if e['path'] == '/data/model.pomar' and e['status'] == 206)

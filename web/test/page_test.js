@@ -93,7 +93,7 @@ function snapshot(model, covered, extra = {}) {
   const s = model.stats;
   return { bytesFetched: s.bytesFetched, fileBytes: s.fileBytes, requests: s.requests, triangles: s.triangles,
     vertices: s.vertices, minLevel: Math.min(...model.levels), maxLevel: Math.max(...model.levels),
-    maxInFlightSeen: s.maxInFlightSeen, damaged: s.damaged, covered, heldBytes: s.heldBytes, blocksHeld: s.blocksHeld, ...extra };
+    ranges: s.ranges, maxInFlightSeen: s.maxInFlightSeen, damaged: s.damaged, covered, heldBytes: s.heldBytes, blocksHeld: s.blocksHeld, ...extra };
 }
 /** Refinement steps for the current camera until the model is stable for it. */
 async function settle(v, what) {
@@ -158,11 +158,24 @@ export async function run(v) {
     result.interactive = snapshot(model, await screenshot('interactive', v));
     note('viewer loop', JSON.stringify(result.interactive));
 
-    // Full resolution everywhere: every block, each fetched once.
+    // Full resolution everywhere: every block, each fetched once, in few requests.
     v.camera.distance = 1.6 * v.camera.extent;
+    const requestsBefore = model.stats.requests;
     await within(30000, model.want({ all: model.info.finestLevel }), 'full resolution');
-    result.full = snapshot(model, await screenshot('full', v));
+    result.full = snapshot(model, await screenshot('full', v), { requestsForFull: model.stats.requests - requestsBefore });
+    const { maxRanges, maxRequestBytes, maxInFlight } = model.options;
+    result.fetchPolicy = { maxRanges, maxRequestBytes, maxInFlight };
     note('full resolution', JSON.stringify(result.full));
+
+    // A server that answers a request for several ranges with the whole file (as Amazon
+    // S3 does): the answer is dropped, then one range a request; same mesh. (Two clusters
+    // first: their neighbours' block prefixes leave holes for full resolution to fill.)
+    const single = await within(20000, v.openSource(params.get('singleRange')), 'single-range server');
+    await within(30000, single.want({ cluster: 0, level: single.info.finestLevel }), 'single-range server');
+    await within(30000, single.want({ cluster: single.info.clusters >> 1, level: single.info.finestLevel }), 'single-range server');
+    await within(30000, single.want({ all: single.info.finestLevel }), 'single-range server');
+    result.singleRange = snapshot(single, -1, { multiRange: single.stats.multiRange });
+    note('single-range server', JSON.stringify(result.singleRange));
 
     // Error cases: each must show a message in the page, never hang.
     result.errors = {};

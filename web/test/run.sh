@@ -6,7 +6,8 @@
 #     decoder decodes them bit for bit like the native one, and that damaged/truncated
 #     copies give messages (web/test/wasm_decode_test.mjs, Node.js);
 #  3. runs the viewer in headless Chromium (web/test/browser_test.py), screenshots compared
-#     with docs/images/web_test/.
+#     with docs/images/web_test/, then on an emulated phone with touch input
+#     (web/test/mobile_test.py).
 # (Plus web/test/unit_test.mjs: request coalescing and the choice of levels for a view.)
 # Each step is skipped with a message when emscripten, Node.js or Chromium is missing.
 set -euo pipefail
@@ -32,12 +33,17 @@ if ! command -v chromium >/dev/null 2>&1; then
   echo "web tests: browser test SKIPPED: chromium not installed"
   exit 0
 fi
-echo "web tests: the viewer in headless Chromium (web/test/browser_test.py)"
-status=0
-python3 "$REPO/web/test/browser_test.py" "$samples/bunny_c5.pomar" || status=$?
-if [ "$status" = 77 ]; then
-  echo "web tests: browser test SKIPPED"
-elif [ "$status" != 0 ]; then
-  exit "$status"
-fi
+# A browser test: exit status 77 = skipped (Chromium or the build missing).
+in_browser() {
+  echo "web tests: $1 (web/test/$2)"
+  local status=0
+  python3 "$REPO/web/test/$2" "$samples/bunny_c5.pomar" || status=$?
+  if [ "$status" = 77 ]; then
+    echo "web tests: $2 SKIPPED"
+  elif [ "$status" != 0 ]; then
+    exit "$status"
+  fi
+}
+in_browser "the viewer in headless Chromium" browser_test.py
+in_browser "the viewer on an emulated phone, touch input" mobile_test.py
 echo "web tests: passed"

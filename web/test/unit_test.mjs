@@ -1,6 +1,6 @@
 // Unit tests of the pure parts of web/: request coalescing (range_fetch.js) and the choice
 // of levels for a view (view_refine.js).   node web/test/unit_test.mjs
-import { coalesce } from '../range_fetch.js';
+import { coalesce, parseByteranges, RangeFile } from '../range_fetch.js';
 import { BOUNDS_STRIDE, Convergence, chooseLevels } from '../view_refine.js';
 import { checker } from './node_support.mjs';
 
@@ -23,6 +23,62 @@ out = coalesce([r('a', 0, 600), r('b', 600, 600), r('c', 1200, 600)], 0, 1000);
 check(out.length === 3, 'maxRequestBytes splits requests');
 out = coalesce([r('a', 0, 0), r('b', 10, 5)]);
 check(out.length === 1 && out[0].parts.length === 1, 'empty ranges are dropped');
+
+// ---- several ranges in one request, against fake servers (globalThis.fetch replaced)
+const file = Uint8Array.from({ length: 5000 }, (_, i) => (i * 7) & 255);
+function fakeServer(multipart) {
+  const log = [];
+  globalThis.fetch = async (url, { headers }) => {
+    const specs = /^bytes=(.*)$/.exec(headers.Range)[1].split(',').map((x) => x.split('-').map(Number));
+    log.push(specs.length);
+    if (specs.length === 1) {
+      const [a, b] = specs[0];
+      return new Response(file.slice(a, b + 1), { status: 206, headers: { 'Content-Range': `bytes ${a}-${b}/${file.length}` } });
+    }
+    if (!multipart) return new Response(file, { status: 200 }); // as Amazon S3 answers
+    const pieces = [];
+    for (const [a, b] of specs) {
+      pieces.push(new TextEncoder().encode(`\r\n--XYZ\r\nContent-Type: application/octet-stream\r\nContent-Range: bytes ${a}-${b}/${file.length}\r\n\r\n`));
+      pieces.push(file.slice(a, b + 1));
+    }
+    pieces.push(new TextEncoder().encode('\r\n--XYZ--\r\n'));
+    return new Response(new Blob(pieces), { status: 206, headers: { 'Content-Type': 'multipart/byteranges; boundary=XYZ' } });
+  };
+  return log;
+}
+const wanted = [r('a', 100, 50), r('b', 1000, 10), r('c', 3000, 600), r('d', 4990, 10)];
+const sameBytes = (got, want) => got.length === want.length && got.every((x, i) => x === want[i]);
+const allParts = (parts) => wanted.every((w) => sameBytes(parts.get(w.key), file.slice(w.offset, w.offset + w.size)));
+let log = fakeServer(true);
+let rf = new RangeFile('http://x/f.pomar', { maxGap: 0 });
+let got = await rf.readMany(wanted);
+check(allParts(got.parts) && same(log, [4]) && rf.multiRange === true && rf.stats.requests === 1 && rf.stats.ranges === 4 &&
+  rf.stats.bytesFetched === 670, `four ranges in one multipart request: ${JSON.stringify(log)} ${JSON.stringify(rf.stats)}`);
+rf = new RangeFile('http://x/f.pomar', { maxGap: 0, maxRanges: 3, maxRequestBytes: 700 });
+log = fakeServer(true);
+got = await rf.readMany(wanted);
+check(allParts(got.parts) && same(log.sort(), [1, 3]), `maxRanges splits requests: ${JSON.stringify(log)}`);
+rf = new RangeFile('http://x/f.pomar', { maxGap: 0, maxRequestBytes: 620 });
+log = fakeServer(true);
+got = await rf.readMany(wanted);
+check(allParts(got.parts) && same(log, [2, 2]), `maxRequestBytes splits requests: ${JSON.stringify(log)}`);
+log = fakeServer(false);
+rf = new RangeFile('http://x/f.pomar', { maxGap: 0 });
+got = await rf.readMany(wanted);
+check(allParts(got.parts) && same(log, [4, 1, 1, 1, 1]) && rf.multiRange === false && rf.stats.bytesFetched === 670,
+  `a server answering several ranges with the whole file: dropped, one range a request: ${JSON.stringify(log)}`);
+log.length = 0;
+got = await rf.readMany(wanted);
+check(allParts(got.parts) && same(log, [1, 1, 1, 1]), 'and no second try');
+const parts = parseByteranges(new TextEncoder().encode('--B\r\nContent-Range: bytes 5-7/9\r\n\r\nabc\r\n--B--'), 'B');
+check(parts.length === 1 && parts[0].offset === 5 && new TextDecoder().decode(parts[0].bytes) === 'abc', 'a multipart body parsed');
+let message = '';
+try {
+  parseByteranges(new TextEncoder().encode('--B\r\nContent-Range: bytes 5-9/9\r\n\r\nabc'), 'B', 'f.pomar');
+} catch (e) {
+  message = e.message;
+}
+check(/f.pomar.*cut short/.test(message), `a part cut short is an error naming the file: ${message}`);
 
 // ---- chooseLevels: two clusters, one near the eye and one far, one behind it.
 function lookAlongMinusZ(eye) {

@@ -149,6 +149,14 @@ public:
   /// the vertex of mesh() it comes from (UINT32_MAX for a vertex no coded face uses), e.g.
   /// to carry vertex_cluster() and vertex_level() over.
   Mesh exact_mesh(std::vector<uint32_t> *source = nullptr) const;
+  /// Every cluster at finest_level() and no block skipped: exact_mesh() is then the
+  /// encoded input.
+  bool complete() const;
+  /// mesh(), handing the decoder's arrays over instead of copying them (a one-shot decode
+  /// then needs no memory for a second copy of the mesh). The decoder goes back to the base
+  /// clustered mesh (progressive files: the base mesh); the requests stay, so update()
+  /// decodes them again.
+  Mesh take_mesh();
   /// Per vertex of mesh(): its cluster and the level that created it.
   std::vector<uint32_t> vertex_cluster() const;
   std::vector<uint32_t> vertex_level() const;

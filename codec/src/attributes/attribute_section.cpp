@@ -261,7 +261,8 @@ void attach_attributes(const AttributeTable &t, const LevelMesh &lm, const Attri
     out.texture_files = t.texture_files;
   if (!keeps_any(t, mask))
     return;
-  const uint32_t nv = lm.vertex_count(), n = t.codes;
+  // (the vertex count of `out`: `lm` may have handed its arrays over, codes excepted)
+  const uint32_t nv = static_cast<uint32_t>(out.vertex_count()), n = t.codes;
   if (lm.attr_codes != n || lm.attr.size() != size_t(nv) * n)
     throw Error("internal error: the decoded mesh lacks attribute codes");
   for (size_t i = 0, first = 0; i < t.stored.size(); first += t.stored[i].codes(), ++i) {

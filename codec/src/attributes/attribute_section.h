@@ -62,7 +62,8 @@ AttributeTable read_attributes(const uint8_t *data, size_t size, uint32_t base_v
 /// The table of the file's ATTR section (checksum checked), or nullptr if it has none.
 std::unique_ptr<AttributeTable> load_attribute_table(const uint8_t *data, const FileLayout &layout);
 
-/// Add the attributes `mask` keeps of every vertex of `lm` to `out` (and the texture files).
+/// Add the attributes `mask` keeps of every vertex of `out` (made from `lm` by to_mesh) to `out`
+/// (and the texture files): the codes come from `lm`.
 void attach_attributes(const AttributeTable &table, const LevelMesh &lm, const AttributeMask &mask,
                        Mesh &out);
 

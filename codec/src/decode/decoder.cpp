@@ -97,10 +97,27 @@ Mesh decode(const uint8_t *data, size_t size, int level, const Progress &progres
   return decode(data, size, options);
 }
 
+namespace {
+
 /// What a skip_damaged decode says when the lossless record is damaged.
 const char *const kCutMeshKept =
     " (the mesh is the coded one: cut into a manifold, oriented mesh, without its duplicate and "
     "degenerate faces and unreferenced vertices)";
+
+/// Undo the lossless record's cut on the full decoded mesh; with skip_damaged, a damaged
+/// record is reported and the coded mesh kept (undo_cut changes nothing when it throws).
+void undo_cut_or_report(const uint8_t *data, const FileLayout &layout, const DecodeOptions &options,
+                        DecodeReport &r, Mesh &mesh) {
+  try {
+    undo_cut(data, layout, mesh);
+  } catch (const Error &e) {
+    if (!options.skip_damaged)
+      throw;
+    r.damaged.push_back({"lossless record", std::string(e.what()) + kCutMeshKept, -1});
+  }
+}
+
+} // namespace
 
 Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, DecodeReport *report) {
   DecodeReport scratch_report;
@@ -147,14 +164,11 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
       r.level = std::max(r.level, l);
       r.clusters_below_request += l < static_cast<int>(target);
     }
-    try {
-      return d.exact_mesh(); // the full mesh, intact: as it was input
-    } catch (const Error &e) {
-      if (!options.skip_damaged)
-        throw;
-      r.damaged.push_back({"lossless record", std::string(e.what()) + kCutMeshKept, -1});
-      return d.mesh();
-    }
+    const bool complete = d.complete();
+    Mesh mesh = d.take_mesh(); // (no second copy of the mesh)
+    if (complete)
+      undo_cut_or_report(data, layout, options, r, mesh); // the full mesh: as it was input
+    return mesh;
   }
   LevelMesh lm = base_level_mesh(data, layout);
   Models models;
@@ -172,15 +186,8 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
   Mesh mesh = to_mesh(std::move(lm), h.grid);
   if (attributes)
     attach_attributes(*attributes, lm, options.attributes, mesh);
-  if (r.level == static_cast<int>(levels)) {
-    try {
-      undo_cut(data, layout, mesh); // the full mesh: as it was input (attributes follow)
-    } catch (const Error &e) {
-      if (!options.skip_damaged)
-        throw;
-      r.damaged.push_back({"lossless record", std::string(e.what()) + kCutMeshKept, -1});
-    }
-  }
+  if (r.level == static_cast<int>(levels))
+    undo_cut_or_report(data, layout, options, r, mesh); // the full mesh: as it was input
   return mesh;
 }
 

@@ -18,9 +18,20 @@ Mesh to_mesh(const LevelMesh &lm, const Quantizer &grid) {
   return out;
 }
 
+namespace {
+template <class T> void release(std::vector<T> &v) { std::vector<T>().swap(v); }
+} // namespace
+
 Mesh to_mesh(LevelMesh &&lm, const Quantizer &grid) {
+  // What only refinement needs is freed before the positions are made, so that they do
+  // not add to the peak: opposite corners, corners of vertices, lineage, face claims.
+  release(lm.ct.O);
+  release(lm.ct.VC);
+  release(lm.lineage);
+  release(lm.face_claim);
   Mesh out;
   out.positions = dequantize(grid, lm.q);
+  release(lm.q);
   out.triangles = std::move(lm.ct.V);
   return out;
 }

@@ -26,8 +26,8 @@ LevelMesh base_level_mesh(const uint8_t *data, const FileLayout &layout);
 
 /// Dequantized positions and triangles of a LevelMesh.
 Mesh to_mesh(const LevelMesh &lm, const Quantizer &grid);
-/// The same, taking the triangles over (no copy of the corner table's vertex array); `lm`
-/// keeps everything else (its vertex count, positions and attribute codes).
+/// The same, taking the triangles over (no copy of the corner table's vertex array) and
+/// freeing the rest of the mesh first; `lm` keeps only its attribute codes.
 Mesh to_mesh(LevelMesh &&lm, const Quantizer &grid);
 
 } // namespace pomar

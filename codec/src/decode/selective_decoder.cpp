@@ -73,6 +73,7 @@ struct SelectiveDecoder::State {
 
   bool clustered() const { return layout.header.clustered(); }
   void reset_to_snapshot();
+  void back_to_base(); // after take_mesh(): the base (clustered) mesh, requests kept
   void decode_cluster_level(uint32_t c, int level, uint32_t older_than);
   void decode_batch(const uint32_t *batch, size_t n, int level, uint32_t older_than,
                     const std::function<void()> &applied, uint32_t &decoding);
@@ -90,6 +91,14 @@ void SelectiveDecoder::State::reset_to_snapshot() {
     k.level = global_levels;
     k.next_local = 1;
   }
+}
+
+void SelectiveDecoder::State::back_to_base() {
+  reset_to_snapshot();
+  levels.assign(clusters.size(), global_levels);
+  global_models = Models(); // (progressive files: the models adapt from the base mesh on)
+  if (attributes)
+    global_models.attr = attribute_models(*attributes);
 }
 
 /// The codec reading cluster c's data of `level` (the cluster is at level - 1) from its
@@ -539,14 +548,16 @@ Mesh SelectiveDecoder::mesh() const {
   return out;
 }
 
+bool SelectiveDecoder::complete() const {
+  return s_->damaged.empty() &&
+         (s_->clustered() ? std::all_of(s_->levels.begin(), s_->levels.end(),
+                                        [&](int l) { return l == s_->finest; })
+                          : s_->uniform_level == s_->finest);
+}
+
 Mesh SelectiveDecoder::exact_mesh(std::vector<uint32_t> *source) const {
   Mesh m = mesh();
-  const bool complete =
-      s_->damaged.empty() &&
-      (s_->clustered() ? std::all_of(s_->levels.begin(), s_->levels.end(),
-                                     [&](int l) { return l == s_->finest; })
-                       : s_->uniform_level == s_->finest);
-  if (complete) {
+  if (complete()) {
     undo_cut(s_->global.data(), s_->layout, m, source); // the record lies in the global part
   } else if (source) {
     source->resize(m.vertex_count());
@@ -554,6 +565,20 @@ Mesh SelectiveDecoder::exact_mesh(std::vector<uint32_t> *source) const {
       (*source)[v] = v;
   }
   return m;
+}
+
+Mesh SelectiveDecoder::take_mesh() {
+  State &s = *s_;
+  // The working memory of the traversals goes first, so that the returned arrays do not
+  // add to it: a one-shot decode's peak is then the decode's, not the decode's plus a copy.
+  s.steps.assign(s.steps.size(), LevelStep());
+  s.traversed = {};
+  s.stream_before = {};
+  Mesh out = to_mesh(std::move(s.mesh), s.layout.header.grid);
+  if (s.attributes)
+    attach_attributes(*s.attributes, s.mesh, s.attribute_mask, out);
+  s.back_to_base();
+  return out;
 }
 
 std::vector<uint32_t> SelectiveDecoder::vertex_cluster() const {

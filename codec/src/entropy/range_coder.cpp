@@ -16,22 +16,6 @@ FrequencyModel::FrequencyModel(int symbols) : n_(symbols), total_(0) {
   total_ = static_cast<uint32_t>(n_);
 }
 
-uint32_t FrequencyModel::cumulative(int s) const {
-  uint32_t c = 0;
-  for (int i = 0; i < s; ++i)
-    c += freq_[i];
-  return c;
-}
-
-int FrequencyModel::find(uint32_t target, uint32_t *start) const {
-  uint32_t c = 0;
-  int s = 0;
-  while (s < n_ - 1 && c + freq_[s] <= target)
-    c += freq_[s++];
-  *start = c;
-  return s;
-}
-
 void FrequencyModel::freeze_from_counts(const uint32_t *counts) {
   uint64_t sum = 0;
   for (int i = 0; i < n_; ++i)
@@ -63,18 +47,7 @@ bool FrequencyModel::freeze_with(const uint16_t *freq) {
   return true;
 }
 
-void FrequencyModel::update(int s) {
-  if (frozen_)
-    return;
-  // In 32 bits: a dominant symbol can be at 65,512 or more, and 16-bit arithmetic used to
-  // wrap it to 0..23 (0 halved stays 0: a symbol of frequency 0 empties the coder's range
-  // and the encoder never stopped writing; found on a 100k-vertex mesh).
-  const uint32_t f = uint32_t(freq_[s]) + kIncrement;
-  total_ += kIncrement;
-  if (total_ <= kMaxTotal) {
-    freq_[s] = static_cast<uint16_t>(f); // f < total_ <= 2^16: fits
-    return;
-  }
+void FrequencyModel::halve(int s, uint32_t f) {
   total_ = 0;
   for (int i = 0; i < n_; ++i) {
     const uint32_t fi = i == s ? f : freq_[i];
@@ -110,37 +83,6 @@ void RangeEncoder::shift_low() {
   }
   ++pending_;
   low_ = (low_ & 0x00FFFFFFu) << 8;
-}
-
-void RangeEncoder::normalize() {
-  while (range_ < kRangeTop) {
-    range_ <<= 8;
-    shift_low();
-  }
-}
-
-void RangeEncoder::encode(uint32_t start, uint32_t size, uint32_t total) {
-  const uint32_t r = range_ / total;
-  low_ += static_cast<uint64_t>(r) * start;
-  range_ = r * size;
-  normalize();
-}
-
-void RangeEncoder::encode(FrequencyModel &m, int symbol) {
-  encode(m.cumulative(symbol), m.freq(symbol), m.total());
-  m.update(symbol);
-}
-
-void RangeEncoder::encode_bit(BitModel &m, int bit) {
-  const uint32_t bound = (range_ >> kBitModelBits) * m.p0;
-  if (bit) {
-    low_ += bound;
-    range_ -= bound;
-  } else {
-    range_ = bound;
-  }
-  m.update(bit);
-  normalize();
 }
 
 void RangeEncoder::encode_bypass(uint32_t value, int nbits) {
@@ -183,9 +125,7 @@ void RangeDecoder::reset(const uint8_t *data, size_t size, StreamRefill *refill)
     code_ = (code_ << 8) | next_byte();
 }
 
-uint8_t RangeDecoder::next_byte() {
-  if (pos_ < size_)
-    return data_[pos_++];
+uint8_t RangeDecoder::byte_past_end() {
   if (refill_) {
     size_ = refill_->more(pos_ + 1);
     if (pos_ < size_)
@@ -193,43 +133,6 @@ uint8_t RangeDecoder::next_byte() {
   }
   ++overrun_;
   return 0;
-}
-
-void RangeDecoder::normalize() {
-  while (range_ < kRangeTop) {
-    range_ <<= 8;
-    code_ = (code_ << 8) | next_byte();
-  }
-}
-
-int RangeDecoder::decode(FrequencyModel &m) {
-  const uint32_t r = range_ / m.total();
-  uint32_t target = code_ / r;
-  if (target >= m.total())
-    target = m.total() - 1; // only reachable on corrupt data
-  uint32_t start;
-  const int s = m.find(target, &start);
-  code_ -= r * start;
-  range_ = r * m.freq(s);
-  m.update(s);
-  normalize();
-  return s;
-}
-
-int RangeDecoder::decode_bit(BitModel &m) {
-  const uint32_t bound = (range_ >> kBitModelBits) * m.p0;
-  int bit;
-  if (code_ < bound) {
-    range_ = bound;
-    bit = 0;
-  } else {
-    code_ -= bound;
-    range_ -= bound;
-    bit = 1;
-  }
-  m.update(bit);
-  normalize();
-  return bit;
 }
 
 uint32_t RangeDecoder::decode_uniform(uint32_t total) {

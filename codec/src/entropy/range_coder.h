@@ -43,10 +43,34 @@ public:
   int symbols() const { return n_; }
   uint32_t total() const { return total_; }
   uint32_t freq(int s) const { return freq_[s]; }
-  uint32_t cumulative(int s) const; // sum of freq of symbols < s
+  uint32_t cumulative(int s) const { // sum of freq of symbols < s
+    uint32_t c = 0;
+    for (int i = 0; i < s; ++i)
+      c += freq_[i];
+    return c;
+  }
   /// Find the symbol whose cumulative interval holds `target`; sets its cumulative start.
-  int find(uint32_t target, uint32_t *start) const;
-  void update(int s);
+  int find(uint32_t target, uint32_t *start) const {
+    uint32_t c = 0;
+    int s = 0;
+    while (s < n_ - 1 && c + freq_[s] <= target)
+      c += freq_[s++];
+    *start = c;
+    return s;
+  }
+  void update(int s) {
+    if (frozen_)
+      return;
+    // In 32 bits: a dominant symbol can be at 65,512 or more, and 16-bit arithmetic used
+    // to wrap it to 0..23 (0 halved stays 0: a symbol of frequency 0 empties the coder's
+    // range and the encoder never stopped writing; found on a 100k-vertex mesh).
+    const uint32_t f = uint32_t(freq_[s]) + kIncrement;
+    total_ += kIncrement;
+    if (total_ <= kMaxTotal)
+      freq_[s] = static_cast<uint16_t>(f); // f < total_ <= 2^16: fits
+    else
+      halve(s, f);
+  }
   /// Make the model static with frequencies proportional to `counts` (total about
   /// 2^kStaticBits, every counted symbol at least 1); all-zero counts give a uniform model.
   void freeze_from_counts(const uint32_t *counts);
@@ -56,18 +80,41 @@ public:
   static constexpr int kStaticBits = 12;
 
 private:
+  void halve(int s, uint32_t f); // update() past kMaxTotal: symbol s at f, all halved
   int n_;
   uint32_t total_;
   bool frozen_ = false;
   uint16_t freq_[kMaxSymbols];
 };
 
+// The per-symbol functions of both coders are defined in this header: they run a few
+// times per coded vertex and inlining them into the traversal saves the calls; the rare
+// paths (a byte out, a stream refill, a model rescale) stay in range_coder.cpp.
+
 class RangeEncoder {
 public:
   explicit RangeEncoder(std::vector<uint8_t> *out) : out_(out) {}
-  void encode(uint32_t start, uint32_t size, uint32_t total);
-  void encode(FrequencyModel &m, int symbol);
-  void encode_bit(BitModel &m, int bit);
+  void encode(uint32_t start, uint32_t size, uint32_t total) {
+    const uint32_t r = range_ / total;
+    low_ += static_cast<uint64_t>(r) * start;
+    range_ = r * size;
+    normalize();
+  }
+  void encode(FrequencyModel &m, int symbol) {
+    encode(m.cumulative(symbol), m.freq(symbol), m.total());
+    m.update(symbol);
+  }
+  void encode_bit(BitModel &m, int bit) {
+    const uint32_t bound = (range_ >> kBitModelBits) * m.p0;
+    if (bit) {
+      low_ += bound;
+      range_ -= bound;
+    } else {
+      range_ = bound;
+    }
+    m.update(bit);
+    normalize();
+  }
   void encode_bypass(uint32_t value, int nbits); // nbits <= 24, equiprobable bits
   /// value in [0, total), all equally likely; total <= 2^16.
   void encode_uniform(uint32_t value, uint32_t total) { encode(value, 1, total); }
@@ -76,7 +123,12 @@ public:
   void finish();
 
 private:
-  void normalize();
+  void normalize() {
+    while (range_ < kRangeTop) {
+      range_ <<= 8;
+      shift_low();
+    }
+  }
   void shift_low();
   std::vector<uint8_t> *out_;
   uint64_t low_ = 0;
@@ -102,8 +154,34 @@ public:
   /// Decode data[0..size); with `refill`, size may grow as the decoder needs bytes.
   void reset(const uint8_t *data, size_t size, StreamRefill *refill = nullptr);
   size_t consumed() const { return pos_; }
-  int decode(FrequencyModel &m);
-  int decode_bit(BitModel &m);
+  int decode(FrequencyModel &m) {
+    const uint32_t r = range_ / m.total();
+    uint32_t target = code_ / r;
+    if (target >= m.total())
+      target = m.total() - 1; // only reachable on corrupt data
+    uint32_t start;
+    const int s = m.find(target, &start);
+    code_ -= r * start;
+    range_ = r * m.freq(s);
+    m.update(s);
+    normalize();
+    return s;
+  }
+  int decode_bit(BitModel &m) {
+    const uint32_t bound = (range_ >> kBitModelBits) * m.p0;
+    int bit;
+    if (code_ < bound) {
+      range_ = bound;
+      bit = 0;
+    } else {
+      code_ -= bound;
+      range_ -= bound;
+      bit = 1;
+    }
+    m.update(bit);
+    normalize();
+    return bit;
+  }
   uint32_t decode_bypass(int nbits);
   uint32_t decode_uniform(uint32_t total); ///< mirror of RangeEncoder::encode_uniform
   /// True when the decoder has asked for more bytes than the stream holds by more than
@@ -111,8 +189,14 @@ public:
   bool overrun() const { return overrun_ > 8; }
 
 private:
-  uint8_t next_byte();
-  void normalize();
+  uint8_t next_byte() { return pos_ < size_ ? data_[pos_++] : byte_past_end(); }
+  uint8_t byte_past_end(); // a refill, or 0 counted as an overrun
+  void normalize() {
+    while (range_ < kRangeTop) {
+      range_ <<= 8;
+      code_ = (code_ << 8) | next_byte();
+    }
+  }
   const uint8_t *data_ = nullptr;
   size_t size_ = 0, pos_ = 0;
   StreamRefill *refill_ = nullptr;

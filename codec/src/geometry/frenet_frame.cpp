@@ -9,24 +9,9 @@
 namespace pomar {
 namespace {
 
-constexpr int kShift = 16;
-constexpr int64_t kHalf = int64_t(1) << (kShift - 1);
+using frenet_detail::apply;
 
 int64_t fixed_round(double x) { return static_cast<int64_t>(std::floor(x * 65536.0 + 0.5)); }
-
-// round(c * y / 2^16) with floor semantics on the shifted sum, identical on both sides.
-int64_t shear(int64_t c, int64_t y) { return (c * y + kHalf) >> kShift; }
-
-void quarter_turn(int64_t &x, int64_t &y) { // (x,y) -> (y,-x)
-  const int64_t t = x;
-  x = y;
-  y = -t;
-}
-void quarter_turn_back(int64_t &x, int64_t &y) { // (x,y) -> (-y,x)
-  const int64_t t = x;
-  x = -y;
-  y = t;
-}
 
 /// Rotation in plane (i,j) that maps direction (a,b) onto the positive i axis.
 Givens givens_from_pair(int i, int j, double a, double b) {
@@ -56,28 +41,6 @@ Givens givens_from_pair(int i, int j, double a, double b) {
   return g;
 }
 
-void apply(const Givens &g, int64_t v[3]) {
-  int64_t &x = v[g.i], &y = v[g.j];
-  for (int q = 0; q < g.quarter_turns; ++q)
-    quarter_turn(x, y);
-  if (g.active) {
-    x += shear(g.t, y);
-    y += shear(g.s, x);
-    x += shear(g.t, y);
-  }
-}
-
-void unapply(const Givens &g, int64_t v[3]) {
-  int64_t &x = v[g.i], &y = v[g.j];
-  if (g.active) {
-    x -= shear(g.t, y);
-    y -= shear(g.s, x);
-    x -= shear(g.t, y);
-  }
-  for (int q = 0; q < g.quarter_turns; ++q)
-    quarter_turn_back(x, y);
-}
-
 } // namespace
 
 FrenetFrame make_frenet_frame(const int64_t normal[3], const int64_t edge[3]) {
@@ -95,16 +58,6 @@ FrenetFrame make_frenet_frame(const int64_t normal[3], const int64_t edge[3]) {
   apply(f.g[1], e);
   f.g[2] = givens_from_pair(0, 1, static_cast<double>(e[0]), static_cast<double>(e[1]));
   return f;
-}
-
-void to_local(const FrenetFrame &f, int64_t v[3]) {
-  for (int k = 0; k < 3; ++k)
-    apply(f.g[k], v);
-}
-
-void to_global(const FrenetFrame &f, int64_t v[3]) {
-  for (int k = 2; k >= 0; --k)
-    unapply(f.g[k], v);
 }
 
 } // namespace pomar

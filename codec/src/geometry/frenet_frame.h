@@ -19,8 +19,8 @@ namespace pomar {
 struct Givens {
   uint8_t i = 0, j = 1;
   uint8_t quarter_turns = 0;
-  bool active = false;   // residual shears present
-  int64_t t = 0, s = 0;  // Q16 shear coefficients
+  bool active = false;  // residual shears present
+  int64_t t = 0, s = 0; // Q16 shear coefficients
 };
 
 /// The local frame of one vertex split, as three Givens rotations.
@@ -33,9 +33,53 @@ struct FrenetFrame {
 /// normal, edge parallel to the normal) leave the corresponding rotations at identity.
 FrenetFrame make_frenet_frame(const int64_t normal[3], const int64_t edge[3]);
 
+// Integer only (defined here so that the traversal inlines them: they run once or twice
+// per split); the floating-point part, the coefficients, is in frenet_frame.cpp.
+namespace frenet_detail {
+constexpr int kShift = 16;
+constexpr int64_t kHalf = int64_t(1) << (kShift - 1);
+
+/// round(c * y / 2^16) with floor semantics on the shifted sum, identical on both sides.
+inline int64_t shear(int64_t c, int64_t y) { return (c * y + kHalf) >> kShift; }
+
+inline void apply(const Givens &g, int64_t v[3]) {
+  int64_t &x = v[g.i], &y = v[g.j];
+  for (int q = 0; q < g.quarter_turns; ++q) { // (x,y) -> (y,-x)
+    const int64_t t = x;
+    x = y;
+    y = -t;
+  }
+  if (g.active) {
+    x += shear(g.t, y);
+    y += shear(g.s, x);
+    x += shear(g.t, y);
+  }
+}
+
+inline void unapply(const Givens &g, int64_t v[3]) {
+  int64_t &x = v[g.i], &y = v[g.j];
+  if (g.active) {
+    x -= shear(g.t, y);
+    y -= shear(g.s, x);
+    x -= shear(g.t, y);
+  }
+  for (int q = 0; q < g.quarter_turns; ++q) { // (x,y) -> (-y,x)
+    const int64_t t = x;
+    x = -y;
+    y = t;
+  }
+}
+} // namespace frenet_detail
+
 /// Global residual -> local (t1, t2, n) components. Exact inverse of to_global().
-void to_local(const FrenetFrame &f, int64_t v[3]);
+inline void to_local(const FrenetFrame &f, int64_t v[3]) {
+  for (int k = 0; k < 3; ++k)
+    frenet_detail::apply(f.g[k], v);
+}
 /// Local components -> global residual.
-void to_global(const FrenetFrame &f, int64_t v[3]);
+inline void to_global(const FrenetFrame &f, int64_t v[3]) {
+  for (int k = 2; k >= 0; --k)
+    frenet_detail::unapply(f.g[k], v);
+}
 
 } // namespace pomar
