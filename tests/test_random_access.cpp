@@ -236,26 +236,23 @@ Mesh coloured(Mesh m) {
   return m;
 }
 
+/// Same positions, triangles and colours, in the same order.
+void expect_same_mesh(const Mesh &a, const Mesh &b) {
+  EXPECT_EQ(a.positions, b.positions);
+  EXPECT_EQ(a.triangles, b.triangles);
+  ASSERT_EQ(a.attributes.size(), b.attributes.size());
+  for (size_t i = 0; i < a.attributes.size(); ++i)
+    EXPECT_EQ(a.attributes[i].colour, b.attributes[i].colour);
+}
+
 /// take_mesh() gives what mesh() gives, leaves the decoder at the base (clustered) mesh with
 /// the requests kept, and the next update() brings the same mesh back.
 void expect_take_mesh_round_trip(SelectiveDecoder &d, const Mesh &base) {
   const Mesh before = d.mesh();
-  const Mesh taken = d.take_mesh();
-  EXPECT_EQ(taken.positions, before.positions);
-  EXPECT_EQ(taken.triangles, before.triangles);
-  ASSERT_EQ(taken.attributes.size(), before.attributes.size());
-  for (size_t i = 0; i < taken.attributes.size(); ++i)
-    EXPECT_EQ(taken.attributes[i].colour, before.attributes[i].colour);
-  const Mesh after = d.mesh();
-  EXPECT_EQ(after.positions, base.positions);
-  EXPECT_EQ(after.triangles, base.triangles);
+  expect_same_mesh(d.take_mesh(), before);
+  expect_same_mesh(d.mesh(), base);
   d.update();
-  const Mesh again = d.mesh();
-  EXPECT_EQ(again.positions, before.positions);
-  EXPECT_EQ(again.triangles, before.triangles);
-  ASSERT_EQ(again.attributes.size(), before.attributes.size());
-  for (size_t i = 0; i < again.attributes.size(); ++i)
-    EXPECT_EQ(again.attributes[i].colour, before.attributes[i].colour);
+  expect_same_mesh(d.mesh(), before);
 }
 
 TEST(RandomAccess, TakeMeshHandsTheMeshOverAndGoesBackToTheBase) {

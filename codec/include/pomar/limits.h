@@ -81,8 +81,8 @@ void check_encode_memory(uint64_t vertices, uint64_t faces, uint64_t limit, uint
                          uint64_t attribute_bytes = 0, unsigned threads = 1);
 
 /// What each decoding thread past the first adds to decode_memory_estimate for a clustered
-/// file (and each encoding thread to encode_memory_estimate): its traversal marks, 8 bytes
-/// per vertex and 4 per face.
+/// file (and each encoding thread to encode_memory_estimate): its traversal marks, pending
+/// splits and allocator arena, 2 MiB + 16 bytes per vertex + 4 per face.
 uint64_t decode_thread_memory(uint64_t vertices, uint64_t faces);
 
 /// check_memory with decode_memory_estimate for the mesh of `level` (-1 = full resolution)

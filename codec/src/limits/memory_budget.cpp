@@ -24,27 +24,41 @@ namespace {
 // Linear fits (fixed + per vertex + per face) of the peak resident set size of `pomar
 // encode` / `pomar decode` (random access and --progressive files), measured with
 // /usr/bin/time on closed meshes (F = 2V) and open strips (F = V, F = 4V/3) of 30k to 2M
-// vertices, rounded up so that every measured peak is at least 15% below the estimate
-// (bench/README.md, "Memory"). Least-squares fits: encode 13.7 MiB + 258 B/vertex +
-// 127 B/face; decode 4.8 MiB + 56 B/vertex + 52 B/face (random access), 4.2 MiB + 75
-// B/vertex + 34 B/face (progressive). Small meshes peak above the fit (allocator, vcglib
-// buffers): hence the larger fixed parts.
+// vertices (bench/README.md, "Memory").
+//
+// Decode (refitted 2026-12-02, after the one-shot decode stopped copying its mesh and a
+// pending split shrank from 160 to 28 bytes; binary PLY output, one thread): least-squares
+// 5.0 MiB + 45 B/vertex + 31 B/face (random access), 5.4 MiB + 56 B/vertex + 29 B/face
+// (progressive), rounded up so that every peak of 300k vertices and more is 17-21% below
+// the estimate. Each further decoding thread: 13.6-28 B/vertex measured (small meshes:
+// the thread's allocator arena), estimated at 2 MiB + 16 B/vertex + 4 B/face.
+//
+// Encode (fitted 2026-11-23: 13.7 MiB + 258 B/vertex + 127 B/face): kept although a PLY
+// input now peaks at about 40% of it (1M-vertex sphere: 212 MiB, estimate 596 MiB),
+// because the estimate also stands for inputs whose readers hold more: an OBJ (through
+// tinyobjloader) peaks at 426 MiB and an ASCII STL (the whole text held) at 625 MiB on the
+// same mesh. A per-format estimate would let it shrink for PLY; not done.
 
 constexpr uint64_t kEncodeFixed = 24ull << 20;
 constexpr uint64_t kEncodePerVertex = 300;
 constexpr uint64_t kEncodePerFace = 150;
 
 constexpr uint64_t kDecodeFixed = 8ull << 20;
-constexpr uint64_t kClusteredDecodePerVertex = 64;
-constexpr uint64_t kClusteredDecodePerFace = 60;
-constexpr uint64_t kProgressiveDecodePerVertex = 86;
-constexpr uint64_t kProgressiveDecodePerFace = 40;
+constexpr uint64_t kClusteredDecodePerVertex = 52;
+constexpr uint64_t kClusteredDecodePerFace = 36;
+constexpr uint64_t kProgressiveDecodePerVertex = 64;
+constexpr uint64_t kProgressiveDecodePerFace = 34;
+constexpr uint64_t kThreadFixed = 2ull << 20;
+constexpr uint64_t kThreadPerVertex = 16;
+constexpr uint64_t kThreadPerFace = 4;
 
 // Per-vertex attributes (bench/README.md, "Memory", attributes): a 1M-vertex torus (2M
 // faces) with 8 codes per vertex (RGB, normal, quality, UV) peaked 611 B/vertex above the
-// same mesh without attributes when encoding, with 1 code (quality) 96 B/vertex: about
-// 22 + 74 B per code, rounded up. Decoding: 97 B/vertex (8 codes, 27 bytes of values) and
-// 12 B/vertex (1 code, 4 bytes): the codes (8 B each) plus the values, plus slack.
+// same mesh without attributes when encoding (241 B/vertex since 2026-12-02: the encoder
+// frees its input once quantized), with 1 code (quality) 96 B/vertex (31): about 22 + 74 B
+// per code, kept (see the encode estimate above). Decoding: 81 B/vertex (8 codes, 27 bytes
+// of values) and 12 B/vertex (1 code, 4 bytes): the codes (8 B each) plus the values, plus
+// slack.
 constexpr uint64_t kEncodeAttributeFixed = 32;
 constexpr uint64_t kEncodePerAttributeCode = 84;
 constexpr uint64_t kDecodePerAttributeCode = 8;
@@ -340,7 +354,7 @@ void check_encode_memory(uint64_t vertices, uint64_t faces, uint64_t limit, uint
 }
 
 uint64_t decode_thread_memory(uint64_t vertices, uint64_t faces) {
-  return add_mul(add_mul(0, vertices, 8), faces, 4);
+  return add_mul(add_mul(kThreadFixed, vertices, kThreadPerVertex), faces, kThreadPerFace);
 }
 
 void check_decode_memory(const FileInfo &info, int level, uint64_t limit, const AttributeMask &keep,
