@@ -205,5 +205,39 @@ TEST(Codec, FileDoesNotDependOnThreadCount) {
   }
 }
 
+// encode(Mesh&&) frees a clean mesh once quantized: the file must be the one encode(const
+// Mesh&) writes, for a clean mesh (also strict, with attributes) and for one the lossless
+// stage cuts (given a mesh, it still reads it after the manifold encoder), and the mesh is
+// left empty, also when the encoder refuses it.
+TEST(Codec, EncodeTakingTheMeshWritesTheSameFile) {
+  Mesh messy = gen::noisy_sphere(3000, 5);
+  messy.triangles.insert(messy.triangles.end(), messy.triangles.begin(),
+                         messy.triangles.begin() + 3); // a duplicate face: cut and recorded
+  messy.positions.insert(messy.positions.end(), {0.5f, 0.5f, 0.5f}); // unreferenced
+  const Mesh inputs[] = {gen::noisy_sphere(5000, 9),
+                         with_attributes(gen::noisy_sphere(4000, 2), kColour | kNormals), messy};
+  for (const Mesh &input : inputs)
+    for (bool strict : {false, true}) {
+      if (strict && &input == &inputs[2])
+        continue;
+      EncodeOptions options;
+      options.strict = strict;
+      EncodeReport given, taken;
+      const std::vector<uint8_t> expected = encode(input, options, &given);
+      Mesh copy = input;
+      EXPECT_EQ(encode(std::move(copy), options, &taken), expected);
+      EXPECT_EQ(copy.vertex_count(), 0u);
+      EXPECT_TRUE(copy.triangles.empty() && copy.attributes.empty());
+      EXPECT_EQ(taken.input_vertices, given.input_vertices);
+      EXPECT_EQ(taken.unreferenced_vertices, given.unreferenced_vertices);
+      EXPECT_EQ(taken.decoded_to_input, given.decoded_to_input);
+    }
+  Mesh refused = gen::nonmanifold_edge();
+  EncodeOptions bad_bits;
+  bad_bits.bits = 3;
+  EXPECT_THROW(encode(std::move(refused), bad_bits), Error);
+  EXPECT_EQ(refused.vertex_count(), 0u);
+}
+
 } // namespace
 } // namespace pomar

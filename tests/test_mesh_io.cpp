@@ -494,6 +494,87 @@ TEST_F(MeshIoTest, PlyBinaryBigEndianAndIndexTypes) {
   EXPECT_NE(msg.find("misreads"), std::string::npos) << msg;
 }
 
+/// A fast reading path gave what the general one gives: the same floats bit for bit, the
+/// same faces and the same report (two unreferenced vertices in the tests' files).
+void expect_same_load(const Mesh &fast, const LoadReport &fast_report, const Mesh &general,
+                      const LoadReport &general_report) {
+  EXPECT_TRUE(same_bits(fast.positions, general.positions));
+  EXPECT_EQ(fast.triangles, general.triangles);
+  EXPECT_EQ(fast_report.unreferenced_vertices, 2u);
+  EXPECT_EQ(fast_report.unreferenced_vertices, general_report.unreferenced_vertices);
+  EXPECT_EQ(fast_report.file_vertices, general_report.file_vertices);
+  EXPECT_EQ(fast_report.file_faces, general_report.file_faces);
+  EXPECT_EQ(fast_report.ignored_attributes, general_report.ignored_attributes);
+}
+
+// ASCII PLY of float x, y, z and uchar-counted int faces is read without vcglib (io/ply_io.cpp,
+// read_simple_ascii): it must give the floats fscanf gives (vcglib's general path, taken
+// here for the same data by an extra empty element) for every way of writing a number,
+// decline what it does not take ('+', hex, overflow, junk: the general path decides) and
+// count unreferenced vertices the same.
+TEST_F(MeshIoTest, PlyAsciiFastPathReadsWhatVcglibReads) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> mantissa(-1.0, 1.0);
+  std::uniform_int_distribution<int> exponent(-45, 38);
+  const char *formats[] = {"%.9g", "%.3f", "%e", "%.20g", "%.1e", "%g"};
+  std::string vertices;
+  const size_t nv = 303;
+  char buf[64];
+  for (size_t i = 0; i < nv; ++i) {
+    for (int k = 0; k < 3; ++k) {
+      const double x = std::ldexp(mantissa(rng), exponent(rng) / 4);
+      std::snprintf(buf, sizeof buf, formats[(i + k) % 6], x);
+      vertices += buf;
+      vertices += k < 2 ? (i % 7 ? " " : "\t ") : (i % 5 ? "\n" : "\r\n");
+    }
+  }
+  std::string faces;
+  const size_t nf = 299; // vertices 301 and 302 unreferenced
+  for (size_t f = 0; f < nf; ++f)
+    faces +=
+        "3 " + std::to_string(f) + " " + std::to_string(f + 1) + " " + std::to_string(f + 2) + "\n";
+  auto header = [&](const std::string &extra) {
+    return "ply\nformat ascii 1.0\nelement vertex " + std::to_string(nv) +
+           "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
+           std::to_string(nf) + "\nproperty list uchar int vertex_indices\n" + extra +
+           "end_header\n";
+  };
+  LoadReport fast_report, general_report;
+  const Mesh fast =
+      pomar::load_mesh(write("fast.ply", header("") + vertices + faces), &fast_report);
+  const Mesh general = pomar::load_mesh(
+      write("general.ply", header("element material 0\nproperty float shine\n") + vertices + faces),
+      &general_report);
+  expect_same_load(fast, fast_report, general, general_report);
+  // Odd numbers, first coordinate of the file: read as the general path reads them; what the
+  // fast path declines fails as the general path fails.
+  for (const std::string &odd :
+       {std::string("-0"), std::string(".5"), std::string("5."), std::string("1e-40"),
+        std::string("-3.4028234e38"), std::string("-2.50E+1"),
+        std::string("0.") + std::string(44, '0') + "1",
+        std::string("123456789012345678901234567890"), std::string("+1"), std::string("0x1p3"),
+        std::string("1e39"), std::string("1.5f"), std::string("nan")}) {
+    const std::string v = odd + vertices.substr(vertices.find(' '));
+    const std::string a = write("odd_fast.ply", header("") + v + faces);
+    const std::string b =
+        write("odd_general.ply", header("element material 0\nproperty float shine\n") + v + faces);
+    std::string error_a, error_b;
+    Mesh ma, mb;
+    try {
+      ma = pomar::load_mesh(a);
+    } catch (const pomar::Error &e) {
+      error_a = e.what();
+    }
+    try {
+      mb = pomar::load_mesh(b);
+    } catch (const pomar::Error &e) {
+      error_b = e.what();
+    }
+    EXPECT_EQ(error_a.empty(), error_b.empty()) << odd << ": " << error_a << " / " << error_b;
+    EXPECT_TRUE(same_bits(ma.positions, mb.positions)) << odd;
+  }
+}
+
 TEST_F(MeshIoTest, PlyFaceListTypeVcglibCannotReadIsError) {
   const std::string data = "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
   const std::string msg = load_error(write("t.ply", ply_header("ascii", "list ushort int") + data));
@@ -537,6 +618,41 @@ TEST_F(MeshIoTest, PlyTruncatedIsError) {
 // ------------------------------------------------------------------------------------
 // OFF
 // ------------------------------------------------------------------------------------
+
+// A plain OFF file ("OFF", counts, x y z lines, "3 a b c" lines) is read without vcglib
+// (io/off_io.cpp, read_simple_off): the same floats as vcglib's atof-then-float, the same
+// faces and report as the general path, taken here for the same data by a comment line.
+TEST_F(MeshIoTest, OffFastPathReadsWhatVcglibReads) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> mantissa(-1.0, 1.0);
+  std::uniform_int_distribution<int> exponent(-60, 60);
+  const char *formats[] = {"%.17g", "%.3f", "%e", "%.9g", "%.1e", "%g"};
+  const size_t nv = 204, nf = 200; // vertices 202 and 203 unreferenced
+  std::string body;
+  char buf[64];
+  for (size_t i = 0; i < nv; ++i)
+    for (int k = 0; k < 3; ++k) {
+      std::snprintf(buf, sizeof buf, formats[(i + k) % 6],
+                    std::ldexp(mantissa(rng), exponent(rng) / 3));
+      body += buf;
+      body += k < 2 ? (i % 3 ? " " : " \t") : "\n";
+    }
+  for (size_t f = 0; f < nf; ++f)
+    body +=
+        "3 " + std::to_string(f) + " " + std::to_string(f + 2) + " " + std::to_string(f + 1) + "\n";
+  const std::string counts = std::to_string(nv) + " " + std::to_string(nf) + " 0\n";
+  LoadReport fast_report, general_report;
+  const Mesh fast = pomar::load_mesh(write("fast.off", "OFF\n" + counts + body), &fast_report);
+  const Mesh general =
+      pomar::load_mesh(write("general.off", "OFF\n# a comment\n" + counts + body), &general_report);
+  expect_same_load(fast, fast_report, general, general_report);
+  // Doubles that round differently straight to float and through double (vcglib's way).
+  const std::string tricky = "OFF\n3 1 0\n1.00000005960464477539062500000001 0 0\n"
+                             "0 0.100000001490116119384765625000001 0\n0 0 1e-44\n3 0 1 2\n";
+  const Mesh t_fast = pomar::load_mesh(write("t_fast.off", tricky));
+  const Mesh t_general = pomar::load_mesh(write("t_general.off", "OFF\n#\n" + tricky.substr(4)));
+  EXPECT_TRUE(same_bits(t_fast.positions, t_general.positions));
+}
 
 TEST_F(MeshIoTest, OffQuadAndPolygon) {
   const std::string file = write("poly.off", "OFF\n# comment\n6 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n"

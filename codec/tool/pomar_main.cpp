@@ -178,8 +178,11 @@ int run_encode(const EncodeArgs &a) {
   pomar::EncodeReport r;
   const auto t1 = Clock::now();
   std::vector<uint8_t> file;
+  const size_t input_vertices = mesh.vertex_count(), input_faces = mesh.triangle_count();
   try {
-    file = pomar::encode(mesh, opt, &r);
+    // The mesh is handed over (freed once quantized: a smaller peak), except with --strict,
+    // whose refusal looks at it again to hint at --repair.
+    file = a.strict ? pomar::encode(mesh, opt, &r) : pomar::encode(std::move(mesh), opt, &r);
   } catch (const pomar::Error &e) {
     if (a.strict && pomar::repair_would_change(mesh))
       throw pomar::Error(e.kind(), e.what() + std::string(kRepairHint));
@@ -192,8 +195,7 @@ int run_encode(const EncodeArgs &a) {
   const pomar::FileInfo &i = r.info;
   if (r.lossless.stored) // the one line saying what the file keeps beyond the coded mesh
     std::fprintf(stderr, "pomar: stored for an exact decode: %s\n", r.lossless.summary().c_str());
-  std::printf("%s: %zu vertices, %zu faces", a.in.c_str(), mesh.vertex_count(),
-              mesh.triangle_count());
+  std::printf("%s: %zu vertices, %zu faces", a.in.c_str(), input_vertices, input_faces);
   if (r.unreferenced_vertices)
     std::printf(" (%zu unreferenced vertices %s)", r.unreferenced_vertices,
                 r.lossless.unreferenced_vertices ? "kept" : "dropped");

@@ -265,6 +265,12 @@ struct EncodeReport {
 /// and, with `strict`, on any mesh that needs cutting.
 std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options = {},
                             EncodeReport *report = nullptr);
+/// The same (the same file), taking the mesh: a mesh coded as it is (manifold, oriented,
+/// every vertex used, or `strict`) is freed as soon as it is quantized and its attributes
+/// coded, so that the encoder's peak memory does not hold it as well. `mesh` is left empty,
+/// whether encode returns or throws.
+std::vector<uint8_t> encode(Mesh &&mesh, const EncodeOptions &options = {},
+                            EncodeReport *report = nullptr);
 
 /// Drops the vertices no triangle uses (the others keep their order, triangles are
 /// renumbered; indices out of range are left as they are); returns how many were dropped.

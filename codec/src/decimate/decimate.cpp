@@ -444,6 +444,7 @@ Decimation decimate(CornerTable ct, const std::vector<int32_t> &q, const Decimat
     std::vector<Collapse> level = d.run_level(alive);
     if (level.empty())
       break;
+    level.shrink_to_fit(); // kept to the end of the encode: without push_back's slack
     result.levels.push_back(std::move(level));
     if (progress)
       progress(std::min(1.0, std::log(initial / double(alive.size())) /

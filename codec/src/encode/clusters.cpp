@@ -84,6 +84,14 @@ public:
       codec.add_emitted(w);
   }
 
+  /// Range-code every cluster's recording of the level into its own coder, the clusters
+  /// spread over the threads (the models are frozen: coding only reads them).
+  void code(const std::vector<SymbolRecorder> &recordings, const ModelSlots &slots,
+            std::vector<RangeEncoder> &coders) {
+    pool_->run(recordings.size(),
+               [&](size_t c, unsigned) { code_recording(recordings[c], slots, coders[c]); });
+  }
+
 private:
   static constexpr uint32_t kBatch = 1024;     // clusters whose traversals are held at once
   static constexpr uint32_t kMinClusters = 64; // fewer: the threads cost more than they save
@@ -131,9 +139,9 @@ ClusteredLevels encode_clustered_levels(Rebuild &rb, size_t global, FileHeader &
     Models &models = level_models[r - global];
     codec.begin_level(rb.collapses(level), &models);
     const uint32_t older_than = lm.vertex_count(); // levels are encoded in order
-    const ModelAddresses addresses(models);
+    const ModelSlots slots(models);
     for (SymbolRecorder &recording : recordings)
-      recording.addresses = &addresses;
+      recording.slots = &slots;
     if (parallel.on()) {
       parallel.level(codec, recordings, {0, level, older_than}, next_local);
     } else {
@@ -145,11 +153,19 @@ ClusteredLevels encode_clustered_levels(Rebuild &rb, size_t global, FileHeader &
     }
     codec.end_level();
     add_level_entry(header, lm, 0, 0);
-    freezer.freeze(models, recordings);
-    for (uint32_t c = 0; c < clusters; ++c) {
-      code_recording(recordings[c], block_coders[c], bits);
-      recordings[c].events.clear(); // keeps its capacity for the next, larger level
-    }
+    freezer.freeze(models, slots, recordings);
+    // The ideal code lengths summed in cluster order (the same sums for any thread count),
+    // then each cluster's symbols coded into its own coder.
+    const std::vector<double> costs = symbol_costs(slots, freezer.counts());
+    for (const SymbolRecorder &recording : recordings)
+      add_recording_bits(recording, slots, costs, bits);
+    if (parallel.on())
+      parallel.code(recordings, slots, block_coders);
+    else
+      for (uint32_t c = 0; c < clusters; ++c)
+        code_recording(recordings[c], slots, block_coders[c]);
+    for (SymbolRecorder &recording : recordings)
+      recording.events.clear(); // keeps its capacity for the next, larger level
     if (progress)
       progress(double(r + 1) / double(L), "encode");
   }

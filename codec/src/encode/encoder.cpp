@@ -2,8 +2,10 @@
 // decimate (section 4) -> base mesh -> global levels (section 5.1) -> clustered levels
 // (section 5.2, encode/clusters.cpp) -> file (format/file_format.cpp) -> report.
 // The levels are coded by the traversal the decoder runs (encode/encoder_codec.h).
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <string>
 
 #include "attributes/attribute_section.h"
@@ -25,31 +27,38 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-/// Drop unreferenced vertices; returns the compact positions and fills the index maps.
-std::vector<float> compact_vertices(const Mesh &mesh, std::vector<uint32_t> &triangles,
-                                    std::vector<uint32_t> &compact_to_input) {
+/// The triangles in the numbering of the referenced vertices (unreferenced ones dropped,
+/// the others kept in input order); fills compact_to_input. Checks every index.
+std::vector<uint32_t> compact_triangles(const Mesh &mesh, std::vector<uint32_t> &compact_to_input) {
   const size_t nv = mesh.vertex_count();
   std::vector<uint32_t> remap(nv, kNone);
-  triangles = mesh.triangles;
-  for (uint32_t &i : triangles) {
+  std::vector<uint32_t> triangles = mesh.triangles;
+  for (uint32_t i : triangles) {
     if (i >= nv)
       throw Error(Error::Kind::InvalidMesh, "a triangle refers to vertex " + std::to_string(i) +
                                                 " but the mesh has only " + std::to_string(nv) +
                                                 " vertices");
-    if (remap[i] == kNone) {
-      remap[i] = 0; // mark used; numbered below in input order
+    remap[i] = 0; // mark used; numbered below in input order
+  }
+  compact_to_input.clear();
+  compact_to_input.reserve(nv);
+  for (uint32_t v = 0; v < nv; ++v)
+    if (remap[v] != kNone) {
+      remap[v] = static_cast<uint32_t>(compact_to_input.size());
+      compact_to_input.push_back(v);
     }
-  }
-  std::vector<float> positions;
-  for (uint32_t v = 0; v < nv; ++v) {
-    if (remap[v] == kNone)
-      continue;
-    remap[v] = static_cast<uint32_t>(compact_to_input.size());
-    compact_to_input.push_back(v);
-    positions.insert(positions.end(), &mesh.positions[3 * v], &mesh.positions[3 * v] + 3);
-  }
-  for (uint32_t &i : triangles)
-    i = remap[i];
+  if (compact_to_input.size() < nv) // else the numbering is the input's
+    for (uint32_t &i : triangles)
+      i = remap[i];
+  return triangles;
+}
+
+/// The positions of the vertices compact_to_input names, in that order (xyz floats).
+std::vector<float> gather_positions(const Mesh &mesh,
+                                    const std::vector<uint32_t> &compact_to_input) {
+  std::vector<float> positions(3 * compact_to_input.size());
+  for (size_t i = 0; i < compact_to_input.size(); ++i)
+    std::copy_n(&mesh.positions[3 * size_t(compact_to_input[i])], 3, &positions[3 * i]);
   return positions;
 }
 
@@ -90,17 +99,21 @@ PreparedInput prepare_input(const Mesh &mesh, const EncodeOptions &options,
                       encode_attribute_bytes_per_vertex(mesh, options.attributes),
                       decode_threads(options.threads));
   PreparedInput in;
-  std::vector<uint32_t> triangles, compact_to_input;
-  const std::vector<float> positions = compact_vertices(mesh, triangles, compact_to_input);
+  std::vector<uint32_t> compact_to_input;
+  std::vector<uint32_t> triangles = compact_triangles(mesh, compact_to_input);
   const uint32_t nv = static_cast<uint32_t>(compact_to_input.size());
   const uint32_t nf = static_cast<uint32_t>(triangles.size() / 3);
   in.vertices = nv;
   in.faces = nf;
-  in.grid = hook ? hook->grid : make_quantizer(positions.data(), nv, options.bits);
-  in.q = quantize(in.grid, positions.data(), nv);
-  // Renumber for memory locality, then build (and validate) the connectivity. An invalid
-  // mesh is validated again in the caller's numbering so that the message names its indices.
-  const std::vector<uint32_t> input_triangles = triangles;
+  { // quantize the referenced vertices (the input's own array when it has no other)
+    std::vector<float> gathered;
+    if (nv < mesh.vertex_count())
+      gathered = gather_positions(mesh, compact_to_input);
+    const float *positions = gathered.empty() ? mesh.positions.data() : gathered.data();
+    in.grid = hook ? hook->grid : make_quantizer(positions, nv, options.bits);
+    in.q = quantize(in.grid, positions, nv);
+  }
+  // Renumber for memory locality, then build (and validate) the connectivity.
   const std::vector<uint32_t> old_to_new = reorder_for_locality(in.q, triangles);
   in.to_input.resize(nv);
   for (uint32_t v = 0; v < nv; ++v)
@@ -108,6 +121,9 @@ PreparedInput prepare_input(const Mesh &mesh, const EncodeOptions &options,
   try {
     build_corner_table(triangles.data(), nf, nv, in.ct);
   } catch (const Error &) {
+    // An invalid mesh is validated again in the caller's numbering (its face order too) so
+    // that the message names its indices.
+    const std::vector<uint32_t> input_triangles = compact_triangles(mesh, compact_to_input);
     build_corner_table(input_triangles.data(), nf, nv, in.ct); // throws with input indices
     throw;
   }
@@ -178,11 +194,21 @@ void check_encode_input(const Mesh &mesh, const EncodeOptions &options) {
 }
 
 std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &options,
-                                     EncodeReport *report, const LosslessHook *hook) {
+                                     EncodeReport *report, const LosslessHook *hook,
+                                     const std::function<void()> &release_input) {
   auto t0 = std::chrono::steady_clock::now();
   PreparedInput in = prepare_input(mesh, options, hook);
   const uint32_t nv = in.vertices, nf = in.faces;
   const double t_quantize = seconds_since(t0);
+  // Attributes: codes of every vertex (prepared numbering); the base mesh's go to the ATTR
+  // section, the others are coded with their positions by the level steps.
+  AttributeTable attributes = plan_attributes(mesh, options.attributes);
+  const std::vector<int64_t> codes =
+      attributes.codes ? attribute_codes(mesh, attributes, options.attributes, in.to_input)
+                       : std::vector<int64_t>();
+  const size_t input_vertices = mesh.vertex_count();
+  if (release_input)
+    release_input(); // `mesh` is not read past this point
 
   auto t1 = std::chrono::steady_clock::now();
   DecimationOptions decimation;
@@ -194,12 +220,6 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
   Rebuild rb(in.q, dec);
   const BaseMesh base = start_from_base_mesh(rb, nv);
   rb.mesh.reserve_counts(nv, nf); // the splits append without reallocating
-  // Attributes: codes of every vertex (prepared numbering); the base mesh's go to the ATTR
-  // section, the others are coded with their positions by the level steps.
-  AttributeTable attributes = plan_attributes(mesh, options.attributes);
-  const std::vector<int64_t> codes =
-      attributes.codes ? attribute_codes(mesh, attributes, options.attributes, in.to_input)
-                       : std::vector<int64_t>();
   for (uint32_t v : rb.dec_to_input)
     attributes.base.insert(attributes.base.end(), codes.begin() + size_t(v) * attributes.codes,
                            codes.begin() + size_t(v + 1) * attributes.codes);
@@ -252,8 +272,8 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
     report->info = file_info(layout, file.size());
     if (const auto table = load_attribute_table(file.data(), layout))
       describe_attributes(*table, report->info);
-    report->input_vertices = mesh.vertex_count();
-    report->unreferenced_vertices = mesh.vertex_count() - nv;
+    report->input_vertices = input_vertices;
+    report->unreferenced_vertices = input_vertices - nv;
     report->quantize_seconds = t_quantize;
     report->decimate_seconds = t_decimate;
     report->encode_seconds = seconds_since(t2);

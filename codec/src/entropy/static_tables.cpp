@@ -57,150 +57,157 @@ namespace {
 
 /// Bits to code `counts` with frozen frequencies `freq` (infinite if a counted symbol
 /// has frequency 0).
-double data_bits(const std::vector<uint32_t> &counts, const uint16_t *freq, int n) {
+double data_bits(const uint32_t *counts, const uint16_t *freq, int n) {
   double total = 0, bits = 0;
   for (int s = 0; s < n; ++s)
     total += freq[s];
   for (int s = 0; s < n; ++s) {
-    if (!counts[size_t(s)])
+    if (!counts[s])
       continue;
     if (!freq[s])
       return 1e300;
-    bits += counts[size_t(s)] * std::log2(total / freq[s]);
+    bits += counts[s] * std::log2(total / freq[s]);
   }
   return bits;
 }
 
 } // namespace
 
-ModelAddresses::ModelAddresses(Models &m) {
-  auto add = [&](const void *begin, size_t bytes) {
-    const uintptr_t b = reinterpret_cast<uintptr_t>(begin);
-    if (bytes)
-      ranges_.push_back({b, b + bytes});
+ModelSlots::ModelSlots(Models &m) {
+  // for_each_model visits each array's models one after the other: a model that does not
+  // follow the previous one of its type starts a new array.
+  auto add = [&](std::vector<Array> &arrays, void *model, size_t size, uint32_t symbols, bool bit) {
+    const uintptr_t p = reinterpret_cast<uintptr_t>(model);
+    const uint32_t slot = static_cast<uint32_t>(models_.size());
+    Array *last = arrays.empty() ? nullptr : &arrays.back();
+    if (last && p == last->begin + last->bytes && slot == last->first_slot + last->bytes / size)
+      last->bytes += size;
+    else
+      arrays.push_back({p, size, slot});
+    models_.push_back(model);
+    is_bit_.push_back(bit);
+    first_symbol_.push_back(symbols_);
+    symbols_ += symbols;
   };
-  auto add_vector = [&](const std::vector<FrequencyModel> &v) {
-    add(v.data(), v.size() * sizeof(FrequencyModel));
-  };
-  add(&m, sizeof(Models)); // the models held in the struct itself (sv, mantissa)
-  add_vector(m.conn.se);
-  add_vector(m.conn.faces);
-  add_vector(m.conn.sl);
-  for (const auto &kind : m.geom.magnitude)
-    add_vector(kind);
-  add(m.attr.data(), m.attr.size() * sizeof(AttributeCodeModels)); // their `top` models
-  for (const AttributeCodeModels &a : m.attr)
-    add_vector(a.classes);
-  std::sort(ranges_.begin(), ranges_.end());
-  if (ranges_.size() > 256)
-    throw Error(Error::Kind::Internal, "internal encoder error: too many model arrays");
+  for_each_model(
+      m,
+      [&](FrequencyModel &f) {
+        add(frequency_arrays_, &f, sizeof(FrequencyModel), static_cast<uint32_t>(f.symbols()),
+            false);
+      },
+      [&](BitModel &b) { add(bit_arrays_, &b, sizeof(BitModel), 2, true); });
 }
 
-uint32_t ModelAddresses::name(const void *model) const {
-  const uintptr_t p = reinterpret_cast<uintptr_t>(model);
-  auto it = std::upper_bound(ranges_.begin(), ranges_.end(), std::make_pair(p, ~uintptr_t(0)));
-  if (it == ranges_.begin() || p >= (it - 1)->second || p - (it - 1)->first > 0xFFFFFFu)
-    throw Error(Error::Kind::Internal, "internal encoder error: a model outside its level");
-  --it;
-  return uint32_t(it - ranges_.begin()) << 24 | uint32_t(p - it->first);
+void ModelSlots::outside_level() {
+  throw Error(Error::Kind::Internal, "internal encoder error: a model outside its level");
 }
 
-void LevelFreezer::freeze(Models &m, const std::vector<SymbolRecorder> &recordings) {
-  std::unordered_map<const void *, std::vector<uint32_t>> counts;
+void LevelFreezer::freeze(Models &m, const ModelSlots &slots,
+                          const std::vector<SymbolRecorder> &recordings) {
+  // How often each symbol of each model was recorded, and which models were used at all.
+  std::vector<uint32_t> &counts = counts_;
+  counts.assign(slots.symbols(), 0);
+  std::vector<uint8_t> used(slots.slots(), 0);
   for (const SymbolRecorder &r : recordings)
     for (const SymbolRecorder::Event &e : r.events) {
       if (e.kind() == 2)
         continue;
-      void *model = r.model(e);
-      auto &c = counts[model];
-      const size_t n = e.kind() == 0 ? size_t(static_cast<FrequencyModel *>(model)->symbols()) : 2;
-      c.resize(n, 0);
-      ++c[e.value()];
+      ++counts[slots.first_symbol(e.model) + e.value()];
+      used[e.model] = 1;
     }
   // A model whose previous-level table codes this level's symbols nearly as well as its
   // own would (within what storing its own costs) reuses it.
   std::vector<std::vector<uint16_t>> &previous = previous_;
-  {
-    size_t slot = 0;
-    auto prev_of = [&]() -> std::vector<uint16_t> & {
-      if (previous.size() <= slot)
-        previous.resize(slot + 1);
-      return previous[slot++];
-    };
-    for_each_model(
-        m,
-        [&](FrequencyModel &f) {
-          std::vector<uint16_t> &before = prev_of();
-          const int n = f.symbols();
-          auto it = counts.find(&f);
-          std::vector<uint32_t> c(size_t(n), 0);
-          if (it != counts.end())
-            c = it->second;
-          f.freeze_from_counts(c.data());
-          if (it == counts.end()) {
-            before.clear(); // unused: stays uniform, stored as such
+  if (previous.size() < slots.slots())
+    previous.resize(slots.slots());
+  uint32_t slot = 0;
+  for_each_model(
+      m,
+      [&](FrequencyModel &f) {
+        std::vector<uint16_t> &before = previous[slot];
+        const uint32_t *c = &counts[slots.first_symbol(slot)];
+        const bool in_use = used[slot++];
+        const int n = f.symbols();
+        f.freeze_from_counts(c);
+        if (!in_use) {
+          before.clear(); // unused: stays uniform, stored as such
+          return;
+        }
+        uint16_t q[FrequencyModel::kMaxSymbols];
+        for (int i = 0; i < n; ++i)
+          q[i] = static_cast<uint16_t>(f.freq(i) ? log_frequency(log_code(f.freq(i))) : 0);
+        if (!before.empty()) {
+          int used_symbols = 0;
+          for (int i = 0; i < n; ++i)
+            used_symbols += q[i] != 0;
+          const double own = data_bits(c, q, n) + 1.5 * used_symbols + 2;
+          if (data_bits(c, before.data(), n) <= own) {
+            f.freeze_with(before.data());
             return;
           }
-          uint16_t q[FrequencyModel::kMaxSymbols];
-          for (int i = 0; i < n; ++i)
-            q[i] = static_cast<uint16_t>(f.freq(i) ? log_frequency(log_code(f.freq(i))) : 0);
-          if (!before.empty()) {
-            int used = 0;
-            for (int i = 0; i < n; ++i)
-              used += q[i] != 0;
-            const double own = data_bits(c, q, n) + 1.5 * used + 2;
-            if (data_bits(c, before.data(), n) <= own) {
-              f.freeze_with(before.data());
-              return;
-            }
-          }
-          f.freeze_with(q);
-          before.assign(q, q + n);
-        },
-        [&](BitModel &b) {
-          std::vector<uint16_t> &before = prev_of();
-          auto it = counts.find(&b);
-          uint32_t p0 = 1u << (kBitModelBits - 1);
-          if (it != counts.end()) {
-            const uint64_t zeros = it->second[0], all = zeros + it->second[1];
-            p0 = static_cast<uint32_t>((zeros << kBitModelBits) / all);
-          }
-          p0 = std::min<uint32_t>(p0 >> 4, 255) * 16 + 8; // the 8-bit code the table keeps
-          if (it != counts.end() && !before.empty()) {
-            auto bits = [&](double p) {
-              return -(it->second[0] * std::log2(p / 4096.0) +
-                       it->second[1] * std::log2(1 - p / 4096.0));
-            };
-            if (bits(before[0]) <= bits(p0) + 6)
-              p0 = before[0];
-          }
-          b.p0 = static_cast<uint16_t>(p0);
-          b.frozen = true;
-          if (it == counts.end())
-            before.clear();
-          else
-            before.assign(1, b.p0);
-        });
-  }
+        }
+        f.freeze_with(q);
+        before.assign(q, q + n);
+      },
+      [&](BitModel &b) {
+        std::vector<uint16_t> &before = previous[slot];
+        const uint32_t *c = &counts[slots.first_symbol(slot)];
+        const bool in_use = used[slot++];
+        uint32_t p0 = 1u << (kBitModelBits - 1);
+        if (in_use) {
+          const uint64_t zeros = c[0], all = zeros + c[1];
+          p0 = static_cast<uint32_t>((zeros << kBitModelBits) / all);
+        }
+        p0 = std::min<uint32_t>(p0 >> 4, 255) * 16 + 8; // the 8-bit code the table keeps
+        if (in_use && !before.empty()) {
+          auto bits = [&](double p) {
+            return -(c[0] * std::log2(p / 4096.0) + c[1] * std::log2(1 - p / 4096.0));
+          };
+          if (bits(before[0]) <= bits(p0) + 6)
+            p0 = before[0];
+        }
+        b.p0 = static_cast<uint16_t>(p0);
+        b.frozen = true;
+        if (!in_use)
+          before.clear();
+        else
+          before.assign(1, b.p0);
+      });
 }
 
-void code_recording(const SymbolRecorder &r, RangeEncoder &rc, double *bits) {
+std::vector<double> symbol_costs(const ModelSlots &slots, const std::vector<uint32_t> &counts) {
+  std::vector<double> costs(slots.symbols(), 0.0);
+  for (uint32_t slot = 0; slot < slots.slots(); ++slot) {
+    const uint32_t first = slots.first_symbol(slot);
+    for (uint32_t s = 0; s < slots.symbols(slot); ++s) {
+      if (!counts[first + s])
+        continue; // never looked up
+      costs[first + s] =
+          slots.is_bit(slot)
+              ? cost_bits(*static_cast<const BitModel *>(slots.model(slot)), int(s))
+              : cost_bits(*static_cast<const FrequencyModel *>(slots.model(slot)), int(s));
+    }
+  }
+  return costs;
+}
+
+void add_recording_bits(const SymbolRecorder &r, const ModelSlots &slots,
+                        const std::vector<double> &costs, double *bits) {
+  for (const SymbolRecorder::Event &e : r.events)
+    bits[e.stream()] +=
+        e.kind() == 2 ? double(e.nbits()) : costs[slots.first_symbol(e.model) + e.value()];
+}
+
+void code_recording(const SymbolRecorder &r, const ModelSlots &slots, RangeEncoder &rc) {
   for (const SymbolRecorder::Event &e : r.events) {
     switch (e.kind()) {
-    case 0: {
-      auto &m = *static_cast<FrequencyModel *>(r.model(e));
-      bits[e.stream()] += cost_bits(m, int(e.value()));
-      rc.encode(m, int(e.value()));
+    case 0:
+      rc.encode(*static_cast<FrequencyModel *>(slots.model(e.model)), int(e.value()));
       break;
-    }
-    case 1: {
-      auto &m = *static_cast<BitModel *>(r.model(e));
-      bits[e.stream()] += cost_bits(m, int(e.value()));
-      rc.encode_bit(m, int(e.value()));
+    case 1:
+      rc.encode_bit(*static_cast<BitModel *>(slots.model(e.model)), int(e.value()));
       break;
-    }
     default:
-      bits[e.stream()] += e.nbits();
       rc.encode_bypass(e.value(), int(e.nbits()));
     }
   }

@@ -15,27 +15,57 @@
 
 namespace pomar {
 
-/// Names every model of one level's Models in 32 bits: the array holding it (8 bits: the
-/// Models struct itself, each vector of models, each attribute's) and its byte offset in
-/// that array (24 bits). Lets a recorded event take 8 bytes instead of 16.
-class ModelAddresses {
+/// Numbers every model of one level's Models by its slot, its place in for_each_model's
+/// order, and finds a model's slot from its address. The models lie in a few arrays of one
+/// model type each (s_v's binary models, each vector of frequency models, the mantissa
+/// bits, each attribute code's classes and top bits): a slot is an array's first slot plus
+/// the model's index in it. Also lays out one counter per symbol of every model (2 for a
+/// binary model), for the freezer's counts and the frozen code lengths.
+class ModelSlots {
 public:
-  explicit ModelAddresses(Models &level);
-  uint32_t name(const void *model) const;
-  void *model(uint32_t name) const {
-    return reinterpret_cast<void *>(ranges_[name >> 24].first + (name & 0xFFFFFFu));
+  explicit ModelSlots(Models &level);
+  uint32_t slot(const FrequencyModel *m) const { return find(frequency_arrays_, m); }
+  uint32_t slot(const BitModel *m) const { return find(bit_arrays_, m); }
+  uint32_t slots() const { return static_cast<uint32_t>(first_symbol_.size()); }
+  void *model(uint32_t slot) const { return models_[slot]; }
+  bool is_bit(uint32_t slot) const { return is_bit_[slot] != 0; }
+  /// The slot's number of symbols (2 for a binary model).
+  uint32_t symbols(uint32_t slot) const {
+    return (slot + 1 < slots() ? first_symbol_[slot + 1] : symbols_) - first_symbol_[slot];
   }
+  /// Where the slot's symbols start among all models' symbols (symbols() of them in all).
+  uint32_t first_symbol(uint32_t slot) const { return first_symbol_[slot]; }
+  uint32_t symbols() const { return symbols_; }
 
 private:
-  std::vector<std::pair<uintptr_t, uintptr_t>> ranges_; // [begin, end) of each array, sorted
+  struct Array {
+    uintptr_t begin;
+    uintptr_t bytes;
+    uint32_t first_slot;
+  };
+  /// Hot (once per recorded symbol): a few arrays, one unsigned comparison each.
+  template <class Model> static uint32_t find(const std::vector<Array> &arrays, const Model *m) {
+    const uintptr_t p = reinterpret_cast<uintptr_t>(m);
+    for (const Array &a : arrays)
+      if (p - a.begin < a.bytes)
+        return a.first_slot + static_cast<uint32_t>((p - a.begin) / sizeof(Model));
+    outside_level();
+  }
+  [[noreturn]] static void outside_level();
+  std::vector<Array> frequency_arrays_, bit_arrays_;
+  std::vector<void *> models_;         // per slot
+  std::vector<uint32_t> first_symbol_; // per slot
+  std::vector<uint8_t> is_bit_;        // per slot
+  uint32_t symbols_ = 0;
 };
 
-/// Stands in for a RangeEncoder: records symbols (with their model) instead of coding.
-/// An event is 8 bytes (a 10M-vertex encode records about 10^8 of them in its finest level).
+/// Stands in for a RangeEncoder: records symbols (with their model's slot) instead of
+/// coding. An event is 8 bytes (a 10M-vertex encode records about 10^8 of them in its
+/// finest level).
 class SymbolRecorder {
 public:
   struct Event {
-    uint32_t model; // ModelAddresses name; bypass bits: their count
+    uint32_t model; // ModelSlots slot; bypass bits: their count
     uint32_t word;  // value (24 bits) | kind << 24 (0 frequency symbol, 1 binary, 2 bypass
                     // bits) | stream << 26 (0 connectivity, 1 geometry, 2 + k attribute code k)
     uint32_t value() const { return word & 0xFFFFFFu; }
@@ -43,15 +73,14 @@ public:
     uint32_t stream() const { return word >> 26; }
     uint32_t nbits() const { return model; }
   };
-  void encode(FrequencyModel &m, int s) { events.push_back({addresses->name(&m), pack(s, 0)}); }
-  void encode_bit(BitModel &m, int bit) { events.push_back({addresses->name(&m), pack(bit, 1)}); }
+  void encode(FrequencyModel &m, int s) { events.push_back({slots->slot(&m), pack(s, 0)}); }
+  void encode_bit(BitModel &m, int bit) { events.push_back({slots->slot(&m), pack(bit, 1)}); }
   void encode_bypass(uint32_t v, int nbits) { // nbits <= 24
     events.push_back({uint32_t(nbits), pack(v, 2)});
   }
   void finish() {}
-  void *model(const Event &e) const { return addresses->model(e.model); }
   std::vector<Event> events;
-  const ModelAddresses *addresses = nullptr; // of the level being recorded
+  const ModelSlots *slots = nullptr; // of the level being recorded
   uint8_t stream = 0;
 
 private:
@@ -86,18 +115,31 @@ struct RecorderStream {
 /// would (within what storing its own costs) reuses them: call freeze() in level order.
 class LevelFreezer {
 public:
-  void freeze(Models &level, const std::vector<SymbolRecorder> &recordings);
+  void freeze(Models &level, const ModelSlots &slots,
+              const std::vector<SymbolRecorder> &recordings);
+  /// How often each symbol was recorded in the level last frozen (at first_symbol + symbol).
+  const std::vector<uint32_t> &counts() const { return counts_; }
 
 private:
+  std::vector<uint32_t> counts_;
   std::vector<std::vector<uint16_t>>
       previous_; // per model slot: frozen frequencies (empty: unused)
 };
 
+/// The ideal code length (cost_bits) of every symbol of a frozen level that was recorded
+/// (`counts`, LevelFreezer::counts), at ModelSlots::first_symbol(slot) + symbol (0 for the
+/// others): computed once per level and symbol, not once per event.
+std::vector<double> symbol_costs(const ModelSlots &slots, const std::vector<uint32_t> &counts);
+
+/// Add the ideal code lengths of a recording's events (`costs` of its frozen level) to
+/// bits[stream]: 0 connectivity, 1 geometry, 2 + k attribute code k (the array must have
+/// room for every stream recorded), in event order.
+void add_recording_bits(const SymbolRecorder &recording, const ModelSlots &slots,
+                        const std::vector<double> &costs, double *bits);
+
 /// Range-code a recording into `rc` with the (frozen) models its events point to (a
 /// cluster's encoder lives across levels: call once per level, finish() after the last).
-/// Adds the ideal code lengths per stream to bits[stream]: 0 connectivity, 1 geometry,
-/// 2 + k attribute code k (the array must have room for every stream recorded).
-void code_recording(const SymbolRecorder &recording, RangeEncoder &rc, double *bits);
+void code_recording(const SymbolRecorder &recording, const ModelSlots &slots, RangeEncoder &rc);
 
 /// The log-scale code (1..103) whose stored frequency is nearest to f >= 1 (smallest code
 /// on ties); log_code_reference is the plain search over every code, kept for the tests.

@@ -41,9 +41,16 @@ Quantizer make_quantizer(const float *p, size_t n, int bits) {
 }
 
 std::vector<int32_t> quantize(const Quantizer &g, const float *p, size_t n) {
+  // Quantizer::quantize for every coordinate, the step and the grid's top computed once
+  // (the same doubles, so the same values).
   std::vector<int32_t> q(3 * n);
-  for (size_t i = 0; i < 3 * n; ++i)
-    q[i] = static_cast<int32_t>(g.quantize(static_cast<int>(i % 3), p[i]));
+  const double s = g.step();
+  const double top = double((uint32_t(1) << g.bits) - 1);
+  for (size_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) {
+      const double t = s > 0 ? (double(p[3 * i + k]) - double(g.origin[k])) / s : 0.0;
+      q[3 * i + k] = static_cast<int32_t>(std::clamp(std::floor(t + 0.5), 0.0, top));
+    }
   return q;
 }
 

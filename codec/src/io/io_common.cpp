@@ -91,6 +91,29 @@ bool parse_float(const std::string &token, float &value) {
   return end == token.c_str() + token.size();
 }
 
+bool plain_decimal(const char *b, const char *e) {
+  if (b != e && *b == '-')
+    ++b;
+  bool digits = false;
+  while (b != e && *b >= '0' && *b <= '9')
+    ++b, digits = true;
+  if (b != e && *b == '.')
+    for (++b; b != e && *b >= '0' && *b <= '9'; ++b)
+      digits = true;
+  if (!digits)
+    return false;
+  if (b != e && (*b == 'e' || *b == 'E')) {
+    ++b;
+    if (b != e && (*b == '-' || *b == '+'))
+      ++b;
+    if (b == e || *b < '0' || *b > '9')
+      return false;
+    while (b != e && *b >= '0' && *b <= '9')
+      ++b;
+  }
+  return b == e;
+}
+
 std::vector<std::string> split_ws(const std::string &line) {
   std::vector<std::string> out;
   size_t i = 0;

@@ -66,6 +66,11 @@ bool parse_int(const std::string &token, int64_t &value);
 /// Parses a whole token as a decimal float (hex floats are refused: not every reader
 /// supports them). Returns false for text that is not a number; NaN/Inf parse.
 bool parse_float(const std::string &token, float &value);
+/// Whether [b, e) is a plain decimal number, [-]digits[.digits][(e|E)[+-]digits] (at least
+/// one digit before the exponent): what the fast paths parse with from_chars. For such
+/// text from_chars rounds as strtof/strtod (and so vcglib's fscanf/atof) do; anything else
+/// ('+', hex, inf, nan, ...) is left to the general readers.
+bool plain_decimal(const char *b, const char *e);
 /// Splits a line at spaces, tabs, CR and LF.
 std::vector<std::string> split_ws(const std::string &line);
 void add_unique(std::vector<std::string> &list, const char *name);

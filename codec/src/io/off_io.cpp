@@ -6,7 +6,10 @@
 
 #include <wrap/io_trimesh/import_off.h>
 
+#include <algorithm>
+#include <charconv>
 #include <climits>
+#include <cmath>
 
 namespace pomar::io {
 namespace {
@@ -181,10 +184,127 @@ private:
 
 using OffImporter = vcg::tri::io::ImporterOFF<IoMesh>;
 
+/// The lines of a small file held in memory, split at '\n'.
+class TextLines {
+public:
+  explicit TextLines(std::string text) : text_(std::move(text)) {}
+  /// The next line in [b, e); false at the end of the text.
+  bool next(const char *&b, const char *&e) {
+    if (pos_ >= text_.size())
+      return false;
+    const size_t end = std::min(text_.find('\n', pos_), text_.size());
+    b = text_.data() + pos_;
+    e = text_.data() + end;
+    pos_ = end + 1;
+    return true;
+  }
+
+private:
+  std::string text_;
+  size_t pos_ = 0;
+};
+
+/// Splits [b, e) at spaces and tabs into at most `n` tokens; false if the line has another
+/// number of tokens (or a character vcglib's line reader treats specially: '#', '\r').
+bool tokens_of(const char *b, const char *e, size_t n, std::pair<const char *, const char *> *out) {
+  size_t k = 0;
+  while (b != e) {
+    if (*b == ' ' || *b == '\t') {
+      ++b;
+      continue;
+    }
+    const char *t = b;
+    while (b != e && *b != ' ' && *b != '\t') {
+      if (*b == '#' || *b == '\r')
+        return false;
+      ++b;
+    }
+    if (k == n)
+      return false;
+    out[k++] = {t, b};
+  }
+  return k == n;
+}
+
+bool parse_index(std::pair<const char *, const char *> t, uint64_t max, uint64_t &v) {
+  if (t.first == t.second || *t.first < '0' || *t.first > '9') // from_chars takes '-'
+    return false;
+  const auto r = std::from_chars(t.first, t.second, v);
+  return r.ec == std::errc() && r.ptr == t.second && v <= max;
+}
+
+/// The common case read straight into the flat arrays: "OFF", the counts line, one vertex
+/// of 3 plain decimal coordinates a line (atof then float, as vcglib reads them; all
+/// finite), one "3 a b c" triangle a line (distinct indices in range), nothing else (no
+/// comment, empty line, CR, colour or normal). Returns false for anything else, and the
+/// walk and vcglib read the file; files over 256 MiB are left to them too (this path holds
+/// the text in memory).
+bool read_simple_off(const std::string &path, const SizeCheck &check, Mesh &out,
+                     LoadReport &report) {
+  FileReader in(path);
+  if (in.remaining() > (uint64_t(256) << 20))
+    return false;
+  std::string text(in.remaining(), '\0');
+  if (!in.read(text.data(), text.size()))
+    return false;
+  TextLines lines(std::move(text));
+  const char *b = nullptr, *e = nullptr;
+  std::pair<const char *, const char *> t[4];
+  uint64_t nv = 0, nf = 0, edges = 0;
+  if (!lines.next(b, e) || std::string(b, e) != "OFF" || !lines.next(b, e) ||
+      !tokens_of(b, e, 3, t) || !parse_index(t[0], INT_MAX, nv) ||
+      !parse_index(t[1], INT_MAX, nf) || !parse_index(t[2], UINT64_MAX, edges) || nv == 0 ||
+      nf == 0)
+    return false;
+  run_size_check(check, path, nv, nf);
+  Mesh mesh;
+  mesh.positions.resize(3 * nv);
+  for (uint64_t v = 0; v < nv; ++v) {
+    if (!lines.next(b, e) || !tokens_of(b, e, 3, t))
+      return false;
+    for (int k = 0; k < 3; ++k) {
+      double x = 0;
+      if (!plain_decimal(t[k].first, t[k].second))
+        return false;
+      const auto r = std::from_chars(t[k].first, t[k].second, x);
+      float &c = mesh.positions[3 * v + k];
+      c = static_cast<float>(x);
+      if (r.ec != std::errc() || r.ptr != t[k].second || !std::isfinite(c))
+        return false;
+    }
+  }
+  mesh.triangles.resize(3 * nf);
+  std::vector<uint8_t> used(nv, 0);
+  for (uint64_t f = 0; f < nf; ++f) {
+    uint64_t count = 0, v[3];
+    if (!lines.next(b, e) || !tokens_of(b, e, 4, t) || !parse_index(t[0], 3, count) || count != 3)
+      return false;
+    for (int k = 0; k < 3; ++k) {
+      if (!parse_index(t[k + 1], nv - 1, v[k]))
+        return false;
+      mesh.triangles[3 * f + k] = static_cast<uint32_t>(v[k]);
+      used[v[k]] = 1;
+    }
+    if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2])
+      return false;
+  }
+  if (lines.next(b, e)) // only an empty last line may follow
+    if (b != e || lines.next(b, e))
+      return false;
+  report.file_vertices = nv;
+  report.file_faces = nf;
+  report.unreferenced_vertices = static_cast<size_t>(std::count(used.begin(), used.end(), 0));
+  out = std::move(mesh);
+  return true;
+}
+
 } // namespace
 
 Mesh load_off(const std::string &path, LoadReport &report, const SizeCheck &check) {
   check_regular_file(path);
+  Mesh fast;
+  if (read_simple_off(path, check, fast, report))
+    return fast;
   const OffLayout layout = OffWalker(path, check).run();
   IoMesh m;
   int mask = 0;

@@ -226,18 +226,31 @@ LosslessRecord build_lossless_record(const Mesh &input, const Mesh &cut, const R
   return r;
 }
 
-std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, EncodeReport *report) {
+namespace {
+
+/// encode(), given the mesh (`owned`, the same mesh) or not (nullptr): a clean mesh given is
+/// freed once the manifold encoder has quantized it.
+std::vector<uint8_t> encode_any(const Mesh &mesh, const EncodeOptions &options,
+                                EncodeReport *report, Mesh *owned) {
+  bool released = false;
+  std::function<void()> release;
+  if (owned)
+    release = [&] {
+      *owned = Mesh();
+      released = true;
+    };
   if (options.strict)
-    return encode_manifold(mesh, options, report, nullptr);
+    return encode_manifold(mesh, options, report, nullptr, release);
 
   if (!options.keep_order && all_vertices_used(mesh)) {
     // Most meshes are clean: code them as they are (the file is then byte for byte what
-    // strict gives). The manifold encoder checks the topology early (its corner table);
-    // only if it refuses is the topology checked here, and the mesh cut.
+    // strict gives). The manifold encoder checks the topology early (its corner table),
+    // before it releases the mesh; only if it refuses is the topology checked here, and
+    // the mesh cut.
     try {
-      return encode_manifold(mesh, options, report, nullptr);
+      return encode_manifold(mesh, options, report, nullptr, release);
     } catch (const Error &) {
-      if (mesh.triangles.size() % 3 || valid_topology(mesh))
+      if (released || mesh.triangles.size() % 3 || valid_topology(mesh))
         throw; // not a matter of topology: the error stands
     }
   }
@@ -295,6 +308,20 @@ std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, Enco
     }
   }
   return file;
+}
+
+} // namespace
+
+std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, EncodeReport *report) {
+  return encode_any(mesh, options, report, nullptr);
+}
+
+std::vector<uint8_t> encode(Mesh &&mesh, const EncodeOptions &options, EncodeReport *report) {
+  struct LeaveEmpty { // whether encode returns or throws
+    Mesh &mesh;
+    ~LeaveEmpty() { mesh = Mesh(); }
+  } leave_empty{mesh};
+  return encode_any(mesh, options, report, &mesh);
 }
 
 namespace {

@@ -27,8 +27,11 @@ struct LosslessHook {
 
 /// The codec proper (codec/src/encode/encoder.cpp): a manifold, oriented mesh; unreferenced
 /// vertices are dropped. With a hook, the file is version 4 and carries the record.
+/// `release_input` (optional) is called once `mesh` is no longer read (quantized, its
+/// attributes coded): the caller may free it then.
 std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &options,
-                                     EncodeReport *report, const LosslessHook *hook);
+                                     EncodeReport *report, const LosslessHook *hook,
+                                     const std::function<void()> &release_input = {});
 
 /// The manifold encoder's checks of the input that do not depend on its topology (bits,
 /// array sizes, no triangle, NaN/Inf); throws pomar::Error.

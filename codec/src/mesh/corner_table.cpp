@@ -23,50 +23,63 @@ void match_opposites(const uint32_t *t, size_t nt, size_t nv, CornerTable &ct) {
     a = t[CornerTable::next(c)];
     b = t[CornerTable::prev(c)];
   };
-  for (uint32_t c = 0; c < nc; ++c) {
-    uint32_t a, b;
-    edge(c, a, b);
-    ++start[std::min(a, b) + 1];
+  // Corner c of face f faces the edge (t[next(c)], t[prev(c)]): for the corners of a face
+  // in turn, the edges (t1, t2), (t2, t0), (t0, t1).
+  for (size_t f = 0; f < nt; ++f) {
+    const uint32_t *v = &t[3 * f];
+    ++start[std::min(v[1], v[2]) + 1];
+    ++start[std::min(v[2], v[0]) + 1];
+    ++start[std::min(v[0], v[1]) + 1];
   }
   for (size_t v = 0; v < nv; ++v)
     start[v + 1] += start[v];
   std::vector<uint32_t> fill(start.begin(), start.end() - 1);
-  for (uint32_t c = 0; c < nc; ++c) {
-    uint32_t a, b;
-    edge(c, a, b);
-    order[fill[std::min(a, b)]++] = c;
+  for (size_t f = 0; f < nt; ++f) {
+    const uint32_t *v = &t[3 * f], c = static_cast<uint32_t>(3 * f);
+    order[fill[std::min(v[1], v[2])]++] = c;
+    order[fill[std::min(v[2], v[0])]++] = c + 1;
+    order[fill[std::min(v[0], v[1])]++] = c + 2;
   }
+  std::vector<uint32_t>().swap(fill);
   size_t nonmanifold = 0, flipped = 0;
   std::string nm_example, flip_example;
-  auto hi_of = [&](uint32_t c) {
-    uint32_t a, b;
-    edge(c, a, b);
-    return std::max(a, b);
+  // A bucket's corners with the other end of their edge, sorted by it. std::sort's moves
+  // depend only on its comparisons, so sorting (end, corner) pairs by the end gives the
+  // order sorting the corners by their edge's end does (ties too), one load a comparison.
+  struct Facing {
+    uint32_t hi, c;
   };
+  std::vector<Facing> bucket;
   for (size_t v = 0; v < nv; ++v) {
-    // Sort the bucket by the other end of the edge, then look at runs of one edge.
-    uint32_t *first = order.data() + start[v], *last = order.data() + start[v + 1];
-    std::sort(first, last, [&](uint32_t x, uint32_t y) { return hi_of(x) < hi_of(y); });
-    for (uint32_t *run = first; run != last;) {
-      uint32_t *end = run + 1;
-      while (end != last && hi_of(*end) == hi_of(*run))
+    bucket.clear();
+    for (uint32_t i = start[v]; i < start[v + 1]; ++i) {
+      uint32_t a, b;
+      edge(order[i], a, b);
+      bucket.push_back({std::max(a, b), order[i]});
+    }
+    std::sort(bucket.begin(), bucket.end(),
+              [](const Facing &x, const Facing &y) { return x.hi < y.hi; });
+    const Facing *first = bucket.data(), *last = first + bucket.size();
+    for (const Facing *run = first; run != last;) {
+      const Facing *end = run + 1;
+      while (end != last && end->hi == run->hi)
         ++end;
       uint32_t a, b;
-      edge(run[0], a, b);
+      edge(run[0].c, a, b);
       if (end - run > 2) {
         if (nonmanifold++ == 0)
           nm_example = "edge (" + std::to_string(a) + ", " + std::to_string(b) +
                        ") is shared by " + std::to_string(end - run) + " faces";
       } else if (end - run == 2) {
         uint32_t a2, b2;
-        edge(run[1], a2, b2);
+        edge(run[1].c, a2, b2);
         if (a2 == a) {
           if (flipped++ == 0)
             flip_example = "edge (" + std::to_string(a) + ", " + std::to_string(b) +
                            ") is used in the same direction by two faces";
         } else {
-          ct.O[run[0]] = run[1];
-          ct.O[run[1]] = run[0];
+          ct.O[run[0].c] = run[1].c;
+          ct.O[run[1].c] = run[0].c;
         }
       }
       run = end;
@@ -82,16 +95,28 @@ void match_opposites(const uint32_t *t, size_t nt, size_t nv, CornerTable &ct) {
                     " edges are used twice in the same direction; e.g. " + flip_example);
 }
 
+/// The faces of v's fan, counted as get_ring walks them (without storing the ring).
+uint32_t fan_faces(const CornerTable &ct, uint32_t v) {
+  const uint32_t start = ct.VC[v];
+  uint32_t faces = 0, c = start;
+  do {
+    ++faces;
+    c = ct.swing_ccw(c);
+  } while (c != kNone && c != start);
+  if (c == kNone) // a boundary vertex: the faces clockwise of start too
+    for (uint32_t b = ct.swing_cw(start); b != kNone; b = ct.swing_cw(b))
+      ++faces;
+  return faces;
+}
+
 // A manifold vertex has a single fan of faces: walking it must reach every face.
 void check_vertex_fans(const CornerTable &ct, const std::vector<uint32_t> &faces_at) {
   size_t bad = 0;
   uint32_t example = 0;
-  Ring ring;
   for (uint32_t v = 0; v < ct.vertex_count(); ++v) {
     if (ct.VC[v] == kNone)
       continue;
-    get_ring(ct, v, ring);
-    if (ring.faces() != faces_at[v] && bad++ == 0)
+    if (fan_faces(ct, v) != faces_at[v] && bad++ == 0)
       example = v;
   }
   if (bad)

@@ -1,7 +1,6 @@
 #include "mesh/reorder.h"
 
 #include <algorithm>
-#include <array>
 
 namespace pomar {
 namespace {
@@ -17,38 +16,84 @@ uint64_t spread3(uint64_t x) {
   return x;
 }
 
+struct Keyed {
+  uint64_t key;
+  uint32_t v;
+};
+
+/// Sort by (key, v) when the entries arrive by increasing v: a stable least-significant-
+/// digit radix sort on the key alone, 11 bits a pass, skipping the digits every key shares
+/// (a 12-bit grid gives 27-bit keys: 3 passes instead of 6).
+void sort_by_key(std::vector<Keyed> &a) {
+  constexpr int kBits = 11;
+  constexpr uint64_t kMask = (uint64_t(1) << kBits) - 1;
+  std::vector<Keyed> scratch(a.size());
+  std::vector<uint32_t> start(kMask + 2);
+  for (int shift = 0; shift < 64; shift += kBits) {
+    std::fill(start.begin(), start.end(), 0);
+    for (const Keyed &x : a)
+      ++start[((x.key >> shift) & kMask) + 1];
+    if (std::count(start.begin(), start.end(), uint32_t(a.size())) == 1)
+      continue; // one digit for all: the pass would not move anything
+    for (size_t d = 1; d < start.size(); ++d)
+      start[d] += start[d - 1];
+    for (const Keyed &x : a)
+      scratch[start[(x.key >> shift) & kMask]++] = x;
+    a.swap(scratch);
+  }
+}
+
+/// The order std::sort gives the faces `t` (renamed by old_to_new) when comparing them by
+/// their smallest vertex. std::sort's moves depend only on its comparisons' results, so
+/// sorting (smallest vertex, face) pairs with the same comparison gives the same order
+/// (ties included) while each comparison reads one number instead of six.
+std::vector<uint32_t> face_order(const std::vector<uint32_t> &t,
+                                 const std::vector<uint32_t> &old_to_new) {
+  struct Face {
+    uint32_t lowest, f;
+  };
+  const size_t nf = t.size() / 3;
+  std::vector<Face> faces(nf);
+  for (size_t f = 0; f < nf; ++f)
+    faces[f] = {
+        std::min({old_to_new[t[3 * f]], old_to_new[t[3 * f + 1]], old_to_new[t[3 * f + 2]]}),
+        static_cast<uint32_t>(f)};
+  std::sort(faces.begin(), faces.end(),
+            [](const Face &a, const Face &b) { return a.lowest < b.lowest; });
+  std::vector<uint32_t> order(nf);
+  for (size_t i = 0; i < nf; ++i)
+    order[i] = faces[i].f;
+  return order;
+}
+
 } // namespace
 
 std::vector<uint32_t> reorder_for_locality(std::vector<int32_t> &q,
                                            std::vector<uint32_t> &triangles) {
   const uint32_t nv = static_cast<uint32_t>(q.size() / 3);
   // Morton key from the top 21 bits of each coordinate (grids have at most 24 bits).
-  std::vector<std::pair<uint64_t, uint32_t>> key(nv);
+  std::vector<Keyed> key(nv);
   for (uint32_t v = 0; v < nv; ++v) {
     const uint64_t x = uint64_t(q[3 * v]) >> 3, y = uint64_t(q[3 * v + 1]) >> 3,
                    z = uint64_t(q[3 * v + 2]) >> 3;
     key[v] = {spread3(x) | spread3(y) << 1 | spread3(z) << 2, v};
   }
-  std::sort(key.begin(), key.end());
+  sort_by_key(key);
   std::vector<uint32_t> old_to_new(nv);
   std::vector<int32_t> nq(q.size());
   for (uint32_t i = 0; i < nv; ++i) {
-    const uint32_t v = key[i].second;
+    const uint32_t v = key[i].v;
     old_to_new[v] = i;
     std::copy(&q[3 * v], &q[3 * v] + 3, &nq[3 * i]);
   }
   q.swap(nq);
   // Faces: rename, then sort by their smallest vertex (rotation and orientation kept).
-  const size_t nf = triangles.size() / 3;
-  std::vector<std::array<uint32_t, 3>> faces(nf);
-  for (size_t f = 0; f < nf; ++f)
+  const std::vector<uint32_t> order = face_order(triangles, old_to_new);
+  std::vector<uint32_t> sorted(triangles.size());
+  for (size_t i = 0; i < order.size(); ++i)
     for (int k = 0; k < 3; ++k)
-      faces[f][k] = old_to_new[triangles[3 * f + k]];
-  std::sort(faces.begin(), faces.end(), [](const auto &a, const auto &b) {
-    return std::min({a[0], a[1], a[2]}) < std::min({b[0], b[1], b[2]});
-  });
-  for (size_t f = 0; f < nf; ++f)
-    std::copy(faces[f].begin(), faces[f].end(), &triangles[3 * f]);
+      sorted[3 * i + k] = old_to_new[triangles[3 * size_t(order[i]) + k]];
+  triangles.swap(sorted);
   return old_to_new;
 }
 
