@@ -36,8 +36,8 @@ inline void add_face_normal(const Spoke *spokes, uint32_t m, uint32_t k, int64_t
 
 /// Predict v_from for the split of `v_to` (at position `at`) with patch `p` of its ring,
 /// whose spokes (refine/patch.h) give the neighbours' offsets from v_to.
-inline void predict(const int32_t at[3], const Ring &ring, const Spoke *spokes,
-                    const PatchRange &p, Prediction &out) {
+inline void predict(const int32_t at[3], const Ring &ring, const Spoke *spokes, const PatchRange &p,
+                    Prediction &out) {
   const uint32_t m = ring.size();
   // Barycentre of v_to and the patch ring: sum = count * at + the spokes' offsets.
   int64_t sum[3] = {0, 0, 0};

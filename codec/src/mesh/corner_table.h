@@ -173,7 +173,8 @@ void get_named_ring(const CornerTable &ct, uint32_t v, const Name &name, Ring &r
 
 /// Fill `ring` with the one-ring of vertex v (empty if v has no face).
 inline void get_ring(const CornerTable &ct, uint32_t v, Ring &ring) {
-  get_named_ring(ct, v, [](uint32_t n) { return n; }, ring);
+  get_named_ring(
+      ct, v, [](uint32_t n) { return n; }, ring);
 }
 
 /// Build the corner table of `triangle_count` triangles over `vertex_count` vertices.

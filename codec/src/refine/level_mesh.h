@@ -40,9 +40,7 @@ struct LevelMesh {
   uint32_t vertex_count() const { return ct.vertex_count(); }
   uint32_t level_of(uint32_t v) const { return lineage[v].level; }
   uint32_t cluster_of(uint32_t v) const { return lineage[v].cluster; }
-  uint64_t key(uint32_t v) const {
-    return (uint64_t(lineage[v].cluster) << 32) | lineage[v].local;
-  }
+  uint64_t key(uint32_t v) const { return (uint64_t(lineage[v].cluster) << 32) | lineage[v].local; }
   void init_lineage() {
     lineage.assign(vertex_count(), Lineage{});
     for (uint32_t v = 0; v < vertex_count(); ++v)

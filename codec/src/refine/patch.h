@@ -94,7 +94,8 @@ uint32_t ranked_edge(const Ring &ring, const Spoke *spokes, uint32_t e, const Ke
       if (taken >> i & 1)
         continue;
       if (best == kNone || spokes[i].len2 > spokes[best].len2 ||
-          (spokes[i].len2 == spokes[best].len2 && key(ring.neighbour[i]) < key(ring.neighbour[best])))
+          (spokes[i].len2 == spokes[best].len2 &&
+           key(ring.neighbour[i]) < key(ring.neighbour[best])))
         best = i;
     }
     if (r == e)
