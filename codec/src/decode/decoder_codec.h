@@ -26,6 +26,9 @@ public:
     cluster_ = cluster;
   }
 
+  /// split_symbols does not read the ranked edges (code_vertex looks up the one s_e names).
+  static constexpr bool kSelectsSplitEdge = true;
+
   int split_flag(uint32_t, int context) { return conn_->decode_bit(m_->conn.sv[context]); }
 
   void split_symbols(uint32_t, const Ring &ring, const uint32_t *, SplitSymbols &s) {

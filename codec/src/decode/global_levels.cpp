@@ -27,9 +27,7 @@ Mesh to_mesh(LevelMesh &&lm, const Quantizer &grid) {
   // not add to the peak: opposite corners, corners of vertices, lineage, face claims.
   release(lm.ct.O);
   release(lm.ct.VC);
-  release(lm.tag);
-  release(lm.parent);
-  release(lm.local);
+  release(lm.lineage);
   release(lm.face_claim);
   Mesh out;
   out.positions = dequantize(grid, lm.q);

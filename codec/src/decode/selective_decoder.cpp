@@ -424,7 +424,7 @@ void SelectiveDecoder::update(const Progress &progress) {
   if (!s.clustered()) {
     // The progressive mesh's level is the highest level of any vertex.
     int have = 0;
-    for (const LevelMesh::Tag &t : s.mesh.tag)
+    for (const LevelMesh::Lineage &t : s.mesh.lineage)
       have = std::max(have, int(t.level));
     if (s.uniform_level < have) {
       s.mesh = s.snapshot;

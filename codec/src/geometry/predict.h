@@ -26,51 +26,45 @@ struct Prediction {
   int context;       // geometry model context (local edge length class)
 };
 
-/// Integer normal of face k of the ring (v, n_k, n_k+1).
-inline void add_face_normal(const std::vector<int32_t> &q, uint32_t v, const Ring &ring,
-                            uint32_t k, int64_t n[3]) {
-  const uint32_t a = ring.neighbour[k], b = ring.neighbour[(k + 1) % ring.size()];
-  int64_t u[3], w[3];
-  for (int i = 0; i < 3; ++i) {
-    u[i] = int64_t(q[3 * a + i]) - q[3 * v + i];
-    w[i] = int64_t(q[3 * b + i]) - q[3 * v + i];
-  }
+/// Integer normal of face k of the ring (v, n_k, n_k+1), from the spokes of v.
+inline void add_face_normal(const Spoke *spokes, uint32_t m, uint32_t k, int64_t n[3]) {
+  const int64_t *u = spokes[k].d, *w = spokes[(k + 1) % m].d;
   n[0] += u[1] * w[2] - u[2] * w[1];
   n[1] += u[2] * w[0] - u[0] * w[2];
   n[2] += u[0] * w[1] - u[1] * w[0];
 }
 
-/// Predict v_from for the split of `v_to` with patch `p` of its ring (positions `q`).
-inline void predict(const std::vector<int32_t> &q, uint32_t v_to, const Ring &ring,
-                    const PatchRange &p, Prediction &out) {
+/// Predict v_from for the split of `v_to` (at position `at`) with patch `p` of its ring,
+/// whose spokes (refine/patch.h) give the neighbours' offsets from v_to.
+inline void predict(const int32_t at[3], const Ring &ring, const Spoke *spokes, const PatchRange &p,
+                    Prediction &out) {
   const uint32_t m = ring.size();
-  int64_t sum[3] = {q[3 * v_to], q[3 * v_to + 1], q[3 * v_to + 2]};
+  // Barycentre of v_to and the patch ring: sum = count * at + the spokes' offsets.
+  int64_t sum[3] = {0, 0, 0};
   int64_t count = 1;
-  for (uint32_t t = 0, i = p.first_face; t <= p.faces; ++t, i = (i + 1) % m) {
-    const uint32_t n = ring.neighbour[i];
+  for (uint32_t t = 0, i = p.first_face; t <= p.faces; ++t, i = i + 1 == m ? 0 : i + 1) {
     for (int k = 0; k < 3; ++k)
-      sum[k] += q[3 * n + k];
+      sum[k] += spokes[i].d[k];
     ++count;
   }
-  for (int k = 0; k < 3; ++k) // round to nearest; sums are non-negative
+  for (int k = 0; k < 3; ++k) { // round to nearest; sums are non-negative
+    sum[k] += count * at[k];
     out.barycentre[k] = static_cast<int32_t>((2 * sum[k] + count) / (2 * count));
+  }
   int64_t normal[3] = {0, 0, 0};
   const uint32_t j = p.j;
   if (ring.closed || j < ring.faces())
-    add_face_normal(q, v_to, ring, j, normal);
+    add_face_normal(spokes, m, j, normal);
   if (ring.closed || j > 0)
-    add_face_normal(q, v_to, ring, (j + m - 1) % m, normal);
-  const uint32_t ref = ring.neighbour[j];
-  int64_t edge[3];
-  for (int k = 0; k < 3; ++k)
-    edge[k] = int64_t(q[3 * ref + k]) - q[3 * v_to + k];
+    add_face_normal(spokes, m, (j + m - 1) % m, normal);
+  const int64_t *edge = spokes[j].d;
   out.frame = make_frenet_frame(normal, edge);
-  out.context = geometry_context(edge[0] * edge[0] + edge[1] * edge[1] + edge[2] * edge[2]);
+  out.context = geometry_context(spokes[j].len2);
   // v_to's umbrella vector (integer mean, truncated), in the local frame.
   int64_t umbrella[3] = {0, 0, 0};
-  for (uint32_t n : ring.neighbour)
+  for (uint32_t i = 0; i < m; ++i)
     for (int k = 0; k < 3; ++k)
-      umbrella[k] += int64_t(q[3 * n + k]) - q[3 * v_to + k];
+      umbrella[k] += spokes[i].d[k];
   for (int k = 0; k < 3; ++k)
     umbrella[k] /= int64_t(m);
   to_local(out.frame, umbrella);

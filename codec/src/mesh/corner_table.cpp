@@ -7,43 +7,6 @@
 
 namespace pomar {
 
-void get_ring(const CornerTable &ct, uint32_t v, Ring &ring) {
-  ring.neighbour.clear();
-  ring.corner.clear();
-  ring.closed = true;
-  const uint32_t start = ct.VC[v];
-  if (start == kNone)
-    return;
-  // Walk counter-clockwise from any corner; an interior vertex comes back to it.
-  uint32_t c = start;
-  do {
-    ring.corner.push_back(c);
-    ring.neighbour.push_back(ct.V[CornerTable::next(c)]);
-    c = ct.swing_ccw(c);
-  } while (c != kNone && c != start);
-  if (c == start)
-    return;
-  // A boundary vertex: close the fan's last face, then prepend the faces clockwise of
-  // `start` up to the other end of the fan.
-  ring.closed = false;
-  ring.neighbour.push_back(ct.V[CornerTable::prev(ring.corner.back())]);
-  size_t before = 0;
-  for (uint32_t b = ct.swing_cw(start); b != kNone; b = ct.swing_cw(b)) {
-    ring.corner.push_back(b);
-    ++before;
-  }
-  if (before == 0)
-    return;
-  // Move the clockwise part (stored reversed at the back) to the front.
-  const size_t n = ring.corner.size() - before;
-  std::rotate(ring.corner.begin(), ring.corner.begin() + n, ring.corner.end());
-  std::reverse(ring.corner.begin(), ring.corner.begin() + before);
-  ring.neighbour.resize(ring.corner.size() + 1);
-  for (size_t i = 0; i < ring.corner.size(); ++i)
-    ring.neighbour[i] = ct.V[CornerTable::next(ring.corner[i])];
-  ring.neighbour.back() = ct.V[CornerTable::prev(ring.corner.back())];
-}
-
 namespace {
 
 std::string face_text(const uint32_t *t, size_t f) {

@@ -6,6 +6,7 @@
 // neighbours of v in counter-clockwise order go ... a, b ... .
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -43,16 +44,55 @@ struct CornerTable {
   }
 };
 
+/// The growable array of a Ring: storage that only grows (a ring reused vertex after
+/// vertex stops allocating once it has seen the largest fan) and a count. The walks that
+/// fill a ring write through `grow_to` + `data()` and set the count once (no per-element
+/// capacity bookkeeping); the rest reads it like a vector.
+class RingArray {
+public:
+  uint32_t size() const { return n_; }
+  bool empty() const { return n_ == 0; }
+  const uint32_t *begin() const { return buf_.data(); }
+  const uint32_t *end() const { return buf_.data() + n_; }
+  uint32_t *data() { return buf_.data(); }
+  const uint32_t *data() const { return buf_.data(); }
+  uint32_t operator[](size_t i) const { return buf_[i]; }
+  uint32_t &operator[](size_t i) { return buf_[i]; }
+  uint32_t back() const { return buf_[n_ - 1]; }
+  void clear() { n_ = 0; }
+  void pop_back() { --n_; }
+  void push_back(uint32_t x) {
+    grow_to(n_ + 1);
+    buf_[n_++] = x;
+  }
+  /// Room for at least `n` elements (the count is unchanged); returns the storage.
+  uint32_t *grow_to(size_t n) {
+    if (n > buf_.size())
+      buf_.resize(std::max<size_t>(2 * buf_.size(), std::max<size_t>(n, 32)));
+    return buf_.data();
+  }
+  /// Set the count (elements past the old count must have been written).
+  void resize(uint32_t n) {
+    grow_to(n);
+    n_ = n;
+  }
+  size_t capacity() const { return buf_.size(); }
+
+private:
+  std::vector<uint32_t> buf_;
+  uint32_t n_ = 0;
+};
+
 /// The one-ring of a vertex in counter-clockwise order. For a closed ring there are as
 /// many faces as neighbours; an open ring (boundary vertex) has one face less and a gap
 /// between its last and first neighbour. corner[i] is the corner of the vertex in the
 /// face (v, neighbour[i], neighbour[i+1]).
 struct Ring {
-  std::vector<uint32_t> neighbour;
-  std::vector<uint32_t> corner;
+  RingArray neighbour;
+  RingArray corner;
   bool closed = true;
-  uint32_t size() const { return static_cast<uint32_t>(neighbour.size()); }
-  uint32_t faces() const { return static_cast<uint32_t>(corner.size()); }
+  uint32_t size() const { return neighbour.size(); }
+  uint32_t faces() const { return corner.size(); }
   int index_of(uint32_t v) const {
     for (uint32_t i = 0; i < neighbour.size(); ++i)
       if (neighbour[i] == v)
@@ -61,8 +101,81 @@ struct Ring {
   }
 };
 
+/// One counter-clockwise walk round a fan from its corner `first`, in one pass: each face
+/// (corner c) gives its corner and the name of its second neighbour V[prev(c)], through
+/// `name` (the vertex itself for the mesh; the level-(l-1) view maps new vertices to
+/// their parents, refine/level_traversal.h). A face whose two neighbours get one name is
+/// left out. Returns false if the walk ran into the fan's boundary: the ring is whole
+/// only if `first` was the fan's clockwise end.
+template <class Name>
+bool walk_fan(const CornerTable &ct, uint32_t first, const Name &name, Ring &ring) {
+  const uint32_t *V = ct.V.data(), *O = ct.O.data(); // (locals: the stores below are
+  uint32_t *corner = ring.corner.grow_to(32);        //  uint32_t too and could alias)
+  uint32_t *neighbour = ring.neighbour.grow_to(ring.corner.capacity() + 1);
+  const uint32_t room = static_cast<uint32_t>(ring.corner.capacity());
+  uint32_t before = name(V[CornerTable::next(first)]);
+  neighbour[0] = before;
+  uint32_t kept = 0; // faces kept; neighbour[0..kept] are named
+  bool closed = true;
+  // Face c = (v, a, b) of the fan gives corner c and neighbour b; the next face is the one
+  // across edge (v, b): corner next(o) for o = O[next(c)], and its b is V[prev(next(o))]
+  // = V[o]. So each step takes one `% 3`, of o.
+  uint32_t c = first, b = V[CornerTable::prev(first)], o = O[CornerTable::next(first)];
+  for (;;) {
+    if (kept == room) { // a fan larger than any seen so far: walk it again with room
+      ring.corner.grow_to(room + 1);
+      return walk_fan(ct, first, name, ring);
+    }
+    const uint32_t after = name(b);
+    if (after != before) {
+      corner[kept++] = c;
+      neighbour[kept] = after;
+    }
+    before = after;
+    if (o == kNone) {
+      closed = false;
+      break;
+    }
+    const uint32_t k = o % 3;
+    c = k == 2 ? o - 2 : o + 1; // next(o)
+    if (c == first)
+      break;
+    b = V[o];
+    o = O[k == 0 ? o + 2 : o - 1]; // O[next(c)] = O[prev(o)]
+  }
+  ring.corner.resize(kept);
+  // (a closed fan's wrap-around repeats the first neighbour)
+  ring.neighbour.resize(closed && kept > 0 ? kept : kept + 1);
+  ring.closed = closed;
+  return closed;
+}
+
+/// The one-ring of vertex v with neighbours named by `name` (see walk_fan); empty if v
+/// has no face. A closed fan is walked once from VC[v]; an open one from its clockwise
+/// end, found by swinging clockwise once the first walk met the boundary.
+template <class Name>
+void get_named_ring(const CornerTable &ct, uint32_t v, const Name &name, Ring &ring) {
+  const uint32_t start = ct.VC[v];
+  if (start == kNone) {
+    ring.neighbour.clear();
+    ring.corner.clear();
+    ring.closed = true;
+    return;
+  }
+  if (walk_fan(ct, start, name, ring))
+    return;
+  uint32_t first = start;
+  for (uint32_t b = ct.swing_cw(start); b != kNone; b = ct.swing_cw(b))
+    first = b;
+  if (first != start)
+    walk_fan(ct, first, name, ring);
+}
+
 /// Fill `ring` with the one-ring of vertex v (empty if v has no face).
-void get_ring(const CornerTable &ct, uint32_t v, Ring &ring);
+inline void get_ring(const CornerTable &ct, uint32_t v, Ring &ring) {
+  get_named_ring(
+      ct, v, [](uint32_t n) { return n; }, ring);
+}
 
 /// Build the corner table of `triangle_count` triangles over `vertex_count` vertices.
 /// Throws pomar::Error naming the problem (with counts and one example) when the mesh is

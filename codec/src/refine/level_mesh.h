@@ -13,17 +13,20 @@ struct LevelMesh {
   CornerTable ct;
   std::vector<int32_t> q;  // quantized xyz per vertex
   uint32_t seed_faces = 0; // faces of the base mesh (traversal seeds, never removed)
-  // Lineage of every vertex: the level that created it (0 = base mesh), its cluster
-  // (clustered levels: the base clustered mesh vertex it descends from), its parent (the
-  // v_to it was split from; itself for base vertices) and its rank of creation inside its
-  // cluster. (cluster, local) names a vertex the same way whatever clusters were decoded
-  // in whatever order. Level and cluster share a cache line: the walks read both.
-  struct Tag {
+  // Lineage of every vertex, one record per vertex (the walks read its fields together:
+  // the view reads level and parent, a cluster's walk cluster and local): the level that
+  // created it (0 = base mesh), its cluster (clustered levels: the base clustered mesh
+  // vertex it descends from), its parent (the v_to it was split from; itself for base
+  // vertices) and its rank of creation inside its cluster (0 before the clustered
+  // levels). (cluster, local) names a vertex the same way whatever clusters were decoded
+  // in whatever order.
+  struct Lineage {
     uint32_t cluster = 0;
+    uint32_t parent = 0;
+    uint32_t local = 0;
     uint16_t level = 0;
   };
-  std::vector<Tag> tag;
-  std::vector<uint32_t> parent, local;
+  std::vector<Lineage> lineage;
   std::vector<uint16_t> face_claim; // per face: last level whose patch held it
   // Per-vertex attributes (attributes/): `attr_codes` integer codes per vertex, each in
   // [attr_lo[k], attr_hi[k]]; a split vertex's codes are coded after its position.
@@ -35,14 +38,13 @@ struct LevelMesh {
   int normal_code = -1; // first code of a quantized normal attribute (-1: none)
   int normal_bits = 0;  // its octahedral bits
   uint32_t vertex_count() const { return ct.vertex_count(); }
-  uint32_t level_of(uint32_t v) const { return tag[v].level; }
-  uint32_t cluster_of(uint32_t v) const { return tag[v].cluster; }
-  uint64_t key(uint32_t v) const { return (uint64_t(tag[v].cluster) << 32) | local[v]; }
+  uint32_t level_of(uint32_t v) const { return lineage[v].level; }
+  uint32_t cluster_of(uint32_t v) const { return lineage[v].cluster; }
+  uint64_t key(uint32_t v) const { return (uint64_t(lineage[v].cluster) << 32) | lineage[v].local; }
   void init_lineage() {
-    tag.assign(vertex_count(), Tag{});
-    parent.resize(vertex_count());
+    lineage.assign(vertex_count(), Lineage{});
     for (uint32_t v = 0; v < vertex_count(); ++v)
-      parent[v] = v;
+      lineage[v].parent = v;
     face_claim.assign(ct.face_count(), 0);
   }
   /// Room for the counts a decode will reach (from the level table), so that applying the
@@ -61,18 +63,16 @@ struct LevelMesh {
     ct.VC.reserve(vertices);
     q.reserve(3 * vertices);
     attr.reserve(attr_codes * vertices);
-    tag.reserve(vertices);
-    parent.reserve(vertices);
-    if (!local.empty())
-      local.reserve(vertices);
+    lineage.reserve(vertices);
     face_claim.reserve(faces);
   }
   /// Make the current mesh the base clustered mesh (paper section 5.2): each vertex
   /// roots the cluster with its id; vertices created later inherit their v_to's cluster.
   void root_clusters() {
-    local.assign(vertex_count(), 0);
-    for (uint32_t c = 0; c < vertex_count(); ++c)
-      tag[c].cluster = c;
+    for (uint32_t c = 0; c < vertex_count(); ++c) {
+      lineage[c].cluster = c;
+      lineage[c].local = 0;
+    }
   }
 };
 

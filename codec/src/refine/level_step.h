@@ -5,7 +5,7 @@
 //
 // 1. traverse: a global level walks the whole mesh (traverse_level), a clustered level one
 //    cluster on the level-(l-1) view (traverse_cluster); the Codec policy codes or reads
-//    s_v, the split symbols and, per split vertex, the data of v_from (NewVertex);
+//    s_v, the split symbols and, per split vertex, the data of v_from (SplitList);
 // 2. check: the caller's check sees the counts the mesh will have and may throw (a stream
 //    that ended early, a level table that disagrees);
 // 3. apply: the splits are applied in the order they were coded; the i-th split coded
@@ -25,6 +25,7 @@
 // the vertex numbering and the errors of cluster_level called in cluster order.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <exception>
 #include <vector>
@@ -53,7 +54,7 @@ struct NoCheck {
 
 /// A cluster traversed but not yet applied (traverse_cluster_level -> apply_cluster_level).
 struct TraversedCluster {
-  std::vector<PendingSplit> splits;
+  SplitList splits;
   std::vector<uint32_t> claims; // the faces its patches hold, in claim order
   std::exception_ptr error;     // what its traversal or check threw (nothing to apply)
 };
@@ -128,7 +129,7 @@ private:
     try {
       traverse();
       StepCounts n{mesh.vertex_count() + splits_.size(), mesh.ct.face_count()};
-      for (const PendingSplit &ps : splits_)
+      for (const PendingSplit &ps : splits_.split)
         n.faces += uint64_t(ps.op.has_l) + uint64_t(ps.op.has_r);
       check(n);
     } catch (...) {
@@ -146,25 +147,39 @@ private:
         mesh.face_claim[f] = static_cast<uint16_t>(level - 1);
   }
 
-  /// Apply the splits in traversal order; new vertices get consecutive ids. A cluster's
-  /// new vertices are numbered inside the cluster by `next_local`.
-  static void apply_splits(LevelMesh &mesh, const std::vector<PendingSplit> &splits, uint32_t level,
+  /// Apply the splits in traversal order; new vertices get consecutive ids, new faces
+  /// too. A cluster's new vertices are numbered inside the cluster by `next_local`. The
+  /// arrays are sized once for the whole step, each split writes its entries in place.
+  static void apply_splits(LevelMesh &mesh, const SplitList &splits, uint32_t level,
                            uint32_t cluster, uint32_t *next_local) {
-    for (const PendingSplit &ps : splits) {
-      const uint32_t v_from = mesh.vertex_count();
-      apply_split(mesh.ct, ps.op, v_from);
-      mesh.q.insert(mesh.q.end(), ps.v_from.position, ps.v_from.position + 3);
-      mesh.attr.insert(mesh.attr.end(), ps.v_from.attr, ps.v_from.attr + mesh.attr_codes);
-      mesh.tag.push_back({cluster, static_cast<uint16_t>(level)});
-      mesh.parent.push_back(ps.op.v_to);
-      if (next_local)
-        mesh.local.push_back((*next_local)++);
+    CornerTable &ct = mesh.ct;
+    const uint32_t v0 = mesh.vertex_count(), n = static_cast<uint32_t>(splits.size());
+    uint32_t face = ct.face_count(), new_faces = 0;
+    for (const PendingSplit &ps : splits.split)
+      new_faces += uint32_t(ps.op.has_l) + uint32_t(ps.op.has_r);
+    const size_t vertices = size_t(v0) + n, faces = size_t(face) + new_faces;
+    ct.V.resize(3 * faces);
+    ct.O.resize(3 * faces);
+    ct.VC.resize(vertices);
+    mesh.q.resize(3 * vertices);
+    mesh.attr.resize(mesh.attr_codes * vertices);
+    mesh.lineage.resize(vertices);
+    mesh.face_claim.resize(faces, 0);
+    const uint32_t codes = mesh.attr_codes;
+    for (uint32_t i = 0; i < n; ++i) {
+      const PendingSplit &ps = splits.split[i];
+      const uint32_t v_from = v0 + i;
+      face += apply_split(ct, ps.op, v_from, face);
+      std::copy(ps.position, ps.position + 3, &mesh.q[3 * size_t(v_from)]);
+      const int64_t *codes_i = splits.attr.data() + size_t(i) * codes;
+      std::copy(codes_i, codes_i + codes, mesh.attr.data() + size_t(v_from) * codes);
+      mesh.lineage[v_from] = {cluster, ps.op.v_to, next_local ? (*next_local)++ : 0,
+                              static_cast<uint16_t>(level)};
     }
-    mesh.face_claim.resize(mesh.ct.face_count(), 0);
   }
 
   TraversalScratch scratch_;
-  std::vector<PendingSplit> splits_;
+  SplitList splits_;
 };
 
 } // namespace pomar

@@ -13,6 +13,7 @@
 //   int  split_flag(uint32_t v, int context);
 //   void split_symbols(uint32_t v, const Ring& ring, const uint32_t* ranked,
 //                      SplitSymbols& s);      // ranked = ring indices, longest edge first
+//                                     (nullptr if Codec::kSelectsSplitEdge: see code_vertex)
 //   void geometry(uint32_t v_to, const Prediction& prediction, int32_t position[3]);
 //                                     // prediction: geometry/predict.h
 //   void attributes(const LevelMesh& mesh, const int64_t* prediction, int64_t* codes); // if any
@@ -38,18 +39,29 @@
 namespace pomar {
 
 /// What is coded per split vertex besides the split itself: the data of the new vertex
-/// v_from. code_vertex codes it (Codec::geometry), apply_splits (level_step.h) stores it
-/// with the new vertex. A per-vertex attribute adds its field here, its coding next to
-/// Codec::geometry and its storage next to LevelMesh::q.
+/// v_from. code_vertex codes it (Codec::geometry, Codec::attributes), apply_splits
+/// (level_step.h) stores it with the new vertex: the position in PendingSplit, the
+/// attribute codes (LevelMesh::attr_codes per split, often none) beside, in
+/// SplitList::attr, so that a split takes 28 bytes whatever the attributes.
 constexpr uint32_t kMaxAttributeCodes = 16; // integer codes of all attributes of a vertex
-struct NewVertex {
-  int32_t position[3];               // quantized xyz
-  int64_t attr[kMaxAttributeCodes]; // attribute codes (LevelMesh::attr_codes of them)
-};
-
 struct PendingSplit {
   SplitOp op;
-  NewVertex v_from;
+  int32_t position[3]; // v_from's, quantized
+};
+
+/// The splits of one step, in the order they were coded.
+struct SplitList {
+  std::vector<PendingSplit> split;
+  std::vector<int64_t> attr; // split i's attribute codes: [i * attr_codes, (i + 1) * attr_codes)
+  size_t size() const { return split.size(); }
+  void clear() {
+    split.clear();
+    attr.clear();
+  }
+  void swap(SplitList &other) {
+    split.swap(other.split);
+    attr.swap(other.attr);
+  }
 };
 
 /// Per-vertex and per-face marks of one traversal (level stamps, reused across levels).
@@ -66,8 +78,8 @@ struct TraversalScratch {
   bool defer_claims = false;
   std::vector<std::pair<uint32_t, uint32_t>> queue; // (vertex, came from)
   Ring ring;
-  std::vector<uint32_t> ranked;
-  std::vector<int64_t> len2;
+  std::vector<Spoke> spokes;    // of the split vertex being coded
+  std::vector<uint32_t> ranked; // its ring's edges, longest first
   void begin(uint32_t vertices, uint32_t faces) {
     if (marks.size() < vertices)
       marks.resize(vertices);
@@ -78,17 +90,15 @@ struct TraversalScratch {
     claims.clear();
   }
   bool queued(uint32_t v) const { return marks[v].queued == stamp; }
-  bool split(uint32_t v) const { return marks[v].split == stamp; }
 };
 
 /// s_v context from what the decoder already knows at v: how many of v's faces earlier
 /// patches of this level hold (0..3+), how many neighbours were split (0..2+), and v's
 /// valence (<=5, 6, 7, 8+: a v_to gained the valence of the vertex it absorbed).
 /// Returns -1 when every face is held: v cannot be split, s_v is not coded at all.
-inline int sv_context(const TraversalScratch &s, const Ring &ring) {
-  uint32_t split_neighbours = 0;
-  for (uint32_t n : ring.neighbour)
-    split_neighbours += s.split(n);
+/// `split_neighbours` counts the ring's entries split earlier in this traversal
+/// (queue_neighbours counts them).
+inline int sv_context(const TraversalScratch &s, const Ring &ring, uint32_t split_neighbours) {
   // Every patch face contains its v_to: without a split neighbour no face is held.
   uint32_t claimed = 0;
   if (split_neighbours) {
@@ -115,62 +125,22 @@ struct LevelView {
 /// their parents, and the faces those splits added (degenerate in the view) are skipped.
 /// The view is the same whatever clusters were decoded before, which is what makes
 /// selective and incremental decoding equal to a full decode.
-inline uint32_t view_of(const LevelMesh &mesh, uint32_t v, const LevelView &view) {
+inline uint32_t view_of(const LevelMesh::Lineage *lineage, uint32_t v, const LevelView &view) {
   if (v < view.older_than)
     return v;
-  while (mesh.tag[v].level >= view.level && mesh.parent[v] != v)
-    v = mesh.parent[v];
+  while (lineage[v].level >= view.level && lineage[v].parent != v)
+    v = lineage[v].parent;
   return v;
 }
 
-/// Like get_ring, mapping neighbours through view_of and skipping the faces that collapse
-/// in the view. One walk round the fan collects its corners (counter-clockwise from the
-/// fan's clockwise end); one pass over them maps the neighbours and keeps, in place, the
-/// corners of the faces the view does not skip.
+/// Like get_ring, naming the neighbours through view_of: the faces that collapse in the
+/// view (two neighbours with one name) are left out.
 inline void get_view_ring(const LevelMesh &mesh, uint32_t v, const LevelView &level, Ring &view) {
-  const CornerTable &ct = mesh.ct;
-  std::vector<uint32_t> &corner = view.corner;
-  view.neighbour.clear();
-  corner.clear();
-  view.closed = true;
-  const uint32_t start = ct.VC[v];
-  if (start == kNone)
-    return;
-  uint32_t c = start;
-  do {
-    corner.push_back(c);
-    const uint32_t o = ct.O[CornerTable::next(c)];
-    if (o == kNone) {
-      view.closed = false;
-      break;
-    }
-    c = CornerTable::next(o);
-  } while (c != start);
-  if (!view.closed) { // open fan: the corners clockwise of `start` go first
-    const size_t after = corner.size();
-    for (uint32_t b = ct.swing_cw(start); b != kNone; b = ct.swing_cw(b))
-      corner.push_back(b);
-    if (corner.size() > after) {
-      std::rotate(corner.begin(), corner.begin() + after, corner.end());
-      std::reverse(corner.begin(), corner.begin() + (corner.size() - after));
-    }
-  }
-  const size_t n = corner.size();
-  uint32_t prev = view_of(mesh, ct.V[CornerTable::next(corner[0])], level);
-  view.neighbour.push_back(prev);
-  size_t kept = 0;
-  for (size_t i = 0; i < n; ++i) {
-    const uint32_t ci = corner[i];
-    const uint32_t next = view_of(mesh, ct.V[CornerTable::prev(ci)], level);
-    if (next != prev) {
-      corner[kept++] = ci;
-      view.neighbour.push_back(next);
-    }
-    prev = next;
-  }
-  corner.resize(kept);
-  if (view.closed && view.neighbour.size() > 1)
-    view.neighbour.pop_back(); // the wrap-around repeats the first neighbour
+  // (What view_of reads, copied: kept in registers through the walk.)
+  const auto name = [lineage = mesh.lineage.data(), level](uint32_t n) {
+    return view_of(lineage, n, level);
+  };
+  get_named_ring(mesh.ct, v, name, view);
 }
 
 /// Prediction of v_from's attribute codes: v_to's codes, except a quantized normal, which is
@@ -226,25 +196,46 @@ struct SkipsAttributes<Codec,
                        std::void_t<decltype(std::declval<Codec &>().skip_attributes(0u))>>
     : std::true_type {};
 
+/// Whether a Codec's split_symbols ignores the ranked edges (the decoder: it reads s_e and
+/// code_vertex then looks up that one edge, ranked_edge, instead of sorting them all).
+template <class Codec, class = void> struct SelectsSplitEdge : std::false_type {};
+template <class Codec>
+struct SelectsSplitEdge<Codec, std::enable_if_t<Codec::kSelectsSplitEdge>> : std::true_type {};
+
 /// Code (or decode) s_v at v and, for a split vertex, the split: symbols, patch, claim of
 /// its faces, prediction and position. `ring` is v's ring as the level sees it.
 template <class Codec, class Key>
 void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v, const Ring &ring,
-                 uint32_t level, const Key &key, std::vector<PendingSplit> &splits) {
-  const int context = sv_context(s, ring);
+                 uint32_t level, const Key &key, uint32_t split_neighbours, SplitList &splits) {
+  const int context = sv_context(s, ring, split_neighbours);
   if (context < 0 || !codec.split_flag(v, context))
     return;
   s.marks[v].split = s.stamp;
-  rank_edges(mesh, v, ring, s.ranked, s.len2, key);
+  load_spokes(mesh.q, v, ring, s.spokes);
   SplitSymbols sym;
-  codec.split_symbols(v, ring, s.ranked.data(), sym);
+  uint32_t j = kNone; // the ring index of edge v_to-v_ref (rank s_e)
+  if constexpr (SelectsSplitEdge<Codec>::value) {
+    codec.split_symbols(v, ring, nullptr, sym);
+    if (sym.s_e < ring.size() && ring.size() <= 16)
+      j = ranked_edge(ring, s.spokes.data(), sym.s_e, key);
+    else if (sym.s_e < ring.size()) {
+      rank_edges(ring, s.spokes.data(), s.ranked, key);
+      j = s.ranked[sym.s_e];
+    }
+  } else {
+    rank_edges(ring, s.spokes.data(), s.ranked, key);
+    codec.split_symbols(v, ring, s.ranked.data(), sym);
+    if (sym.s_e < ring.size())
+      j = s.ranked[sym.s_e];
+  }
   PatchRange p;
-  if (!resolve_patch(ring, s.ranked.data(), sym, p))
+  if (!resolve_patch(ring, j, sym, p))
     codec.corrupt("split symbols do not fit the vertex's neighbourhood");
   // Patches of one level must not share faces (that is what makes the splits
   // independent); a stream that says otherwise is damaged.
-  for (uint32_t t = 0; t < p.faces; ++t) {
-    const uint32_t f = ring.corner[(p.first_face + t) % ring.size()] / 3;
+  const uint32_t m = ring.size();
+  for (uint32_t t = 0, i = p.first_face; t < p.faces; ++t, i = i + 1 == m ? 0 : i + 1) {
+    const uint32_t f = ring.corner[i] / 3;
     if (mesh.face_claim[f] == level || s.claimed[f] == s.stamp)
       codec.corrupt(kSharedFace);
     if (!s.defer_claims)
@@ -255,63 +246,93 @@ void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v,
   // The split walks the patch faces counter-clockwise in the actual mesh: they must be the
   // ring's faces (true for valid data; a damaged stream could point across a boundary or a
   // face the view skipped).
-  for (uint32_t t = 0, c = ring.corner[p.first_face]; t < p.faces; ++t) {
-    if (c != ring.corner[(p.first_face + t) % ring.size()])
+  for (uint32_t t = 0, i = p.first_face, c = ring.corner[i]; t < p.faces;
+       ++t, i = i + 1 == m ? 0 : i + 1) {
+    if (c != ring.corner[i])
       codec.corrupt("a vertex split does not match the mesh");
     c = mesh.ct.swing_ccw(c);
   }
   PendingSplit ps;
   ps.op = {v, ring.corner[p.first_face], p.faces, p.il != kNone, p.ir != kNone};
   Prediction prediction;
-  predict(mesh.q, v, ring, p, prediction);
-  codec.geometry(v, prediction, ps.v_from.position);
+  predict(&mesh.q[3 * size_t(v)], ring, s.spokes.data(), p, prediction);
+  codec.geometry(v, prediction, ps.position);
   if (mesh.attr_codes) {
-    int64_t pred[kMaxAttributeCodes];
-    predict_attributes(mesh, v, ring, p, ps.v_from.position, pred);
-    codec.attributes(mesh, pred, ps.v_from.attr);
+    int64_t pred[kMaxAttributeCodes], codes[kMaxAttributeCodes];
+    predict_attributes(mesh, v, ring, p, ps.position, pred);
+    codec.attributes(mesh, pred, codes);
+    splits.attr.insert(splits.attr.end(), codes, codes + mesh.attr_codes);
   } else if constexpr (SkipsAttributes<Codec>::value) {
     if (mesh.attr_skipped)
       codec.skip_attributes(mesh.attr_skipped);
   }
-  splits.push_back(ps);
+  splits.split.push_back(ps);
 }
 
-/// Queue v's neighbours clockwise, starting with the one back to `from`.
+/// Queue v's neighbours clockwise, starting with the one back to `from`; returns how many
+/// of them were split earlier in this traversal (for sv_context: one pass over the ring's
+/// marks; v's own coding, which follows, changes neither the queue nor those marks).
 template <class Accept>
-void queue_neighbours(TraversalScratch &s, uint32_t v, uint32_t from, const Ring &ring,
-                      const Accept &accept) {
-  const uint32_t m = ring.size();
-  int start = ring.index_of(from);
-  if (start < 0)
-    start = 0;
-  for (uint32_t t = 0; t < m; ++t) {
-    const uint32_t n = ring.neighbour[(uint32_t(start) + m - t) % m];
-    if (!s.queued(n) && accept(n)) {
-      s.marks[n].queued = s.stamp;
+uint32_t queue_neighbours(TraversalScratch &s, uint32_t v, uint32_t from, const Ring &ring,
+                          const Accept &accept) {
+  const uint32_t m = ring.size(), stamp = s.stamp; // (a local: the mark stores could alias it)
+  if (m == 0)
+    return 0;
+  const int at = ring.index_of(from);
+  const uint32_t start = at < 0 ? 0 : uint32_t(at);
+  uint32_t split = 0;
+  const auto visit = [&](uint32_t n) {
+    TraversalScratch::VertexMarks &marks = s.marks[n];
+    split += marks.split == stamp;
+    if (marks.queued != stamp && accept(n)) {
+      marks.queued = stamp;
       s.queue.emplace_back(n, v);
     }
-  }
+  };
+  // Clockwise: start, start - 1, ..., 0, then m - 1, ..., start + 1.
+  for (uint32_t i = start + 1; i-- > 0;)
+    visit(ring.neighbour[i]);
+  for (uint32_t i = m; i-- > start + 1;)
+    visit(ring.neighbour[i]);
+  return split;
 }
 
-/// The walks are memory bound: fetch the corners of the vertex 8 places ahead in the
-/// queue, and the corner reference of the one 16 places ahead.
+/// The walks are memory bound: fetch the corner reference of the vertex 16 places ahead in
+/// the queue, the corners of its first face 8 places ahead, and 4 places ahead the two
+/// faces next to that one in its fan (their O entries have arrived by then).
 inline void prefetch_ahead(const LevelMesh &mesh, const TraversalScratch &s, size_t head) {
-  if (head + 8 < s.queue.size()) {
-    const uint32_t ahead = mesh.ct.VC[s.queue[head + 8].first];
-    if (ahead != kNone) {
-      __builtin_prefetch(&mesh.ct.O[ahead]);
-      __builtin_prefetch(&mesh.ct.V[ahead]);
+  const CornerTable &ct = mesh.ct;
+  const size_t n = s.queue.size();
+  if (head + 4 < n) {
+    const uint32_t c = ct.VC[s.queue[head + 4].first];
+    if (c != kNone) {
+      const uint32_t a = ct.O[CornerTable::next(c)], b = ct.O[CornerTable::prev(c)];
+      if (a != kNone) {
+        __builtin_prefetch(&ct.O[a]);
+        __builtin_prefetch(&ct.V[a]);
+      }
+      if (b != kNone) {
+        __builtin_prefetch(&ct.O[b]);
+        __builtin_prefetch(&ct.V[b]);
+      }
     }
   }
-  if (head + 16 < s.queue.size())
-    __builtin_prefetch(&mesh.ct.VC[s.queue[head + 16].first]);
+  if (head + 8 < n) {
+    const uint32_t ahead = ct.VC[s.queue[head + 8].first];
+    if (ahead != kNone) {
+      __builtin_prefetch(&ct.O[ahead]);
+      __builtin_prefetch(&ct.V[ahead]);
+    }
+  }
+  if (head + 16 < n)
+    __builtin_prefetch(&ct.VC[s.queue[head + 16].first]);
 }
 
 /// Traverse the whole mesh once for global level `level` (all components, seeded by the
 /// base faces in order), appending the splits to `splits`. `s` is begun by the caller.
 template <class Codec>
 void traverse_level(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t level,
-                    std::vector<PendingSplit> &splits) {
+                    SplitList &splits) {
   const auto id = [](uint32_t v) { return uint64_t(v); };
   const auto all = [](uint32_t) { return true; };
   size_t head = 0;
@@ -325,8 +346,8 @@ void traverse_level(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t
       prefetch_ahead(mesh, s, head);
       const auto [v, from] = s.queue[head++];
       get_ring(mesh.ct, v, s.ring);
-      code_vertex(mesh, codec, s, v, s.ring, level, id, splits);
-      queue_neighbours(s, v, from, s.ring, all);
+      const uint32_t split = queue_neighbours(s, v, from, s.ring, all);
+      code_vertex(mesh, codec, s, v, s.ring, level, id, split, splits);
     }
   }
 }
@@ -338,10 +359,10 @@ void traverse_level(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t
 /// caller.
 template <class Codec>
 void traverse_cluster(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t root,
-                      const LevelView &level, std::vector<PendingSplit> &splits) {
+                      const LevelView &level, SplitList &splits) {
   const uint32_t cluster = mesh.cluster_of(root);
   const auto key = [&](uint32_t v) { return mesh.key(v); };
-  const auto mine = [&](uint32_t v) { return mesh.tag[v].cluster == cluster; };
+  const auto mine = [&](uint32_t v) { return mesh.lineage[v].cluster == cluster; };
   get_view_ring(mesh, root, level, s.ring);
   if (s.ring.neighbour.empty())
     return;
@@ -355,8 +376,8 @@ void traverse_cluster(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32
     prefetch_ahead(mesh, s, head);
     const auto [v, came_from] = s.queue[head++];
     get_view_ring(mesh, v, level, s.ring);
-    code_vertex(mesh, codec, s, v, s.ring, level.level, key, splits);
-    queue_neighbours(s, v, came_from, s.ring, mine);
+    const uint32_t split = queue_neighbours(s, v, came_from, s.ring, mine);
+    code_vertex(mesh, codec, s, v, s.ring, level.level, key, split, splits);
   }
 }
 

@@ -23,50 +23,94 @@ struct PatchRange {
   uint32_t first_face, faces;
 };
 
-inline int64_t squared_distance(const std::vector<int32_t> &q, uint32_t a, uint32_t b) {
-  const int64_t dx = q[3 * a] - q[3 * b], dy = q[3 * a + 1] - q[3 * b + 1],
-                dz = q[3 * a + 2] - q[3 * b + 2];
-  return dx * dx + dy * dy + dz * dz;
+/// The edge from a split vertex v to neighbour[i] of its ring: the neighbour's offset
+/// from v and the edge's squared length. Loaded once per split (load_spokes) for the edge
+/// ranking and the prediction (geometry/predict.h), which read the ring's positions only
+/// through them.
+struct Spoke {
+  int64_t d[3];
+  int64_t len2;
+};
+
+/// spokes[0..ring.size()) for vertex v (grown as needed, never shrunk).
+inline void load_spokes(const std::vector<int32_t> &q, uint32_t v, const Ring &ring,
+                        std::vector<Spoke> &spokes) {
+  const uint32_t m = ring.size();
+  if (spokes.size() < m)
+    spokes.resize(m);
+  const int32_t *at = &q[3 * size_t(v)];
+  for (uint32_t i = 0; i < m; ++i) {
+    const int32_t *n = &q[3 * size_t(ring.neighbour[i])];
+    Spoke &s = spokes[i];
+    for (int k = 0; k < 3; ++k)
+      s.d[k] = int64_t(n[k]) - at[k];
+    s.len2 = s.d[0] * s.d[0] + s.d[1] * s.d[1] + s.d[2] * s.d[2];
+  }
 }
 
-/// Ring indices sorted by decreasing edge length (ties: smaller key first).
+/// Ring indices sorted by decreasing edge length (ties: smaller key first) into
+/// ranked[0..ring.size()) (grown as needed, never shrunk).
 template <class Key>
-void rank_edges(const LevelMesh &mesh, uint32_t v, const Ring &ring, std::vector<uint32_t> &ranked,
-                std::vector<int64_t> &len2, const Key &key) {
+void rank_edges(const Ring &ring, const Spoke *spokes, std::vector<uint32_t> &ranked,
+                const Key &key) {
   const uint32_t m = ring.size();
-  ranked.resize(m);
-  len2.resize(m);
-  for (uint32_t i = 0; i < m; ++i) {
-    ranked[i] = i;
-    len2[i] = squared_distance(mesh.q, v, ring.neighbour[i]);
-  }
+  if (ranked.size() < m)
+    ranked.resize(m);
+  uint32_t *r = ranked.data();
+  for (uint32_t i = 0; i < m; ++i)
+    r[i] = i;
   const auto before = [&](uint32_t a, uint32_t b) {
-    if (len2[a] != len2[b])
-      return len2[a] > len2[b];
+    if (spokes[a].len2 != spokes[b].len2)
+      return spokes[a].len2 > spokes[b].len2;
     return key(ring.neighbour[a]) < key(ring.neighbour[b]);
   };
   if (m > 16) {
-    std::sort(ranked.begin(), ranked.end(), before);
+    std::sort(r, r + m, before);
     return;
   }
   // What std::sort does with 16 elements or fewer, inlined: an insertion sort. (A view
   // ring can name one neighbour twice: such ties must stay in std::sort's order.)
   for (uint32_t i = 1; i < m; ++i) {
-    const uint32_t x = ranked[i];
+    const uint32_t x = r[i];
     uint32_t j = i;
-    for (; j > 0 && before(x, ranked[j - 1]); --j)
-      ranked[j] = ranked[j - 1];
-    ranked[j] = x;
+    for (; j > 0 && before(x, r[j - 1]); --j)
+      r[j] = r[j - 1];
+    r[j] = x;
   }
 }
 
-/// Turn (s_e, s_l, s_r) into ring positions; false if they do not describe a valid patch.
-inline bool resolve_patch(const Ring &ring, const uint32_t *ranked, const SplitSymbols &s,
-                          PatchRange &p) {
+/// The ring index of rank `e` in rank_edges' order (e < ring.size() <= 16), without
+/// sorting: the longest edges are taken out one by one. What the decoder needs (it reads
+/// s_e, then looks up one edge): s_e is 0 for about 2 splits in 3 and rarely above 2.
+/// rank_edges sorts <= 16 edges stably, i.e. by (len2 descending, key ascending, index
+/// ascending); scanning by increasing index and keeping the first of equals gives the same.
+template <class Key>
+uint32_t ranked_edge(const Ring &ring, const Spoke *spokes, uint32_t e, const Key &key) {
+  const uint32_t m = ring.size();
+  uint32_t taken = 0; // bit i: edge i has a rank below the one looked for
+  for (uint32_t r = 0;; ++r) {
+    uint32_t best = kNone;
+    for (uint32_t i = 0; i < m; ++i) {
+      if (taken >> i & 1)
+        continue;
+      if (best == kNone || spokes[i].len2 > spokes[best].len2 ||
+          (spokes[i].len2 == spokes[best].len2 &&
+           key(ring.neighbour[i]) < key(ring.neighbour[best])))
+        best = i;
+    }
+    if (r == e)
+      return best;
+    taken |= 1u << best;
+  }
+}
+
+/// Turn (s_e, s_l, s_r) into ring positions, `j` being the ring index of the edge of rank
+/// s_e (when s_e < ring.size()); false if they do not describe a valid patch.
+inline bool resolve_patch(const Ring &ring, uint32_t j, const SplitSymbols &s, PatchRange &p) {
   const uint32_t m = ring.size();
   if (s.s_e >= m)
     return false;
-  p.j = ranked[s.s_e];
+  p.j = j;
   if (ring.closed) {
     if (s.s_l >= m || s.s_r >= m || s.s_l + s.s_r == 0 || s.s_l + s.s_r > m - 1)
       return false;

@@ -18,8 +18,11 @@ struct SplitOp {
   bool has_l, has_r;
 };
 
-/// Apply `op`, creating vertex `v_from` (== ct.vertex_count(), appended) and up to two
-/// faces (appended). Valid as long as the op's faces were not touched by other splits.
-void apply_split(CornerTable &ct, const SplitOp &op, uint32_t v_from);
+/// Apply `op` in place: vertex `v_from` and the new faces, `face` then `face + 1`
+/// (has_l's first), are already in the arrays (refine/level_step.h sizes them once for
+/// all the splits of a step); their entries are written here. Returns the number of
+/// faces created (has_l + has_r). Valid as long as the op's faces were not touched by
+/// other splits.
+uint32_t apply_split(CornerTable &ct, const SplitOp &op, uint32_t v_from, uint32_t face);
 
 } // namespace pomar

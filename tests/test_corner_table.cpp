@@ -1,0 +1,80 @@
+// Ring walks (mesh/corner_table.h): get_ring on fans larger than a ring's first storage
+// (32 corners), closed and open, whatever corner the walk starts from.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <vector>
+
+#include "mesh/corner_table.h"
+
+namespace pomar {
+namespace {
+
+/// A fan of n faces (0, i, i+1) round vertex 0, closed (the last face wraps to vertex 1)
+/// or open.
+CornerTable fan(uint32_t n, bool closed) {
+  std::vector<uint32_t> t;
+  for (uint32_t i = 1; i <= n; ++i)
+    t.insert(t.end(), {0, i, closed && i == n ? 1 : i + 1});
+  CornerTable ct;
+  build_corner_table(t.data(), n, closed ? n + 1 : n + 2, ct);
+  return ct;
+}
+
+/// The ring's corners are vertex 0's, counter-clockwise, with the neighbours they name.
+void expect_consistent(const CornerTable &ct, const Ring &ring) {
+  for (uint32_t i = 0; i < ring.faces(); ++i) {
+    const uint32_t c = ring.corner[i];
+    EXPECT_EQ(ct.V[c], 0u);
+    EXPECT_EQ(ct.V[CornerTable::next(c)], ring.neighbour[i]);
+    EXPECT_EQ(ct.V[CornerTable::prev(c)], ring.neighbour[(i + 1) % ring.size()]);
+  }
+}
+
+TEST(Ring, LargeClosedFanFromEveryCorner) {
+  for (uint32_t n : {3u, 31u, 32u, 33u, 100u}) {
+    CornerTable ct = fan(n, true);
+    Ring ring;
+    for (uint32_t f = 0; f < n; ++f) {
+      ct.VC[0] = 3 * f; // start the walk in face f
+      get_ring(ct, 0, ring);
+      ASSERT_TRUE(ring.closed);
+      ASSERT_EQ(ring.size(), n);
+      ASSERT_EQ(ring.faces(), n);
+      EXPECT_EQ(ring.corner[0], 3 * f);
+      EXPECT_EQ(ring.neighbour[0], f + 1);
+      expect_consistent(ct, ring);
+    }
+  }
+}
+
+TEST(Ring, LargeOpenFanStartsAtItsClockwiseEnd) {
+  for (uint32_t n : {1u, 31u, 32u, 33u, 100u}) {
+    CornerTable ct = fan(n, false);
+    Ring ring;
+    for (uint32_t f = 0; f < n; ++f) {
+      ct.VC[0] = 3 * f;
+      get_ring(ct, 0, ring);
+      ASSERT_FALSE(ring.closed);
+      ASSERT_EQ(ring.size(), n + 1);
+      ASSERT_EQ(ring.faces(), n);
+      for (uint32_t i = 0; i <= n; ++i)
+        EXPECT_EQ(ring.neighbour[i], i + 1);
+      expect_consistent(ct, ring);
+    }
+  }
+}
+
+TEST(Ring, VertexWithoutFacesHasAnEmptyRing) {
+  CornerTable ct = fan(40, true);
+  Ring ring;
+  get_ring(ct, 0, ring); // storage grown by a large fan first
+  ct.VC[0] = kNone;
+  get_ring(ct, 0, ring);
+  EXPECT_EQ(ring.size(), 0u);
+  EXPECT_EQ(ring.faces(), 0u);
+  EXPECT_TRUE(ring.closed);
+}
+
+} // namespace
+} // namespace pomar
