@@ -50,9 +50,14 @@ void expect_same_mesh(const Mesh &a, const Mesh &b, const std::string &what) {
   }
 }
 
-Mesh full_decode(const std::vector<uint8_t> &file, unsigned threads, int level = -1) {
+// The decodes below put every clustered level on the threads (min_parallel_vertices = 0):
+// by default small levels stay on the calling thread, which would leave most levels of
+// these small meshes off the parallel path under test.
+Mesh full_decode(const std::vector<uint8_t> &file, unsigned threads, int level = -1,
+                 uint32_t min_parallel_vertices = 0) {
   DecodeOptions o;
   o.threads = threads;
+  o.min_parallel_vertices = min_parallel_vertices;
   o.level = level;
   return decode(file.data(), file.size(), o);
 }
@@ -85,6 +90,7 @@ void expect_same(const Snapshot &a, const Snapshot &b, const std::string &what) 
 std::vector<Snapshot> selective_session(const std::vector<uint8_t> &file, unsigned threads) {
   SelectiveOptions o;
   o.threads = threads;
+  o.min_parallel_vertices = 0;
   SelectiveDecoder d(std::make_unique<MemorySource>(file.data(), file.size()), o);
   std::vector<Snapshot> seen;
   std::mt19937 rng(7);
@@ -127,6 +133,9 @@ TEST(DecodeThreads, FullDecodesAreTheSameForAnyThreadCount) {
     for (unsigned t : kThreadCounts)
       expect_same_mesh(one, full_decode(file, t),
                        std::string(c.name) + ", " + std::to_string(t) + " threads");
+    // The default: small levels on the calling thread, the others on the threads.
+    expect_same_mesh(one, full_decode(file, 2, -1, DecodeOptions().min_parallel_vertices),
+                     std::string(c.name) + ", 2 threads, small levels on one");
     // A level between the base clustered mesh and the finest.
     const FileInfo info = inspect(file.data(), file.size());
     const int mid = int(info.global_levels + info.levels.size()) / 2 + 1;
@@ -170,6 +179,7 @@ Outcome damaged_decode(const std::vector<uint8_t> &file, unsigned threads, bool 
   Outcome out;
   DecodeOptions o;
   o.threads = threads;
+  o.min_parallel_vertices = 0;
   o.skip_damaged = skip;
   DecodeReport report;
   try {

@@ -125,7 +125,7 @@ struct EncodeOptions {
   /// Threads for the encoder's parallel steps (decimation's candidate evaluation); 0 = the
   /// cores this process may run on. The file does not depend on it.
   unsigned threads = 0;
-  Progress progress;        ///< optional
+  Progress progress; ///< optional
   /// Peak memory allowed, in bytes: encode() throws pomar::Error before its large
   /// allocations if it would need more (pomar/limits.h). 0 = automatic (the memory
   /// available to the process), UINT64_MAX (kNoMemoryLimit) = do not check.
@@ -326,6 +326,11 @@ struct DecodeOptions {
   /// depend on it.
   /// Global levels, and so pure progressive files, are decoded on one thread.
   unsigned threads = 0;
+  /// With threads > 1, a clustered level with less work than this (its vertices per
+  /// cluster times the clusters to refine, from the level table) is decoded on the calling
+  /// thread: on small levels the parallel phases cost more than they save. 0: every level
+  /// on the threads. The mesh does not depend on it.
+  uint32_t min_parallel_vertices = 4096;
 };
 
 struct DecodeReport {

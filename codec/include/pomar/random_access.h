@@ -84,6 +84,11 @@ struct SelectiveOptions {
   /// With more than one, the ByteSource is called from the decoder's threads, one call at
   /// a time.
   unsigned threads = 0;
+  /// With threads > 1, a clustered level with less work than this (its vertices per
+  /// cluster times the clusters to refine, from the level table) is decoded on the calling
+  /// thread: on small levels the parallel phases cost more than they save. 0: every level
+  /// on the threads. The mesh does not depend on it.
+  uint32_t min_parallel_vertices = 4096;
 };
 
 /// Selective, incremental decoder of a .pomar file. Levels are numbered as everywhere

@@ -156,6 +156,7 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
     so.attributes = options.attributes;
     so.memory_limit = kNoMemoryLimit;
     so.threads = threads;
+    so.min_parallel_vertices = options.min_parallel_vertices;
     SelectiveDecoder d(std::make_unique<MemorySource>(data, size), so);
     d.want_all(static_cast<int>(target));
     d.update(options.progress);
