@@ -31,7 +31,7 @@ ctest --test-dir "$BUILD" --output-on-failure -j "$JOBS"
 # ---- web: the WebAssembly decoder and the viewer in headless Chromium -----------------------------
 # web/test/run.sh builds the decoder with emscripten (build-web-test/), checks WASM decode = native
 # decode bit for bit and that damaged inputs give messages (Node.js), then runs the viewer page in
-# headless Chromium. About 1-2 minutes on 2 cores; each part is skipped with a message when
+# headless Chromium. About 2-3 minutes on 2 cores (the phone-emulation test included); each part is skipped with a message when
 # emscripten, node or chromium is missing. POMAR_TEST_WEB=0 skips it.
 if [ "${POMAR_TEST_WEB:-1}" != 0 ]; then
   JOBS="$JOBS" bash web/test/run.sh "$REPO/build-web-test" "$REPO/$BUILD/codec/pomar"
