@@ -114,6 +114,13 @@ bool plain_decimal(const char *b, const char *e) {
   return b == e;
 }
 
+bool parse_digits(const char *b, const char *e, uint64_t max, uint64_t &value) {
+  if (b == e || *b < '0' || *b > '9') // (from_chars would take a '-')
+    return false;
+  const auto r = std::from_chars(b, e, value);
+  return r.ec == std::errc() && r.ptr == e && value <= max;
+}
+
 std::vector<std::string> split_ws(const std::string &line) {
   std::vector<std::string> out;
   size_t i = 0;

@@ -71,6 +71,9 @@ bool parse_float(const std::string &token, float &value);
 /// text from_chars rounds as strtof/strtod (and so vcglib's fscanf/atof) do; anything else
 /// ('+', hex, inf, nan, ...) is left to the general readers.
 bool plain_decimal(const char *b, const char *e);
+/// Parses [b, e) as a plain unsigned decimal integer (digits only: no sign, no space) of
+/// at most `max`: what the fast paths read counts and vertex indices with.
+bool parse_digits(const char *b, const char *e, uint64_t max, uint64_t &value);
 /// Splits a line at spaces, tabs, CR and LF.
 std::vector<std::string> split_ws(const std::string &line);
 void add_unique(std::vector<std::string> &list, const char *name);

@@ -227,10 +227,7 @@ bool tokens_of(const char *b, const char *e, size_t n, std::pair<const char *, c
 }
 
 bool parse_index(std::pair<const char *, const char *> t, uint64_t max, uint64_t &v) {
-  if (t.first == t.second || *t.first < '0' || *t.first > '9') // from_chars takes '-'
-    return false;
-  const auto r = std::from_chars(t.first, t.second, v);
-  return r.ec == std::errc() && r.ptr == t.second && v <= max;
+  return parse_digits(t.first, t.second, max, v);
 }
 
 /// The common case read straight into the flat arrays: "OFF", the counts line, one vertex

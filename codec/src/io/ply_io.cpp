@@ -822,12 +822,10 @@ bool read_simple_ascii(FileReader &in, uint64_t nv, uint64_t nf, Mesh &out,
     if (!tokens.next(b, e) || e - b != 1 || *b != '3')
       return false;
     for (int k = 0; k < 3; ++k) {
-      uint32_t &v = out.triangles[3 * f + k];
-      if (!tokens.next(b, e) || *b < '0' || *b > '9') // digits only (from_chars takes '-')
+      uint64_t v = 0;
+      if (!tokens.next(b, e) || !parse_digits(b, e, nv - 1, v))
         return false;
-      const auto r = std::from_chars(b, e, v);
-      if (r.ec != std::errc() || r.ptr != e || v >= nv)
-        return false;
+      out.triangles[3 * f + k] = static_cast<uint32_t>(v);
       used[v] = 1;
     }
   }
