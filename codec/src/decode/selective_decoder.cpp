@@ -44,7 +44,9 @@ struct SelectiveDecoder::State {
   std::vector<Models> level_models;
   ClusterIndex index;
   ClusterGraph graph;
-  struct Cluster {
+  // (Cache-line aligned: the clusters of a batch are decoded on several threads, each
+  // writing its cluster's stream state at every symbol.)
+  struct alignas(64) Cluster {
     ClusterStream stream;
     int level = 0;           // the level it is decoded to
     uint32_t next_local = 1; // its counter of created vertices (LevelMesh::local)

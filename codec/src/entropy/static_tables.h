@@ -61,8 +61,8 @@ private:
 
 /// Stands in for a RangeEncoder: records symbols (with their model's slot) instead of
 /// coding. An event is 8 bytes (a 10M-vertex encode records about 10^8 of them in its
-/// finest level).
-class SymbolRecorder {
+/// finest level). Cache-line aligned: neighbouring clusters record on different threads.
+class alignas(64) SymbolRecorder {
 public:
   struct Event {
     uint32_t model; // ModelSlots slot; bypass bits: their count

@@ -53,13 +53,16 @@ struct NoCheck {
 };
 
 /// A cluster traversed but not yet applied (traverse_cluster_level -> apply_cluster_level).
-struct TraversedCluster {
+/// Cache-line aligned, as LevelStep: the threads of a level fill neighbouring ones.
+struct alignas(64) TraversedCluster {
   SplitList splits;
   std::vector<uint32_t> claims; // the faces its patches hold, in claim order
   std::exception_ptr error;     // what its traversal or check threw (nothing to apply)
 };
 
-class LevelStep {
+// (Cache-line aligned: with threads, each runs its own step and writes its scratch at every
+// vertex; two steps sharing a cache line slowed both down.)
+class alignas(64) LevelStep {
 public:
   /// Refine the whole mesh by global level `level` (vertices get cluster 0).
   template <class Codec, class Check = NoCheck>
