@@ -27,6 +27,7 @@ PACKAGES=(
   pybind11-dev python3-dev python3-numpy python3-pytest   # the Python module (python/) and its tests
   imagemagick x11-utils xdotool        # scripts/gui_screenshot.sh (GUI checks under Xvfb)
   emscripten nodejs chromium           # web/: the WebAssembly decoder and its browser test
+  nginx-light apache2                  # web/test/real_servers.sh: the client against real web servers
 )
 
 log() { printf 'setup: %s\n' "$*"; }

@@ -5,7 +5,10 @@
 #  2. encodes samples/bunny.ply three ways with the native tool and checks that the WASM
 #     decoder decodes them bit for bit like the native one, and that damaged/truncated
 #     copies give messages (web/test/wasm_decode_test.mjs, Node.js);
-#  3. runs the viewer in headless Chromium (web/test/browser_test.py), screenshots compared
+#  3. streams one of them from Debian's nginx and Apache through the client's own transport
+#     (multipart/byteranges answers) and checks the meshes against the local file's
+#     (web/test/real_servers.sh);
+#  4. runs the viewer in headless Chromium (web/test/browser_test.py), screenshots compared
 #     with docs/images/web_test/, then on an emulated phone with touch input
 #     (web/test/mobile_test.py).
 # (Plus web/test/unit_test.mjs: request coalescing and the choice of levels for a view.)
@@ -29,6 +32,7 @@ node "$REPO/web/test/unit_test.mjs"
 echo "web tests: WASM decode = native decode (node web/test/wasm_decode_test.mjs)"
 node "$REPO/web/test/wasm_decode_test.mjs" "$TOOL" "$samples/bunny.pomar" "$samples/bunny_c5.pomar" \
   "$samples/bunny_progressive.pomar"
+bash "$REPO/web/test/real_servers.sh" "$samples/bunny_c5.pomar"
 if ! command -v chromium >/dev/null 2>&1; then
   echo "web tests: browser test SKIPPED: chromium not installed"
   exit 0
