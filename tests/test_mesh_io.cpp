@@ -29,9 +29,9 @@ extern "C" const char *__lsan_default_suppressions() { return "leak:cb_read_list
 
 namespace {
 
+using pomar::AttributeKind;
 using pomar::LoadReport;
 using pomar::Mesh;
-using pomar::AttributeKind;
 using pomar::VertexAttribute;
 
 // ------------------------------------------------------------------------------------
@@ -47,8 +47,7 @@ std::string read_text(const std::string &path) {
 }
 
 /// The message of the pomar::Error that `f` throws (fails the test if it does not).
-template <class F>
-std::string error_of(F f) {
+template <class F> std::string error_of(F f) {
   try {
     f();
   } catch (const pomar::Error &e) {
@@ -74,14 +73,22 @@ bool same_bits(const std::vector<float> &a, const std::vector<float> &b) {
 /// (so STL's welding gives back the same numbering).
 Mesh awkward_mesh() {
   Mesh m;
-  m.positions = {0.1f,        1e-7f,          123456.789f,    // 0
-                 -0.0f,       0.0f,           1.0f,           // 1
-                 1e-40f,      -3.4028235e38f, 0.333333343f,   // 2 (denormal, -FLT_MAX)
-                 16777216.0f, -1.17549435e-38f, 2.71828175f,  // 3
-                 -7.5f,       1.0e30f,        -2.0e-30f,      // 4
-                 3.14159274f, -0.0f,          -0.0f,          // 5
-                 1.4e-45f,    65504.0f,       -123.456f,      // 6 (smallest denormal)
-                 0.5f,        0.25f,          -1e-7f};        // 7
+  m.positions = {0.1f,         1e-7f,
+                 123456.789f, // 0
+                 -0.0f,        0.0f,
+                 1.0f, // 1
+                 1e-40f,       -3.4028235e38f,
+                 0.333333343f, // 2 (denormal, -FLT_MAX)
+                 16777216.0f,  -1.17549435e-38f,
+                 2.71828175f, // 3
+                 -7.5f,        1.0e30f,
+                 -2.0e-30f, // 4
+                 3.14159274f,  -0.0f,
+                 -0.0f, // 5
+                 1.4e-45f,     65504.0f,
+                 -123.456f, // 6 (smallest denormal)
+                 0.5f,         0.25f,
+                 -1e-7f}; // 7
   m.triangles = {0, 1, 2, 0, 2, 3, 3, 2, 4, 4, 5, 6, 6, 7, 0, 7, 1, 5};
   return m;
 }
@@ -203,10 +210,11 @@ TEST_F(MeshIoTest, ObjQuadIsFanTriangulated) {
 }
 
 TEST_F(MeshIoTest, ObjRelativeIndicesSlashesGroupsAndAttributes) {
-  const std::string file = write("rel.obj", "mtllib x.mtl\r\no a\r\nv 0 0 0 1 0 0\r\nv 1 0 0 1 0 0\r\n"
-                                            "v 0 1 0 1 0 0\r\nvn 0 0 1\r\nvt 0 0\r\n"
-                                            "g first\r\nusemtl red\r\nf -3/1/1 -2/1/1 -1/1/1\r\n"
-                                            "v 1 1 0 1 0 0\r\ng second\r\nf 2//1 4//1 3//1\r\n");
+  const std::string file =
+      write("rel.obj", "mtllib x.mtl\r\no a\r\nv 0 0 0 1 0 0\r\nv 1 0 0 1 0 0\r\n"
+                       "v 0 1 0 1 0 0\r\nvn 0 0 1\r\nvt 0 0\r\n"
+                       "g first\r\nusemtl red\r\nf -3/1/1 -2/1/1 -1/1/1\r\n"
+                       "v 1 1 0 1 0 0\r\ng second\r\nf 2//1 4//1 3//1\r\n");
   LoadReport r;
   const Mesh m = pomar::load_mesh(file, &r);
   EXPECT_EQ(m.triangles, (std::vector<uint32_t>{0, 1, 2, 1, 3, 2}));
@@ -270,14 +278,16 @@ TEST_F(MeshIoTest, ObjBadFacesAreErrors) {
   EXPECT_NE(load_error(write("range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n"))
                 .find("references vertex 4"),
             std::string::npos);
-  EXPECT_NE(load_error(write("rel.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -4\n")).find(path("rel.obj")),
-            std::string::npos);
+  EXPECT_NE(
+      load_error(write("rel.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -4\n")).find(path("rel.obj")),
+      std::string::npos);
   EXPECT_NE(load_error(write("zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n")).find("zero.obj"),
             std::string::npos);
 }
 
 TEST_F(MeshIoTest, ObjNonFiniteAndBadCoordinates) {
-  const std::string nan_msg = load_error(write("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n"));
+  const std::string nan_msg =
+      load_error(write("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n"));
   EXPECT_NE(nan_msg.find("vertex 1"), std::string::npos) << nan_msg;
   EXPECT_NE(nan_msg.find("non-finite"), std::string::npos) << nan_msg;
   const std::string bad = load_error(write("bad.obj", "v 0 0 0\nv 1,5 0 0\nv 0 1 0\nf 1 2 3\n"));
@@ -291,11 +301,12 @@ TEST_F(MeshIoTest, ObjNonFiniteAndBadCoordinates) {
 TEST_F(MeshIoTest, PlyTristrips) {
   // Strip 0 1 2 3 gives (0,1,2) and (2,1,3) (every other triangle flipped to keep the
   // orientation); -1 restarts: strip 1 3 4 gives (1,3,4).
-  const std::string file = write("strips.ply", "ply\nformat ascii 1.0\nelement vertex 5\n"
-                                               "property float x\nproperty float y\nproperty float z\n"
-                                               "element tristrips 1\nproperty list int int vertex_indices\n"
-                                               "end_header\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n2 1 0\n"
-                                               "8 0 1 2 3 -1 1 3 4\n");
+  const std::string file =
+      write("strips.ply", "ply\nformat ascii 1.0\nelement vertex 5\n"
+                          "property float x\nproperty float y\nproperty float z\n"
+                          "element tristrips 1\nproperty list int int vertex_indices\n"
+                          "end_header\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n2 1 0\n"
+                          "8 0 1 2 3 -1 1 3 4\n");
   LoadReport r;
   const Mesh m = pomar::load_mesh(file, &r);
   EXPECT_EQ(m.triangles, (std::vector<uint32_t>{0, 1, 2, 2, 1, 3, 1, 3, 4}));
@@ -303,23 +314,25 @@ TEST_F(MeshIoTest, PlyTristrips) {
 }
 
 TEST_F(MeshIoTest, PlyTristripsBadIndexIsError) {
-  const std::string file = write("strips.ply", "ply\nformat ascii 1.0\nelement vertex 3\n"
-                                               "property float x\nproperty float y\nproperty float z\n"
-                                               "element tristrips 1\nproperty list int int vertex_indices\n"
-                                               "end_header\n0 0 0\n1 0 0\n0 1 0\n4 0 1 2 7\n");
+  const std::string file =
+      write("strips.ply", "ply\nformat ascii 1.0\nelement vertex 3\n"
+                          "property float x\nproperty float y\nproperty float z\n"
+                          "element tristrips 1\nproperty list int int vertex_indices\n"
+                          "end_header\n0 0 0\n1 0 0\n0 1 0\n4 0 1 2 7\n");
   EXPECT_NE(load_error(file).find("references vertex 7"), std::string::npos);
 }
 
 TEST_F(MeshIoTest, PlyPolygonsKeptVertexAttributesAndIgnoredFaceAttributes) {
-  const std::string file = write("quad.ply", "ply\nformat ascii 1.0\nelement vertex 5\n"
-                                             "property float x\nproperty float y\nproperty float z\n"
-                                             "property float nx\nproperty float ny\nproperty float nz\n"
-                                             "property uchar red\nproperty uchar green\nproperty uchar blue\n"
-                                             "element face 2\nproperty list uchar int vertex_indices\n"
-                                             "property float quality\nend_header\n"
-                                             "0 0 0 0 0 1 255 0 0\n1 0 0 0 0 1 255 0 0\n1 1 0 0 0 1 255 0 0\n"
-                                             "0 1 0 0 0 1 255 0 0\n2 2 2 0 0 1 255 0 0\n"
-                                             "4 0 1 2 3 0.5\n3 1 4 2 1\n");
+  const std::string file =
+      write("quad.ply", "ply\nformat ascii 1.0\nelement vertex 5\n"
+                        "property float x\nproperty float y\nproperty float z\n"
+                        "property float nx\nproperty float ny\nproperty float nz\n"
+                        "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+                        "element face 2\nproperty list uchar int vertex_indices\n"
+                        "property float quality\nend_header\n"
+                        "0 0 0 0 0 1 255 0 0\n1 0 0 0 0 1 255 0 0\n1 1 0 0 0 1 255 0 0\n"
+                        "0 1 0 0 0 1 255 0 0\n2 2 2 0 0 1 255 0 0\n"
+                        "4 0 1 2 3 0.5\n3 1 4 2 1\n");
   LoadReport r;
   const Mesh m = pomar::load_mesh(file, &r);
   EXPECT_EQ(m.triangles, (std::vector<uint32_t>{0, 1, 2, 0, 2, 3, 1, 4, 2}));
@@ -389,13 +402,14 @@ TEST_F(MeshIoTest, PlyAttributesRoundTrip) {
 }
 
 TEST_F(MeshIoTest, PlySixteenBitColourIsNotKeptAndSaysSo) {
-  const std::string file = write("c16.ply", "ply\nformat ascii 1.0\nelement vertex 3\n"
-                                            "property float x\nproperty float y\nproperty float z\n"
-                                            "property ushort red\nproperty ushort green\n"
-                                            "property ushort blue\nproperty float intensity\n"
-                                            "element face 1\nproperty list uchar int vertex_indices\n"
-                                            "end_header\n0 0 0 65535 0 0 1\n1 0 0 0 65535 0 2\n"
-                                            "0 1 0 0 0 65535 3\n3 0 1 2\n");
+  const std::string file =
+      write("c16.ply", "ply\nformat ascii 1.0\nelement vertex 3\n"
+                       "property float x\nproperty float y\nproperty float z\n"
+                       "property ushort red\nproperty ushort green\n"
+                       "property ushort blue\nproperty float intensity\n"
+                       "element face 1\nproperty list uchar int vertex_indices\n"
+                       "end_header\n0 0 0 65535 0 0 1\n1 0 0 0 65535 0 2\n"
+                       "0 1 0 0 0 65535 3\n3 0 1 2\n");
   LoadReport r;
   const Mesh m = load_mesh(file, &r);
   EXPECT_EQ(r.ignored_attributes,
@@ -406,10 +420,11 @@ TEST_F(MeshIoTest, PlySixteenBitColourIsNotKeptAndSaysSo) {
 }
 
 TEST_F(MeshIoTest, PlyUnreferencedVerticesAreKeptAndCounted) {
-  const std::string file = write("unref.ply", "ply\nformat ascii 1.0\nelement vertex 5\n"
-                                              "property float x\nproperty float y\nproperty float z\n"
-                                              "element face 1\nproperty list uchar int vertex_indices\n"
-                                              "end_header\n0 0 0\n9 9 9\n1 0 0\n8 8 8\n0 1 0\n3 4 0 2\n");
+  const std::string file =
+      write("unref.ply", "ply\nformat ascii 1.0\nelement vertex 5\n"
+                         "property float x\nproperty float y\nproperty float z\n"
+                         "element face 1\nproperty list uchar int vertex_indices\n"
+                         "end_header\n0 0 0\n9 9 9\n1 0 0\n8 8 8\n0 1 0\n3 4 0 2\n");
   LoadReport r;
   const Mesh m = pomar::load_mesh(file, &r);
   EXPECT_EQ(m.positions, (std::vector<float>{0, 0, 0, 9, 9, 9, 1, 0, 0, 8, 8, 8, 0, 1, 0}));
@@ -420,21 +435,24 @@ TEST_F(MeshIoTest, PlyUnreferencedVerticesAreKeptAndCounted) {
 
 TEST_F(MeshIoTest, UnreferencedVerticesInObjAndOff) {
   LoadReport r;
-  const Mesh obj = pomar::load_mesh(write("u.obj", "v 9 9 9\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 2 3 4\n"), &r);
+  const Mesh obj =
+      pomar::load_mesh(write("u.obj", "v 9 9 9\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 2 3 4\n"), &r);
   EXPECT_EQ(obj.triangles, (std::vector<uint32_t>{1, 2, 3}));
   EXPECT_EQ(obj.vertex_count(), 4u);
   EXPECT_EQ(r.unreferenced_vertices, 1u);
-  const Mesh off = pomar::load_mesh(write("u.off", "OFF\n4 1 0\n0 0 0\n1 0 0\n9 9 9\n0 1 0\n3 0 1 3\n"), &r);
+  const Mesh off =
+      pomar::load_mesh(write("u.off", "OFF\n4 1 0\n0 0 0\n1 0 0\n9 9 9\n0 1 0\n3 0 1 3\n"), &r);
   EXPECT_EQ(off.positions, (std::vector<float>{0, 0, 0, 1, 0, 0, 9, 9, 9, 0, 1, 0}));
   EXPECT_EQ(r.unreferenced_vertices, 1u);
 }
 
 TEST_F(MeshIoTest, PlyLastPolygonCornerOutOfRangeIsError) {
   // vcglib does not range-check the last corner of a polygon; we must.
-  const std::string file = write("bad.ply", "ply\nformat ascii 1.0\nelement vertex 4\n"
-                                            "property float x\nproperty float y\nproperty float z\n"
-                                            "element face 1\nproperty list uchar int vertex_indices\n"
-                                            "end_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 100000\n");
+  const std::string file =
+      write("bad.ply", "ply\nformat ascii 1.0\nelement vertex 4\n"
+                       "property float x\nproperty float y\nproperty float z\n"
+                       "element face 1\nproperty list uchar int vertex_indices\n"
+                       "end_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 100000\n");
   const std::string msg = load_error(file);
   EXPECT_NE(msg.find("references vertex 100000"), std::string::npos) << msg;
   EXPECT_NE(msg.find(file), std::string::npos) << msg;
@@ -451,11 +469,12 @@ TEST_F(MeshIoTest, PlyHugePolygonIsError) {
 }
 
 TEST_F(MeshIoTest, PlyEdgesAreIgnored) {
-  const std::string file = write("edge.ply", "ply\nformat ascii 1.0\nelement vertex 3\n"
-                                             "property float x\nproperty float y\nproperty float z\n"
-                                             "element face 1\nproperty list uchar int vertex_indices\n"
-                                             "element edge 1\nproperty int vertex1\nproperty int vertex2\n"
-                                             "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n0 1\n");
+  const std::string file =
+      write("edge.ply", "ply\nformat ascii 1.0\nelement vertex 3\n"
+                        "property float x\nproperty float y\nproperty float z\n"
+                        "element face 1\nproperty list uchar int vertex_indices\n"
+                        "element edge 1\nproperty int vertex1\nproperty int vertex2\n"
+                        "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n0 1\n");
   LoadReport r;
   EXPECT_EQ(pomar::load_mesh(file, &r).triangle_count(), 1u);
   EXPECT_NE(std::find(r.ignored_attributes.begin(), r.ignored_attributes.end(), "edges"),
@@ -464,12 +483,13 @@ TEST_F(MeshIoTest, PlyEdgesAreIgnored) {
 
 /// Header for a PLY file with three float vertices and one face list of the given type.
 std::string ply_header(const std::string &format, const std::string &face_list) {
-  return "ply\nformat " + format + " 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-         "property float z\nelement face 1\nproperty " + face_list + " vertex_indices\nend_header\n";
+  return "ply\nformat " + format +
+         " 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+         "property float z\nelement face 1\nproperty " +
+         face_list + " vertex_indices\nend_header\n";
 }
 
-template <class T>
-std::string bytes_of(T v, bool big_endian) {
+template <class T> std::string bytes_of(T v, bool big_endian) {
   std::string b(reinterpret_cast<const char *>(&v), sizeof v);
   if (big_endian)
     std::reverse(b.begin(), b.end());
@@ -483,7 +503,8 @@ TEST_F(MeshIoTest, PlyBinaryBigEndianAndIndexTypes) {
   std::string faces = bytes_of<uint8_t>(3, true);
   for (uint32_t i : {0u, 1u, 2u})
     faces += bytes_of(i, true);
-  const Mesh m = pomar::load_mesh(write("be.ply", ply_header("binary_big_endian", "list uchar uint") + body + faces));
+  const Mesh m = pomar::load_mesh(
+      write("be.ply", ply_header("binary_big_endian", "list uchar uint") + body + faces));
   EXPECT_EQ(m.positions, (std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0}));
   EXPECT_EQ(m.triangles, (std::vector<uint32_t>{0, 1, 2}));
 
@@ -491,7 +512,8 @@ TEST_F(MeshIoTest, PlyBinaryBigEndianAndIndexTypes) {
   faces = bytes_of<uint16_t>(3, true);
   for (uint32_t i : {0u, 1u, 2u})
     faces += bytes_of(i, true);
-  const std::string msg = load_error(write("be2.ply", ply_header("binary_big_endian", "list ushort uint") + body + faces));
+  const std::string msg = load_error(
+      write("be2.ply", ply_header("binary_big_endian", "list ushort uint") + body + faces));
   EXPECT_NE(msg.find("misreads"), std::string::npos) << msg;
 }
 
@@ -576,35 +598,129 @@ TEST_F(MeshIoTest, PlyAsciiFastPathReadsWhatVcglibReads) {
   }
 }
 
+// OBJ of positions and faces only is read without tinyobjloader (io/obj_io.cpp,
+// read_simple_obj): it must give tinyobjloader's floats (its own decimal sum, not a correctly
+// rounded conversion) for every way of writing a number, triangulate polygons as the general
+// path does, keep faces in file order across o/g/s lines, and decline what it does not take.
+// The general path reads the same data when an unknown keyword line ("mg 1", which the scan
+// and tinyobjloader skip) makes the fast path decline.
+TEST_F(MeshIoTest, ObjFastPathReadsWhatTinyobjloaderReads) {
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> mantissa(-1.0, 1.0);
+  std::uniform_int_distribution<int> exponent(-45, 38);
+  // (%.20g: fraction digits past the 8th, where tinyobjloader calls std::pow.)
+  const char *formats[] = {"%.9g", "%.3f", "%e", "%.20g", "%.1e", "%g", "%.12f"};
+  const size_t nv = 407;
+  std::string body = "# made by the test\n";
+  char buf[64];
+  for (size_t i = 0; i < nv; ++i) {
+    body += i % 11 ? "v " : "v\t ";
+    for (int k = 0; k < 3; ++k) {
+      std::snprintf(buf, sizeof buf, formats[(i + k) % 7],
+                    std::ldexp(mantissa(rng), exponent(rng) / 4));
+      body += buf;
+      body += k < 2 ? (i % 7 ? " " : "\t ") : (i % 5 ? "\n" : "\r\n");
+    }
+    if (i == 100)
+      body += "o part\ng group one\ns 1\n\n";
+  }
+  // Triangles, quads and pentagons (fan-triangulated); the last two vertices unreferenced.
+  for (size_t f = 0; f + 6 < nv; f += 3) {
+    const size_t n = 3 + (f / 3) % 3;
+    body += "f";
+    for (size_t c = 0; c < n; ++c)
+      body += " " + std::to_string(f + c + 1);
+    body += f % 2 ? "\n" : " \r\n";
+    if (f == 201)
+      body += "g another\ns off\n# a comment\n";
+  }
+  body += "f 403 404 405\n";
+  LoadReport fast_report, general_report;
+  const Mesh fast = pomar::load_mesh(write("fast.obj", body), &fast_report);
+  const Mesh general = pomar::load_mesh(write("general.obj", body + "mg 1\n"), &general_report);
+  expect_same_load(fast, fast_report, general, general_report);
+  EXPECT_EQ(fast_report.polygons_triangulated, general_report.polygons_triangulated);
+  EXPECT_GT(fast_report.polygons_triangulated, 80u);
+  // Odd numbers as the first coordinate, and lines the fast path declines: read as the
+  // general path reads them, or failing as it fails.
+  const std::string rest = body.substr(body.find('\n', body.find("v ")));
+  for (const std::string &first :
+       {std::string("v -0 0 0"),
+        std::string("v .5 0 0"),
+        std::string("v 5. 0 0"),
+        std::string("v 1e-40 0 0"),
+        std::string("v -3.4028234e38 0 0"),
+        std::string("v -2.50E+1 1.e5 0"),
+        std::string("v -282.72e8 341.93550e5 -310.65e6"), // (not correctly rounded)
+        std::string("v 0.") + std::string(44, '0') + "1 0 0",
+        std::string("v 123456789012345678901234567890 0 0"),
+        std::string("v +1 0 0"),
+        std::string("v 0x1p3 0 0"),
+        std::string("v 1e39 0 0"),
+        std::string("v 1.5f 0 0"),
+        std::string("v nan 0 0"),
+        std::string("v 1 2"),
+        std::string("v 1 2 3 4"),
+        std::string("v 1 2 3 # c"),
+        std::string("v 1 2 3\nf 1 2"),
+        std::string("v 1 2 3\nf 1 2 0"),
+        std::string("v 1 2 3\nf 1 2 999"),
+        std::string("v 1 2 3\nf -1 -2 -3"),
+        std::string("v 1 2 3\nf 1/1 2/2 3/3"),
+        std::string("v 1 2 3\nvn 0 0 1"),
+        std::string("v 1 2 3\nl 1 2")}) {
+    const std::string text = "# x\n" + first + rest;
+    std::string error_a, error_b;
+    Mesh ma, mb;
+    try {
+      ma = pomar::load_mesh(write("odd_fast.obj", text));
+    } catch (const pomar::Error &e) {
+      error_a = e.what();
+    }
+    try {
+      mb = pomar::load_mesh(write("odd_general.obj", text + "mg 1\n"));
+    } catch (const pomar::Error &e) {
+      error_b = e.what();
+    }
+    EXPECT_EQ(error_a.empty(), error_b.empty()) << first << ": " << error_a << " / " << error_b;
+    EXPECT_TRUE(same_bits(ma.positions, mb.positions)) << first;
+    EXPECT_EQ(ma.triangles, mb.triangles) << first;
+  }
+}
+
 TEST_F(MeshIoTest, PlyFaceListTypeVcglibCannotReadIsError) {
   const std::string data = "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
   const std::string msg = load_error(write("t.ply", ply_header("ascii", "list ushort int") + data));
-  EXPECT_NE(msg.find("without a vertex index list of a type vcglib reads"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("without a vertex index list of a type vcglib reads"), std::string::npos)
+      << msg;
 }
 
 TEST_F(MeshIoTest, PlyMalformedAsciiNumberIsError) {
   // fscanf would read "0-5" as 0 and -5, shifting everything after it.
-  const std::string file = write("m.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
-                                          "property float y\nproperty float z\nelement face 1\n"
-                                          "property list uchar int vertex_indices\nproperty float q\n"
-                                          "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2 0-5\n");
+  const std::string file =
+      write("m.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                     "property float y\nproperty float z\nelement face 1\n"
+                     "property list uchar int vertex_indices\nproperty float q\n"
+                     "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2 0-5\n");
   EXPECT_NE(load_error(file).find("bad number '0-5'"), std::string::npos);
 }
 
 TEST_F(MeshIoTest, PlyEdgeWithoutVertexPropertiesIsError) {
-  const std::string file = write("e.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
-                                          "property float y\nproperty float z\nelement face 1\n"
-                                          "property list uchar int vertex_indices\nelement edge 1\n"
-                                          "property int a\nproperty int b\nend_header\n"
-                                          "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n0 1\n");
+  const std::string file =
+      write("e.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                     "property float y\nproperty float z\nelement face 1\n"
+                     "property list uchar int vertex_indices\nelement edge 1\n"
+                     "property int a\nproperty int b\nend_header\n"
+                     "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n0 1\n");
   EXPECT_NE(load_error(file).find("edge element"), std::string::npos);
 }
 
 TEST_F(MeshIoTest, PlyNaNNamesVertex) {
-  const std::string file = write("nan.ply", "ply\nformat ascii 1.0\nelement vertex 3\n"
-                                            "property float x\nproperty float y\nproperty float z\n"
-                                            "element face 1\nproperty list uchar int vertex_indices\n"
-                                            "end_header\n0 0 0\n1 0 0\n0 nan 0\n3 0 1 2\n");
+  const std::string file =
+      write("nan.ply", "ply\nformat ascii 1.0\nelement vertex 3\n"
+                       "property float x\nproperty float y\nproperty float z\n"
+                       "element face 1\nproperty list uchar int vertex_indices\n"
+                       "end_header\n0 0 0\n1 0 0\n0 nan 0\n3 0 1 2\n");
   const std::string msg = load_error(file);
   EXPECT_NE(msg.find("vertex 2 has a non-finite coordinate"), std::string::npos) << msg;
 }
@@ -668,16 +784,18 @@ TEST_F(MeshIoTest, OffQuadAndPolygon) {
 TEST_F(MeshIoTest, OffWithNormalsColorsAndTexCoords) {
   // NOFF makes vcglib store normals whether or not the mesh type has them.
   LoadReport r;
-  const Mesh m = pomar::load_mesh(write("n.off", "NOFF\n3 1 0\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n"
-                                                 "3 0 1 2\n"), &r);
+  const Mesh m =
+      pomar::load_mesh(write("n.off", "NOFF\n3 1 0\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n"
+                                      "3 0 1 2\n"),
+                       &r);
   EXPECT_EQ(m.triangles, (std::vector<uint32_t>{0, 1, 2}));
   EXPECT_TRUE(r.ignored_attributes.empty()); // per-vertex normals are kept
   ASSERT_NE(m.find(AttributeKind::Normal), nullptr);
-  EXPECT_EQ(m.find(AttributeKind::Normal)->values,
-            (std::vector<float>{0, 0, 1, 0, 0, 1, 0, 0, 1}));
+  EXPECT_EQ(m.find(AttributeKind::Normal)->values, (std::vector<float>{0, 0, 1, 0, 0, 1, 0, 0, 1}));
   const Mesh c = pomar::load_mesh(write("c.off", "STCOFF 3 1 0\n0 0 0 255 0 0 255 0.5 0.5\n"
                                                  "1 0 0 255 0 0 255 1 0\n0 1 0 9 9 9 9 0 1\n"
-                                                 "3 0 1 2 255 0 0\n"), &r);
+                                                 "3 0 1 2 255 0 0\n"),
+                                  &r);
   EXPECT_EQ(c.positions, (std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0}));
   // Vertex colours (RGBA: an alpha is not 255) are kept; the face colour and the texture
   // coordinates (which vcglib's importer does not store) are not.
@@ -690,7 +808,8 @@ TEST_F(MeshIoTest, OffWithNormalsColorsAndTexCoords) {
 
 TEST_F(MeshIoTest, OffTruncatedFaceListIsError) {
   // vcglib reads a token of an empty line here (out of bounds); we must stop first.
-  const std::string msg = load_error(write("cut.off", "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"));
+  const std::string msg =
+      load_error(write("cut.off", "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"));
   EXPECT_NE(msg.find("truncated"), std::string::npos) << msg;
 }
 
@@ -698,7 +817,8 @@ TEST_F(MeshIoTest, OffBadIndexAndNaN) {
   EXPECT_NE(load_error(write("i.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n"))
                 .find("references vertex '3'"),
             std::string::npos);
-  const std::string msg = load_error(write("n.off", "OFF\n3 1 0\n0 0 0\n1 inf 0\n0 1 0\n3 0 1 2\n"));
+  const std::string msg =
+      load_error(write("n.off", "OFF\n3 1 0\n0 0 0\n1 inf 0\n0 1 0\n3 0 1 2\n"));
   EXPECT_NE(msg.find("vertex 1 has a non-finite coordinate"), std::string::npos) << msg;
 }
 
@@ -735,11 +855,12 @@ TEST_F(MeshIoTest, StlBinaryIsWelded) {
 }
 
 TEST_F(MeshIoTest, StlAsciiIsWeldedAndMinusZeroEqualsZero) {
-  const std::string file = write("t.stl", "solid t\n"
-                                          "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"
-                                          "vertex 0 1 0\nendloop\nendfacet\n"
-                                          "facet normal 0 0 1\nouter loop\nvertex 1 0 0\nvertex 1 1 0\n"
-                                          "vertex -0 1 -0\nendloop\nendfacet\nendsolid t\n");
+  const std::string file =
+      write("t.stl", "solid t\n"
+                     "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"
+                     "vertex 0 1 0\nendloop\nendfacet\n"
+                     "facet normal 0 0 1\nouter loop\nvertex 1 0 0\nvertex 1 1 0\n"
+                     "vertex -0 1 -0\nendloop\nendfacet\nendsolid t\n");
   LoadReport r;
   const Mesh m = pomar::load_mesh(file, &r);
   EXPECT_EQ(m.triangles, (std::vector<uint32_t>{0, 1, 2, 1, 3, 2}));
@@ -815,8 +936,10 @@ TEST_F(MeshIoTest, GarbageAndEmptyFiles) {
     const std::string msg2 = load_error(write(empty, ""));
     EXPECT_NE(msg2.find(path(empty)), std::string::npos) << msg2;
   }
-  EXPECT_NE(load_error(write("e.obj", "# nothing\n")).find("contains no triangles"), std::string::npos);
-  EXPECT_NE(load_error(write("e.off", "OFF\n0 0 0\n")).find("contains no triangles"), std::string::npos);
+  EXPECT_NE(load_error(write("e.obj", "# nothing\n")).find("contains no triangles"),
+            std::string::npos);
+  EXPECT_NE(load_error(write("e.off", "OFF\n0 0 0\n")).find("contains no triangles"),
+            std::string::npos);
   EXPECT_NE(load_error(write("e.ply", "ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\n"
                                       "property float y\nproperty float z\nend_header\n"))
                 .find("contains no triangles"),
@@ -889,7 +1012,8 @@ TEST_F(MeshIoTest, SaveIntoMissingDirectoryNamesPath) {
     EXPECT_NE(msg.find(target), std::string::npos) << msg;
   }
   const std::string target = path("no/such/dir/m.stl");
-  EXPECT_NE(error_of([&] { pomar::save_mesh(target, awkward_mesh()); }).find(target), std::string::npos);
+  EXPECT_NE(error_of([&] { pomar::save_mesh(target, awkward_mesh()); }).find(target),
+            std::string::npos);
 }
 
 TEST_F(MeshIoTest, WriteAndReadFile) {

@@ -1,4 +1,5 @@
-// OBJ: a line scan with tinyobjloader's rules (it silently skips short faces and does not
+// OBJ: the common case (positions and faces only) read here in one pass; anything else a
+// line scan with tinyobjloader's rules (it silently skips short faces and does not
 // range-check indices), then tinyobjloader itself (vcglib's OBJ importer drops faces), with
 // the material libraries (`mtllib`) beside the file for their texture names (`map_Kd`);
 // writing formatted here (vcglib's exporter needs material code), with a `.mtl` beside
@@ -183,7 +184,8 @@ void take_obj_attributes(const tinyobj::attrib_t &attrib,
     c.name = "colour";
     c.components = 3;
     for (float x : attrib.colors)
-      c.colour.push_back(static_cast<uint8_t>(std::lround(std::min(1.0f, std::max(0.0f, x)) * 255)));
+      c.colour.push_back(
+          static_cast<uint8_t>(std::lround(std::min(1.0f, std::max(0.0f, x)) * 255)));
     mesh.attributes.push_back(std::move(c));
   } else if (scan.colors) {
     add_unique(ignored, "colors");
@@ -229,8 +231,7 @@ public:
     dir_ = slash == std::string::npos ? "" : obj_path.substr(0, slash + 1);
   }
   bool operator()(const std::string &name, std::vector<tinyobj::material_t> *materials,
-                  std::map<std::string, int> *names, std::string *warn,
-                  std::string *err) override {
+                  std::map<std::string, int> *names, std::string *warn, std::string *err) override {
     const std::string path = !name.empty() && name[0] == '/' ? name : dir_ + name;
     struct stat st;
     const char *why = nullptr;
@@ -317,10 +318,125 @@ void take_obj_materials(const std::vector<tinyobj::material_t> &materials,
     add_unique(ignored, "materials (usemtl without a material library)");
 }
 
+/// A coordinate as tinyobjloader reads it (so that both paths give the same floats):
+/// not a correctly rounded conversion but its own sum in doubles, reproduced here
+/// operation by operation: the integer digits accumulated as m = m * 10 + d, each fraction
+/// digit d at place k added as d * 10^-k (a table of 0.1 ... 1e-7, std::pow beyond), an
+/// exponent applied as ldexp(m * 5^x, x), the sign last; then rounded to float. Only plain
+/// decimals (io_common's plain_decimal) with at most 4 exponent digits come here.
+bool obj_coordinate(const char *b, const char *e, float &out) {
+  static const double kTenths[] = {1.0, 0.1, 0.01, 0.001, 0.0001, 0.00001, 0.000001, 0.0000001};
+  if (!plain_decimal(b, e))
+    return false;
+  const bool negative = *b == '-';
+  b += negative;
+  double m = 0.0;
+  for (; b != e && *b >= '0' && *b <= '9'; ++b) {
+    m *= 10;
+    m += static_cast<int>(*b - '0');
+  }
+  if (b != e && *b == '.')
+    for (int place = 1; ++b != e && *b >= '0' && *b <= '9'; ++place)
+      m += static_cast<int>(*b - '0') * (place < 8 ? kTenths[place] : std::pow(10.0, -place));
+  int exponent = 0;
+  if (b != e) { // (e|E)[+-]digits: plain_decimal checked the form
+    ++b;
+    const bool down = *b == '-';
+    b += *b == '-' || *b == '+';
+    if (e - b > 4)
+      return false;
+    for (; b != e; ++b)
+      exponent = exponent * 10 + (*b - '0');
+    exponent = down ? -exponent : exponent;
+  }
+  const double value =
+      (negative ? -1 : 1) * (exponent ? std::ldexp(m * std::pow(5.0, exponent), exponent) : m);
+  out = static_cast<float>(value);
+  return std::isfinite(out);
+}
+
+/// The common OBJ read straight into the flat arrays, without tinyobjloader: lines "v x y
+/// z" (three plain decimal coordinates, finite), "f a b c ..." (3 to 255 positive indices,
+/// no '/', fan-triangulated as fan_triangles does), comments, empty lines and the "o", "g"
+/// and "s" lines (which change nothing here: faces stay in file order). Anything else
+/// (normals, texture coordinates, colours, materials, relative or slashed indices, an index
+/// past the last vertex, a NUL byte, ...) returns false, and the scan and tinyobjloader
+/// read the file with every check and message of theirs. The mesh is the one they give.
+bool read_simple_obj(const std::vector<uint8_t> &bytes, const std::string &path,
+                     const SizeCheck &check, Mesh &out, LoadReport &report) {
+  const char *p = reinterpret_cast<const char *>(bytes.data());
+  const char *const end = p + bytes.size();
+  if (std::find(p, end, '\0') != end)
+    return false;
+  Mesh mesh;
+  size_t faces = 0, polygons = 0;
+  uint32_t corner[256];
+  while (p < end) {
+    const char *eol = p;
+    while (eol < end && *eol != '\n' && *eol != '\r')
+      ++eol;
+    const char *q = p;
+    p = eol + (eol < end && *eol == '\r' && eol + 1 < end && eol[1] == '\n' ? 2 : 1);
+    const auto blank = [](char c) { return c == ' ' || c == '\t'; };
+    const auto token = [&](const char *&b, const char *&e) { // the next token of the line
+      while (q < eol && blank(*q))
+        ++q;
+      b = q;
+      while (q < eol && !blank(*q))
+        ++q;
+      e = q;
+      return b != e;
+    };
+    const char *b, *e;
+    if (!token(b, e) || *b == '#')
+      continue;
+    const size_t key = size_t(e - b);
+    if (key == 1 && (*b == 'o' || *b == 'g' || *b == 's'))
+      continue;
+    if (key == 1 && *b == 'v') {
+      for (int k = 0; k < 3; ++k) {
+        float x;
+        if (!token(b, e) || !obj_coordinate(b, e, x))
+          return false;
+        mesh.positions.push_back(x);
+      }
+      if (token(b, e)) // a w or a colour: tinyobjloader's path
+        return false;
+      continue;
+    }
+    if (key != 1 || *b != 'f')
+      return false;
+    uint32_t n = 0;
+    for (uint64_t index; token(b, e); corner[n++] = uint32_t(index - 1))
+      if (n == 255 || !parse_digits(b, e, INT_MAX, index) || index == 0)
+        return false;
+    if (n < 3)
+      return false;
+    for (uint32_t c = 1; c + 1 < n; ++c)
+      mesh.triangles.insert(mesh.triangles.end(), {corner[0], corner[c], corner[c + 1]});
+    ++faces;
+    polygons += n > 3;
+  }
+  const size_t vertices = mesh.positions.size() / 3;
+  for (const uint32_t v : mesh.triangles)
+    if (v >= vertices)
+      return false;
+  run_size_check(check, path, vertices, mesh.triangles.size() / 3);
+  report.file_vertices = vertices;
+  report.file_faces = faces;
+  report.polygons_triangulated = polygons;
+  report.unreferenced_vertices = count_unreferenced(mesh);
+  out = std::move(mesh);
+  return true;
+}
+
 } // namespace
 
 Mesh load_obj(const std::string &path, LoadReport &report, const SizeCheck &check) {
   const std::vector<uint8_t> bytes = read_file(path);
+  Mesh fast;
+  if (read_simple_obj(bytes, path, check, fast, report))
+    return fast;
   const ObjScan scan = scan_obj(bytes, path);
   run_size_check(check, path, scan.vertices, scan.triangles);
 
@@ -340,19 +456,20 @@ Mesh load_obj(const std::string &path, LoadReport &report, const SizeCheck &chec
   if (!ok)
     fail(path, "OBJ parse error: " + first_line(err));
   if (attrib.vertices.size() != 3 * scan.vertices)
-    fail(path, "tinyobjloader read " + num(attrib.vertices.size() / 3) + " vertices but the file has " +
-                   num(scan.vertices) + " 'v' lines");
+    fail(path, "tinyobjloader read " + num(attrib.vertices.size() / 3) +
+                   " vertices but the file has " + num(scan.vertices) + " 'v' lines");
   size_t faces = 0;
   for (const auto &shape : shapes)
     faces += shape.mesh.num_face_vertices.size();
   if (faces != scan.faces)
-    fail(path, "tinyobjloader read " + num(faces) + " faces but the file has " + num(scan.faces) + " 'f' lines");
+    fail(path, "tinyobjloader read " + num(faces) + " faces but the file has " + num(scan.faces) +
+                   " 'f' lines");
 
   Mesh mesh;
   mesh.triangles = fan_triangles(shapes, scan.vertices, path);
   if (mesh.triangles.size() != 3 * scan.triangles)
-    fail(path, "triangulation produced " + num(mesh.triangles.size() / 3) + " triangles, expected " +
-                   num(scan.triangles));
+    fail(path, "triangulation produced " + num(mesh.triangles.size() / 3) +
+                   " triangles, expected " + num(scan.triangles));
   mesh.positions.assign(attrib.vertices.begin(), attrib.vertices.end());
   take_obj_attributes(attrib, shapes, scan, scan.vertices, mesh, report.ignored_attributes);
   take_obj_materials(materials, shapes, scan, libraries, mesh, report.ignored_attributes);
