@@ -196,7 +196,13 @@ TEST(Codec, FileDoesNotDependOnThreadCount) {
         EncodeOptions options;
         options.threads = threads[i];
         options.clusters = clusters;
+        options.min_parallel_vertices = 0; // every clustered level on the threads
         files[i] = encode(*mesh, options);
+        if (threads[i] == 2) { // and the default: the small levels on this thread
+          EncodeOptions by_default = options;
+          by_default.min_parallel_vertices = EncodeOptions().min_parallel_vertices;
+          EXPECT_EQ(encode(*mesh, by_default), files[i]) << "clusters " << clusters;
+        }
       }
       ASSERT_GT(inspect(files[0].data(), files[0].size()).clusters, 64u);
       EXPECT_EQ(files[0], files[1]) << "clusters " << clusters;

@@ -122,9 +122,14 @@ struct EncodeOptions {
   uint32_t clusters = 0;
   double cluster_ratio = 0.01;
   bool progressive = false; ///< pure progressive mode: global levels only, no clusters
-  /// Threads for the encoder's parallel steps (decimation's candidate evaluation); 0 = the
-  /// cores this process may run on. The file does not depend on it.
+  /// Threads for the encoder's parallel steps (decimation's candidate evaluation, the
+  /// clustered levels); 0 = the cores this process may run on. The file does not depend on
+  /// it.
   unsigned threads = 0;
+  /// With threads > 1, a clustered level started on a mesh of fewer vertices than this is
+  /// recorded and coded on the calling thread: on small levels the parallel phases cost
+  /// more than they save. 0: every level on the threads. The file does not depend on it.
+  uint32_t min_parallel_vertices = 4096;
   Progress progress; ///< optional
   /// Peak memory allowed, in bytes: encode() throws pomar::Error before its large
   /// allocations if it would need more (pomar/limits.h). 0 = automatic (the memory

@@ -106,7 +106,8 @@ private:
 } // namespace
 
 ClusteredLevels encode_clustered_levels(Rebuild &rb, size_t global, FileHeader &header,
-                                        unsigned threads, const Progress &progress) {
+                                        unsigned threads, uint32_t min_parallel_vertices,
+                                        const Progress &progress) {
   const size_t L = rb.levels();
   LevelMesh &lm = rb.mesh;
   header.flags |= kFlagClustered;
@@ -142,7 +143,11 @@ ClusteredLevels encode_clustered_levels(Rebuild &rb, size_t global, FileHeader &
     const ModelSlots slots(models);
     for (SymbolRecorder &recording : recordings)
       recording.slots = &slots;
-    if (parallel.on()) {
+    // A level with little work (the coarse clustered levels: a few vertices per cluster)
+    // is recorded and coded on this thread, like the decoder's small levels: the two
+    // phases' hand-overs cost more than the threads save there. Same symbols either way.
+    const bool threaded = parallel.on() && lm.vertex_count() >= min_parallel_vertices;
+    if (threaded) {
       parallel.level(codec, recordings, {0, level, older_than}, next_local);
     } else {
       for (uint32_t c = 0; c < clusters; ++c) {
@@ -159,7 +164,7 @@ ClusteredLevels encode_clustered_levels(Rebuild &rb, size_t global, FileHeader &
     const std::vector<double> costs = symbol_costs(slots, freezer.counts());
     for (const SymbolRecorder &recording : recordings)
       add_recording_bits(recording, slots, costs, bits);
-    if (parallel.on())
+    if (threaded)
       parallel.code(recordings, slots, block_coders);
     else
       for (uint32_t c = 0; c < clusters; ++c)

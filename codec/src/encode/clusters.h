@@ -25,9 +25,11 @@ struct ClusteredLevels {
 /// mesh: every vertex roots a cluster) and fill the clustered fields and level entries of
 /// `header`. Each cluster's splits of every clustered level are recorded, the level models
 /// frozen on all clusters' symbols, then every cluster is coded into its own block.
-/// The clusters of a level are recorded on `threads` threads (1: one after the other); the
-/// file does not depend on it.
+/// The clusters of a level are recorded on `threads` threads (1: one after the other),
+/// those of a level started on fewer than `min_parallel_vertices` vertices on the calling
+/// thread; the file does not depend on either.
 ClusteredLevels encode_clustered_levels(Rebuild &rebuild, size_t global, FileHeader &header,
-                                        unsigned threads, const Progress &progress);
+                                        unsigned threads, uint32_t min_parallel_vertices,
+                                        const Progress &progress);
 
 } // namespace pomar

@@ -242,7 +242,7 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
   ClusteredLevels clustered;
   if (global < rb.levels())
     clustered = encode_clustered_levels(rb, global, header, decode_threads(options.threads),
-                                        options.progress);
+                                        options.min_parallel_vertices, options.progress);
   if (rb.mesh.vertex_count() != nv || rb.mesh.ct.face_count() != nf)
     throw Error(Error::Kind::Internal,
                 "internal encoder error: the refined mesh does not match the input");
