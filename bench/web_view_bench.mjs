@@ -18,7 +18,7 @@
 import { readFileSync } from 'node:fs';
 import { PomarStream } from '../web/pomar_stream.js';
 import { RangeFile } from '../web/range_fetch.js';
-import { chooseLevels, Convergence } from '../web/view_refine.js';
+import { chooseLevels, Convergence, detailDecay } from '../web/view_refine.js';
 import { closeUp, frameMesh, orbitCamera, viewOf } from '../web/camera.js';
 import { loadModuleInNode } from '../web/test/node_support.mjs';
 
@@ -38,13 +38,14 @@ const fetchOptions = { maxGap: 128 }; // pomar.js's default
 for (const name of ['maxGap', 'maxRanges', 'wholeBlockBytes', 'estimateMargin', 'estimateSlack'])
   if (opt(name) !== undefined) fetchOptions[name] = Number(opt(name));
 const settings = { targetPixels: Number(opt('target', 3)), backface: args.includes('--backface'),
-  occlusion: !args.includes('--no-occlusion') };
+  occlusion: !args.includes('--no-occlusion'), errorModel: opt('errorModel', undefined),
+  detailSafety: opt('detailSafety') === undefined ? undefined : Number(opt('detailSafety')) };
 const M = await loadModuleInNode();
 const blob = new Blob([readFileSync(file)]);
 
 async function fresh() {
   const stream = await new PomarStream(M, new RangeFile(blob, fetchOptions), fetchOptions).open();
-  return { stream, mesh: stream.decoder.mesh(), errorSeen: new Map() };
+  return { stream, mesh: stream.decoder.mesh(), errorSeen: new Map(), detailSeen: new Map() };
 }
 const pct = (s, b) => `${(100 * b / s.file.size).toFixed(2)}%`;
 function line(what, s, extra = '') {
@@ -62,8 +63,9 @@ async function settle(s, camera) {
   for (; steps < 64; ++steps) {
     const v = viewOf(camera, width, height);
     const choice = chooseLevels({ info: s.stream.info, levels: s.stream.levels, clusterBounds: s.mesh.clusterBounds,
-      errorSeen: s.errorSeen, mesh: s.mesh }, v, settings);
-    if (process.env.DEBUG) console.log(steps, choice.refine, choice.coarsen, choice.hidden, choice.culled);
+      errorSeen: s.errorSeen, detailSeen: s.detailSeen, mesh: s.mesh }, v, settings);
+    if (process.env.DEBUG) console.log(steps, choice.refine, choice.coarsen, choice.hidden, choice.culled,
+      `decay ${detailDecay(s.detailSeen).toFixed(3)}`);
     const wanted = choice.changed ? convergence.next(choice.levels, s.stream.levels, v) : null;
     if (!wanted) break;
     await s.stream.want(wanted);

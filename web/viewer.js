@@ -2,7 +2,8 @@
 // web/build.sh), orbit camera, view-dependent refinement through pomar.js.
 // URL parameters: ?file=URL opens a file, &target=PX sets the target error, &refine=0 starts
 // with refinement off (the base clustered mesh only); &test=1 runs the scripted browser test
-// (web/test/browser_test.py) and reports to the test server.
+// (web/test/browser_test.py) and reports to the test server; &test=fidelity the pixel
+// comparison of bench/web_fidelity_bench.py (web/test/fidelity_page.js).
 import { open } from './pomar.js';
 import { frameMesh, orbitCamera, pan, viewOf } from './camera.js';
 import * as THREE from './dist/three.module.js';
@@ -239,7 +240,7 @@ try {
   initGL();
   frame(null);
   if (params.get('test')) {
-    import('./test/page_test.js').then((t) => t.run({ openSource, camera, moved, view, frame: () => frame(model),
+    import(params.get('test') === 'fidelity' ? './test/fidelity_page.js' : './test/page_test.js').then((t) => t.run({ openSource, camera, moved, view, frame: () => frame(model),
       model: () => model, showError, refineLoop }));
   } else if (params.get('file')) {
     if (params.get('target')) $('target').value = params.get('target');
