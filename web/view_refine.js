@@ -63,11 +63,12 @@ export function detailDecay(detailSeen, minClusters = 16) {
  *    coarser one; the level after them is expected to move it by `decay` times that),
  *    never above the longest edge; the edge alone where no detail was measured (a cluster
  *    whose vertices all come from the global levels). */
-export function clusterError(b, c, l, { finest, errorModel, detailSafety = 1, decay = 1 }) {
+export function clusterError(b, c, l, { finest, errorModel, detailSafety = 1, decay = 1, maxTilt = Infinity }) {
   const S = BOUNDS_STRIDE;
   if (l >= finest) return 0;
   const edge = b[S * c + 6];
   if (errorModel !== 'measured' || !(b[S * c + 13] > 0)) return edge;
+  if (b[S * c + 12] > maxTilt * edge) return edge;
   return Math.min(edge, detailSafety * decay * b[S * c + 12]);
 }
 
@@ -215,7 +216,7 @@ function backFacing(eye, centre, radius, axis, cosWidth, margin) {
  */
 export function chooseLevels(state, view, {
   targetPixels = 3, coarsenFraction = 0.5, triangleBudget = 2e6, backface = false, backfaceMargin = 0.3,
-  occlusion = true, occlusionWidth = 128, errorModel = 'edge', detailSafety = 1,
+  occlusion = true, occlusionWidth = 128, errorModel = 'edge', detailSafety = 1, maxTilt = Infinity,
 } = {}) {
   const { info, levels, clusterBounds: b, errorSeen } = state;
   const S = BOUNDS_STRIDE;
@@ -233,7 +234,7 @@ export function chooseLevels(state, view, {
     else if (seen[seen.length - 1][0] === level) seen[seen.length - 1][1] = b[S * c + 12];
     detailSeen.set(c, seen);
   }
-  const model = { finest, base, errorModel, detailSafety, decay: detailDecay(detailSeen) };
+  const model = { finest, base, errorModel, detailSafety, maxTilt, decay: detailDecay(detailSeen) };
   const faces = (l) => (l === 0 ? info.baseFaces : info.levels[l - 1].faces);
   const pixelsPerUnit = view.height / (2 * Math.tan(view.fovY / 2));
   const buffer = occlusion && state.mesh && view.width ? occlusionBuffer(state.mesh, view, occlusionWidth) : null;

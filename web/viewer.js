@@ -1,7 +1,8 @@
 // The pomar web viewer: three.js (WebGL2; web/dist/three.module.js, vendored from npm by
 // web/build.sh), orbit camera, view-dependent refinement through pomar.js.
 // URL parameters: ?file=URL opens a file, &target=PX sets the target error, &refine=0 starts
-// with refinement off (the base clustered mesh only); &test=1 runs the scripted browser test
+// with refinement off (the base clustered mesh only), &error=measured&safety=K the measured
+// error model (view_refine.js); &test=1 runs the scripted browser test
 // (web/test/browser_test.py) and reports to the test server; &test=fidelity the pixel
 // comparison of bench/web_fidelity_bench.py (web/test/fidelity_page.js).
 import { open } from './pomar.js';
@@ -138,6 +139,10 @@ function showError(message) {
   $('error').textContent = message ? 'error: ' + message : '';
 }
 
+// &error=measured[&safety=K]: view_refine.js's measured error model (default: the edge).
+const errorModel = params.get('error') === 'measured'
+  ? { errorModel: 'measured', ...(params.get('safety') ? { detailSafety: Number(params.get('safety')) } : {}) } : {};
+
 /** Refine/coarsen for the current view until the model is stable for it. */
 async function refineLoop() {
   if (refining || !model || !$('refine').checked) return;
@@ -148,7 +153,7 @@ async function refineLoop() {
       // The target is in CSS pixels (what one sees), the view in drawn pixels.
       const v = view();
       const targetPixels = (Number($('target').value) || 3) * (v.width / Math.max(1, canvas.clientWidth));
-      const r = await model.wantView(v, { targetPixels });
+      const r = await model.wantView(v, { targetPixels, ...errorModel });
       if (!r.changed && version === cameraVersion) break;
     }
   } catch (e) {

@@ -175,6 +175,13 @@ check(choice.levels[0] === 4, `a measured detail over the target refines to the 
 // A detail larger than the edge: the edge caps it (same choice as the edge model).
 choice = chooseLevels({ info: one, levels: Int32Array.of(2), clusterBounds: withDetail(five, 1), errorSeen: new Map() }, view, measured);
 check(choice.levels[0] === 4, `the longest edge caps the measured error: ${choice.levels}`);
+// maxTilt: a detail over maxTilt x the edge (facets that would tilt by more) takes the edge.
+choice = chooseLevels({ info: one, levels: Int32Array.of(2), clusterBounds: withDetail(near, 0.001), errorSeen: new Map() }, view,
+  { ...measured, maxTilt: 0.01 });
+check(choice.levels[0] === 5, `a detail over maxTilt x the edge is refined as by the edge: ${choice.levels}`);
+choice = chooseLevels({ info: one, levels: Int32Array.of(2), clusterBounds: withDetail(near, 0.001), errorSeen: new Map() }, view,
+  { ...measured, maxTilt: 0.05 });
+check(choice.levels[0] === 2, `a detail under maxTilt x the edge keeps the measured error: ${choice.levels}`);
 // No vertex measured (count 0): the edge.
 choice = chooseLevels({ info: one, levels: Int32Array.of(2), clusterBounds: withDetail(near, 0, 0), errorSeen: new Map() }, view, measured);
 check(choice.levels[0] === 5, `without a measured detail, the edge model: ${choice.levels}`);
