@@ -12,6 +12,12 @@
 // there, the current one scaled by sqrt(faces(l) / faces(l-1)) from the level table
 // (edges grow like 1/sqrt of the face count).
 //
+// `errorModel: 'measured'` (an option; see clusterError and web/README.md) bounds the error
+// instead by what the last decoded level did: `detailSafety` x decay x the detail of the
+// cluster's newest vertices (measured in WebAssembly), under the longest edge. On the
+// dragon it saves bytes only where it draws differently from full resolution (measured
+// with bench/web_fidelity_bench.py), hence not the default.
+//
 // A cluster is refined while its error projected to pixels exceeds `targetPixels` (largest
 // first, within `triangleBudget`), straight to the level where the error extrapolated with
 // the level table (as for coarsening, below) meets the target, coarsened one level when the
