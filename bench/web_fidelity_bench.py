@@ -29,7 +29,7 @@ WEB = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), 
 sys.path.insert(0, WEB)
 sys.path.insert(0, os.path.join(WEB, 'test'))
 import serve  # noqa: E402
-from browser_support import parse  # noqa: E402
+from browser_support import CHROMIUM_FLAGS, parse, stop  # noqa: E402
 
 
 def main():
@@ -57,10 +57,7 @@ def main():
         query = urllib.parse.urlencode({'test': 'fidelity', 'file': '/data/model.pomar', 'views': args.views,
                                         'policies': json.dumps(policies)})
         url = f'http://127.0.0.1:{server.server_address[1]}/web/index.html?{query}'
-        cmd = [args.chromium, '--headless=new', '--no-sandbox', '--use-angle=swiftshader',
-               '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist', '--no-first-run',
-               '--no-default-browser-check', '--disable-extensions', '--window-size=800,600',
-               f'--user-data-dir={os.path.join(work, "profile")}', url]
+        cmd = [args.chromium, *CHROMIUM_FLAGS, f'--user-data-dir={os.path.join(work, "profile")}', url]
         proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         result_path = os.path.join(reports, 'result.json')
         deadline = time.time() + args.timeout
@@ -77,14 +74,7 @@ def main():
                 if name.endswith('.png'):
                     shutil.copy(os.path.join(reports, name), os.path.join(args.images, name))
     finally:
-        if proc is not None:
-            proc.terminate()
-            try:
-                proc.wait(10)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-        if server is not None:
-            server.shutdown()
+        stop(proc, server)
         shutil.rmtree(work, ignore_errors=True)
     if not r.get('ok'):
         print('web_fidelity_bench: the page failed: ' + str(r.get('exception')))
