@@ -12,7 +12,8 @@ F x the model's size, as web/test/page_test.js; overview = the whole model frame
 a fresh stream, the view refined until stable, and counts the pixels of the 800x457 drawing
 buffer that differ (|dR|+|dG|+|dB| > 32, the browser test's metric). Prints one line per
 view and policy: bytes fetched (% of the file), triangles, finest level used, steps,
-differing pixels. See web/README.md, "View-dependent refinement".
+differing pixels, and how many of those are covered by the surface in one image only (the
+silhouette moved; the others differ by their shading). See web/README.md, "View-dependent refinement".
 """
 import argparse
 import json
@@ -85,7 +86,8 @@ def main():
         for p in v['policies']:
             print(f"  {json.dumps(p['settings']):60s} {100 * p['bytesFetched'] / v['fileBytes']:6.2f}% "
                   f"{p['bytesFetched']:8d} B {p['triangles']:7d} triangles, max level {p['maxLevel']}, "
-                  f"{p['steps']:2d} steps, {p['differing']:6d} pixels differ ({100 * p['differing'] / total:.2f}%)")
+                  f"{p['steps']:2d} steps, {p['differing']:6d} pixels differ ({100 * p['differing'] / total:.2f}%), "
+                  f"{p['silhouette']} of them on the silhouette")
     return 0
 
 
