@@ -3,7 +3,7 @@
 resolution, in headless Chromium (WebGL2 on SwiftShader), and what they fetch.
 
     python3 bench/web_fidelity_bench.py FILE.pomar [--views closeup:0.1,overview]
-        [--policy JSON]... [--images DIR] [--timeout S]
+        [--policy JSON]... [--shading flat|smooth] [--images DIR] [--timeout S]
 
 Each --policy is a JSON object of view_refine.js chooseLevels settings (default: one
 policy, the defaults). For each view (closeup:F = the surface point facing the camera from
@@ -40,6 +40,8 @@ def main():
     ap.add_argument('--policy', action='append', help='chooseLevels settings as JSON (repeatable)')
     ap.add_argument('--images', help='keep the screenshots here (VIEW_full.png, VIEW_K.png for policy K)')
     ap.add_argument('--timeout', type=float, default=900)
+    ap.add_argument('--shading', choices=['flat', 'smooth'], default='flat',
+                    help="the viewer's shading: flat facets (its default) or vertex normals")
     args = parse(ap, 'web_fidelity_bench')
     if args is None:
         return 77
@@ -56,7 +58,7 @@ def main():
         server = serve.make_server(root, 0, test=True, report_dir=reports)
         threading.Thread(target=server.serve_forever, daemon=True).start()
         query = urllib.parse.urlencode({'test': 'fidelity', 'file': '/data/model.pomar', 'views': args.views,
-                                        'policies': json.dumps(policies)})
+                                        'policies': json.dumps(policies), 'shading': args.shading})
         url = f'http://127.0.0.1:{server.server_address[1]}/web/index.html?{query}'
         cmd = [args.chromium, *CHROMIUM_FLAGS, f'--user-data-dir={os.path.join(work, "profile")}', url]
         proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
