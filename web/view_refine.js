@@ -67,8 +67,10 @@ export function detailDecay(detailSeen, minClusters = 16) {
  *  - 'measured': `detailSafety` x decay x the detail of its newest vertices (b[12], measured
  *    in WebAssembly: how far the last level's vertex splits moved the surface off the
  *    coarser one; the level after them is expected to move it by `decay` times that),
- *    never above the longest edge; the edge alone where no detail was measured (a cluster
- *    whose vertices all come from the global levels). */
+ *    never above the longest edge; the edge alone where no detail was measured (no
+ *    vertex of the cluster has a defined plane, b[13] = 0) or where the detail exceeds
+ *    `maxTilt` x the edge (facets that would tilt by more than that). At the base
+ *    clustered level the detail is the offset of the cluster's one vertex. */
 export function clusterError(b, c, l, { finest, errorModel, detailSafety = 1, decay = 1, maxTilt = Infinity }) {
   const S = BOUNDS_STRIDE;
   if (l >= finest) return 0;
