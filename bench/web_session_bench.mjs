@@ -31,6 +31,7 @@ const blob = new Blob([readFileSync(file)]);
 const stream = await new PomarStream(M, new RangeFile(blob, options), options).open();
 let mesh = stream.decoder.mesh();
 const errorSeen = new Map();
+const detailSeen = new Map();
 const info = stream.info;
 let last = { bytesFetched: 0, requests: 0 };
 function line(what) {
@@ -46,7 +47,7 @@ async function settle(camera) {
   const convergence = new Convergence();
   for (let steps = 0; steps < 64; ++steps) {
     const v = viewOf(camera, width, height);
-    const choice = chooseLevels({ info, levels: stream.levels, clusterBounds: mesh.clusterBounds, errorSeen, mesh }, v, settings);
+    const choice = chooseLevels({ info, levels: stream.levels, clusterBounds: mesh.clusterBounds, errorSeen, detailSeen, mesh }, v, settings);
     const wanted = choice.changed ? convergence.next(choice.levels, stream.levels, v) : null;
     if (!wanted) break;
     await stream.want(wanted);

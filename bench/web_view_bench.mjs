@@ -4,7 +4,7 @@
 //
 //   node bench/web_view_bench.mjs FILE.pomar [--closeup 0.1] [--target 3] [--size 800x457]
 //        [--clusters 1000,2000] [--maxGap B] [--wholeBlockBytes B] [--estimateMargin F]
-//        [--backface] [--no-occlusion]
+//        [--backface] [--no-occlusion] [--errorModel measured [--detailSafety K] [--maxTilt T]]
 //
 // Reports, each from a fresh stream: the base clustered mesh (open), the overview (whole
 // model framed as the viewer frames it, refined to `target` pixels), a close-up (the
@@ -18,7 +18,7 @@
 import { readFileSync } from 'node:fs';
 import { PomarStream } from '../web/pomar_stream.js';
 import { RangeFile } from '../web/range_fetch.js';
-import { chooseLevels, Convergence } from '../web/view_refine.js';
+import { chooseLevels, Convergence, detailDecay } from '../web/view_refine.js';
 import { closeUp, frameMesh, orbitCamera, viewOf } from '../web/camera.js';
 import { loadModuleInNode } from '../web/test/node_support.mjs';
 
@@ -30,7 +30,8 @@ const opt = (name, fallback) => {
 };
 if (!file) {
   console.error('usage: node bench/web_view_bench.mjs FILE.pomar [--closeup F] [--target PX] [--size WxH] ' +
-    '[--clusters C,C] [--maxGap B] [--wholeBlockBytes B] [--estimateMargin F] [--backface] [--no-occlusion]');
+    '[--clusters C,C] [--maxGap B] [--wholeBlockBytes B] [--estimateMargin F] [--backface] [--no-occlusion] ' +
+    '[--errorModel measured [--detailSafety K] [--maxTilt T]]');
   process.exit(2);
 }
 const [width, height] = opt('size', '800x457').split('x').map(Number);
@@ -38,13 +39,14 @@ const fetchOptions = { maxGap: 128 }; // pomar.js's default
 for (const name of ['maxGap', 'maxRanges', 'wholeBlockBytes', 'estimateMargin', 'estimateSlack'])
   if (opt(name) !== undefined) fetchOptions[name] = Number(opt(name));
 const settings = { targetPixels: Number(opt('target', 3)), backface: args.includes('--backface'),
-  occlusion: !args.includes('--no-occlusion') };
+  occlusion: !args.includes('--no-occlusion'), errorModel: opt('errorModel', 'edge') };
+for (const name of ['detailSafety', 'maxTilt']) if (opt(name) !== undefined) settings[name] = Number(opt(name));
 const M = await loadModuleInNode();
 const blob = new Blob([readFileSync(file)]);
 
 async function fresh() {
   const stream = await new PomarStream(M, new RangeFile(blob, fetchOptions), fetchOptions).open();
-  return { stream, mesh: stream.decoder.mesh(), errorSeen: new Map() };
+  return { stream, mesh: stream.decoder.mesh(), errorSeen: new Map(), detailSeen: new Map() };
 }
 const pct = (s, b) => `${(100 * b / s.file.size).toFixed(2)}%`;
 function line(what, s, extra = '') {
@@ -62,8 +64,9 @@ async function settle(s, camera) {
   for (; steps < 64; ++steps) {
     const v = viewOf(camera, width, height);
     const choice = chooseLevels({ info: s.stream.info, levels: s.stream.levels, clusterBounds: s.mesh.clusterBounds,
-      errorSeen: s.errorSeen, mesh: s.mesh }, v, settings);
-    if (process.env.DEBUG) console.log(steps, choice.refine, choice.coarsen, choice.hidden, choice.culled);
+      errorSeen: s.errorSeen, detailSeen: s.detailSeen, mesh: s.mesh }, v, settings);
+    if (process.env.DEBUG) console.log(steps, choice.refine, choice.coarsen, choice.hidden, choice.culled,
+      `decay ${detailDecay(s.detailSeen).toFixed(3)}`);
     const wanted = choice.changed ? convergence.next(choice.levels, s.stream.levels, v) : null;
     if (!wanted) break;
     await s.stream.want(wanted);
@@ -77,7 +80,9 @@ const info = s.stream.info;
 console.log(`${file}: ${info.vertices} vertices, ${info.fileBytes} bytes, ${info.clusters} clusters, levels ` +
   `${info.baseLevel}..${info.finestLevel}, global part ${info.globalBytes} B (${pct(s.stream, info.globalBytes)}); ` +
   `view ${width}x${height}, target ${settings.targetPixels} px, backface ${settings.backface}, occlusion ` +
-  `${settings.occlusion}, fetch ${JSON.stringify(fetchOptions)}`);
+  `${settings.occlusion}, error model ${settings.errorModel}` +
+  `${settings.errorModel === 'measured' ? ` (detailSafety ${settings.detailSafety ?? 1}, maxTilt ${settings.maxTilt ?? 'none'})` : ''}, ` +
+  `fetch ${JSON.stringify(fetchOptions)}`);
 line('open (base mesh)', s);
 if (info.clusters) {
   const camera = orbitCamera();

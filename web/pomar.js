@@ -45,6 +45,7 @@ export class PomarModel {
     this.nextId = 1;
     this.waiters = []; // {id, resolve, reject}
     this.errorSeen = new Map();
+    this.detailSeen = new Map();
     this.lastWanted = null;
     this.convergence = new Convergence(); // damps wantView's steps for one camera
     this.worker.onmessage = (e) => this.receive(e.data);
@@ -119,7 +120,7 @@ export class PomarModel {
       return { changed: false, refine: 0, coarsen: 0, hidden: 0 };
     }
     const choice = chooseLevels({ info: this.info, levels: this.levels, clusterBounds: this.mesh.clusterBounds,
-      errorSeen: this.errorSeen, mesh: this.mesh }, view, settings);
+      errorSeen: this.errorSeen, detailSeen: this.detailSeen, mesh: this.mesh }, view, settings);
     const wanted = this.convergence.next(choice.levels, this.levels, view);
     if (!wanted || sameLevels(wanted, this.lastWanted)) return { ...choice, changed: false };
     await this.want({ levels: wanted }, true);

@@ -124,8 +124,8 @@ export class Decoder {
   }
 
   /** The current mesh as typed arrays (copies, transferable), plus per-cluster bounds:
-   *  BOUNDS_STRIDE floats per cluster (bbox min, max, longest edge, face count, normal cone:
-   *  see view_refine.js). */
+   *  BOUNDS_STRIDE floats per cluster (bbox min, max, longest edge, face count, normal cone,
+   *  detail of its newest vertices and their count: see view_refine.js). */
   mesh() {
     const M = this.M;
     if (M._pw_extract(this.h) < 0) throw new PomarError(lastError(M));

@@ -12,6 +12,12 @@
 // there, the current one scaled by sqrt(faces(l) / faces(l-1)) from the level table
 // (edges grow like 1/sqrt of the face count).
 //
+// `errorModel: 'measured'` (an option; see clusterError and web/README.md) bounds the error
+// instead by what the last decoded level did: `detailSafety` x decay x the detail of the
+// cluster's newest vertices (measured in WebAssembly), under the longest edge. On the
+// dragon it saves bytes only where it draws differently from full resolution (measured
+// with bench/web_fidelity_bench.py), hence not the default.
+//
 // A cluster is refined while its error projected to pixels exceeds `targetPixels` (largest
 // first, within `triangleBudget`), straight to the level where the error extrapolated with
 // the level table (as for coarsening, below) meets the target, coarsened one level when the
@@ -34,8 +40,45 @@
 //    of its screen rectangle is hidden. This keeps the body behind a close-up coarse.
 
 /** Floats per cluster in `clusterBounds` (pw_cluster_bounds in web/src/pomar_web.cpp):
- *  box min xyz, max xyz, error proxy, faces, normal cone axis xyz, cosine of its width. */
-export const BOUNDS_STRIDE = 12;
+ *  box min xyz, max xyz, longest edge, faces, normal cone axis xyz, cosine of its width,
+ *  detail of its newest vertices, how many they are (0: no detail measured). */
+export const BOUNDS_STRIDE = 14;
+
+/** The per-level decay of the measured detail, from what the client has seen: for every
+ *  cluster measured at two or more levels above the base clustered level (`detailSeen`:
+ *  cluster -> [[level, detail], ...], levels rising), (last / first)^(1 / levels between); the median
+ *  over those clusters, within [0.5, 1]; 1 (no decay: the conservative guess) while fewer
+ *  than `minClusters` clusters have two measurements. */
+export function detailDecay(detailSeen, minClusters = 16) {
+  const ratios = [];
+  for (const seen of detailSeen.values()) {
+    if (seen.length < 2) continue;
+    const [l0, d0] = seen[0];
+    const [l1, d1] = seen[seen.length - 1];
+    if (d0 > 0 && d1 > 0 && l1 > l0) ratios.push(Math.pow(d1 / d0, 1 / (l1 - l0)));
+  }
+  if (ratios.length < minClusters) return 1;
+  ratios.sort((a, b) => a - b);
+  return Math.min(1, Math.max(0.5, ratios[ratios.length >> 1]));
+}
+
+/** The error bound of cluster c at its current level `l` used to refine it:
+ *  - 'edge': the longest edge (b[6]);
+ *  - 'measured': `detailSafety` x decay x the detail of its newest vertices (b[12], measured
+ *    in WebAssembly: how far the last level's vertex splits moved the surface off the
+ *    coarser one; the level after them is expected to move it by `decay` times that),
+ *    never above the longest edge; the edge alone where no detail was measured (no
+ *    vertex of the cluster has a defined plane, b[13] = 0) or where the detail exceeds
+ *    `maxTilt` x the edge (facets that would tilt by more than that). At the base
+ *    clustered level the detail is the offset of the cluster's one vertex. */
+export function clusterError(b, c, l, { finest, errorModel, detailSafety = 1, decay = 1, maxTilt = Infinity }) {
+  const S = BOUNDS_STRIDE;
+  if (l >= finest) return 0;
+  const edge = b[S * c + 6];
+  if (errorModel !== 'measured' || !(b[S * c + 13] > 0)) return edge;
+  if (b[S * c + 12] > maxTilt * edge) return edge;
+  return Math.min(edge, detailSafety * decay * b[S * c + 12]);
+}
 
 /** Does the box [lo, hi] lie entirely outside one plane of the frustum of `viewProj`
  *  (column-major 4x4, clip = viewProj * [x,y,z,1])? */
@@ -181,13 +224,25 @@ function backFacing(eye, centre, radius, axis, cosWidth, margin) {
  */
 export function chooseLevels(state, view, {
   targetPixels = 3, coarsenFraction = 0.5, triangleBudget = 2e6, backface = false, backfaceMargin = 0.3,
-  occlusion = true, occlusionWidth = 128,
+  occlusion = true, occlusionWidth = 128, errorModel = 'edge', detailSafety = 1, maxTilt = Infinity,
 } = {}) {
   const { info, levels, clusterBounds: b, errorSeen } = state;
   const S = BOUNDS_STRIDE;
   const n = info.clusters;
   const base = info.baseLevel;
   const finest = info.finestLevel;
+  // The detail measured per cluster and level, kept for the decay (state.detailSeen, made
+  // here when the caller keeps none).
+  const detailSeen = state.detailSeen ?? (state.detailSeen = new Map());
+  for (let c = 0; c < n; ++c) {
+    const level = levels[c];
+    if (level <= base || level >= finest || !(b[S * c + 13] > 0)) continue;
+    const seen = detailSeen.get(c) ?? [];
+    if (!seen.length || seen[seen.length - 1][0] < level) seen.push([level, b[S * c + 12]]);
+    else if (seen[seen.length - 1][0] === level) seen[seen.length - 1][1] = b[S * c + 12];
+    detailSeen.set(c, seen);
+  }
+  const model = { finest, base, errorModel, detailSafety, maxTilt, decay: detailDecay(detailSeen) };
   const faces = (l) => (l === 0 ? info.baseFaces : info.levels[l - 1].faces);
   const pixelsPerUnit = view.height / (2 * Math.tan(view.fovY / 2));
   const buffer = occlusion && state.mesh && view.width ? occlusionBuffer(state.mesh, view, occlusionWidth) : null;
@@ -202,7 +257,7 @@ export function chooseLevels(state, view, {
     const l = levels[c];
     const lo = [b[S * c], b[S * c + 1], b[S * c + 2]];
     const hi = [b[S * c + 3], b[S * c + 4], b[S * c + 5]];
-    const error = l >= finest ? 0 : b[S * c + 6];
+    const error = clusterError(b, c, l, model);
     errorSeen.set(`${c}:${l}`, error);
     if (outsideFrustum(view.viewProj, lo, hi)) {
       if (l > base) ++hidden;
@@ -227,8 +282,14 @@ export function chooseLevels(state, view, {
     if (l < finest && error * toPixels > targetPixels) {
       candidates.push({ c, pixels: error * toPixels });
     } else if (l > base) {
-      const coarser = errorSeen.get(`${c}:${l - 1}`) ??
-        (l >= finest ? b[S * c + 6] : error) * Math.sqrt(faces(l) / faces(l - 1));
+      // Never seen at l - 1: at the finest level, the longest edge scaled (or, measured,
+      // the detail the finest level added); otherwise the current error scaled.
+      let coarser = errorSeen.get(`${c}:${l - 1}`);
+      if (coarser === undefined) {
+        coarser = (l >= finest ? b[S * c + 6] : error) * Math.sqrt(faces(l) / faces(l - 1));
+        if (l >= finest && errorModel === 'measured' && b[S * c + 13] > 0)
+          coarser = Math.min(coarser, detailSafety * b[S * c + 12]);
+      }
       if (coarser * toPixels < coarsenFraction * targetPixels) {
         wanted[c] = l - 1;
         ++coarsen;

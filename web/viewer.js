@@ -1,8 +1,10 @@
 // The pomar web viewer: three.js (WebGL2; web/dist/three.module.js, vendored from npm by
 // web/build.sh), orbit camera, view-dependent refinement through pomar.js.
 // URL parameters: ?file=URL opens a file, &target=PX sets the target error, &refine=0 starts
-// with refinement off (the base clustered mesh only); &test=1 runs the scripted browser test
-// (web/test/browser_test.py) and reports to the test server.
+// with refinement off (the base clustered mesh only), &error=measured&safety=K the measured
+// error model (view_refine.js); &test=1 runs the scripted browser test
+// (web/test/browser_test.py) and reports to the test server; &test=fidelity the pixel
+// comparison of bench/web_fidelity_bench.py (web/test/fidelity_page.js).
 import { open } from './pomar.js';
 import { frameMesh, orbitCamera, pan, viewOf } from './camera.js';
 import * as THREE from './dist/three.module.js';
@@ -13,21 +15,26 @@ const params = new URLSearchParams(location.search);
 
 // ------------------------------------------------------------------ renderer
 // One three.js mesh drawn with a small shader: flat shading from screen-space derivatives
-// (the decoded mesh has no normals), colour by cluster or by level.
+// (the decoded mesh has no normals), colour by cluster or by level. &shading=smooth shades
+// with vertex normals instead (area-weighted face normals, computed at each upload), e.g.
+// to compare refinement policies (bench/web_fidelity_bench.py --shading smooth).
 const VS = `precision highp float;
 in vec3 position;
 in float cluster;
 in float level;
+in vec3 normal;
 uniform mat4 projectionMatrix;
 uniform mat4 modelViewMatrix;
 uniform int colourMode;
 uniform float finest;
 uniform float base;
 out vec3 vPosition;
+out vec3 vNormal;
 flat out vec3 vColour;
 vec3 hue(float h) { return clamp(abs(mod(h * 6.0 + vec3(0, 4, 2), 6.0) - 3.0) - 1.0, 0.0, 1.0); }
 void main() {
   vPosition = position;
+  vNormal = normal;
   if (colourMode == 1) vColour = 0.35 + 0.65 * hue(fract(cluster * 0.61803));
   else if (colourMode == 2) vColour = 0.3 + 0.7 * hue(0.66 * (1.0 - (level - base) / max(1.0, finest - base)));
   else vColour = vec3(0.82, 0.80, 0.76);
@@ -35,15 +42,40 @@ void main() {
 }`;
 const FS = `precision highp float;
 in vec3 vPosition;
+in vec3 vNormal;
 flat in vec3 vColour;
 uniform vec3 eye;
+uniform int smoothShading;
 out vec4 colour;
 void main() {
-  vec3 n = normalize(cross(dFdx(vPosition), dFdy(vPosition)));
+  vec3 n = smoothShading == 1 && dot(vNormal, vNormal) > 0.0 ? normalize(vNormal)
+                                                             : normalize(cross(dFdx(vPosition), dFdy(vPosition)));
   vec3 l = normalize(eye - vPosition);
   float d = abs(dot(n, l));
   colour = vec4(vColour * (0.25 + 0.75 * d), 1.0);
 }`;
+
+const smoothShading = params.get('shading') === 'smooth';
+/** Per vertex, the sum of the normals of its faces, each as long as twice its area. */
+function vertexNormals(p, t) {
+  const n = new Float32Array(p.length);
+  for (let f = 0; f < t.length; f += 3) {
+    const a = 3 * t[f];
+    const b = 3 * t[f + 1];
+    const c = 3 * t[f + 2];
+    const u = [p[b] - p[a], p[b + 1] - p[a + 1], p[b + 2] - p[a + 2]];
+    const w = [p[c] - p[a], p[c + 1] - p[a + 1], p[c + 2] - p[a + 2]];
+    const x = u[1] * w[2] - u[2] * w[1];
+    const y = u[2] * w[0] - u[0] * w[2];
+    const z = u[0] * w[1] - u[1] * w[0];
+    for (const v of [a, b, c]) {
+      n[v] += x;
+      n[v + 1] += y;
+      n[v + 2] += z;
+    }
+  }
+  return n;
+}
 
 let renderer = null;
 let scene = null;
@@ -56,7 +88,8 @@ function initGL() {
   scene = new THREE.Scene();
   const material = new THREE.RawShaderMaterial({
     glslVersion: THREE.GLSL3, vertexShader: VS, fragmentShader: FS, side: THREE.DoubleSide,
-    uniforms: { colourMode: { value: 0 }, finest: { value: 1 }, base: { value: 0 }, eye: { value: new THREE.Vector3() } },
+    uniforms: { colourMode: { value: 0 }, finest: { value: 1 }, base: { value: 0 }, eye: { value: new THREE.Vector3() },
+      smoothShading: { value: smoothShading ? 1 : 0 } },
   });
   shown = new THREE.Mesh(new THREE.BufferGeometry(), material);
   shown.frustumCulled = false; // the geometry changes with every decode
@@ -72,6 +105,7 @@ function upload(mesh, model) {
   const level = new Float32Array(mesh.vertexCluster.length);
   for (let v = 0; v < level.length; ++v) level[v] = levels && levels.length ? levels[mesh.vertexCluster[v]] : mesh.vertexLevel[v];
   g.setAttribute('level', new THREE.BufferAttribute(level, 1));
+  if (smoothShading) g.setAttribute('normal', new THREE.BufferAttribute(vertexNormals(mesh.positions, mesh.triangles), 3));
   g.setIndex(new THREE.BufferAttribute(mesh.triangles, 1));
   shown.geometry.dispose();
   shown.geometry = g;
@@ -137,6 +171,10 @@ function showError(message) {
   $('error').textContent = message ? 'error: ' + message : '';
 }
 
+// &error=measured[&safety=K]: view_refine.js's measured error model (default: the edge).
+const errorModel = params.get('error') === 'measured'
+  ? { errorModel: 'measured', ...(params.get('safety') ? { detailSafety: Number(params.get('safety')) } : {}) } : {};
+
 /** Refine/coarsen for the current view until the model is stable for it. */
 async function refineLoop() {
   if (refining || !model || !$('refine').checked) return;
@@ -147,7 +185,7 @@ async function refineLoop() {
       // The target is in CSS pixels (what one sees), the view in drawn pixels.
       const v = view();
       const targetPixels = (Number($('target').value) || 3) * (v.width / Math.max(1, canvas.clientWidth));
-      const r = await model.wantView(v, { targetPixels });
+      const r = await model.wantView(v, { targetPixels, ...errorModel });
       if (!r.changed && version === cameraVersion) break;
     }
   } catch (e) {
@@ -239,7 +277,7 @@ try {
   initGL();
   frame(null);
   if (params.get('test')) {
-    import('./test/page_test.js').then((t) => t.run({ openSource, camera, moved, view, frame: () => frame(model),
+    import(params.get('test') === 'fidelity' ? './test/fidelity_page.js' : './test/page_test.js').then((t) => t.run({ openSource, camera, moved, view, frame: () => frame(model),
       model: () => model, showError, refineLoop }));
   } else if (params.get('file')) {
     if (params.get('target')) $('target').value = params.get('target');

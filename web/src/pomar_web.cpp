@@ -117,6 +117,54 @@ std::vector<int> to_levels(const Handle &h, const int32_t *wanted) {
   return std::vector<int>(wanted, wanted + h.decoder->cluster_count());
 }
 
+/// Per vertex, how far it stands off the surface its neighbours span: the distance from
+/// its position to the plane through the centroid of its neighbours whose normal is the
+/// area-weighted normal of the faces around it (-1 where that normal is zero). A vertex
+/// created by a vertex split at level l lands next to v_to, inside the fan that v_to had at
+/// level l-1; its neighbours are (mostly) vertices of that fan, so this is the offset the
+/// split added to the coarser surface there: on a smooth patch about e^2/2R (edge e,
+/// radius of curvature R), plus the scan's noise. Unlike the distance to v_to, it does not
+/// grow with the edge length on a flat patch; unlike the distance to the coarser faces
+/// themselves, it needs only the current mesh.
+std::vector<float> detail_of(const pomar::Mesh &mesh) {
+  const std::vector<float> &p = mesh.positions;
+  const std::vector<uint32_t> &t = mesh.triangles;
+  const size_t nv = mesh.vertex_count();
+  std::vector<double> centroid(3 * nv, 0.0), normal(3 * nv, 0.0);
+  std::vector<uint32_t> count(nv, 0);
+  for (size_t f = 0; f < mesh.triangle_count(); ++f) {
+    const uint32_t *v = &t[3 * f];
+    double e[2][3], n[3];
+    for (int k = 0; k < 2; ++k)
+      for (int j = 0; j < 3; ++j)
+        e[k][j] = double(p[3 * v[k + 1] + j]) - p[3 * v[0] + j];
+    n[0] = e[0][1] * e[1][2] - e[0][2] * e[1][1];
+    n[1] = e[0][2] * e[1][0] - e[0][0] * e[1][2];
+    n[2] = e[0][0] * e[1][1] - e[0][1] * e[1][0];
+    for (int k = 0; k < 3; ++k) {
+      // Each corner sees the other two; an inner neighbour is counted twice (once per
+      // face of the edge), a border one once: the centroid leans a little inwards.
+      for (int j = 0; j < 3; ++j) {
+        centroid[3 * v[k] + j] += double(p[3 * v[(k + 1) % 3] + j]) + p[3 * v[(k + 2) % 3] + j];
+        normal[3 * v[k] + j] += n[j];
+      }
+      count[v[k]] += 2;
+    }
+  }
+  std::vector<float> out(nv, -1.f);
+  for (size_t v = 0; v < nv; ++v) {
+    const double *n = &normal[3 * v];
+    const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (!(length > 0) || count[v] == 0)
+      continue;
+    double d = 0;
+    for (int j = 0; j < 3; ++j)
+      d += (double(p[3 * v + j]) - centroid[3 * v + j] / count[v]) * n[j];
+    out[v] = float(std::abs(d) / length);
+  }
+  return out;
+}
+
 } // namespace
 
 extern "C" {
@@ -320,8 +368,15 @@ EMSCRIPTEN_KEEPALIVE const uint32_t *pw_vertex_level(Handle *h) { return h->vert
 ///  7    its face count (faces are counted in the cluster of their first vertex);
 ///  8-11 its normal cone: the unit axis (the area-weighted mean normal of the faces touching
 ///       the cluster) and the cosine of the widest angle between it and one of those faces'
-///       normals (-1, a cone of every direction, when the axis is undefined).
-constexpr size_t kBoundsStride = 12;
+///       normals (-1, a cone of every direction, when the axis is undefined);
+///  12   the detail of its newest vertices: over the cluster's vertices created at the
+///       highest level any of them has, the largest distance from a vertex to the plane of
+///       its neighbours (through their centroid, normal to the area-weighted normal of the
+///       faces around the vertex; see detail_of);
+///  13   how many vertices that is (0: none measured, e.g. no vertex with a defined plane).
+///       At the base clustered level a cluster is one vertex (from a global level): its
+///       detail is that vertex's offset from its neighbours in the base clustered mesh.
+constexpr size_t kBoundsStride = 14;
 
 EMSCRIPTEN_KEEPALIVE const float *pw_cluster_bounds(Handle *h) {
   const uint32_t n = std::max<uint32_t>(1, h->decoder->cluster_count());
@@ -396,6 +451,21 @@ EMSCRIPTEN_KEEPALIVE const float *pw_cluster_bounds(Handle *h) {
     for (int k = 0; k < 3; ++k)
       b[8 + k] = length > 0 ? float(b[8 + k] / length) : 0.f;
     b[11] = length > 0 ? 1.f : -1.f;
+  }
+  // The detail of each cluster's newest vertices (entries 12, 13).
+  if (!h->vertex_level.empty()) {
+    const std::vector<float> detail = detail_of(h->mesh);
+    std::vector<uint32_t> newest(n, 0);
+    for (uint32_t v = 0; v < h->mesh.vertex_count(); ++v)
+      if (detail[v] >= 0)
+        newest[cluster(v)] = std::max(newest[cluster(v)], h->vertex_level[v]);
+    for (uint32_t v = 0; v < h->mesh.vertex_count(); ++v) {
+      float *b = at(cluster(v));
+      if (detail[v] >= 0 && h->vertex_level[v] == newest[cluster(v)]) {
+        b[12] = std::max(b[12], detail[v]);
+        b[13] += 1;
+      }
+    }
   }
   // The cone's width: the face normal furthest from the axis (zero-area faces have none).
   for (size_t f = 0; f < h->mesh.triangle_count(); ++f) {

@@ -1,7 +1,26 @@
-"""What web/test/browser_test.py and web/test/mobile_test.py share: the check that Chromium
-and the WebAssembly build are there, and a counter of checks."""
+"""What web/test/browser_test.py, web/test/mobile_test.py and bench/web_fidelity_bench.py
+share: the check that Chromium and the WebAssembly build are there, Chromium's flags, the
+end of a session, and a counter of checks."""
 import os
 import shutil
+import subprocess
+
+# Headless Chromium with WebGL2 on SwiftShader through ANGLE, an 800x600 window.
+CHROMIUM_FLAGS = ['--headless=new', '--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
+                  '--ignore-gpu-blocklist', '--no-first-run', '--no-default-browser-check', '--disable-extensions',
+                  '--window-size=800,600']
+
+
+def stop(proc, server):
+    """End the browser (terminate, kill after 10 s) and the server, whichever was started."""
+    if proc is not None:
+        proc.terminate()
+        try:
+            proc.wait(10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+    if server is not None:
+        server.shutdown()
 
 WEB = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 

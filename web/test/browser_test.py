@@ -35,7 +35,7 @@ WEB = os.path.dirname(HERE)
 sys.path.insert(0, WEB)
 REFERENCES = os.path.join(os.path.dirname(WEB), 'docs', 'images', 'web_test')
 import serve  # noqa: E402
-from browser_support import Checks, parse  # noqa: E402
+from browser_support import CHROMIUM_FLAGS, Checks, parse, stop  # noqa: E402
 
 
 def main():
@@ -92,10 +92,7 @@ def main():
                '&noRange=/no-range/data/model.pomar&singleRange=/single-range/data/model.pomar&truncatedGlobal=/data/truncated_global.pomar'
                '&truncatedBlocks=/data/truncated_blocks.pomar&damagedBlocks=/data/damaged_blocks.pomar')
         profile = os.path.join(work, 'profile')
-        cmd = [args.chromium, '--headless=new', '--no-sandbox', '--use-angle=swiftshader',
-               '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist', '--no-first-run',
-               '--no-default-browser-check', '--disable-extensions', '--window-size=800,600',
-               f'--user-data-dir={profile}', '--enable-logging=stderr', '--v=0', url]
+        cmd = [args.chromium, *CHROMIUM_FLAGS, f'--user-data-dir={profile}', '--enable-logging=stderr', '--v=0', url]
         browser_log = open(os.path.join(work, 'chromium.log'), 'wb')
         proc = subprocess.Popen(cmd, stdout=browser_log, stderr=subprocess.STDOUT)
         result_path = os.path.join(reports, 'result.json')
@@ -117,14 +114,7 @@ def main():
             print('\n'.join('  page: ' + x for x in r.get('log', [])))
         log = server.log
     finally:
-        if proc is not None:
-            proc.terminate()
-            try:
-                proc.wait(10)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-        if server is not None:
-            server.shutdown()
+        stop(proc, server)
 
     try:
         check(r.get('ok'), 'the scripted session ran to the end' + ('' if r.get('ok') else ': ' + str(r.get('exception'))))

@@ -11,7 +11,8 @@
 #  4. runs the viewer in headless Chromium (web/test/browser_test.py), screenshots compared
 #     with docs/images/web_test/, then on an emulated phone with touch input
 #     (web/test/mobile_test.py).
-# (Plus web/test/unit_test.mjs: request coalescing and the choice of levels for a view.)
+# (Plus web/test/unit_test.mjs: request coalescing and the choice of levels for a view;
+# web/test/detail_test.mjs: the detail measured per cluster on a flat + bumpy grid.)
 # Each step is skipped with a message when emscripten, Node.js or Chromium is missing.
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
@@ -29,6 +30,8 @@ mkdir -p "$samples"
 "$TOOL" encode "$REPO/samples/bunny.ply" "$samples/bunny_c5.pomar" --cluster-ratio 0.05 -q
 "$TOOL" encode "$REPO/samples/bunny.ply" "$samples/bunny_progressive.pomar" --progressive -q
 node "$REPO/web/test/unit_test.mjs"
+echo "web tests: the measured detail of each cluster (node web/test/detail_test.mjs)"
+node "$REPO/web/test/detail_test.mjs" "$TOOL"
 echo "web tests: WASM decode = native decode (node web/test/wasm_decode_test.mjs)"
 node "$REPO/web/test/wasm_decode_test.mjs" "$TOOL" "$samples/bunny.pomar" "$samples/bunny_c5.pomar" \
   "$samples/bunny_progressive.pomar"

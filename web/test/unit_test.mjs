@@ -1,7 +1,7 @@
 // Unit tests of the pure parts of web/: request coalescing (range_fetch.js) and the choice
 // of levels for a view (view_refine.js).   node web/test/unit_test.mjs
 import { coalesce, parseByteranges, RangeFile } from '../range_fetch.js';
-import { BOUNDS_STRIDE, Convergence, chooseLevels } from '../view_refine.js';
+import { BOUNDS_STRIDE, Convergence, chooseLevels, detailDecay } from '../view_refine.js';
 import { checker } from './node_support.mjs';
 
 const result = checker();
@@ -152,6 +152,47 @@ check(choice.levels[1] === 5, `without occlusion culling the far cluster refines
 const hole = { positions: wall.positions, triangles: Uint32Array.of(0, 1, 2) }; // half the wall
 choice = chooseLevels({ ...state, mesh: hole }, view, { targetPixels: 3 });
 check(choice.levels[1] === 5, `a cluster seen past the edge of an occluder refines: ${choice.levels}`);
+
+// The measured error model: the detail of a cluster's newest vertices (entries 12, 13 of
+// its bounds; web/test/detail_test.mjs checks how WebAssembly measures it) x detailSafety x
+// the decay, under its longest edge; the edge alone where no detail was measured.
+const withDetail = (box, detail, count = 5) => {
+  const b = bounds([box]);
+  b.set([detail, count], 12);
+  return b;
+};
+const measured = { targetPixels: 3, occlusion: false, errorModel: 'measured', detailSafety: 4 };
+// near: 25 px by its edge; a detail of 0.001 x 4 = 2 px: kept at level 2 (not refined).
+const one = { ...info, clusters: 1 };
+choice = chooseLevels({ info: one, levels: Int32Array.of(2), clusterBounds: withDetail(near, 0.001), errorSeen: new Map() }, view, measured);
+check(choice.levels[0] === 2 && choice.refine === 0, `a small measured detail is not refined: ${choice.levels}`);
+choice = chooseLevels({ info: one, levels: Int32Array.of(2), clusterBounds: withDetail(near, 0.001), errorSeen: new Map() }, view,
+  { targetPixels: 3, occlusion: false });
+check(choice.levels[0] === 5, `the edge model refines the same cluster: ${choice.levels}`);
+// A detail of 0.0025 x 4 = 5 px: refined, to level 4 (faces x4: 5 / 2 = 2.5 px).
+choice = chooseLevels({ info: one, levels: Int32Array.of(2), clusterBounds: withDetail(near, 0.0025), errorSeen: new Map() }, view, measured);
+check(choice.levels[0] === 4, `a measured detail over the target refines to the level meeting it: ${choice.levels}`);
+// A detail larger than the edge: the edge caps it (same choice as the edge model).
+choice = chooseLevels({ info: one, levels: Int32Array.of(2), clusterBounds: withDetail(five, 1), errorSeen: new Map() }, view, measured);
+check(choice.levels[0] === 4, `the longest edge caps the measured error: ${choice.levels}`);
+// maxTilt: a detail over maxTilt x the edge (facets that would tilt by more) takes the edge.
+choice = chooseLevels({ info: one, levels: Int32Array.of(2), clusterBounds: withDetail(near, 0.001), errorSeen: new Map() }, view,
+  { ...measured, maxTilt: 0.01 });
+check(choice.levels[0] === 5, `a detail over maxTilt x the edge is refined as by the edge: ${choice.levels}`);
+choice = chooseLevels({ info: one, levels: Int32Array.of(2), clusterBounds: withDetail(near, 0.001), errorSeen: new Map() }, view,
+  { ...measured, maxTilt: 0.05 });
+check(choice.levels[0] === 2, `a detail under maxTilt x the edge keeps the measured error: ${choice.levels}`);
+// No vertex measured (count 0): the edge.
+choice = chooseLevels({ info: one, levels: Int32Array.of(2), clusterBounds: withDetail(near, 0, 0), errorSeen: new Map() }, view, measured);
+check(choice.levels[0] === 5, `without a measured detail, the edge model: ${choice.levels}`);
+// The decay: the median over clusters seen at two levels of (last / first)^(1 / levels).
+const seen = new Map();
+for (let c = 0; c < 20; ++c) seen.set(c, [[3, 1], [5, c < 11 ? 0.64 : 0.81]]);
+check(Math.abs(detailDecay(seen) - 0.8) < 1e-9, `decay per level, the median of 0.8 and 0.9: ${detailDecay(seen)}`);
+check(detailDecay(new Map([...seen].slice(0, 10))) === 1, 'too few clusters seen twice: no decay assumed');
+seen.set(99, [[3, 1]]);
+for (let c = 0; c < 20; ++c) seen.set(c, [[3, 1], [4, 0.1]]);
+check(detailDecay(seen) === 0.5, `the decay is at least 0.5 a level: ${detailDecay(seen)}`);
 
 // Convergence: a cluster sent back to a level it had for this camera keeps its level; the
 // same map asked again is converged; another camera starts afresh.
