@@ -5,14 +5,14 @@
 
 #include <pomar/vcg_adapter.h>
 
-#include <wrap/io_trimesh/io_mask.h> // export_stl.h uses it without including it
 #include <wrap/io_trimesh/export_stl.h>
 #include <wrap/io_trimesh/import_stl.h>
+#include <wrap/io_trimesh/io_mask.h> // export_stl.h uses it without including it
 
+#include <charconv>
 #include <climits>
 #include <cmath>
 #include <string_view>
-#include <unordered_map>
 
 namespace pomar::io {
 namespace {
@@ -41,10 +41,12 @@ StlKind classify_stl(const std::string &path) {
   kind.facets = uint64_t(head[80]) | uint64_t(head[81]) << 8 | uint64_t(head[82]) << 16 |
                 uint64_t(head[83]) << 24;
   const uint64_t expected = 84 + 50 * kind.facets;
-  const unsigned char *text = std::find_if(head, head + probe, [](unsigned char c) { return !std::isspace(c); });
+  const unsigned char *text =
+      std::find_if(head, head + probe, [](unsigned char c) { return !std::isspace(c); });
   const bool solid = head + probe - text >= 5 && std::memcmp(text, "solid", 5) == 0;
-  kind.binary = size == expected ||
-                (!solid && std::any_of(head + 84, head + probe, [](unsigned char b) { return b > 127; }));
+  kind.binary =
+      size == expected ||
+      (!solid && std::any_of(head + 84, head + probe, [](unsigned char b) { return b > 127; }));
   if (kind.binary) {
     if (size < expected)
       fail(path, "truncated binary STL (header says " + num(kind.facets) +
@@ -62,35 +64,50 @@ StlKind classify_stl(const std::string &path) {
   return kind;
 }
 
-/// Merges vertices with exactly equal coordinates (compared as floats, so -0 equals +0),
-/// keeping the first occurrence's position and the order of first occurrences. Returns the
-/// number of vertices merged away.
+/// Merges vertices with exactly equal coordinates (compared as floats, so -0 equals +0;
+/// the positions are finite), keeping the first occurrence's position and the order of
+/// first occurrences. Returns the number of vertices merged away. An open-addressing table
+/// of kept vertex ids over the coordinates' bits (-0 made +0): a binary STL of 2M facets has
+/// 6M corners to look up.
 size_t weld_identical(Mesh &mesh) {
-  struct Key {
-    float x, y, z;
-    bool operator==(const Key &o) const { return x == o.x && y == o.y && z == o.z; }
-  };
-  struct Hash {
-    size_t operator()(const Key &k) const {
-      uint32_t b[3];
-      const float c[3] = {k.x + 0.0f, k.y + 0.0f, k.z + 0.0f}; // -0 -> +0
-      std::memcpy(b, c, sizeof b);
-      return (size_t(b[0]) * 0x9E3779B1u) ^ (size_t(b[1]) * 0x85EBCA77u) ^ (size_t(b[2]) * 0xC2B2AE3Du);
-    }
-  };
   const size_t n = mesh.vertex_count();
-  std::unordered_map<Key, uint32_t, Hash> first;
-  first.reserve(n);
+  const float *p = mesh.positions.data();
+  const auto bits = [p](size_t v, uint32_t b[3]) {
+    const float c[3] = {p[3 * v] + 0.0f, p[3 * v + 1] + 0.0f, p[3 * v + 2] + 0.0f}; // -0 -> +0
+    std::memcpy(b, c, sizeof c);
+  };
+  size_t slots = 16;
+  while (slots < 2 * n)
+    slots *= 2;
+  std::vector<uint32_t> table(slots, UINT32_MAX); // kept vertex id, UINT32_MAX = empty
+  std::vector<uint32_t> kept_from;                // kept vertex -> its first corner
+  kept_from.reserve(n / 2 + 1);
   std::vector<uint32_t> remap(n);
-  std::vector<float> kept;
-  kept.reserve(mesh.positions.size());
   for (size_t i = 0; i < n; ++i) {
-    const Key key{mesh.positions[3 * i], mesh.positions[3 * i + 1], mesh.positions[3 * i + 2]};
-    const auto ins = first.emplace(key, static_cast<uint32_t>(kept.size() / 3));
-    if (ins.second)
-      kept.insert(kept.end(), {key.x, key.y, key.z});
-    remap[i] = ins.first->second;
+    uint32_t b[3];
+    bits(i, b);
+    uint64_t h = (uint64_t(b[0]) * 0x9E3779B97F4A7C15ull) ^
+                 (uint64_t(b[1]) * 0xC2B2AE3D27D4EB4Full) ^
+                 (uint64_t(b[2]) * 0x165667B19E3779F9ull);
+    h ^= h >> 29;
+    for (size_t at = size_t(h) & (slots - 1);; at = (at + 1) & (slots - 1)) {
+      const uint32_t k = table[at];
+      if (k == UINT32_MAX) { // first occurrence
+        table[at] = remap[i] = static_cast<uint32_t>(kept_from.size());
+        kept_from.push_back(static_cast<uint32_t>(i));
+        break;
+      }
+      uint32_t o[3];
+      bits(kept_from[k], o);
+      if (o[0] == b[0] && o[1] == b[1] && o[2] == b[2]) {
+        remap[i] = k;
+        break;
+      }
+    }
   }
+  std::vector<float> kept(3 * kept_from.size());
+  for (size_t k = 0; k < kept_from.size(); ++k)
+    std::copy(p + 3 * size_t(kept_from[k]), p + 3 * size_t(kept_from[k]) + 3, &kept[3 * k]);
   for (auto &t : mesh.triangles)
     t = remap[t];
   mesh.positions.swap(kept);
@@ -115,7 +132,8 @@ Mesh read_binary_stl(const std::string &path, uint64_t facets, bool &colored) {
       fail(path, "truncated binary STL (facet " + num(f) + ")");
     for (size_t c = 0; c < 9; ++c) {
       const unsigned char *b = rec + 12 + 4 * c;
-      const uint32_t bits = b[0] | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24;
+      const uint32_t bits =
+          b[0] | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24;
       std::memcpy(&mesh.positions[9 * f + c], &bits, 4);
     }
     for (uint32_t k = 0; k < 3; ++k)
@@ -132,10 +150,17 @@ public:
   explicit TokenCursor(std::string_view text) : text_(text) {}
   /// The next token; false at the end of the text.
   bool next(std::string_view &out) {
-    const size_t begin = text_.find_first_not_of(" \t\r\n", pos_);
-    if (begin == std::string_view::npos)
+    // (A loop per character: find_first_of with a set calls memchr for each one.)
+    const auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; };
+    const size_t n = text_.size();
+    size_t begin = pos_;
+    while (begin < n && blank(text_[begin]))
+      ++begin;
+    if (begin == n)
       return false;
-    pos_ = std::min(text_.find_first_of(" \t\r\n", begin), text_.size());
+    pos_ = begin;
+    while (pos_ < n && !blank(text_[pos_]))
+      ++pos_;
     out = text_.substr(begin, pos_ - begin);
     return true;
   }
@@ -151,6 +176,17 @@ uint64_t count_occurrences(std::string_view text, std::string_view word) {
   for (size_t at = text.find(word); at != text.npos; at = text.find(word, at + word.size()))
     ++n;
   return n;
+}
+
+/// A coordinate of ASCII STL: a plain decimal with from_chars (correctly rounded to float,
+/// as strtof), anything else ('+', inf, hex, ...) as parse_float reads it.
+bool stl_float(std::string_view c, float &x) {
+  if (plain_decimal(c.data(), c.data() + c.size())) {
+    const auto r = std::from_chars(c.data(), c.data() + c.size(), x);
+    if (r.ec == std::errc() && r.ptr == c.data() + c.size())
+      return true;
+  }
+  return parse_float(std::string(c), x);
 }
 
 /// ASCII STL, read here rather than by vcglib (whose reader leaks its FILE on a malformed
@@ -180,14 +216,14 @@ Mesh read_ascii_stl(const std::string &path, const SizeCheck &check) {
       float v[3];
       std::string_view c;
       for (float &x : v)
-        if (!looping || !tokens.next(c) || !parse_float(std::string(c), x))
+        if (!looping || !tokens.next(c) || !stl_float(c, x))
           fail(path, "malformed vertex in ASCII STL facet " + num(facet));
       mesh.positions.insert(mesh.positions.end(), v, v + 3);
       ++in_loop;
     } else if (tok == "endloop") {
       if (!looping || in_loop != 3)
-        fail(path, "ASCII STL facet " + num(facet) + " has " + num(in_loop) +
-                       " vertices (3 expected)");
+        fail(path,
+             "ASCII STL facet " + num(facet) + " has " + num(in_loop) + " vertices (3 expected)");
       const uint32_t first = static_cast<uint32_t>(mesh.positions.size() / 3 - 3);
       mesh.triangles.insert(mesh.triangles.end(), {first, first + 1, first + 2});
       looping = false;
@@ -214,7 +250,8 @@ Mesh load_stl(const std::string &path, LoadReport &report, const SizeCheck &chec
   if (colored)
     add_unique(report.ignored_attributes, "colors");
   for (size_t v = 0; v < mesh.vertex_count(); ++v)
-    check_finite(mesh.positions[3 * v], mesh.positions[3 * v + 1], mesh.positions[3 * v + 2], v, path, true);
+    check_finite(mesh.positions[3 * v], mesh.positions[3 * v + 1], mesh.positions[3 * v + 2], v,
+                 path, true);
   report.file_vertices = mesh.vertex_count();
   report.file_faces = mesh.triangle_count();
   report.welded_vertices = weld_identical(mesh);
@@ -253,7 +290,6 @@ std::string stl_ascii_text(const Mesh &mesh) {
   }
   return s + "endsolid pomar\n";
 }
-
 
 void save_stl_binary(const std::string &path, const Mesh &mesh) {
   IoMesh m;
