@@ -183,7 +183,8 @@ void take_obj_attributes(const tinyobj::attrib_t &attrib,
     c.name = "colour";
     c.components = 3;
     for (float x : attrib.colors)
-      c.colour.push_back(static_cast<uint8_t>(std::lround(std::min(1.0f, std::max(0.0f, x)) * 255)));
+      c.colour.push_back(
+          static_cast<uint8_t>(std::lround(std::min(1.0f, std::max(0.0f, x)) * 255)));
     mesh.attributes.push_back(std::move(c));
   } else if (scan.colors) {
     add_unique(ignored, "colors");
@@ -229,8 +230,7 @@ public:
     dir_ = slash == std::string::npos ? "" : obj_path.substr(0, slash + 1);
   }
   bool operator()(const std::string &name, std::vector<tinyobj::material_t> *materials,
-                  std::map<std::string, int> *names, std::string *warn,
-                  std::string *err) override {
+                  std::map<std::string, int> *names, std::string *warn, std::string *err) override {
     const std::string path = !name.empty() && name[0] == '/' ? name : dir_ + name;
     struct stat st;
     const char *why = nullptr;
@@ -340,19 +340,20 @@ Mesh load_obj(const std::string &path, LoadReport &report, const SizeCheck &chec
   if (!ok)
     fail(path, "OBJ parse error: " + first_line(err));
   if (attrib.vertices.size() != 3 * scan.vertices)
-    fail(path, "tinyobjloader read " + num(attrib.vertices.size() / 3) + " vertices but the file has " +
-                   num(scan.vertices) + " 'v' lines");
+    fail(path, "tinyobjloader read " + num(attrib.vertices.size() / 3) +
+                   " vertices but the file has " + num(scan.vertices) + " 'v' lines");
   size_t faces = 0;
   for (const auto &shape : shapes)
     faces += shape.mesh.num_face_vertices.size();
   if (faces != scan.faces)
-    fail(path, "tinyobjloader read " + num(faces) + " faces but the file has " + num(scan.faces) + " 'f' lines");
+    fail(path, "tinyobjloader read " + num(faces) + " faces but the file has " + num(scan.faces) +
+                   " 'f' lines");
 
   Mesh mesh;
   mesh.triangles = fan_triangles(shapes, scan.vertices, path);
   if (mesh.triangles.size() != 3 * scan.triangles)
-    fail(path, "triangulation produced " + num(mesh.triangles.size() / 3) + " triangles, expected " +
-                   num(scan.triangles));
+    fail(path, "triangulation produced " + num(mesh.triangles.size() / 3) +
+                   " triangles, expected " + num(scan.triangles));
   mesh.positions.assign(attrib.vertices.begin(), attrib.vertices.end());
   take_obj_attributes(attrib, shapes, scan, scan.vertices, mesh, report.ignored_attributes);
   take_obj_materials(materials, shapes, scan, libraries, mesh, report.ignored_attributes);
@@ -371,11 +372,12 @@ std::string mtl_text(const Mesh &mesh) {
   return s;
 }
 
-std::string obj_text(const Mesh &mesh, const std::string &mtllib) {
+void write_obj(TextFileWriter &out, const Mesh &mesh, const std::string &mtllib) {
   const VertexAttribute *colour = mesh.find(AttributeKind::Colour);
   const VertexAttribute *normal = mesh.find(AttributeKind::Normal);
   const VertexAttribute *uv = mesh.find(AttributeKind::TexCoord);
-  std::string s = "# pomar\n";
+  std::string &s = out.text();
+  s += "# pomar\n";
   if (!mtllib.empty()) { // tinyobjloader splits the names at spaces unless escaped
     s += "mtllib ";
     for (const char c : mtllib)
@@ -391,6 +393,7 @@ std::string obj_text(const Mesh &mesh, const std::string &mtllib) {
         append_float(s, float(colour->colour[v * colour->components + k]) / 255.0f);
       }
     s += '\n';
+    out.done();
   }
   auto table = [&](const VertexAttribute *a, const char *prefix) {
     if (!a || a->vertex_count() != mesh.vertex_count())
@@ -402,6 +405,7 @@ std::string obj_text(const Mesh &mesh, const std::string &mtllib) {
         append_float(s, a->values[v * a->components + k]);
       }
       s += '\n';
+      out.done();
     }
     return true;
   };
@@ -410,13 +414,23 @@ std::string obj_text(const Mesh &mesh, const std::string &mtllib) {
     s += "usemtl texture_0\n";
   for (size_t t = 0; t < mesh.triangle_count(); ++t) {
     s += 'f';
-    for (int k = 0; k < 3; ++k) {
-      const std::string i = std::to_string(mesh.triangles[3 * t + k] + 1);
-      s += ' ' + i + (vt || vn ? "/" + (vt ? i : "") + (vn ? "/" + i : "") : "");
+    for (int k = 0; k < 3; ++k) { // "f a b c", "f a/a ...", "f a//a ..." or "f a/a/a ..."
+      const uint64_t i = uint64_t(mesh.triangles[3 * t + k]) + 1;
+      s += ' ';
+      append_uint(s, i);
+      if (vt || vn) {
+        s += '/';
+        if (vt)
+          append_uint(s, i);
+        if (vn) {
+          s += '/';
+          append_uint(s, i);
+        }
+      }
     }
     s += '\n';
+    out.done();
   }
-  return s;
 }
 
 } // namespace pomar::io

@@ -5,9 +5,9 @@
 
 #include <pomar/vcg_adapter.h>
 
-#include <wrap/io_trimesh/io_mask.h> // export_stl.h uses it without including it
 #include <wrap/io_trimesh/export_stl.h>
 #include <wrap/io_trimesh/import_stl.h>
+#include <wrap/io_trimesh/io_mask.h> // export_stl.h uses it without including it
 
 #include <climits>
 #include <cmath>
@@ -41,10 +41,12 @@ StlKind classify_stl(const std::string &path) {
   kind.facets = uint64_t(head[80]) | uint64_t(head[81]) << 8 | uint64_t(head[82]) << 16 |
                 uint64_t(head[83]) << 24;
   const uint64_t expected = 84 + 50 * kind.facets;
-  const unsigned char *text = std::find_if(head, head + probe, [](unsigned char c) { return !std::isspace(c); });
+  const unsigned char *text =
+      std::find_if(head, head + probe, [](unsigned char c) { return !std::isspace(c); });
   const bool solid = head + probe - text >= 5 && std::memcmp(text, "solid", 5) == 0;
-  kind.binary = size == expected ||
-                (!solid && std::any_of(head + 84, head + probe, [](unsigned char b) { return b > 127; }));
+  kind.binary =
+      size == expected ||
+      (!solid && std::any_of(head + 84, head + probe, [](unsigned char b) { return b > 127; }));
   if (kind.binary) {
     if (size < expected)
       fail(path, "truncated binary STL (header says " + num(kind.facets) +
@@ -75,7 +77,8 @@ size_t weld_identical(Mesh &mesh) {
       uint32_t b[3];
       const float c[3] = {k.x + 0.0f, k.y + 0.0f, k.z + 0.0f}; // -0 -> +0
       std::memcpy(b, c, sizeof b);
-      return (size_t(b[0]) * 0x9E3779B1u) ^ (size_t(b[1]) * 0x85EBCA77u) ^ (size_t(b[2]) * 0xC2B2AE3Du);
+      return (size_t(b[0]) * 0x9E3779B1u) ^ (size_t(b[1]) * 0x85EBCA77u) ^
+             (size_t(b[2]) * 0xC2B2AE3Du);
     }
   };
   const size_t n = mesh.vertex_count();
@@ -115,7 +118,8 @@ Mesh read_binary_stl(const std::string &path, uint64_t facets, bool &colored) {
       fail(path, "truncated binary STL (facet " + num(f) + ")");
     for (size_t c = 0; c < 9; ++c) {
       const unsigned char *b = rec + 12 + 4 * c;
-      const uint32_t bits = b[0] | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24;
+      const uint32_t bits =
+          b[0] | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24;
       std::memcpy(&mesh.positions[9 * f + c], &bits, 4);
     }
     for (uint32_t k = 0; k < 3; ++k)
@@ -186,8 +190,8 @@ Mesh read_ascii_stl(const std::string &path, const SizeCheck &check) {
       ++in_loop;
     } else if (tok == "endloop") {
       if (!looping || in_loop != 3)
-        fail(path, "ASCII STL facet " + num(facet) + " has " + num(in_loop) +
-                       " vertices (3 expected)");
+        fail(path,
+             "ASCII STL facet " + num(facet) + " has " + num(in_loop) + " vertices (3 expected)");
       const uint32_t first = static_cast<uint32_t>(mesh.positions.size() / 3 - 3);
       mesh.triangles.insert(mesh.triangles.end(), {first, first + 1, first + 2});
       looping = false;
@@ -214,7 +218,8 @@ Mesh load_stl(const std::string &path, LoadReport &report, const SizeCheck &chec
   if (colored)
     add_unique(report.ignored_attributes, "colors");
   for (size_t v = 0; v < mesh.vertex_count(); ++v)
-    check_finite(mesh.positions[3 * v], mesh.positions[3 * v + 1], mesh.positions[3 * v + 2], v, path, true);
+    check_finite(mesh.positions[3 * v], mesh.positions[3 * v + 1], mesh.positions[3 * v + 2], v,
+                 path, true);
   report.file_vertices = mesh.vertex_count();
   report.file_faces = mesh.triangle_count();
   report.welded_vertices = weld_identical(mesh);
@@ -222,8 +227,9 @@ Mesh load_stl(const std::string &path, LoadReport &report, const SizeCheck &chec
 }
 
 /// ASCII STL; the facet normal is the normalized cross product (0 for a degenerate facet).
-std::string stl_ascii_text(const Mesh &mesh) {
-  std::string s = "solid pomar\n";
+void write_stl_ascii(TextFileWriter &out, const Mesh &mesh) {
+  std::string &s = out.text();
+  s += "solid pomar\n";
   for (size_t t = 0; t < mesh.triangle_count(); ++t) {
     const float *p[3];
     for (int k = 0; k < 3; ++k)
@@ -250,10 +256,10 @@ std::string stl_ascii_text(const Mesh &mesh) {
       s += '\n';
     }
     s += "    endloop\n  endfacet\n";
+    out.done();
   }
-  return s + "endsolid pomar\n";
+  s += "endsolid pomar\n";
 }
-
 
 void save_stl_binary(const std::string &path, const Mesh &mesh) {
   IoMesh m;
