@@ -429,8 +429,11 @@ void write_off(TextFileWriter &out, const Mesh &mesh);
 Mesh load_stl(const std::string &path, LoadReport &report, const SizeCheck &check);
 /// ASCII STL; the facet normal is the normalized cross product (0 for a degenerate facet).
 void write_stl_ascii(TextFileWriter &out, const Mesh &mesh);
-/// Binary STL through vcglib's exporter, via a temporary file.
+/// Binary STL, byte for byte what vcglib's exporter writes, from the flat arrays in large
+/// chunks (save_stl_binary_vcg: through vcglib's exporter via a temporary file, the path on
+/// big-endian hosts).
 void save_stl_binary(const std::string &path, const Mesh &mesh);
+void save_stl_binary_vcg(const std::string &path, const Mesh &mesh);
 // obj_io.cpp
 Mesh load_obj(const std::string &path, LoadReport &report, const SizeCheck &check);
 /// The OBJ text; `mtllib` (if not empty) is the material library it names, whose material
