@@ -147,6 +147,7 @@ Mesh load_mesh(const std::string &path, LoadReport *report, const SizeCheck &siz
   LoadReport &r = report ? *report : local;
   r = LoadReport();
   r.format = format_name(format);
+  r.text = format == Format::Obj || format == Format::Off; // PLY and STL: set by their readers
   Mesh mesh;
   switch (format) {
   case Format::Ply:

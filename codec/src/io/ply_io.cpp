@@ -871,6 +871,7 @@ Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &chec
     FileReader in(path);
     const PlyHeader header = read_ply_header(in, path);
     const uint64_t faces = element_count(header, "face");
+    report.text = header.encoding == PlyHeader::Ascii;
     run_size_check(check, path, element_count(header, "vertex"), faces);
     const PlyElement *vertex = nullptr;
     for (const PlyElement &e : header.elements)
