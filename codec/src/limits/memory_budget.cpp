@@ -27,7 +27,9 @@ namespace {
 // vertices (bench/README.md, "Memory").
 //
 // Decode (refitted 2026-12-02, after the one-shot decode stopped copying its mesh and a
-// pending split shrank from 160 to 28 bytes; binary PLY output, one thread): least-squares
+// pending split shrank from 160 to 28 bytes; binary PLY output, one thread; since the text
+// and STL writers write in 1 MiB chunks every output format peaks within 1% of binary
+// PLY, measured at 100k, 300k and 1M vertices): least-squares
 // 5.0 MiB + 45 B/vertex + 31 B/face (random access), 5.4 MiB + 56 B/vertex + 29 B/face
 // (progressive), rounded up so that every peak of 300k vertices and more is 17-21% below
 // the estimate. Each further decoding thread: 13.6-28 B/vertex measured (small meshes:
