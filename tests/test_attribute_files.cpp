@@ -1,5 +1,6 @@
 // Attributes in mesh files: OBJ texture names (mtllib + map_Kd) and UVs through .pomar,
-// OFF colour and normals written back exactly, and what each writer cannot hold named.
+// OFF colour and normals written back exactly, what each writer cannot hold named, and
+// text files of several 1 MiB chunks written whole, or not at all when a write fails.
 #include <pomar/mesh_io.h>
 #include <pomar/pomar.h>
 
@@ -10,6 +11,9 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+
+#include <csignal>
+#include <sys/resource.h>
 #include <vector>
 
 #include <dirent.h>
@@ -203,6 +207,79 @@ TEST_F(AttributeFiles, WritersNameWhatTheyCannotHold) {
   Mesh plain = gen::noisy_sphere(100, 4, 0.1);
   for (const char *ext : {".ply", ".obj", ".off", ".stl"})
     EXPECT_TRUE(attributes_not_saved(std::string("x") + ext, plain).empty());
+}
+
+/// `m` written to `name` in each text format (and binary PLY with attributes): files of
+/// several MiB, which the writers hand to the file in 1 MiB chunks.
+TEST_F(AttributeFiles, FilesOfManyChunksReadBackExactly) {
+  const Mesh plain = gen::noisy_sphere(40000, 5, 0.1);
+  const struct {
+    const char *name;
+    int has;
+    bool binary;
+  } cases[] = {{"a.ply", kAll, false}, {"b.ply", kAll, true},
+               {"p.ply", 0, false},    {"m.off", kColour | kNormals, false},
+               {"p.off", 0, false},    {"m.obj", kColour | kNormals | kTexcoords, false},
+               {"p.obj", 0, false},    {"p.stl", 0, false}};
+  for (const auto &c : cases) {
+    const Mesh m = c.has ? with_attributes(plain, c.has) : plain;
+    const std::string out = path(c.name);
+    save_mesh(out, m, c.binary);
+    EXPECT_GT(read_text(out).size(), 2u << 20) << c.name;
+    const Mesh back = load_mesh(out);
+    if (std::string(c.name) == "p.stl") { // corners welded back, in order of first use
+      EXPECT_EQ(back.triangle_count(), m.triangle_count());
+      EXPECT_EQ(back.vertex_count(), m.vertex_count());
+      continue;
+    }
+    EXPECT_EQ(back.positions, m.positions) << c.name;
+    EXPECT_EQ(back.triangles, m.triangles) << c.name;
+    ASSERT_EQ(back.attributes.size(), m.attributes.size()) << c.name;
+    for (const VertexAttribute &a : m.attributes) { // the readers' order may differ
+      const VertexAttribute *same = nullptr;
+      for (const VertexAttribute &r : back.attributes)
+        if (r.kind == a.kind && (a.kind != AttributeKind::Scalar || r.name == a.name))
+          same = &r;
+      ASSERT_NE(same, nullptr) << c.name << " " << a.name;
+      EXPECT_EQ(same->colour, a.colour) << c.name << " " << a.name;
+      EXPECT_EQ(same->values, a.values) << c.name << " " << a.name;
+    }
+  }
+  for (const std::string &n : list_dir())
+    EXPECT_EQ(n.find(".tmp."), std::string::npos) << n;
+}
+
+/// A write that fails after some chunks have reached the disk (here: a file size limit of
+/// 1.5 MiB, so the second chunk fails) is an I/O error naming the file; the file keeps its
+/// old contents and no temporary file is left.
+TEST_F(AttributeFiles, WriteFailingAfterSomeChunksKeepsTheOldFile) {
+  const Mesh m = with_attributes(gen::noisy_sphere(40000, 5, 0.1), kColour | kNormals);
+  struct rlimit old;
+  ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &old), 0);
+  for (const char *name : {"a.ply", "b.ply", "m.off", "m.obj", "m.stl"}) {
+    const std::string out = write(name, "old");
+    const bool binary = std::string(name) == "b.ply";
+    struct rlimit small = old;
+    small.rlim_cur = 3u << 19;
+    void (*previous)(int) = std::signal(SIGXFSZ, SIG_IGN); // write() fails with EFBIG instead
+    ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &small), 0);
+    std::string message;
+    Error::Kind kind = Error::Kind::Internal;
+    std::string where;
+    try {
+      save_mesh(out, m, binary);
+    } catch (const Error &e) {
+      message = e.what(), kind = e.kind(), where = e.path();
+    }
+    ::setrlimit(RLIMIT_FSIZE, &old);
+    std::signal(SIGXFSZ, previous);
+    EXPECT_EQ(kind, Error::Kind::Io) << name << ": " << message;
+    EXPECT_EQ(where, out) << message;
+    EXPECT_NE(message.find("cannot write"), std::string::npos) << message;
+    EXPECT_EQ(read_text(out), "old") << name;
+  }
+  for (const std::string &n : list_dir())
+    EXPECT_EQ(n.find(".tmp."), std::string::npos) << n;
 }
 
 } // namespace

@@ -35,15 +35,22 @@ TEST_F(SizeCheckTest, SeesTheCountsOfEveryFormat) {
     std::vector<std::pair<uint64_t, uint64_t>> expected;
   } cases[] = {
       {"m.ply", true, {{42, 80}}},  {"m.off", false, {{42, 80}}}, {"m.obj", false, {{42, 80}}},
-      {"m.stl", true, {{40, 80}}},  // binary STL: half a vertex per facet
-      {"a.stl", false, {{80, 80}}}, // ASCII STL: one per facet (its text is held)
+      {"m.stl", true, {{40, 80}}}, // STL: half a vertex per facet, what welding keeps
+      {"a.stl", false, {{40, 80}}}, {"a.ply", false, {{42, 80}}},
   };
   for (const Case &c : cases) {
     save_mesh(path(c.name), cube, c.binary);
     Calls calls;
-    const Mesh m = load_mesh(path(c.name), nullptr, calls.record());
+    LoadReport report;
+    bool text_at_check = false; // what a per-format estimate sees when the check runs
+    const Mesh m = load_mesh(path(c.name), &report, [&](uint64_t v, uint64_t f) {
+      text_at_check = report.text;
+      calls.record()(v, f);
+    });
     EXPECT_EQ(m.triangle_count(), 80u) << c.name;
     EXPECT_EQ(calls.seen, c.expected) << c.name;
+    EXPECT_EQ(text_at_check, !c.binary) << c.name;
+    EXPECT_EQ(report.text, !c.binary) << c.name;
   }
 }
 

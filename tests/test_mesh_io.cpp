@@ -22,7 +22,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "support/mesh_gen.h"
 #include "support/temp_dir.h"
+
+#include <pomar/vcg_adapter.h>
+#include <wrap/io_trimesh/export_stl.h>
 
 // vcglib's PLY importer never frees the index list of a tristrip (plylib allocates it);
 // keep LeakSanitizer builds of this test green.
@@ -1090,6 +1094,36 @@ TEST_F(MeshIoTest, BinaryPlyHasVcglibsExactBytes) {
   }
   EXPECT_EQ(read_text(path("m.ply")), want);
   EXPECT_EQ(list_dir().size(), 1u); // no temporary file left behind
+}
+
+namespace stl_reference { // a vcglib mesh that pomar::to_vcg fills, for vcglib's STL exporter
+class V;
+class F;
+struct Types : vcg::UsedTypes<vcg::Use<V>::AsVertexType, vcg::Use<F>::AsFaceType> {};
+class V : public vcg::Vertex<Types, vcg::vertex::Coord3f, vcg::vertex::Normal3f,
+                             vcg::vertex::Color4b, vcg::vertex::Qualityf,
+                             vcg::vertex::TexCoord2f, vcg::vertex::BitFlags> {};
+class F : public vcg::Face<Types, vcg::face::VertexRef, vcg::face::BitFlags> {};
+class M : public vcg::tri::TriMesh<std::vector<V>, std::vector<F>> {};
+} // namespace stl_reference
+
+// save_mesh writes binary STL from the flat arrays too: the bytes must be exactly what
+// vcglib's exporter writes, facet normals included (computed in float as vcglib does),
+// also for a degenerate facet (zero normal) and over several 1 MiB chunks.
+TEST_F(MeshIoTest, BinaryStlHasVcglibsExactBytes) {
+  pomar::Mesh m = pomar::gen::noisy_sphere(30000, 7);
+  m.positions.insert(m.positions.end(), {0.f, 0.f, 0.f, 1.f, 1.f, 1.f, 2.f, 2.f, 2.f});
+  const uint32_t n = static_cast<uint32_t>(m.vertex_count());
+  m.triangles.insert(m.triangles.end(), {n - 3, n - 2, n - 1}); // collinear: a zero normal
+  stl_reference::M vm;
+  pomar::to_vcg(m, vm);
+  ASSERT_EQ(vcg::tri::io::ExporterSTL<stl_reference::M>::Save(vm, path("vcg.stl").c_str(), true),
+            0);
+  pomar::save_mesh(path("m.stl"), m, true);
+  const std::string want = read_text(path("vcg.stl")), got = read_text(path("m.stl"));
+  EXPECT_EQ(got.size(), 84 + 50 * m.triangle_count());
+  EXPECT_TRUE(got == want) << "the files differ";
+  EXPECT_EQ(list_dir().size(), 2u); // no temporary file left behind
 }
 
 // Binary PLY of float xyz + uchar/int triangles is read without vcglib: unreferenced

@@ -154,9 +154,12 @@ int run_encode(const EncodeArgs &a) {
   const auto t0 = Clock::now();
   const uint64_t memory_limit = pomar::parse_memory_size(a.max_memory);
   pomar::LoadReport load;
-  // Refused as soon as the file's header tells the mesh size, before it is read.
-  pomar::Mesh mesh = pomar::load_mesh(
-      a.in, &load, [&](uint64_t v, uint64_t f) { pomar::check_encode_memory(v, f, memory_limit); });
+  // Refused as soon as the file's header tells the mesh size, before it is read, with the
+  // estimate for the file's format (its reader's own peak).
+  pomar::Mesh mesh = pomar::load_mesh(a.in, &load, [&](uint64_t v, uint64_t f) {
+    pomar::check_encode_memory(v, f, memory_limit, 0, 0, 1,
+                               pomar::encode_input(load.format, load.text));
+  });
   if (!a.quiet)
     warn_dropped(a.in, load.ignored_attributes, "has",
                  ", not kept (.pomar keeps positions, triangles and per-vertex colour, normals, "

@@ -22,9 +22,29 @@ namespace pomar {
 /// The memory limit meaning "do not check".
 constexpr uint64_t kNoMemoryLimit = UINT64_MAX;
 
+/// Where an encode's mesh comes from: the mesh readers hold different amounts on the way
+/// (tinyobjloader's arrays, the whole text of an ASCII STL file), so the peak of loading and
+/// encoding depends on the input format (bench/README.md, "Memory", per input format).
+enum class EncodeInput {
+  Mesh,      ///< a pomar::Mesh in memory, or a reader that holds little more (the default)
+  PlyBinary, ///< binary PLY
+  PlyAscii,  ///< ASCII PLY
+  Obj,       ///< OBJ, through tinyobjloader
+  Off,       ///< OFF
+  StlBinary, ///< binary STL
+  StlAscii,  ///< ASCII STL: its whole text is held while it is parsed
+};
+
+/// The EncodeInput of a mesh file from LoadReport::format ("ply", "obj", "off", "stl") and
+/// LoadReport::text (set by load_mesh before its size check); EncodeInput::Mesh for any
+/// other format name.
+EncodeInput encode_input(const std::string &format, bool text);
+
 /// Peak resident memory of loading a mesh file and encoding it (`pomar encode`), for a mesh
-/// of this many vertices and faces. Conservative: a little above the measured peaks.
-uint64_t encode_memory_estimate(uint64_t vertices, uint64_t faces);
+/// of this many vertices and faces read from `input`. Conservative: 10-25% above the
+/// measured peaks.
+uint64_t encode_memory_estimate(uint64_t vertices, uint64_t faces,
+                                EncodeInput input = EncodeInput::Mesh);
 
 /// Peak resident memory of decoding a mesh of this size and writing it out (`pomar
 /// decode`); `clustered` files (random access) need a little more than progressive ones.
@@ -73,12 +93,13 @@ std::string format_memory_size(uint64_t bytes);
 void check_memory(const char *action, uint64_t vertices, uint64_t faces, uint64_t needed,
                   uint64_t held, uint64_t limit);
 
-/// check_memory with encode_memory_estimate plus `attribute_bytes` per vertex
+/// check_memory with encode_memory_estimate for `input` plus `attribute_bytes` per vertex
 /// (encode_attribute_bytes_per_vertex), plus decode_thread_memory per thread past the first
 /// recording the clustered levels (`threads`: EncodeOptions::threads resolved and capped
 /// like the decoder's, decode_threads) (action "encode").
 void check_encode_memory(uint64_t vertices, uint64_t faces, uint64_t limit, uint64_t held = 0,
-                         uint64_t attribute_bytes = 0, unsigned threads = 1);
+                         uint64_t attribute_bytes = 0, unsigned threads = 1,
+                         EncodeInput input = EncodeInput::Mesh);
 
 /// What each decoding thread past the first adds to decode_memory_estimate for a clustered
 /// file (and each encoding thread to encode_memory_estimate): its traversal marks, pending

@@ -30,7 +30,10 @@ namespace pomar {
 
 /// What load_mesh found in a file besides the mesh it returns.
 struct LoadReport {
-  std::string format;               ///< "ply", "obj", "off" or "stl"
+  std::string format; ///< "ply", "obj", "off" or "stl"
+  /// Whether the file is text (ASCII PLY or STL; OBJ and OFF always): set before the size
+  /// check is called, for a per-format memory estimate (pomar::encode_input).
+  bool text = false;
   size_t file_vertices = 0;         ///< vertices stored in the file (STL: 3 per facet)
   size_t file_faces = 0;            ///< faces/polygons in the file (PLY tristrips: triangles)
   size_t unreferenced_vertices = 0; ///< vertices no face uses (kept: pomar::encode stores them)
@@ -45,11 +48,14 @@ struct LoadReport {
 /// allocations: PLY and OFF header counts (PLY again after its structure walk if polygons
 /// or strips make more triangles), binary STL facet count, OBJ 'v' lines and triangles
 /// (after a line scan, before the parser), ASCII STL facets (counted in the text before it
-/// is parsed). Binary STL passes half a vertex per facet (what a closed mesh keeps once
-/// identical corners are welded), ASCII STL one (its text is held while it is parsed). It
-/// may throw pomar::Error to
+/// is parsed). STL passes half a vertex per facet (what a closed mesh keeps once identical
+/// corners are welded). LoadReport::format and LoadReport::text are set when it is called,
+/// so that the check can allow for the format's reader. It may throw pomar::Error to
 /// refuse the file (load_mesh prefixes the path), e.g. for a memory limit:
-///   [&](uint64_t v, uint64_t f) { pomar::check_encode_memory(v, f, limit); }
+///   [&](uint64_t v, uint64_t f) {
+///     pomar::check_encode_memory(v, f, limit, 0, 0, 1,
+///                                pomar::encode_input(report.format, report.text));
+///   }
 using SizeCheck = std::function<void(uint64_t vertices, uint64_t faces)>;
 
 /// Read a triangle mesh. Polygons are split into triangles (PLY/OBJ: fan from the first

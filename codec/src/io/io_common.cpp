@@ -162,7 +162,6 @@ void add_ignored_from_mask(int mask, std::vector<std::string> &out) {
     add_unique(out, "edges");
 }
 
-
 uint64_t check_regular_file(const std::string &path) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0)
@@ -190,21 +189,34 @@ bool write_all(int fd, const char *data, size_t size) {
   return true;
 }
 
-ChunkedFileWriter::ChunkedFileWriter(const std::string &target)
-    : target_(target), tmp_(target), buf_(size_t(1) << 20) {
+AtomicFile::AtomicFile(const std::string &target) : target_(target), tmp_(target) {
   fd_ = ::open(tmp_.path().c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
   if (fd_ < 0)
     fail_io(target_, "cannot create temporary file '" + tmp_.path() + "': " + errno_text(errno));
 }
 
-ChunkedFileWriter::~ChunkedFileWriter() {
+AtomicFile::~AtomicFile() {
   if (fd_ >= 0)
     ::close(fd_);
 }
 
-void ChunkedFileWriter::flush() {
-  if (!write_all(fd_, buf_.data(), used_))
+void AtomicFile::write(const char *data, size_t size) {
+  if (!write_all(fd_, data, size))
     fail_io(target_, "cannot write: " + errno_text(errno));
+}
+
+void AtomicFile::commit() {
+  if (::fsync(fd_) != 0)
+    fail_io(target_, "fsync failed: " + errno_text(errno));
+  const int fd = fd_;
+  fd_ = -1;
+  if (::close(fd) != 0)
+    fail_io(target_, "cannot write (close): " + errno_text(errno));
+  tmp_.commit(false);
+}
+
+void ChunkedFileWriter::flush() {
+  file_.write(buf_.data(), used_);
   used_ = 0;
 }
 
@@ -221,13 +233,19 @@ void ChunkedFileWriter::put(const void *data, size_t size) {
 
 void ChunkedFileWriter::commit() {
   flush();
-  if (::fsync(fd_) != 0)
-    fail_io(target_, "fsync failed: " + errno_text(errno));
-  const int fd = fd_;
-  fd_ = -1;
-  if (::close(fd) != 0)
-    fail_io(target_, "cannot write (close): " + errno_text(errno));
-  tmp_.commit(false);
+  file_.commit();
+}
+
+void TextFileWriter::flush() {
+  if (!file_)
+    file_ = std::make_unique<AtomicFile>(target_);
+  file_->write(text_.data(), text_.size());
+  text_.clear();
+}
+
+void TextFileWriter::commit() {
+  flush();
+  file_->commit();
 }
 
 void clear_flags(IoMesh &m) {
@@ -266,15 +284,17 @@ void append_point(std::string &out, const float *p) {
   append_float(out, p[2]);
 }
 
-void append_triangles(std::string &out, const Mesh &mesh, const char *prefix, uint64_t base) {
+void append_triangles(TextFileWriter &out, const Mesh &mesh, const char *prefix, uint64_t base) {
+  std::string &s = out.text();
   for (size_t t = 0; t < mesh.triangle_count(); ++t) {
-    out += prefix;
+    s += prefix;
     for (int k = 0; k < 3; ++k) {
       if (k)
-        out += ' ';
-      append_uint(out, mesh.triangles[3 * t + k] + base);
+        s += ' ';
+      append_uint(s, mesh.triangles[3 * t + k] + base);
     }
-    out += '\n';
+    s += '\n';
+    out.done();
   }
 }
 
@@ -285,11 +305,13 @@ size_t count_unreferenced(const Mesh &mesh) {
   return static_cast<size_t>(std::count(used.begin(), used.end(), uint8_t(0)));
 }
 
-void append_vertices(std::string &out, const Mesh &mesh, const char *prefix) {
+void append_vertices(TextFileWriter &out, const Mesh &mesh, const char *prefix) {
+  std::string &s = out.text();
   for (size_t v = 0; v < mesh.vertex_count(); ++v) {
-    out += prefix;
-    append_point(out, &mesh.positions[3 * v]);
-    out += '\n';
+    s += prefix;
+    append_point(s, &mesh.positions[3 * v]);
+    s += '\n';
+    out.done();
   }
 }
 
@@ -299,8 +321,7 @@ void check_written_size(const std::string &file, uint64_t expected, const std::s
     fail_io(target, "cannot stat temporary file: " + errno_text(errno));
   if (static_cast<uint64_t>(st.st_size) != expected)
     fail_io(target, "short write (" + num(uint64_t(st.st_size)) + " of " + num(expected) +
-                     " bytes; disk full?)");
+                        " bytes; disk full?)");
 }
-
 
 } // namespace pomar::io

@@ -25,6 +25,7 @@
 #include <cerrno>
 #include <cstdint>
 #include <cstring>
+#include <memory>
 #include <new>
 #include <stdexcept>
 #include <string>
@@ -257,15 +258,32 @@ private:
 /// Writes all of data to fd, retrying after signals and short writes.
 bool write_all(int fd, const char *data, size_t size);
 
-/// Writes a file atomically (like write_file_atomic) from pieces, through a 1 MiB buffer:
-/// put() / reserve() fill it, commit() flushes, fsyncs and renames the temporary file over
-/// the target. Destroyed without commit(), it removes the temporary file.
+/// The temporary file behind an atomic write (write_file_atomic, ChunkedFileWriter,
+/// TextFileWriter): write() appends to it, commit() fsyncs and closes it and renames it over
+/// the target. Every failure is an I/O error naming the target; destroyed without
+/// commit(), it removes the temporary file, so a failed write never leaves part of a file
+/// under the target's name.
+class AtomicFile {
+public:
+  explicit AtomicFile(const std::string &target);
+  ~AtomicFile();
+  AtomicFile(const AtomicFile &) = delete;
+  AtomicFile &operator=(const AtomicFile &) = delete;
+  void write(const char *data, size_t size);
+  void commit();
+
+private:
+  std::string target_;
+  TempFile tmp_;
+  int fd_ = -1;
+};
+
+/// Writes a file atomically from pieces, through a 1 MiB buffer: put() / reserve() fill
+/// it, commit() flushes, fsyncs and renames the temporary file over the target. Destroyed
+/// without commit(), it removes the temporary file.
 class ChunkedFileWriter {
 public:
-  explicit ChunkedFileWriter(const std::string &target);
-  ~ChunkedFileWriter();
-  ChunkedFileWriter(const ChunkedFileWriter &) = delete;
-  ChunkedFileWriter &operator=(const ChunkedFileWriter &) = delete;
+  explicit ChunkedFileWriter(const std::string &target) : file_(target), buf_(size_t(1) << 20) {}
   void put(const void *data, size_t size);
   /// Room for `size` (<= 4096) bytes at the end of the buffer, which the caller fills.
   char *reserve(size_t size) {
@@ -279,11 +297,35 @@ public:
 
 private:
   void flush();
-  std::string target_;
-  TempFile tmp_;
-  int fd_ = -1;
+  AtomicFile file_;
   std::vector<char> buf_;
   size_t used_ = 0;
+};
+
+/// A file written atomically in chunks by the text writers (OBJ, OFF, ASCII PLY and STL,
+/// PLY with attributes): they append a record at a time (a line, a facet, a run of binary
+/// vertices) to text() and call done() after each, which hands the text to the file once
+/// it holds kChunk bytes, so the whole text is never in memory. The temporary file is
+/// created at the first hand-over (a header that turns out unwritable fails before any
+/// file exists); commit() writes the rest and renames it over the target.
+class TextFileWriter {
+public:
+  static constexpr size_t kChunk = size_t(1) << 20;
+  explicit TextFileWriter(const std::string &target) : target_(target) {
+    text_.reserve(kChunk + 4096);
+  }
+  std::string &text() { return text_; }
+  void done() {
+    if (text_.size() >= kChunk)
+      flush();
+  }
+  void commit();
+
+private:
+  void flush();
+  std::string target_;
+  std::unique_ptr<AtomicFile> file_;
+  std::string text_;
 };
 
 // ---- The vcglib mesh the importers fill ----
@@ -297,9 +339,8 @@ struct IoTypes : vcg::UsedTypes<vcg::Use<IoVertex>::AsVertexType, vcg::Use<IoEdg
 // keeps (PLY: read by our walk and stored here; OFF: by vcglib's importer), so that
 // from_vcg drops them with their unreferenced vertices.
 class IoVertex
-    : public vcg::Vertex<IoTypes, vcg::vertex::Coord3f, vcg::vertex::Normal3f,
-                         vcg::vertex::Color4b, vcg::vertex::Qualityf, vcg::vertex::TexCoord2f,
-                         vcg::vertex::BitFlags> {};
+    : public vcg::Vertex<IoTypes, vcg::vertex::Coord3f, vcg::vertex::Normal3f, vcg::vertex::Color4b,
+                         vcg::vertex::Qualityf, vcg::vertex::TexCoord2f, vcg::vertex::BitFlags> {};
 // Edges only so that the PLY importer has somewhere to put an "edge" element: without an
 // edge container it asserts. They are dropped.
 class IoEdge : public vcg::Edge<IoTypes, vcg::edge::VertexRef, vcg::edge::BitFlags> {};
@@ -317,8 +358,7 @@ public:
 
 /// vcglib's message for an importer/exporter code, guarding against its off-by-one
 /// tables (codes at the table size, empty entries).
-template <class Io>
-std::string vcg_message(int code, int table_size) {
+template <class Io> std::string vcg_message(int code, int table_size) {
   const char *text = code >= 0 && code < table_size ? Io::ErrorMsg(code) : nullptr;
   if (text == nullptr || *text == '\0')
     return "error code " + std::to_string(code);
@@ -339,8 +379,7 @@ void check_counts(const IoMesh &m, size_t vertices, size_t triangles, const std:
 
 /// Runs a vcglib call, turning its C++ exceptions (bad_alloc for absurd counts, ...) into
 /// pomar::Error.
-template <class F>
-auto guarded(const std::string &path, F &&call) -> decltype(call()) {
+template <class F> auto guarded(const std::string &path, F &&call) -> decltype(call()) {
   try {
     return call();
   } catch (const Error &) {
@@ -356,9 +395,10 @@ auto guarded(const std::string &path, F &&call) -> decltype(call()) {
 
 /// Appends "x y z" with full float precision.
 void append_point(std::string &out, const float *p);
-/// Appends the triangles as "<prefix>a b c\n" lines, indices offset by `base`.
-void append_triangles(std::string &out, const Mesh &mesh, const char *prefix, uint64_t base);
-void append_vertices(std::string &out, const Mesh &mesh, const char *prefix);
+/// Writes the triangles as "<prefix>a b c\n" lines, indices offset by `base`.
+void append_triangles(TextFileWriter &out, const Mesh &mesh, const char *prefix, uint64_t base);
+/// Writes the positions as "<prefix>x y z\n" lines.
+void append_vertices(TextFileWriter &out, const Mesh &mesh, const char *prefix);
 /// Vertices no triangle uses.
 size_t count_unreferenced(const Mesh &mesh);
 /// Checks that a file written by a vcglib exporter has the expected size: the exporters
@@ -369,7 +409,7 @@ void check_written_size(const std::string &file, uint64_t expected, const std::s
 
 // ply_io.cpp
 Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &check);
-std::string ply_ascii_text(const Mesh &mesh);
+void write_ply_ascii(TextFileWriter &out, const Mesh &mesh);
 /// Binary little-endian PLY, byte for byte what vcglib's exporter writes, from the flat
 /// arrays in large chunks (save_ply_binary_vcg: through vcglib's exporter, the reference
 /// the tests compare with and the path on big-endian hosts).
@@ -378,23 +418,27 @@ void save_ply_binary_vcg(const std::string &path, const Mesh &mesh);
 /// A PLY file (ASCII or binary little-endian) with the mesh's attributes as vertex
 /// properties (red green blue [alpha] uchar, nx ny nz, texture_u texture_v, one float per
 /// scalar by its name) and "comment TextureFile" lines.
-std::string ply_with_attributes(const Mesh &mesh, bool binary, const std::string &path);
+void write_ply_with_attributes(TextFileWriter &out, const Mesh &mesh, bool binary,
+                               const std::string &path);
 // off_io.cpp
 Mesh load_off(const std::string &path, LoadReport &report, const SizeCheck &check);
 /// OFF text; per-vertex normals and colour (8-bit integers, RGB or RGBA) when the mesh has
 /// them ("[C][N]OFF": what vcglib's importer reads back exactly).
-std::string off_text(const Mesh &mesh);
+void write_off(TextFileWriter &out, const Mesh &mesh);
 // stl_io.cpp
 Mesh load_stl(const std::string &path, LoadReport &report, const SizeCheck &check);
 /// ASCII STL; the facet normal is the normalized cross product (0 for a degenerate facet).
-std::string stl_ascii_text(const Mesh &mesh);
-/// Binary STL through vcglib's exporter, via a temporary file.
+void write_stl_ascii(TextFileWriter &out, const Mesh &mesh);
+/// Binary STL, byte for byte what vcglib's exporter writes, from the flat arrays in large
+/// chunks (save_stl_binary_vcg: through vcglib's exporter via a temporary file, the path on
+/// big-endian hosts).
 void save_stl_binary(const std::string &path, const Mesh &mesh);
+void save_stl_binary_vcg(const std::string &path, const Mesh &mesh);
 // obj_io.cpp
 Mesh load_obj(const std::string &path, LoadReport &report, const SizeCheck &check);
 /// The OBJ text; `mtllib` (if not empty) is the material library it names, whose material
 /// "texture_0" its faces use (mtl_text writes one material per texture file).
-std::string obj_text(const Mesh &mesh, const std::string &mtllib);
+void write_obj(TextFileWriter &out, const Mesh &mesh, const std::string &mtllib);
 /// A material library with one material "texture_<i>" per texture file (map_Kd).
 std::string mtl_text(const Mesh &mesh);
 

@@ -8,7 +8,8 @@
 // exporters into a temporary file whose size is checked (the exporters ignore write
 // errors) before it is renamed over the destination. ASCII PLY, ASCII STL, OFF and OBJ are
 // formatted by pomar, because vcglib prints only 7 significant digits (lossy for float)
-// and its OBJ exporter needs material code.
+// and its OBJ exporter needs material code; their text goes to the temporary file in 1 MiB
+// chunks as it is formatted (TextFileWriter), never whole in memory.
 #include "io/io_common.h"
 
 #include <climits>
@@ -54,10 +55,14 @@ Format format_of(const std::string &path) {
 
 const char *format_name(Format f) {
   switch (f) {
-  case Format::Ply: return "ply";
-  case Format::Obj: return "obj";
-  case Format::Off: return "off";
-  case Format::Stl: return "stl";
+  case Format::Ply:
+    return "ply";
+  case Format::Obj:
+    return "obj";
+  case Format::Off:
+    return "off";
+  case Format::Stl:
+    return "stl";
   }
   return "?";
 }
@@ -97,7 +102,6 @@ std::string file_name(const std::string &path) {
 
 } // namespace
 
-
 std::vector<uint8_t> read_file(const std::string &path) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0)
@@ -132,19 +136,9 @@ std::vector<uint8_t> read_file(const std::string &path) {
 }
 
 void write_file_atomic(const std::string &path, const void *data, size_t size) {
-  TempFile tmp(path);
-  const int fd = ::open(tmp.path().c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
-  if (fd < 0)
-    fail_io(path, "cannot create temporary file '" + tmp.path() + "': " + errno_text(errno));
-  FdGuard guard(fd);
-  if (!write_all(fd, static_cast<const char *>(data), size))
-    fail_io(path, "cannot write: " + errno_text(errno));
-  if (::fsync(fd) != 0)
-    fail_io(path, "fsync failed: " + errno_text(errno));
-  guard.fd = -1;
-  if (::close(fd) != 0)
-    fail_io(path, "cannot write (close): " + errno_text(errno));
-  tmp.commit(false);
+  AtomicFile file(path);
+  file.write(static_cast<const char *>(data), size);
+  file.commit();
 }
 
 Mesh load_mesh(const std::string &path, LoadReport *report, const SizeCheck &size_check) {
@@ -153,6 +147,7 @@ Mesh load_mesh(const std::string &path, LoadReport *report, const SizeCheck &siz
   LoadReport &r = report ? *report : local;
   r = LoadReport();
   r.format = format_name(format);
+  r.text = format == Format::Obj || format == Format::Off; // PLY and STL: set by their readers
   Mesh mesh;
   switch (format) {
   case Format::Ply:
@@ -176,33 +171,36 @@ Mesh load_mesh(const std::string &path, LoadReport *report, const SizeCheck &siz
 void save_mesh(const std::string &path, const Mesh &mesh, bool binary) {
   const Format format = format_of(path);
   check_mesh_for_save(mesh, path);
-  std::string text;
+  const bool attributes = !mesh.attributes.empty() || !mesh.texture_files.empty();
+  if (format == Format::Ply && binary && !attributes)
+    return save_ply_binary(path, mesh);
+  if (format == Format::Stl && binary)
+    return save_stl_binary(path, mesh);
+  std::string mtllib;
+  if (format == Format::Obj && !mesh.texture_files.empty()) { // the library first: the OBJ names it
+    const std::string mtl = material_library_path(path), lib = mtl_text(mesh);
+    write_file_atomic(mtl, lib.data(), lib.size());
+    mtllib = file_name(mtl);
+  }
+  TextFileWriter out(path); // the text goes to the file in chunks as it is formatted
   switch (format) {
   case Format::Ply:
-    if (!mesh.attributes.empty() || !mesh.texture_files.empty())
-      text = ply_with_attributes(mesh, binary, path);
-    else if (binary)
-      return save_ply_binary(path, mesh);
+    if (attributes)
+      write_ply_with_attributes(out, mesh, binary, path);
     else
-      text = ply_ascii_text(mesh);
+      write_ply_ascii(out, mesh);
     break;
   case Format::Stl:
-    if (binary)
-      return save_stl_binary(path, mesh);
-    text = stl_ascii_text(mesh);
+    write_stl_ascii(out, mesh);
     break;
-  case Format::Off: text = off_text(mesh); break;
+  case Format::Off:
+    write_off(out, mesh);
+    break;
   case Format::Obj:
-    if (!mesh.texture_files.empty()) { // the library first: the OBJ names it
-      const std::string mtl = material_library_path(path), lib = mtl_text(mesh);
-      write_file_atomic(mtl, lib.data(), lib.size());
-      text = obj_text(mesh, file_name(mtl));
-    } else {
-      text = obj_text(mesh, "");
-    }
+    write_obj(out, mesh, mtllib);
     break;
   }
-  write_file_atomic(path, text.data(), text.size());
+  out.commit();
 }
 
 std::vector<std::string> attributes_not_saved(const std::string &path, const Mesh &mesh) {
@@ -242,4 +240,3 @@ std::vector<std::string> attributes_not_saved(const std::string &path, const Mes
 }
 
 } // namespace pomar
-

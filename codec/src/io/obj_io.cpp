@@ -488,11 +488,12 @@ std::string mtl_text(const Mesh &mesh) {
   return s;
 }
 
-std::string obj_text(const Mesh &mesh, const std::string &mtllib) {
+void write_obj(TextFileWriter &out, const Mesh &mesh, const std::string &mtllib) {
   const VertexAttribute *colour = mesh.find(AttributeKind::Colour);
   const VertexAttribute *normal = mesh.find(AttributeKind::Normal);
   const VertexAttribute *uv = mesh.find(AttributeKind::TexCoord);
-  std::string s = "# pomar\n";
+  std::string &s = out.text();
+  s += "# pomar\n";
   if (!mtllib.empty()) { // tinyobjloader splits the names at spaces unless escaped
     s += "mtllib ";
     for (const char c : mtllib)
@@ -508,6 +509,7 @@ std::string obj_text(const Mesh &mesh, const std::string &mtllib) {
         append_float(s, float(colour->colour[v * colour->components + k]) / 255.0f);
       }
     s += '\n';
+    out.done();
   }
   auto table = [&](const VertexAttribute *a, const char *prefix) {
     if (!a || a->vertex_count() != mesh.vertex_count())
@@ -519,6 +521,7 @@ std::string obj_text(const Mesh &mesh, const std::string &mtllib) {
         append_float(s, a->values[v * a->components + k]);
       }
       s += '\n';
+      out.done();
     }
     return true;
   };
@@ -527,13 +530,23 @@ std::string obj_text(const Mesh &mesh, const std::string &mtllib) {
     s += "usemtl texture_0\n";
   for (size_t t = 0; t < mesh.triangle_count(); ++t) {
     s += 'f';
-    for (int k = 0; k < 3; ++k) {
-      const std::string i = std::to_string(mesh.triangles[3 * t + k] + 1);
-      s += ' ' + i + (vt || vn ? "/" + (vt ? i : "") + (vn ? "/" + i : "") : "");
+    for (int k = 0; k < 3; ++k) { // "f a b c", "f a/a ...", "f a//a ..." or "f a/a/a ..."
+      const uint64_t i = uint64_t(mesh.triangles[3 * t + k]) + 1;
+      s += ' ';
+      append_uint(s, i);
+      if (vt || vn) {
+        s += '/';
+        if (vt)
+          append_uint(s, i);
+        if (vn) {
+          s += '/';
+          append_uint(s, i);
+        }
+      }
     }
     s += '\n';
+    out.done();
   }
-  return s;
 }
 
 } // namespace pomar::io

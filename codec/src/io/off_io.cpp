@@ -132,7 +132,8 @@ private:
       if (!parse_float(strip_cr(token("vertex", i)), c))
         fail(path_, "OFF vertex " + num(i) + " has a bad coordinate '" + tokens_[k_ - 1] + "'");
     if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
-      fail(path_, "vertex " + num(i) + " has a non-finite coordinate " + point_text(p[0], p[1], p[2]));
+      fail(path_,
+           "vertex " + num(i) + " has a non-finite coordinate " + point_text(p[0], p[1], p[2]));
     for (int j = 0; h.normals && j < 3; ++j)
       token("vertex normal", i);
     if (h.colors) { // the rest of the line, minus texture coordinates
@@ -145,8 +146,8 @@ private:
         const std::string index = strip_cr(tokens_[k_]);
         if (index.empty() || index.size() > 3 ||
             index.find_first_not_of("0123456789") != std::string::npos || std::stoi(index) >= 148)
-          fail(path_, "OFF vertex " + num(i) + " has a colour map index '" + index +
-                          "' outside 0..147");
+          fail(path_,
+               "OFF vertex " + num(i) + " has a colour map index '" + index + "' outside 0..147");
       }
       k_ += static_cast<size_t>(n);
     }
@@ -323,7 +324,7 @@ Mesh load_off(const std::string &path, LoadReport &report, const SizeCheck &chec
   return from_vcg(m, &report.unreferenced_vertices, kept, true); // unreferenced vertices kept
 }
 
-std::string off_text(const Mesh &mesh) {
+void write_off(TextFileWriter &out, const Mesh &mesh) {
   const size_t n = mesh.vertex_count();
   const VertexAttribute *colour = mesh.find(AttributeKind::Colour);
   const VertexAttribute *normal = mesh.find(AttributeKind::Normal);
@@ -331,10 +332,11 @@ std::string off_text(const Mesh &mesh) {
     colour = nullptr;
   if (normal && normal->vertex_count() != n)
     normal = nullptr;
-  std::string s = std::string(colour ? "C" : "") + (normal ? "N" : "") + "OFF\n" + num(n) + " " +
-                  num(mesh.triangle_count()) + " 0\n";
+  std::string &s = out.text();
+  s += std::string(colour ? "C" : "") + (normal ? "N" : "") + "OFF\n" + num(n) + " " +
+       num(mesh.triangle_count()) + " 0\n";
   if (!colour && !normal) {
-    append_vertices(s, mesh, "");
+    append_vertices(out, mesh, "");
   } else { // one vertex a line: x y z [nx ny nz] [r g b [a]] (vcglib's importer needs it)
     for (size_t v = 0; v < n; ++v) {
       append_point(s, &mesh.positions[3 * v]);
@@ -347,10 +349,10 @@ std::string off_text(const Mesh &mesh) {
         append_uint(s, colour->colour[v * colour->components + k]);
       }
       s += '\n';
+      out.done();
     }
   }
-  append_triangles(s, mesh, "3 ", 0);
-  return s;
+  append_triangles(out, mesh, "3 ", 0);
 }
 
 } // namespace pomar::io

@@ -1,6 +1,7 @@
 // PLY: a walk over the header and every element before vcglib's importer sees the file
 // (see io_common.h for why), then the import with count checks; writing as ASCII
-// (formatted here: vcglib prints only 7 significant digits) or binary (vcglib's exporter).
+// (formatted here: vcglib prints only 7 significant digits) or binary (from the flat
+// arrays; vcglib's exporter as the reference and on big-endian hosts).
 #include "io/io_common.h"
 
 #include <pomar/vcg_adapter.h>
@@ -870,6 +871,7 @@ Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &chec
     FileReader in(path);
     const PlyHeader header = read_ply_header(in, path);
     const uint64_t faces = element_count(header, "face");
+    report.text = header.encoding == PlyHeader::Ascii;
     run_size_check(check, path, element_count(header, "vertex"), faces);
     const PlyElement *vertex = nullptr;
     for (const PlyElement &e : header.elements)
@@ -932,28 +934,33 @@ Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &chec
   return mesh;
 }
 
-std::string ply_ascii_text(const Mesh &mesh) {
-  std::string s =
-      "ply\nformat ascii 1.0\ncomment pomar\nelement vertex " + num(mesh.vertex_count()) +
-      "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
-      num(mesh.triangle_count()) + "\nproperty list uchar int vertex_indices\nend_header\n";
-  append_vertices(s, mesh, "");
-  append_triangles(s, mesh, "3 ", 0);
-  return s;
+void write_ply_ascii(TextFileWriter &out, const Mesh &mesh) {
+  out.text() += "ply\nformat ascii 1.0\ncomment pomar\nelement vertex " + num(mesh.vertex_count()) +
+                "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
+                num(mesh.triangle_count()) +
+                "\nproperty list uchar int vertex_indices\nend_header\n";
+  append_vertices(out, mesh, "");
+  append_triangles(out, mesh, "3 ", 0);
 }
 
 namespace {
-/// The binary little-endian body of ply_with_attributes: every vertex record (x y z, then
-/// each attribute's components in the header's order) and every face, written into a
-/// buffer sized once (a byte at a time through std::string::operator+= was 10x slower).
-void append_binary_body(std::string &s, const Mesh &mesh) {
+/// The binary little-endian body of write_ply_with_attributes: every vertex record (x y z,
+/// then each attribute's components in the header's order) and every face, written in runs
+/// of records into room made once per run (a byte at a time through std::string::operator+=
+/// was 10x slower).
+void write_binary_body(TextFileWriter &out, const Mesh &mesh) {
   const size_t nv = mesh.vertex_count(), nt = mesh.triangle_count();
   size_t record = 12;
   for (const VertexAttribute &a : mesh.attributes)
     record += a.kind == AttributeKind::Colour ? a.components : 4 * size_t(a.components);
-  const size_t start = s.size();
-  s.resize(start + nv * record + 13 * nt);
-  char *p = &s[start];
+  std::string &s = out.text();
+  char *p = nullptr;
+  // Room for the next `count` records of `size` bytes at the end of the text (p points to it).
+  auto room = [&](size_t count, size_t size) {
+    const size_t start = s.size();
+    s.resize(start + count * size);
+    p = &s[start];
+  };
   auto put32 = [&p](uint32_t v) {
     for (int i = 0; i < 4; ++i)
       *p++ = static_cast<char>((v >> (8 * i)) & 0xFF);
@@ -963,30 +970,44 @@ void append_binary_body(std::string &s, const Mesh &mesh) {
     std::memcpy(&v, &f, 4);
     put32(v);
   };
-  for (size_t v = 0; v < nv; ++v) {
-    for (int k = 0; k < 3; ++k)
-      put_float32(mesh.positions[3 * v + k]);
-    for (const VertexAttribute &a : mesh.attributes)
-      for (uint32_t k = 0; k < a.components; ++k) {
-        if (a.kind == AttributeKind::Colour)
-          *p++ = static_cast<char>(a.colour[v * a.components + k]);
-        else
-          put_float32(a.values[v * a.components + k]);
-      }
+  const size_t vertex_run = std::max<size_t>(1, TextFileWriter::kChunk / record);
+  for (size_t first = 0; first < nv; first += vertex_run) {
+    const size_t last = std::min(nv, first + vertex_run);
+    room(last - first, record);
+    for (size_t v = first; v < last; ++v) {
+      for (int k = 0; k < 3; ++k)
+        put_float32(mesh.positions[3 * v + k]);
+      for (const VertexAttribute &a : mesh.attributes)
+        for (uint32_t k = 0; k < a.components; ++k) {
+          if (a.kind == AttributeKind::Colour)
+            *p++ = static_cast<char>(a.colour[v * a.components + k]);
+          else
+            put_float32(a.values[v * a.components + k]);
+        }
+    }
+    out.done();
   }
-  for (size_t t = 0; t < nt; ++t) {
-    *p++ = static_cast<char>(3);
-    for (int k = 0; k < 3; ++k)
-      put32(mesh.triangles[3 * t + k]);
+  const size_t face_run = TextFileWriter::kChunk / 13;
+  for (size_t first = 0; first < nt; first += face_run) {
+    const size_t last = std::min(nt, first + face_run);
+    room(last - first, 13);
+    for (size_t t = first; t < last; ++t) {
+      *p++ = static_cast<char>(3);
+      for (int k = 0; k < 3; ++k)
+        put32(mesh.triangles[3 * t + k]);
+    }
+    out.done();
   }
 }
 } // namespace
 
-std::string ply_with_attributes(const Mesh &mesh, bool binary, const std::string &path) {
+void write_ply_with_attributes(TextFileWriter &out, const Mesh &mesh, bool binary,
+                               const std::string &path) {
   validate_attributes(mesh, false);
   const size_t nv = mesh.vertex_count();
-  std::string s = std::string("ply\nformat ") + (binary ? "binary_little_endian" : "ascii") +
-                  " 1.0\ncomment pomar\n";
+  std::string &s = out.text();
+  s += std::string("ply\nformat ") + (binary ? "binary_little_endian" : "ascii") +
+       " 1.0\ncomment pomar\n";
   for (const std::string &t : mesh.texture_files) {
     if (t.find_first_of("\r\n") != std::string::npos || t.size() > 200)
       fail(path, "texture file name cannot be stored in a PLY comment: " + t.substr(0, 64));
@@ -1024,10 +1045,8 @@ std::string ply_with_attributes(const Mesh &mesh, bool binary, const std::string
   }
   s += "element face " + num(mesh.triangle_count()) +
        "\nproperty list uchar int vertex_indices\nend_header\n";
-  if (binary) {
-    append_binary_body(s, mesh);
-    return s;
-  }
+  if (binary)
+    return write_binary_body(out, mesh);
   for (size_t v = 0; v < nv; ++v) { // ASCII
     for (int k = 0; k < 3; ++k) {
       if (k)
@@ -1036,17 +1055,16 @@ std::string ply_with_attributes(const Mesh &mesh, bool binary, const std::string
     }
     for (const VertexAttribute &a : mesh.attributes)
       for (uint32_t k = 0; k < a.components; ++k) {
-        if (a.kind == AttributeKind::Colour) {
-          s += ' ' + std::to_string(a.colour[v * a.components + k]);
-        } else {
-          s += ' ';
+        s += ' ';
+        if (a.kind == AttributeKind::Colour)
+          append_uint(s, a.colour[v * a.components + k]);
+        else
           append_float(s, a.values[v * a.components + k]);
-        }
       }
     s += '\n';
+    out.done();
   }
-  append_triangles(s, mesh, "3 ", 0);
-  return s;
+  append_triangles(out, mesh, "3 ", 0);
 }
 
 void save_ply_binary(const std::string &path, const Mesh &mesh) {

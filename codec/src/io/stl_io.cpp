@@ -198,9 +198,10 @@ Mesh read_ascii_stl(const std::string &path, const SizeCheck &check) {
   const std::vector<uint8_t> bytes = read_file(path);
   const std::string_view text(reinterpret_cast<const char *>(bytes.data()), bytes.size());
   const uint64_t facets = count_occurrences(text, "endloop");
-  // The text (about 250 bytes a facet) stays in memory while the facets are read: counted
-  // as one vertex per facet, twice what the welded mesh keeps (binary STL: see load_stl).
-  run_size_check(check, path, facets, facets);
+  // Half a vertex per facet, as for binary STL (see load_stl); the text (about 280 bytes a
+  // facet), which stays in memory while the facets are read, is in the memory estimate for
+  // ASCII STL input (pomar::EncodeInput::StlAscii, from LoadReport::text).
+  run_size_check(check, path, facets / 2, facets);
   Mesh mesh;
   mesh.positions.reserve(static_cast<size_t>(9 * facets));
   mesh.triangles.reserve(static_cast<size_t>(3 * facets));
@@ -239,6 +240,7 @@ Mesh read_ascii_stl(const std::string &path, const SizeCheck &check) {
 
 Mesh load_stl(const std::string &path, LoadReport &report, const SizeCheck &check) {
   const StlKind kind = classify_stl(path);
+  report.text = !kind.binary;
   // Identical corners are welded below: a closed mesh keeps about one vertex per two
   // facets, which is what the encoder will hold (the 3 corners per facet read first cost
   // less than its per-vertex structures).
@@ -259,8 +261,9 @@ Mesh load_stl(const std::string &path, LoadReport &report, const SizeCheck &chec
 }
 
 /// ASCII STL; the facet normal is the normalized cross product (0 for a degenerate facet).
-std::string stl_ascii_text(const Mesh &mesh) {
-  std::string s = "solid pomar\n";
+void write_stl_ascii(TextFileWriter &out, const Mesh &mesh) {
+  std::string &s = out.text();
+  s += "solid pomar\n";
   for (size_t t = 0; t < mesh.triangle_count(); ++t) {
     const float *p[3];
     for (int k = 0; k < 3; ++k)
@@ -287,11 +290,49 @@ std::string stl_ascii_text(const Mesh &mesh) {
       s += '\n';
     }
     s += "    endloop\n  endfacet\n";
+    out.done();
   }
-  return s + "endsolid pomar\n";
+  s += "endsolid pomar\n";
 }
 
 void save_stl_binary(const std::string &path, const Mesh &mesh) {
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+  // The bytes vcglib's exporter writes (its "VCG" header, the facet count, per facet the
+  // normal as vcglib computes it in float, the corners and a zero attribute word), from the
+  // flat arrays in large chunks instead of through a vcglib copy of the mesh.
+  char header[80];
+  std::memset(header, ' ', sizeof header);
+  std::memcpy(header, "VCG", 3);
+  const uint64_t nf = mesh.triangle_count();
+  const int32_t count = static_cast<int32_t>(nf); // at most INT_MAX (check_mesh_for_save)
+  ChunkedFileWriter out(path);
+  out.put(header, sizeof header);
+  out.put(&count, 4);
+  for (uint64_t t = 0; t < nf; ++t) {
+    const float *p[3];
+    for (int k = 0; k < 3; ++k)
+      p[k] = &mesh.positions[3 * size_t(mesh.triangles[3 * t + k])];
+    // vcg::TriangleNormal(f).Normalize(): (p1 - p0) ^ (p2 - p0), each divided by the float
+    // norm when it is positive.
+    const float a[3] = {p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]};
+    const float b[3] = {p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]};
+    float n[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+    const float norm = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (norm > 0.0f)
+      n[0] /= norm, n[1] /= norm, n[2] /= norm;
+    char *record = out.reserve(50);
+    std::memcpy(record, n, 12);
+    for (int k = 0; k < 3; ++k)
+      std::memcpy(record + 12 + 12 * k, p[k], 12);
+    record[48] = record[49] = 0;
+  }
+  out.commit();
+#else
+  save_stl_binary_vcg(path, mesh);
+#endif
+}
+
+void save_stl_binary_vcg(const std::string &path, const Mesh &mesh) {
   IoMesh m;
   to_vcg(mesh, m);
   TempFile tmp(path);

@@ -27,21 +27,50 @@ namespace {
 // vertices (bench/README.md, "Memory").
 //
 // Decode (refitted 2026-12-02, after the one-shot decode stopped copying its mesh and a
-// pending split shrank from 160 to 28 bytes; binary PLY output, one thread): least-squares
+// pending split shrank from 160 to 28 bytes; binary PLY output, one thread; since the text
+// and STL writers write in 1 MiB chunks every output format peaks within 1% of binary
+// PLY, measured at 100k, 300k and 1M vertices): least-squares
 // 5.0 MiB + 45 B/vertex + 31 B/face (random access), 5.4 MiB + 56 B/vertex + 29 B/face
 // (progressive), rounded up so that every peak of 300k vertices and more is 17-21% below
 // the estimate. Each further decoding thread: 13.6-28 B/vertex measured (small meshes:
 // the thread's allocator arena), estimated at 2 MiB + 16 B/vertex + 4 B/face.
 //
-// Encode (fitted 2026-11-23: 13.7 MiB + 258 B/vertex + 127 B/face): kept although a PLY
-// input now peaks at about 40% of it (1M-vertex sphere: 212 MiB, estimate 596 MiB),
-// because the estimate also stands for inputs whose readers hold more: an OBJ (through
-// tinyobjloader) peaks at 426 MiB and an ASCII STL (the whole text held) at 625 MiB on the
-// same mesh. A per-format estimate would let it shrink for PLY; not done.
-
-constexpr uint64_t kEncodeFixed = 24ull << 20;
-constexpr uint64_t kEncodePerVertex = 300;
-constexpr uint64_t kEncodePerFace = 150;
+// Encode, per input format (EncodeInput; measured 2026-12-02, two encoding threads): peaks
+// of `pomar encode` on noisy spheres (F = 2V) of 100k, 300k and 1M vertices and 2-row
+// strips (F = V) of 300k and 1M, each as binary and ASCII PLY, OBJ, OFF, binary and ASCII
+// STL (bench/README.md, "Memory", per input format). Least-squares lines through the 300k
+// and 1M peaks, raised and rounded so that every peak of 300k vertices and more is 10-25%
+// below its estimate (100k: 15-30%).
+//   - Binary and ASCII PLY, OFF and binary STL peak within 10% of each other: their readers
+//     fill the flat arrays directly (PLY files with more properties or polygons go through
+//     vcglib, 0-4% more), and the encoder's own peak is the maximum. One row, which is
+//     also the estimate for a mesh already in memory (EncodeInput::Mesh, the library's
+//     check): 12 MiB + 200 B/vertex + 36 B/face (the least-squares line: 6.3 MiB + 170 +
+//     29). It was 24 MiB + 300 + 150 for every format until then.
+//   - OBJ: tinyobjloader's arrays (an index triple of 12 bytes per corner, ...) peak above
+//     the encoder: 16 MiB + 24 B/vertex + 244 B/face (least squares: 16 MiB - 3 + 217).
+//   - ASCII STL: the whole text (about 280 bytes a facet) is held while it is parsed:
+//     6 MiB + 370 B/face (fitted on the spheres: 4.2 MiB + 326 B/face).
+// STL's size check sees half a vertex per facet (a closed mesh once welded). For an open
+// STL mesh (the strips: one vertex per facet) the check before reading is too low by the
+// encoder's per-vertex part (binary STL strips peak at 1.24-1.39 times it); the encoder's
+// own check, with the welded counts (EncodeInput::Mesh), holds them (0.80-0.83).
+struct Fit {
+  uint64_t fixed, per_vertex, per_face;
+};
+constexpr Fit kLightReaders = {12ull << 20, 200, 36};
+constexpr Fit kEncodeFits[] = {
+    kLightReaders,          // Mesh
+    kLightReaders,          // PlyBinary
+    kLightReaders,          // PlyAscii
+    {16ull << 20, 24, 244}, // Obj
+    kLightReaders,          // Off
+    kLightReaders,          // StlBinary
+    {6ull << 20, 0, 370},   // StlAscii
+};
+static_assert(sizeof kEncodeFits / sizeof kEncodeFits[0] ==
+                  static_cast<size_t>(EncodeInput::StlAscii) + 1,
+              "one fit per EncodeInput");
 
 constexpr uint64_t kDecodeFixed = 8ull << 20;
 constexpr uint64_t kClusteredDecodePerVertex = 52;
@@ -56,9 +85,9 @@ constexpr uint64_t kThreadPerFace = 4;
 // faces) with 8 codes per vertex (RGB, normal, quality, UV) peaked 611 B/vertex above the
 // same mesh without attributes when encoding (241 B/vertex since 2026-12-02: the encoder
 // frees its input once quantized), with 1 code (quality) 96 B/vertex (31): about 22 + 74 B
-// per code, kept (see the encode estimate above). Decoding: 81 B/vertex (8 codes, 27 bytes
-// of values) and 12 B/vertex (1 code, 4 bytes): the codes (8 B each) plus the values, plus
-// slack.
+// per code, kept (not refitted with the per-format estimates above). Decoding: 81 B/vertex (8
+// codes, 27 bytes of values) and 12 B/vertex (1 code, 4 bytes): the codes (8 B each) plus the
+// values, plus slack.
 constexpr uint64_t kEncodeAttributeFixed = 32;
 constexpr uint64_t kEncodePerAttributeCode = 84;
 constexpr uint64_t kDecodePerAttributeCode = 8;
@@ -226,8 +255,21 @@ std::string lower(std::string s) {
 
 } // namespace
 
-uint64_t encode_memory_estimate(uint64_t vertices, uint64_t faces) {
-  return add_mul(add_mul(kEncodeFixed, vertices, kEncodePerVertex), faces, kEncodePerFace);
+EncodeInput encode_input(const std::string &format, bool text) {
+  if (format == "ply")
+    return text ? EncodeInput::PlyAscii : EncodeInput::PlyBinary;
+  if (format == "stl")
+    return text ? EncodeInput::StlAscii : EncodeInput::StlBinary;
+  if (format == "obj")
+    return EncodeInput::Obj;
+  if (format == "off")
+    return EncodeInput::Off;
+  return EncodeInput::Mesh;
+}
+
+uint64_t encode_memory_estimate(uint64_t vertices, uint64_t faces, EncodeInput input) {
+  const Fit &fit = kEncodeFits[static_cast<size_t>(input)];
+  return add_mul(add_mul(fit.fixed, vertices, fit.per_vertex), faces, fit.per_face);
 }
 
 uint64_t decode_memory_estimate(uint64_t vertices, uint64_t faces, bool clustered) {
@@ -346,8 +388,9 @@ void check_memory(const char *action, uint64_t vertices, uint64_t faces, uint64_
 }
 
 void check_encode_memory(uint64_t vertices, uint64_t faces, uint64_t limit, uint64_t held,
-                         uint64_t attribute_bytes, unsigned threads) {
-  uint64_t needed = add_mul(encode_memory_estimate(vertices, faces), vertices, attribute_bytes);
+                         uint64_t attribute_bytes, unsigned threads, EncodeInput input) {
+  uint64_t needed =
+      add_mul(encode_memory_estimate(vertices, faces, input), vertices, attribute_bytes);
   if (threads > 1)
     needed = add_mul(needed, threads - 1, decode_thread_memory(vertices, faces));
   check_memory("encode", vertices, faces, needed, held, limit);
