@@ -406,6 +406,95 @@ TEST_F(MeshIoTest, PlyAttributesRoundTrip) {
   }
 }
 
+// A binary little-endian PLY with vertex attributes is read without vcglib (the walk takes
+// the positions and triangles too, io/ply_io.cpp mesh_from_capture): it must give what the
+// general path gives for the same values in an ASCII file (vcglib reads its positions and
+// triangles): attributes in the same order with the same values (a colour whose alpha is
+// 255 everywhere kept as RGB, quality, texture coordinates, named scalars, a double
+// converted), the texture file, what is ignored, unreferenced vertices.
+TEST_F(MeshIoTest, PlyBinaryAttributesReadWithoutVcglibAsVcglibReadsThem) {
+  std::mt19937 rng(29);
+  std::uniform_real_distribution<float> u(-2.0f, 2.0f);
+  const size_t nv = 301, nf = 290; // vertex 300 unreferenced, at least
+  const char *props = "property float intensity\nproperty float x\nproperty uchar red\n"
+                      "property uchar green\nproperty uchar blue\nproperty uchar alpha\n"
+                      "property float y\nproperty double confidence\nproperty float nx\n"
+                      "property float ny\nproperty float nz\nproperty float z\n"
+                      "property float quality\nproperty float u\nproperty float v\n"
+                      "property int flags\n";
+  auto header = [&](const char *format) {
+    return std::string("ply\nformat ") + format + " 1.0\ncomment TextureFile skin.png\n" +
+           "element vertex " + std::to_string(nv) + "\n" + props + "element face " +
+           std::to_string(nf) + "\nproperty list uchar int vertex_indices\nend_header\n";
+  };
+  std::string binary = header("binary_little_endian"), ascii = header("ascii");
+  char buf[64];
+  auto f32 = [&](float x) {
+    binary.append(reinterpret_cast<const char *>(&x), 4);
+    std::snprintf(buf, sizeof buf, "%.9g ", double(x));
+    ascii += buf;
+  };
+  auto f64 = [&](double x) {
+    binary.append(reinterpret_cast<const char *>(&x), 8);
+    std::snprintf(buf, sizeof buf, "%.17g ", x);
+    ascii += buf;
+  };
+  auto u8 = [&](uint8_t x) {
+    binary += char(x);
+    ascii += std::to_string(x) + " ";
+  };
+  auto i32 = [&](int32_t x) {
+    binary.append(reinterpret_cast<const char *>(&x), 4);
+    ascii += std::to_string(x) + " ";
+  };
+  for (size_t v = 0; v < nv; ++v) {
+    f32(u(rng)); // intensity
+    f32(u(rng)); // x
+    for (int k = 0; k < 3; ++k)
+      u8(uint8_t(rng()));
+    u8(255);                     // alpha: 255 everywhere
+    f32(v % 7 ? u(rng) : -0.0f); // y
+    f64(double(u(rng)) / 3);     // confidence: a double, kept as float
+    for (int k = 0; k < 3; ++k)  // nx ny nz
+      f32(u(rng));
+    f32(u(rng)); // z
+    f32(u(rng)); // quality
+    f32(u(rng)); // u
+    f32(u(rng)); // v
+    i32(0);      // flags
+    ascii += "\n";
+  }
+  for (size_t f = 0; f < nf; ++f) {
+    u8(3);
+    for (int k = 0; k < 3; ++k)
+      i32(int32_t((f + k * 97) % 300));
+    ascii += "\n";
+  }
+  LoadReport rb, ra;
+  const Mesh b = pomar::load_mesh(write("attr_fast.ply", binary), &rb);
+  const Mesh a = pomar::load_mesh(write("attr_general.ply", ascii), &ra);
+  EXPECT_TRUE(same_bits(b.positions, a.positions));
+  EXPECT_EQ(b.triangles, a.triangles);
+  EXPECT_EQ(b.texture_files, a.texture_files);
+  EXPECT_EQ(b.texture_files, std::vector<std::string>{"skin.png"});
+  ASSERT_EQ(b.attributes.size(), a.attributes.size());
+  ASSERT_EQ(b.attributes.size(), 6u); // colour, normal, quality, texcoord, 2 named scalars
+  for (size_t i = 0; i < a.attributes.size(); ++i) {
+    const VertexAttribute &x = b.attributes[i], &y = a.attributes[i];
+    EXPECT_EQ(x.kind, y.kind) << i;
+    EXPECT_EQ(x.name, y.name) << i;
+    EXPECT_EQ(x.components, y.components) << x.name;
+    EXPECT_EQ(x.colour, y.colour) << x.name;
+    EXPECT_TRUE(same_bits(x.values, y.values)) << x.name;
+  }
+  EXPECT_EQ(b.find(AttributeKind::Colour)->components, 3u);
+  EXPECT_EQ(rb.ignored_attributes, ra.ignored_attributes);
+  EXPECT_EQ(rb.unreferenced_vertices, ra.unreferenced_vertices);
+  EXPECT_GE(rb.unreferenced_vertices, 1u);
+  EXPECT_EQ(rb.file_vertices, ra.file_vertices);
+  EXPECT_EQ(rb.file_faces, ra.file_faces);
+}
+
 TEST_F(MeshIoTest, PlySixteenBitColourIsNotKeptAndSaysSo) {
   const std::string file =
       write("c16.ply", "ply\nformat ascii 1.0\nelement vertex 3\n"
@@ -1100,9 +1189,9 @@ namespace stl_reference { // a vcglib mesh that pomar::to_vcg fills, for vcglib'
 class V;
 class F;
 struct Types : vcg::UsedTypes<vcg::Use<V>::AsVertexType, vcg::Use<F>::AsFaceType> {};
-class V : public vcg::Vertex<Types, vcg::vertex::Coord3f, vcg::vertex::Normal3f,
-                             vcg::vertex::Color4b, vcg::vertex::Qualityf,
-                             vcg::vertex::TexCoord2f, vcg::vertex::BitFlags> {};
+class V
+    : public vcg::Vertex<Types, vcg::vertex::Coord3f, vcg::vertex::Normal3f, vcg::vertex::Color4b,
+                         vcg::vertex::Qualityf, vcg::vertex::TexCoord2f, vcg::vertex::BitFlags> {};
 class F : public vcg::Face<Types, vcg::face::VertexRef, vcg::face::BitFlags> {};
 class M : public vcg::tri::TriMesh<std::vector<V>, std::vector<F>> {};
 } // namespace stl_reference

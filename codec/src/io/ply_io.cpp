@@ -411,20 +411,31 @@ PlyVertexPlan plan_vertex_attributes(const PlyElement *vertex, std::vector<std::
   return plan;
 }
 
+/// Positions and triangles a walk can take on the way (PlyWalker's `capture`), so that a
+/// binary little-endian file of float x, y, z and triangles needs no second read by vcglib:
+/// `ok` turns false as soon as the file is anything else (polygons, triangle strips, no
+/// float x, y, z) and the general path reads it.
+struct PlyCapture {
+  bool ok = true;
+  std::vector<float> positions;
+  std::vector<uint32_t> triangles;
+};
+
 /// Walks the rest of the PLY body, validating the connectivity element (and reading the
 /// vertex attributes of `plan`, if given).
 class PlyWalker {
 public:
   PlyWalker(FileReader &in, const PlyHeader &h, const std::string &path,
-            PlyVertexPlan *plan = nullptr)
-      : in_(in), h_(h), path_(path), values_(in, h.encoding, path), plan_(plan) {}
+            PlyVertexPlan *plan = nullptr, PlyCapture *capture = nullptr)
+      : in_(in), h_(h), path_(path), values_(in, h.encoding, path), plan_(plan), capture_(capture) {
+  }
 
   PlyLayout run() {
     choose_elements();
     for (const PlyElement &e : h_.elements) {
       if (&e == conn_)
         walk(e, e.name == "tristrips");
-      else if (e.name == "vertex" && plan_ && !plan_->attributes.empty())
+      else if (e.name == "vertex" && plan_ && (!plan_->attributes.empty() || capturing(e)))
         read_vertices(e);
       else
         skip_element(e);
@@ -453,6 +464,8 @@ private:
       conn_prop_ = nullptr;
     if (!conn_prop_)
       conn_ = nullptr;
+    if (capture_ && (conn_ != face || !conn_ || !vertex))
+      capture_->ok = false; // (triangle strips, or nothing to capture)
     for (const PlyElement *e : {face, strips})
       if (e && e->count > 0 && e != conn_)
         fail(path_,
@@ -550,8 +563,35 @@ private:
     return values_.skip(p.type, static_cast<uint64_t>(n));
   }
 
-  /// Reads the vertex element's attribute values (the plan's), skipping the rest.
+  /// Whether the vertex element `e` can be captured: fixed-size records the file holds
+  /// whole (else the capture stops, and the element is read or skipped as without it).
+  bool capturing(const PlyElement &e) {
+    if (!capture_ || !capture_->ok)
+      return false;
+    uint64_t stride = 0;
+    for (const PlyProperty &p : e.props)
+      capture_->ok &= !p.is_list, stride += type_size(p.type);
+    capture_->ok &= stride > 0 && e.count <= in_.remaining() / stride;
+    return capture_->ok;
+  }
+
+  /// Reads the vertex element's attribute values (the plan's) and, when capturing, its
+  /// float x, y, z; skips the rest.
   void read_vertices(const PlyElement &e) {
+    int xyz[3] = {-1, -1, -1}; // property index of x, y, z when captured
+    if (capturing(e)) {
+      for (int k = 0; k < 3; ++k) {
+        const PlyProperty *p = e.find(std::string(1, char('x' + k)).c_str());
+        if (!is_scalar_of(p, PlyType::F32))
+          capture_->ok = false;
+        else
+          xyz[k] = static_cast<int>(p - e.props.data());
+      }
+      if (capture_->ok)
+        capture_->positions.reserve(3 * size_t(std::min<uint64_t>(e.count, in_.remaining() / 12)));
+      else
+        xyz[0] = xyz[1] = xyz[2] = -1;
+    }
     for (VertexAttribute &a : plan_->attributes) {
       const size_t n = size_t(std::min<uint64_t>(e.count, in_.remaining())) * a.components;
       if (a.kind == AttributeKind::Colour)
@@ -559,9 +599,18 @@ private:
       else
         a.values.reserve(n);
     }
-    for (uint64_t i = 0; i < e.count; ++i)
+    const bool capturing = xyz[0] >= 0;
+    float position[3] = {0, 0, 0};
+    for (uint64_t i = 0; i < e.count; ++i) {
       for (size_t j = 0; j < e.props.size(); ++j) {
         const PlyVertexPlan::Slot &slot = plan_->slots[j];
+        if (capturing && (int(j) == xyz[0] || int(j) == xyz[1] || int(j) == xyz[2])) {
+          if (!values_.real(PlyType::F32, position[int(j) == xyz[0]   ? 0
+                                                   : int(j) == xyz[1] ? 1
+                                                                      : 2]))
+            truncated(e, i);
+          continue;
+        }
         if (slot.attribute < 0) {
           if (!skip_unstored(e.props[j]))
             truncated(e, i);
@@ -576,6 +625,9 @@ private:
         else
           a.values.push_back(x);
       }
+      if (capturing)
+        capture_->positions.insert(capture_->positions.end(), position, position + 3);
+    }
   }
 
   /// Reads every item of the connectivity element and checks its index list.
@@ -617,6 +669,13 @@ private:
   void face(uint64_t item) {
     for (int64_t v : list_)
       check_index(v, "face", item);
+    if (capture_ && capture_->ok) {
+      if (list_.size() == 3) // (polygons: vcglib's triangulation, the general path)
+        capture_->triangles.insert(capture_->triangles.end(),
+                                   {uint32_t(list_[0]), uint32_t(list_[1]), uint32_t(list_[2])});
+      else
+        capture_->ok = false;
+    }
     ++layout_.faces;
     layout_.triangles += list_.size() - 2;
     layout_.polygons += list_.size() > 3;
@@ -653,6 +712,7 @@ private:
   std::vector<int64_t> list_;
   PlyLayout layout_;
   PlyVertexPlan *plan_ = nullptr;
+  PlyCapture *capture_ = nullptr;
 };
 
 // ======================================================================================
@@ -861,11 +921,53 @@ bool read_simple_ply(FileReader &in, const PlyHeader &h, Mesh &out, size_t &unre
   return true;
 }
 
+/// The mesh of a walk that captured the positions and triangles (PlyCapture), as the
+/// general path would build it without vcglib's second read of the file: the attributes
+/// go through a vcglib mesh of the same vertices (put_attributes, then from_vcg's
+/// take_attributes), so that they come out exactly as there (a colour's alpha of 255
+/// dropped, quality, texture coordinates and named scalars in its order). False if the
+/// capture stopped or met a non-finite coordinate: the general path reads the file, and
+/// names the problem.
+bool mesh_from_capture(PlyCapture &capture, const PlyLayout &layout, const PlyVertexPlan &plan,
+                       const std::vector<std::string> &texture_files, const std::string &path,
+                       Mesh &out, size_t &unreferenced) {
+  const size_t nv = layout.vertices;
+  if (!capture.ok || capture.positions.size() != 3 * nv ||
+      capture.triangles.size() != 3 * layout.triangles || nv >= UINT32_MAX)
+    return false;
+  for (const float x : capture.positions)
+    if (!std::isfinite(x))
+      return false;
+  for (const VertexAttribute &a : plan.attributes)
+    if (a.vertex_count() != nv)
+      fail(path, "PLY vertex attribute '" + a.name + "' was not read for every vertex");
+  Mesh mesh;
+  if (!plan.attributes.empty()) {
+    IoMesh m;
+    vcg::tri::Allocator<IoMesh>::AddVertices(m, nv);
+    const int mask = put_attributes(plan.attributes, texture_files, m);
+    std::vector<uint32_t> identity(nv);
+    for (size_t v = 0; v < nv; ++v)
+      identity[v] = static_cast<uint32_t>(v);
+    vcg_detail::take_attributes(m, identity, mask, mesh);
+  }
+  mesh.positions = std::move(capture.positions);
+  mesh.triangles = std::move(capture.triangles);
+  std::vector<uint8_t> used(nv, 0);
+  for (const uint32_t v : mesh.triangles)
+    used[v] = 1;
+  unreferenced = static_cast<size_t>(std::count(used.begin(), used.end(), uint8_t(0)));
+  mesh.texture_files = texture_files;
+  out = std::move(mesh);
+  return true;
+}
+
 } // namespace
 
 Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &check) {
   PlyLayout layout;
   PlyVertexPlan plan;
+  PlyCapture capture;
   std::vector<std::string> texture_files;
   {
     FileReader in(path);
@@ -888,12 +990,14 @@ Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &chec
       report.unreferenced_vertices = unreferenced;
       return fast;
     }
+    // Binary little-endian files also give the walk their positions and triangles.
+    capture.ok = header.encoding == PlyHeader::BinaryLittle;
     if (in.pos() == data_start) {
-      layout = PlyWalker(in, header, path, &plan).run();
+      layout = PlyWalker(in, header, path, &plan, &capture).run();
     } else { // the general path reads the data from its start
       FileReader again(path);
       read_ply_header(again, path);
-      layout = PlyWalker(again, header, path, &plan).run();
+      layout = PlyWalker(again, header, path, &plan, &capture).run();
     }
     if (layout.triangles > faces) // polygons or triangle strips
       run_size_check(check, path, layout.vertices, layout.triangles);
@@ -910,6 +1014,13 @@ Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &chec
     add_unique(report.ignored_attributes, "edges");
   if (layout.camera)
     add_unique(report.ignored_attributes, "camera");
+  report.file_vertices = layout.vertices;
+  report.file_faces = layout.faces;
+  report.polygons_triangulated = layout.polygons;
+  Mesh captured;
+  if (mesh_from_capture(capture, layout, plan, texture_files, path, captured,
+                        report.unreferenced_vertices))
+    return captured;
 
   IoMesh m;
   int mask = 0;
@@ -921,9 +1032,6 @@ Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &chec
   clear_flags(m);
   check_finite(m, path, false);
 
-  report.file_vertices = layout.vertices;
-  report.file_faces = layout.faces;
-  report.polygons_triangulated = layout.polygons;
   for (const VertexAttribute &a : plan.attributes)
     if (a.vertex_count() != m.vert.size())
       fail(path, "PLY vertex attribute '" + a.name + "' was not read for every vertex");
