@@ -2,6 +2,8 @@
 // suite (and under ASan + UBSan by scripts/test.sh).
 #include <gtest/gtest.h>
 
+#include <fstream>
+
 #include <dirent.h>
 #include <filesystem>
 #include <memory>
@@ -33,8 +35,7 @@ TEST(FuzzRegressions, EmptyInputIsAClearErrorForEveryDecoder) {
 }
 
 TEST(FuzzRegressions, MalformedAsciiStlIsRefusedWithoutLeakingAFile) {
-  const fs::path input =
-      kRegressions / "readers-crash-4401b907a1f8de537c2abb1f6b764df01fb4ad75";
+  const fs::path input = kRegressions / "readers-crash-4401b907a1f8de537c2abb1f6b764df01fb4ad75";
   ASSERT_TRUE(fs::exists(input));
   const fs::path stl = fs::path(::testing::TempDir()) / "pomar_fuzz_regression.stl";
   fs::copy_file(input, stl, fs::copy_options::overwrite_existing);
@@ -62,9 +63,37 @@ TEST(FuzzRegressions, OffColourMapIndexOutOfRangeIsRefused) {
   fs::remove(off);
 }
 
-TEST(FuzzRegressions, TristripPlyLoadsOrFailsCleanly) {
+TEST(FuzzRegressions, OffFloatColourOutOfRangeIsRefused) {
+  // A COFF vertex whose RGB, read as floats by vcglib (a dot in the first value), holds
+  // 2.0: vcglib converted 2 x 255 to a byte (undefined behaviour found by
+  // fuzz_mesh_readers). The walk refuses float colours outside 0..1 first.
   const fs::path input =
-      kRegressions / "readers-leak-fb23e152d22760b7390a120c0738d301e73bd637";
+      kRegressions / "readers-ub-off-float-colour-50a9851dafe258d90841ea5feab775dd68571450";
+  ASSERT_TRUE(fs::exists(input));
+  const fs::path off = fs::path(::testing::TempDir()) / "pomar_fuzz_regression_colour.off";
+  fs::copy_file(input, off, fs::copy_options::overwrite_existing);
+  try {
+    load_mesh(off.string());
+    FAIL() << "the out-of-range float colour was accepted";
+  } catch (const Error &e) {
+    EXPECT_NE(std::string(e.what()).find("outside 0..1"), std::string::npos) << e.what();
+  }
+  fs::remove(off);
+  // In range, the same file shape loads: floats 0..1 are what OFF colours in floats are.
+  const fs::path good = fs::path(::testing::TempDir()) / "pomar_colour_ok.off";
+  {
+    std::ofstream out(good);
+    out << "COFF\n3 1 0\n0 0 0 0.5 1.0 0.0\n1 0 0 0.25 0.5 1\n0 1 0 0. 0 1\n3 0 1 2\n";
+  }
+  const Mesh m = load_mesh(good.string());
+  const VertexAttribute *c = m.find(AttributeKind::Colour);
+  ASSERT_NE(c, nullptr);
+  EXPECT_EQ(c->colour[0], 127); // (unsigned char)(0.5 x 255)
+  fs::remove(good);
+}
+
+TEST(FuzzRegressions, TristripPlyLoadsOrFailsCleanly) {
+  const fs::path input = kRegressions / "readers-leak-fb23e152d22760b7390a120c0738d301e73bd637";
   ASSERT_TRUE(fs::exists(input));
   const fs::path ply = fs::path(::testing::TempDir()) / "pomar_fuzz_regression.ply";
   fs::copy_file(input, ply, fs::copy_options::overwrite_existing);

@@ -2,6 +2,8 @@
 // import with count checks; writing formatted here.
 #include "io/io_common.h"
 
+#include <cstdlib>
+
 #include <pomar/vcg_adapter.h>
 
 #include <wrap/io_trimesh/import_off.h>
@@ -149,6 +151,16 @@ private:
           fail(path_,
                "OFF vertex " + num(i) + " has a colour map index '" + index + "' outside 0..147");
       }
+      if ((n == 3 || n == 4) && tokens_[k_].find('.') != std::string::npos)
+        for (long j = 0; j < n; ++j) {
+          // vcglib reads RGB(A) with a dot in the first value as floats (atof) and converts
+          // each to a byte as (unsigned char)(x * 255): undefined outside (-1, 256) (found
+          // by fuzz_mesh_readers): 0..1, as OFF colours in floats are.
+          const float x = static_cast<float>(std::atof(tokens_[k_ + size_t(j)].c_str()));
+          if (!(x * 255.0f > -1.0f && x * 255.0f < 256.0f))
+            fail(path_, "OFF vertex " + num(i) + " has a colour component '" +
+                            strip_cr(tokens_[k_ + size_t(j)]) + "' outside 0..1");
+        }
       k_ += static_cast<size_t>(n);
     }
     for (int j = 0; h.texcoords && j < 2; ++j)
