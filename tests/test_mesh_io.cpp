@@ -27,6 +27,7 @@
 
 #include <pomar/vcg_adapter.h>
 #include <wrap/io_trimesh/export_stl.h>
+#include <wrap/io_trimesh/import_ply.h>
 
 // vcglib's PLY importer never frees the index list of a tristrip (plylib allocates it);
 // keep LeakSanitizer builds of this test green.
@@ -1195,6 +1196,86 @@ class V
 class F : public vcg::Face<Types, vcg::face::VertexRef, vcg::face::BitFlags> {};
 class M : public vcg::tri::TriMesh<std::vector<V>, std::vector<F>> {};
 } // namespace stl_reference
+
+// PLY files with vertex attributes: the walk takes their positions and triangles
+// (io/ply_io.cpp, PlyCapture) instead of vcglib's importer. For ASCII, binary little- and
+// big-endian files of the same values, positions, triangles and unreferenced vertices must
+// be what vcglib's importer reads from the same file.
+TEST_F(MeshIoTest, PlyCapturedPositionsAndTrianglesAreVcglibs) {
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<float> u(-3.0f, 3.0f);
+  const size_t nv = 203, nf = 190;
+  std::vector<float> values(nv * 5);
+  for (float &x : values)
+    x = u(rng);
+  values[7] = -0.0f;
+  values[11] = 1e-41f; // a denormal
+  for (const char *format : {"ascii", "binary_little_endian", "binary_big_endian"}) {
+    const bool ascii = std::string(format) == "ascii",
+               big = std::string(format) == "binary_big_endian";
+    std::string f = std::string("ply\nformat ") + format + " 1.0\nelement vertex " +
+                    std::to_string(nv) +
+                    "\nproperty float quality\nproperty float z\nproperty float x\n"
+                    "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+                    "property float y\nproperty float confidence\nelement face " +
+                    std::to_string(nf) + "\nproperty list uchar int vertex_indices\nend_header\n";
+    char buf[64];
+    auto put = [&](const void *p, size_t n) {
+      std::string b(static_cast<const char *>(p), n);
+      if (big)
+        std::reverse(b.begin(), b.end());
+      f += b;
+    };
+    auto f32 = [&](float x) {
+      if (ascii) {
+        std::snprintf(buf, sizeof buf, "%.9g ", double(x));
+        f += buf;
+      } else {
+        put(&x, 4);
+      }
+    };
+    auto u8 = [&](uint8_t x) {
+      if (ascii)
+        f += std::to_string(x) + " ";
+      else
+        f += char(x);
+    };
+    auto i32 = [&](int32_t x) {
+      if (ascii)
+        f += std::to_string(x) + " ";
+      else
+        put(&x, 4);
+    };
+    for (size_t v = 0; v < nv; ++v) {
+      f32(values[5 * v]), f32(values[5 * v + 1]), f32(values[5 * v + 2]);
+      u8(uint8_t(v)), u8(uint8_t(2 * v)), u8(uint8_t(3 * v));
+      f32(values[5 * v + 3]), f32(values[5 * v + 4]);
+      if (ascii)
+        f += "\n";
+    }
+    for (size_t t = 0; t < nf; ++t) {
+      u8(3);
+      for (int k = 0; k < 3; ++k)
+        i32(int32_t((t * 7 + size_t(k) * 61) % 200)); // vertices 200..202 unreferenced
+      if (ascii)
+        f += "\n";
+    }
+    const std::string file = write(std::string(format) + ".ply", f);
+    LoadReport r;
+    const Mesh m = pomar::load_mesh(file, &r);
+    stl_reference::M vm;
+    int mask = 0;
+    ASSERT_EQ(vcg::tri::io::ImporterPLY<stl_reference::M>::Open(vm, file.c_str(), mask), 0)
+        << format;
+    size_t unreferenced = 0;
+    const Mesh ref = pomar::from_vcg(vm, &unreferenced, 0, true);
+    EXPECT_TRUE(same_bits(m.positions, ref.positions)) << format;
+    EXPECT_EQ(m.triangles, ref.triangles) << format;
+    EXPECT_EQ(r.unreferenced_vertices, unreferenced) << format;
+    EXPECT_EQ(unreferenced, 3u) << format;
+    ASSERT_EQ(m.attributes.size(), 3u) << format; // colour, quality, confidence
+  }
+}
 
 // save_mesh writes binary STL from the flat arrays too: the bytes must be exactly what
 // vcglib's exporter writes, facet normals included (computed in float as vcglib does),

@@ -412,7 +412,7 @@ PlyVertexPlan plan_vertex_attributes(const PlyElement *vertex, std::vector<std::
 }
 
 /// Positions and triangles a walk can take on the way (PlyWalker's `capture`), so that a
-/// binary little-endian file of float x, y, z and triangles needs no second read by vcglib:
+/// file of float x, y, z and triangles needs no second read by vcglib:
 /// `ok` turns false as soon as the file is anything else (polygons, triangle strips, no
 /// float x, y, z) and the general path reads it.
 struct PlyCapture {
@@ -563,15 +563,19 @@ private:
     return values_.skip(p.type, static_cast<uint64_t>(n));
   }
 
-  /// Whether the vertex element `e` can be captured: fixed-size records the file holds
-  /// whole (else the capture stops, and the element is read or skipped as without it).
+  /// Whether the vertex element `e` can be captured: scalar properties only, and in a
+  /// binary file the whole element there (else the capture stops, and the element is read
+  /// or skipped as without it).
   bool capturing(const PlyElement &e) {
     if (!capture_ || !capture_->ok)
       return false;
     uint64_t stride = 0;
     for (const PlyProperty &p : e.props)
       capture_->ok &= !p.is_list, stride += type_size(p.type);
-    capture_->ok &= stride > 0 && e.count <= in_.remaining() / stride;
+    // (Binary: the whole element in the file, else the skip reports the truncation as
+    // before. ASCII elements are read item by item either way.)
+    capture_->ok &=
+        stride > 0 && (h_.encoding == PlyHeader::Ascii || e.count <= in_.remaining() / stride);
     return capture_->ok;
   }
 
@@ -990,8 +994,9 @@ Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &chec
       report.unreferenced_vertices = unreferenced;
       return fast;
     }
-    // Binary little-endian files also give the walk their positions and triangles.
-    capture.ok = header.encoding == PlyHeader::BinaryLittle;
+    // The walk also takes the positions and triangles (PlyCapture): vcglib need not read
+    // the file again.
+    capture.ok = true;
     if (in.pos() == data_start) {
       layout = PlyWalker(in, header, path, &plan, &capture).run();
     } else { // the general path reads the data from its start
