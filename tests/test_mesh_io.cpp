@@ -989,6 +989,27 @@ TEST_F(MeshIoTest, StlWeldingMatchesReference) {
   EXPECT_EQ(r.welded_vertices, 3 * facets.size() - kept.size());
 }
 
+// ASCII STL is read in chunks of 4 MiB (tokens and "endloop" words cut by a chunk's end):
+// a 12 MB file must give the mesh its binary twin gives, and the size check the facet
+// count.
+TEST_F(MeshIoTest, StlAsciiOverSeveralChunksReadsAsBinary) {
+  const pomar::Mesh m = pomar::gen::noisy_sphere(24000, 3);
+  pomar::save_mesh(path("a.stl"), m, false);
+  pomar::save_mesh(path("b.stl"), m, true);
+  EXPECT_GT(read_text(path("a.stl")).size(), size_t(10) << 20);
+  uint64_t seen_faces = 0;
+  LoadReport ra, rb;
+  const Mesh a = pomar::load_mesh(path("a.stl"), &ra, [&](uint64_t, uint64_t faces) {
+    seen_faces = std::max(seen_faces, faces);
+  });
+  const Mesh b = pomar::load_mesh(path("b.stl"), &rb);
+  EXPECT_EQ(seen_faces, m.triangle_count());
+  EXPECT_TRUE(same_bits(a.positions, b.positions));
+  EXPECT_EQ(a.triangles, b.triangles);
+  EXPECT_EQ(a.triangle_count(), m.triangle_count());
+  EXPECT_EQ(ra.welded_vertices, rb.welded_vertices);
+}
+
 TEST_F(MeshIoTest, StlAsciiIsWeldedAndMinusZeroEqualsZero) {
   const std::string file =
       write("t.stl", "solid t\n"

@@ -143,38 +143,79 @@ Mesh read_binary_stl(const std::string &path, uint64_t facets, bool &colored) {
   return mesh;
 }
 
-/// The tokens of a text separated by spaces, tabs, CR and LF (as split_ws), one at a time,
-/// as views into the text: no copy of a file that may be hundreds of megabytes.
-class TokenCursor {
+/// The tokens of a file separated by spaces, tabs, CR and LF (as split_ws), one at a time,
+/// read in chunks of 4 MiB: an ASCII STL of millions of facets is never whole in memory.
+/// A token returned stays valid until the next call.
+class StlTokens {
 public:
-  explicit TokenCursor(std::string_view text) : text_(text) {}
-  /// The next token; false at the end of the text.
+  explicit StlTokens(const std::string &path) : in_(path), path_(path) {}
+  /// The next token; false at the end of the file.
   bool next(std::string_view &out) {
     // (A loop per character: find_first_of with a set calls memchr for each one.)
     const auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; };
-    const size_t n = text_.size();
-    size_t begin = pos_;
-    while (begin < n && blank(text_[begin]))
-      ++begin;
-    if (begin == n)
-      return false;
-    pos_ = begin;
-    while (pos_ < n && !blank(text_[pos_]))
-      ++pos_;
-    out = text_.substr(begin, pos_ - begin);
-    return true;
+    for (;;) {
+      while (pos_ < buf_.size() && blank(buf_[pos_]))
+        ++pos_;
+      if (pos_ == buf_.size()) { // nothing left but blanks: the next chunk
+        buf_.clear();
+        pos_ = 0;
+        if (!refill())
+          return false;
+        continue;
+      }
+      size_t end = pos_;
+      while (end < buf_.size() && !blank(buf_[end]))
+        ++end;
+      if (end < buf_.size() || at_end_) {
+        out = std::string_view(buf_.data() + pos_, end - pos_);
+        pos_ = end;
+        return true;
+      }
+      buf_.erase(0, pos_); // a token cut by the chunk's end: keep it, read on
+      pos_ = 0;
+      at_end_ = !refill();
+    }
   }
 
 private:
-  std::string_view text_;
+  bool refill() {
+    const size_t n = size_t(std::min<uint64_t>(kChunk, in_.remaining()));
+    if (n == 0)
+      return false;
+    const size_t old = buf_.size();
+    buf_.resize(old + n);
+    if (!in_.read(buf_.data() + old, n))
+      fail_io(path_, "read error");
+    return true;
+  }
+  static constexpr size_t kChunk = size_t(4) << 20;
+  FileReader in_;
+  std::string path_;
+  std::string buf_;
   size_t pos_ = 0;
+  bool at_end_ = false;
 };
 
-/// Counts the occurrences of `word` in `text` (for ASCII STL: "endloop" = facets).
-uint64_t count_occurrences(std::string_view text, std::string_view word) {
+/// Counts the occurrences of `word` in the file (for ASCII STL: "endloop" = facets), in
+/// chunks of 4 MiB; the last word.size() - 1 bytes of each chunk are searched again with
+/// the next, so that a word cut by a chunk's end counts ("endloop" cannot overlap itself:
+/// no occurrence is counted twice).
+uint64_t count_occurrences(const std::string &path, std::string_view word) {
+  FileReader in(path);
+  std::string buf;
   uint64_t n = 0;
-  for (size_t at = text.find(word); at != text.npos; at = text.find(word, at + word.size()))
-    ++n;
+  constexpr size_t kChunk = size_t(4) << 20;
+  while (in.remaining() > 0) {
+    const size_t keep = std::min(buf.size(), word.size() - 1);
+    buf.erase(0, buf.size() - keep);
+    const size_t k = size_t(std::min<uint64_t>(kChunk, in.remaining()));
+    buf.resize(keep + k);
+    if (!in.read(buf.data() + keep, k))
+      fail_io(path, "read error");
+    const std::string_view text(buf);
+    for (size_t at = text.find(word); at != text.npos; at = text.find(word, at + word.size()))
+      ++n;
+  }
   return n;
 }
 
@@ -195,19 +236,16 @@ bool stl_float(std::string_view c, float &x) {
 /// vertices per facet, in file order. The size check sees the facet count ("endloop"
 /// keywords) before the mesh is allocated.
 Mesh read_ascii_stl(const std::string &path, const SizeCheck &check) {
-  const std::vector<uint8_t> bytes = read_file(path);
-  const std::string_view text(reinterpret_cast<const char *>(bytes.data()), bytes.size());
-  const uint64_t facets = count_occurrences(text, "endloop");
-  // Half a vertex per facet, as for binary STL (see load_stl); the text (about 280 bytes a
-  // facet), which stays in memory while the facets are read, is in the memory estimate for
-  // ASCII STL input (pomar::EncodeInput::StlAscii, from LoadReport::text).
+  const uint64_t facets = count_occurrences(path, "endloop");
+  // Half a vertex per facet, as for binary STL (see load_stl). The text is read in chunks
+  // (StlTokens), twice: once to count, once to read.
   run_size_check(check, path, facets / 2, facets);
   Mesh mesh;
   mesh.positions.reserve(static_cast<size_t>(9 * facets));
   mesh.triangles.reserve(static_cast<size_t>(3 * facets));
   size_t in_loop = 0, facet = 0;
   bool looping = false;
-  TokenCursor tokens(text);
+  StlTokens tokens(path);
   std::string_view tok;
   while (tokens.next(tok)) {
     if (tok == "loop") {

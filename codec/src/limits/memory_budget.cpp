@@ -49,8 +49,10 @@ namespace {
 //     29). It was 24 MiB + 300 + 150 for every format until then.
 //   - OBJ: tinyobjloader's arrays (an index triple of 12 bytes per corner, ...) peak above
 //     the encoder: 16 MiB + 24 B/vertex + 244 B/face (least squares: 16 MiB - 3 + 217).
-//   - ASCII STL: the whole text (about 280 bytes a facet) is held while it is parsed:
-//     6 MiB + 370 B/face (fitted on the spheres: 4.2 MiB + 326 B/face).
+//   - ASCII STL: fitted when the whole text (about 280 bytes a facet) was held while it
+//     was parsed: 6 MiB + 370 B/face (on the spheres: 4.2 MiB + 326 B/face). The reader
+//     now reads it in 4 MiB chunks and peaks as binary STL does (1M sphere: 212 MB, this
+//     estimate 711 MB): kept, not refitted, so it refuses early but never too late.
 // STL's size check sees half a vertex per facet (a closed mesh once welded). For an open
 // STL mesh (the strips: one vertex per facet) the check before reading is too low by the
 // encoder's per-vertex part (binary STL strips peak at 1.24-1.39 times it); the encoder's
