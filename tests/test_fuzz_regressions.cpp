@@ -46,39 +46,39 @@ TEST(FuzzRegressions, MalformedAsciiStlIsRefusedWithoutLeakingAFile) {
   fs::remove(stl);
 }
 
+/// The message load_mesh refuses regression file `name` with, read as an OFF file (empty,
+/// and a test failure, if it loads).
+std::string off_refusal(const char *name) {
+  const fs::path input = kRegressions / name;
+  EXPECT_TRUE(fs::exists(input)) << name;
+  const fs::path off = fs::path(::testing::TempDir()) / "pomar_fuzz_regression.off";
+  fs::copy_file(input, off, fs::copy_options::overwrite_existing);
+  std::string message;
+  try {
+    load_mesh(off.string());
+    ADD_FAILURE() << name << " was accepted";
+  } catch (const Error &e) {
+    message = e.what();
+  }
+  fs::remove(off);
+  return message;
+}
+
 TEST(FuzzRegressions, OffColourMapIndexOutOfRangeIsRefused) {
   // A COFF vertex with one colour value (a colour map index) of 255: vcglib's importer
   // indexed its 148-entry map with it (undefined behaviour found by fuzz_mesh_readers).
-  const fs::path input =
-      kRegressions / "readers-ub-off-colormap-6395a3bbed1ac736d4e77c2f3808ef9e5cb09a1d";
-  ASSERT_TRUE(fs::exists(input));
-  const fs::path off = fs::path(::testing::TempDir()) / "pomar_fuzz_regression.off";
-  fs::copy_file(input, off, fs::copy_options::overwrite_existing);
-  try {
-    load_mesh(off.string());
-    FAIL() << "the out-of-range colour map index was accepted";
-  } catch (const Error &e) {
-    EXPECT_NE(std::string(e.what()).find("colour map index"), std::string::npos) << e.what();
-  }
-  fs::remove(off);
+  const std::string e =
+      off_refusal("readers-ub-off-colormap-6395a3bbed1ac736d4e77c2f3808ef9e5cb09a1d");
+  EXPECT_NE(e.find("colour map index"), std::string::npos) << e;
 }
 
 TEST(FuzzRegressions, OffFloatColourOutOfRangeIsRefused) {
   // A COFF vertex whose RGB, read as floats by vcglib (a dot in the first value), holds
   // 2.0: vcglib converted 2 x 255 to a byte (undefined behaviour found by
   // fuzz_mesh_readers). The walk refuses float colours outside 0..1 first.
-  const fs::path input =
-      kRegressions / "readers-ub-off-float-colour-50a9851dafe258d90841ea5feab775dd68571450";
-  ASSERT_TRUE(fs::exists(input));
-  const fs::path off = fs::path(::testing::TempDir()) / "pomar_fuzz_regression_colour.off";
-  fs::copy_file(input, off, fs::copy_options::overwrite_existing);
-  try {
-    load_mesh(off.string());
-    FAIL() << "the out-of-range float colour was accepted";
-  } catch (const Error &e) {
-    EXPECT_NE(std::string(e.what()).find("outside 0..1"), std::string::npos) << e.what();
-  }
-  fs::remove(off);
+  const std::string e =
+      off_refusal("readers-ub-off-float-colour-50a9851dafe258d90841ea5feab775dd68571450");
+  EXPECT_NE(e.find("outside 0..1"), std::string::npos) << e;
   // In range, the same file shape loads: floats 0..1 are what OFF colours in floats are.
   const fs::path good = fs::path(::testing::TempDir()) / "pomar_colour_ok.off";
   {
