@@ -75,24 +75,14 @@ check() { # label mesh args... : encode with both tools, compare file, status an
   fi
 }
 
-meshes=()
-for f in "$ROOT"/samples/*.ply "$ROOT"/samples/*.off; do meshes+=("$f"); done
-for f in bunny.ply horse.ply armadillo_50k.obj armadillo_photo_colour.ply fertility_23k.off \
-  bimba_9k.off rocker_arm.off dragon_res4.ply meshlab_many_small_holes.ply snowden.ply \
-  meshlab_lato315.ply meshlab_bunny10k_textured.obj meshlab_non_manif_hole.ply \
+# shellcheck source=bench/identity_meshes.sh
+. "$ROOT/bench/identity_meshes.sh"
+identity_meshes "$W/in" bunny.ply horse.ply armadillo_50k.obj armadillo_photo_colour.ply \
+  fertility_23k.off bimba_9k.off rocker_arm.off dragon_res4.ply meshlab_many_small_holes.ply \
+  snowden.ply meshlab_lato315.ply meshlab_bunny10k_textured.obj meshlab_non_manif_hole.ply \
   mepp2_cube_nonman.off mepp2_cut_vertices.off cgal_oblong_shuffled.off cgal_pig.stl \
   thingi10k_100036.stl thingi10k_130976.stl trimesh_soup.stl trimesh_wallhole.obj \
-  draco_test_nm.obj; do
-  [ -f "$DATA/$f" ] && meshes+=("$DATA/$f")
-done
-if [ -z "$QUICK" ] && [ -f "$DATA/dragon.ply.xz" ]; then
-  xz -dc "$DATA/dragon.ply.xz" >"$W/in/dragon.ply" && meshes+=("$W/in/dragon.ply")
-fi
-sizes="20000 134000"
-[ -z "$QUICK" ] && sizes="$sizes 1000000"
-for n in $sizes; do
-  "$GEN" noisy_sphere "$n" "$W/in/sphere_$n.ply" >/dev/null && meshes+=("$W/in/sphere_$n.ply")
-done
+  draco_test_nm.obj
 
 options_for() { # mesh name -> one option set per line ("-" = default)
   local name=$1

@@ -48,19 +48,10 @@ run_both() { # label out_ext args... (the output path is the last arg, written a
   same "$label" "$a" "$b"
 }
 
-meshes=()
-for f in "$ROOT"/samples/*.ply "$ROOT"/samples/*.off; do meshes+=("$f"); done
-for f in bunny.ply horse.ply armadillo_50k.obj fertility_23k.off meshlab_many_small_holes.ply; do
-  [ -f "$DATA/$f" ] && meshes+=("$DATA/$f")
-done
-if [ -z "$QUICK" ] && [ -f "$DATA/dragon.ply.xz" ]; then
-  xz -dc "$DATA/dragon.ply.xz" >"$W/dragon.ply" && meshes+=("$W/dragon.ply")
-fi
-sizes="20000 134000"
-[ -z "$QUICK" ] && sizes="$sizes 1000000"
-for n in $sizes; do
-  "$GEN" noisy_sphere "$n" "$W/sphere_$n.ply" >/dev/null && meshes+=("$W/sphere_$n.ply")
-done
+# shellcheck source=bench/identity_meshes.sh
+. "$ROOT/bench/identity_meshes.sh"
+identity_meshes "$W" bunny.ply horse.ply armadillo_50k.obj fertility_23k.off \
+  meshlab_many_small_holes.ply
 
 for m in "${meshes[@]}"; do
   name=$(basename "$m")

@@ -435,8 +435,8 @@ public:
     for (const PlyElement &e : h_.elements) {
       if (&e == conn_)
         walk(e, e.name == "tristrips");
-      else if (e.name == "vertex" && plan_ && (!plan_->attributes.empty() || capturing(e)))
-        read_vertices(e);
+      else if (e.name == "vertex" && plan_)
+        vertex_element(e);
       else
         skip_element(e);
       layout_.edges |= e.name == "edge" && e.count > 0;
@@ -563,10 +563,21 @@ private:
     return values_.skip(p.type, static_cast<uint64_t>(n));
   }
 
-  /// Whether the vertex element `e` can be captured: scalar properties only, and in a
-  /// binary file the whole element there (else the capture stops, and the element is read
-  /// or skipped as without it).
-  bool capturing(const PlyElement &e) {
+  /// The vertex element: read when it has attributes or its positions are captured,
+  /// else skipped.
+  void vertex_element(const PlyElement &e) {
+    const bool capturing = capture_vertices(e);
+    if (capturing || !plan_->attributes.empty())
+      read_vertices(e, capturing);
+    else
+      skip_element(e);
+  }
+
+  /// Whether the positions of vertex element `e` are captured: float x, y, z, scalar
+  /// properties only and, in a binary file, the whole element there (else the capture
+  /// stops, and the element is read or skipped as without it). Fills axis_: per property,
+  /// the coordinate it holds (0, 1, 2) or -1.
+  bool capture_vertices(const PlyElement &e) {
     if (!capture_ || !capture_->ok)
       return false;
     uint64_t stride = 0;
@@ -576,26 +587,21 @@ private:
     // before. ASCII elements are read item by item either way.)
     capture_->ok &=
         stride > 0 && (h_.encoding == PlyHeader::Ascii || e.count <= in_.remaining() / stride);
+    axis_.assign(e.props.size(), -1);
+    for (int k = 0; k < 3 && capture_->ok; ++k) {
+      const PlyProperty *p = e.find(std::string(1, char('x' + k)).c_str());
+      capture_->ok = is_scalar_of(p, PlyType::F32);
+      if (capture_->ok)
+        axis_[size_t(p - e.props.data())] = static_cast<int8_t>(k);
+    }
+    if (capture_->ok)
+      capture_->positions.reserve(3 * size_t(std::min<uint64_t>(e.count, in_.remaining() / 12)));
     return capture_->ok;
   }
 
-  /// Reads the vertex element's attribute values (the plan's) and, when capturing, its
-  /// float x, y, z; skips the rest.
-  void read_vertices(const PlyElement &e) {
-    int xyz[3] = {-1, -1, -1}; // property index of x, y, z when captured
-    if (capturing(e)) {
-      for (int k = 0; k < 3; ++k) {
-        const PlyProperty *p = e.find(std::string(1, char('x' + k)).c_str());
-        if (!is_scalar_of(p, PlyType::F32))
-          capture_->ok = false;
-        else
-          xyz[k] = static_cast<int>(p - e.props.data());
-      }
-      if (capture_->ok)
-        capture_->positions.reserve(3 * size_t(std::min<uint64_t>(e.count, in_.remaining() / 12)));
-      else
-        xyz[0] = xyz[1] = xyz[2] = -1;
-    }
+  /// Reads the vertex element's attribute values (the plan's) and, with `capturing`, its
+  /// float x, y, z (axis_); skips the rest.
+  void read_vertices(const PlyElement &e, bool capturing) {
     for (VertexAttribute &a : plan_->attributes) {
       const size_t n = size_t(std::min<uint64_t>(e.count, in_.remaining())) * a.components;
       if (a.kind == AttributeKind::Colour)
@@ -603,15 +609,12 @@ private:
       else
         a.values.reserve(n);
     }
-    const bool capturing = xyz[0] >= 0;
     float position[3] = {0, 0, 0};
     for (uint64_t i = 0; i < e.count; ++i) {
       for (size_t j = 0; j < e.props.size(); ++j) {
         const PlyVertexPlan::Slot &slot = plan_->slots[j];
-        if (capturing && (int(j) == xyz[0] || int(j) == xyz[1] || int(j) == xyz[2])) {
-          if (!values_.real(PlyType::F32, position[int(j) == xyz[0]   ? 0
-                                                   : int(j) == xyz[1] ? 1
-                                                                      : 2]))
+        if (capturing && axis_[j] >= 0) {
+          if (!values_.real(PlyType::F32, position[axis_[j]]))
             truncated(e, i);
           continue;
         }
@@ -717,6 +720,7 @@ private:
   PlyLayout layout_;
   PlyVertexPlan *plan_ = nullptr;
   PlyCapture *capture_ = nullptr;
+  std::vector<int8_t> axis_; // per vertex property: the captured coordinate, or -1
 };
 
 // ======================================================================================

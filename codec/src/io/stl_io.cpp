@@ -143,6 +143,9 @@ Mesh read_binary_stl(const std::string &path, uint64_t facets, bool &colored) {
   return mesh;
 }
 
+/// What ASCII STL is read in (StlTokens, count_occurrences).
+constexpr size_t kStlChunk = size_t(4) << 20;
+
 /// The tokens of a file separated by spaces, tabs, CR and LF (as split_ws), one at a time,
 /// read in chunks of 4 MiB: an ASCII STL of millions of facets is never whole in memory.
 /// A token returned stays valid until the next call.
@@ -179,7 +182,7 @@ public:
 
 private:
   bool refill() {
-    const size_t n = size_t(std::min<uint64_t>(kChunk, in_.remaining()));
+    const size_t n = size_t(std::min<uint64_t>(kStlChunk, in_.remaining()));
     if (n == 0)
       return false;
     const size_t old = buf_.size();
@@ -188,7 +191,6 @@ private:
       fail_io(path_, "read error");
     return true;
   }
-  static constexpr size_t kChunk = size_t(4) << 20;
   FileReader in_;
   std::string path_;
   std::string buf_;
@@ -204,11 +206,10 @@ uint64_t count_occurrences(const std::string &path, std::string_view word) {
   FileReader in(path);
   std::string buf;
   uint64_t n = 0;
-  constexpr size_t kChunk = size_t(4) << 20;
   while (in.remaining() > 0) {
     const size_t keep = std::min(buf.size(), word.size() - 1);
     buf.erase(0, buf.size() - keep);
-    const size_t k = size_t(std::min<uint64_t>(kChunk, in.remaining()));
+    const size_t k = size_t(std::min<uint64_t>(kStlChunk, in.remaining()));
     buf.resize(keep + k);
     if (!in.read(buf.data() + keep, k))
       fail_io(path, "read error");
