@@ -126,6 +126,11 @@ bool walk_fan(const CornerTable &ct, uint32_t first, const Name &name, Ring &rin
       ring.corner.grow_to(room + 1);
       return walk_fan(ct, first, name, ring);
     }
+    const uint32_t across = O[c]; // the face beyond edge (a, b): see the comment above
+    if (across != kNone) {
+      __builtin_prefetch(&V[across]);
+      __builtin_prefetch(&O[across]);
+    }
     const uint32_t after = name(b);
     if (after != before) {
       corner[kept++] = c;

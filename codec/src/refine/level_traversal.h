@@ -69,7 +69,11 @@ struct TraversalScratch {
   struct VertexMarks {
     uint32_t queued = 0, split = 0; // together: one cache line per vertex visit
   };
-  std::vector<VertexMarks> marks;
+  std::vector<VertexMarks> marks; // a global level's, by vertex id
+  // A cluster's, by the vertex's rank in its cluster (LevelMesh::Lineage::local): as many
+  // entries as the largest cluster has vertices, so they stay in the core's cache, where
+  // marks by vertex id (8 bytes per mesh vertex) missed at almost every neighbour.
+  std::vector<VertexMarks> local_marks;
   std::vector<uint32_t> claimed; // per face: stamp of the level whose patch holds it
   uint32_t stamp = 0;
   std::vector<uint32_t> claims; // the faces this traversal's patches hold, in claim order
@@ -80,6 +84,7 @@ struct TraversalScratch {
   Ring ring;
   std::vector<Spoke> spokes;    // of the split vertex being coded
   std::vector<uint32_t> ranked; // its ring's edges, longest first
+  /// Start a traversal: `vertices` marks by vertex id (0 for a cluster's traversal).
   void begin(uint32_t vertices, uint32_t faces) {
     if (marks.size() < vertices)
       marks.resize(vertices);
@@ -90,6 +95,32 @@ struct TraversalScratch {
     claims.clear();
   }
   bool queued(uint32_t v) const { return marks[v].queued == stamp; }
+  /// The marks of the cluster vertex of rank `local` (grown on first use; new entries
+  /// carry stamp 0, which no traversal has).
+  VertexMarks &local_mark(uint32_t local) {
+    if (local >= local_marks.size())
+      local_marks.resize(std::max<size_t>(2 * local_marks.size(), size_t(local) + 64));
+    return local_marks[local];
+  }
+};
+
+/// Where a global level's traversal keeps a vertex's marks: by vertex id, every vertex
+/// is visited.
+struct MarksById {
+  TraversalScratch &s;
+  TraversalScratch::VertexMarks *operator()(uint32_t v) const { return &s.marks[v]; }
+};
+
+/// Where a cluster's traversal keeps them: by rank in the cluster, for the cluster's own
+/// vertices; nullptr for the others, which it neither visits nor splits.
+struct MarksInCluster {
+  TraversalScratch &s;
+  const LevelMesh::Lineage *lineage;
+  uint32_t cluster;
+  TraversalScratch::VertexMarks *operator()(uint32_t v) const {
+    const LevelMesh::Lineage &l = lineage[v];
+    return l.cluster == cluster ? &s.local_mark(l.local) : nullptr;
+  }
 };
 
 /// s_v context from what the decoder already knows at v: how many of v's faces earlier
@@ -204,13 +235,14 @@ struct SelectsSplitEdge<Codec, std::enable_if_t<Codec::kSelectsSplitEdge>> : std
 
 /// Code (or decode) s_v at v and, for a split vertex, the split: symbols, patch, claim of
 /// its faces, prediction and position. `ring` is v's ring as the level sees it.
-template <class Codec, class Key>
+template <class Codec, class Key, class MarksOf>
 void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v, const Ring &ring,
-                 uint32_t level, const Key &key, uint32_t split_neighbours, SplitList &splits) {
+                 uint32_t level, const Key &key, const MarksOf &marks_of,
+                 uint32_t split_neighbours, SplitList &splits) {
   const int context = sv_context(s, ring, split_neighbours);
   if (context < 0 || !codec.split_flag(v, context))
     return;
-  s.marks[v].split = s.stamp;
+  marks_of(v)->split = s.stamp;
   load_spokes(mesh.q, v, ring, s.spokes);
   SplitSymbols sym;
   uint32_t j = kNone; // the ring index of edge v_to-v_ref (rank s_e)
@@ -272,9 +304,11 @@ void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v,
 /// Queue v's neighbours clockwise, starting with the one back to `from`; returns how many
 /// of them were split earlier in this traversal (for sv_context: one pass over the ring's
 /// marks; v's own coding, which follows, changes neither the queue nor those marks).
-template <class Accept>
+/// `marks_of(n)` is where n's marks are, nullptr for a vertex the traversal does not visit
+/// (another cluster's: never queued nor split here).
+template <class MarksOf>
 uint32_t queue_neighbours(TraversalScratch &s, uint32_t v, uint32_t from, const Ring &ring,
-                          const Accept &accept) {
+                          const MarksOf &marks_of) {
   const uint32_t m = ring.size(), stamp = s.stamp; // (a local: the mark stores could alias it)
   if (m == 0)
     return 0;
@@ -282,10 +316,12 @@ uint32_t queue_neighbours(TraversalScratch &s, uint32_t v, uint32_t from, const 
   const uint32_t start = at < 0 ? 0 : uint32_t(at);
   uint32_t split = 0;
   const auto visit = [&](uint32_t n) {
-    TraversalScratch::VertexMarks &marks = s.marks[n];
-    split += marks.split == stamp;
-    if (marks.queued != stamp && accept(n)) {
-      marks.queued = stamp;
+    TraversalScratch::VertexMarks *marks = marks_of(n);
+    if (!marks)
+      return;
+    split += marks->split == stamp;
+    if (marks->queued != stamp) {
+      marks->queued = stamp;
       s.queue.emplace_back(n, v);
     }
   };
@@ -334,7 +370,7 @@ template <class Codec>
 void traverse_level(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t level,
                     SplitList &splits) {
   const auto id = [](uint32_t v) { return uint64_t(v); };
-  const auto all = [](uint32_t) { return true; };
+  const MarksById marks_of{s};
   size_t head = 0;
   for (uint32_t f = 0; f < mesh.seed_faces; ++f) {
     const uint32_t a = mesh.ct.V[3 * f], b = mesh.ct.V[3 * f + 1];
@@ -346,8 +382,8 @@ void traverse_level(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t
       prefetch_ahead(mesh, s, head);
       const auto [v, from] = s.queue[head++];
       get_ring(mesh.ct, v, s.ring);
-      const uint32_t split = queue_neighbours(s, v, from, s.ring, all);
-      code_vertex(mesh, codec, s, v, s.ring, level, id, split, splits);
+      const uint32_t split = queue_neighbours(s, v, from, s.ring, marks_of);
+      code_vertex(mesh, codec, s, v, s.ring, level, id, marks_of, split, splits);
     }
   }
 }
@@ -362,7 +398,7 @@ void traverse_cluster(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32
                       const LevelView &level, SplitList &splits) {
   const uint32_t cluster = mesh.cluster_of(root);
   const auto key = [&](uint32_t v) { return mesh.key(v); };
-  const auto mine = [&](uint32_t v) { return mesh.lineage[v].cluster == cluster; };
+  const MarksInCluster marks_of{s, mesh.lineage.data(), cluster};
   get_view_ring(mesh, root, level, s.ring);
   if (s.ring.neighbour.empty())
     return;
@@ -370,14 +406,14 @@ void traverse_cluster(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32
   for (uint32_t n : s.ring.neighbour)
     if (mesh.key(n) < mesh.key(from))
       from = n;
-  s.marks[root].queued = s.stamp;
+  marks_of(root)->queued = s.stamp;
   s.queue.emplace_back(root, from);
   for (size_t head = 0; head < s.queue.size();) {
     prefetch_ahead(mesh, s, head);
     const auto [v, came_from] = s.queue[head++];
     get_view_ring(mesh, v, level, s.ring);
-    const uint32_t split = queue_neighbours(s, v, came_from, s.ring, mine);
-    code_vertex(mesh, codec, s, v, s.ring, level.level, key, split, splits);
+    const uint32_t split = queue_neighbours(s, v, came_from, s.ring, marks_of);
+    code_vertex(mesh, codec, s, v, s.ring, level.level, key, marks_of, split, splits);
   }
 }
 
