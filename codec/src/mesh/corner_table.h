@@ -126,7 +126,9 @@ bool walk_fan(const CornerTable &ct, uint32_t first, const Name &name, Ring &rin
       ring.corner.grow_to(room + 1);
       return walk_fan(ct, first, name, ring);
     }
-    const uint32_t across = O[c]; // the face beyond edge (a, b): see the comment above
+    // The face beyond edge (a, b) is in the fans of a and b, which a breadth-first walk
+    // visits soon: fetch it now.
+    const uint32_t across = O[c];
     if (across != kNone) {
       __builtin_prefetch(&V[across]);
       __builtin_prefetch(&O[across]);

@@ -67,7 +67,7 @@ public:
   /// Refine the whole mesh by global level `level` (vertices get cluster 0).
   template <class Codec, class Check = NoCheck>
   void global_level(LevelMesh &mesh, Codec &codec, uint32_t level, const Check &check = {}) {
-    traverse_and_check(mesh, level, mesh.vertex_count(), check,
+    traverse_and_check(mesh, level, true, check,
                        [&] { traverse_level(mesh, codec, scratch_, level, splits_); });
     apply_splits(mesh, splits_, level, 0, nullptr);
   }
@@ -78,7 +78,7 @@ public:
   void cluster_level(LevelMesh &mesh, Codec &codec, const ClusterLevel &where, uint32_t &next_local,
                      const Check &check = {}) {
     const LevelView view{where.level, where.older_than};
-    traverse_and_check(mesh, where.level, 0, check, [&] {
+    traverse_and_check(mesh, where.level, false, check, [&] {
       traverse_cluster(mesh, codec, scratch_, where.cluster, view, splits_);
     });
     apply_splits(mesh, splits_, where.level, where.cluster, &next_local);
@@ -94,7 +94,7 @@ public:
     scratch_.defer_claims = true;
     out.error = nullptr;
     try {
-      traverse_and_check(mesh, where.level, 0, check, [&] {
+      traverse_and_check(mesh, where.level, false, check, [&] {
         traverse_cluster(mesh, codec, scratch_, where.cluster, view, splits_);
       });
     } catch (...) {
@@ -124,11 +124,12 @@ public:
   }
 
 private:
-  /// (`marked`: the vertices the traversal marks by id, TraversalScratch::begin.)
+  /// (`by_id`: a global level, whose traversal marks vertices by id,
+  /// TraversalScratch::begin.)
   template <class Check, class Traverse>
-  void traverse_and_check(LevelMesh &mesh, uint32_t level, uint32_t marked, const Check &check,
+  void traverse_and_check(LevelMesh &mesh, uint32_t level, bool by_id, const Check &check,
                           const Traverse &traverse) {
-    scratch_.begin(marked, mesh.ct.face_count());
+    scratch_.begin(by_id ? mesh.vertex_count() : 0, mesh.ct.face_count());
     splits_.clear();
     try {
       traverse();

@@ -34,6 +34,7 @@
 #include "mesh/corner_table.h"
 #include "refine/level_mesh.h"
 #include "refine/patch.h"
+#include "refine/traversal_marks.h"
 #include "refine/vertex_split.h"
 
 namespace pomar {
@@ -64,77 +65,19 @@ struct SplitList {
   }
 };
 
-/// Per-vertex and per-face marks of one traversal (level stamps, reused across levels).
-struct TraversalScratch {
-  struct VertexMarks {
-    uint32_t queued = 0, split = 0; // together: one cache line per vertex visit
-  };
-  std::vector<VertexMarks> marks; // a global level's, by vertex id
-  // A cluster's, by the vertex's rank in its cluster (LevelMesh::Lineage::local): as many
-  // entries as the largest cluster has vertices, so they stay in the core's cache, where
-  // marks by vertex id (8 bytes per mesh vertex) missed at almost every neighbour.
-  std::vector<VertexMarks> local_marks;
-  std::vector<uint32_t> claimed; // per face: stamp of the level whose patch holds it
-  uint32_t stamp = 0;
-  std::vector<uint32_t> claims; // the faces this traversal's patches hold, in claim order
-  // Leave LevelMesh::face_claim to the caller (clusters traversed in parallel: the caller
-  // checks and writes their claims in cluster order, refine/level_step.h).
-  bool defer_claims = false;
-  std::vector<std::pair<uint32_t, uint32_t>> queue; // (vertex, came from)
-  Ring ring;
-  std::vector<Spoke> spokes;    // of the split vertex being coded
-  std::vector<uint32_t> ranked; // its ring's edges, longest first
-  /// Start a traversal: `vertices` marks by vertex id (0 for a cluster's traversal).
-  void begin(uint32_t vertices, uint32_t faces) {
-    if (marks.size() < vertices)
-      marks.resize(vertices);
-    if (claimed.size() < faces)
-      claimed.resize(faces, 0);
-    ++stamp;
-    queue.clear();
-    claims.clear();
-  }
-  bool queued(uint32_t v) const { return marks[v].queued == stamp; }
-  /// The marks of the cluster vertex of rank `local` (grown on first use; new entries
-  /// carry stamp 0, which no traversal has).
-  VertexMarks &local_mark(uint32_t local) {
-    if (local >= local_marks.size())
-      local_marks.resize(std::max<size_t>(2 * local_marks.size(), size_t(local) + 64));
-    return local_marks[local];
-  }
-};
-
-/// Where a global level's traversal keeps a vertex's marks: by vertex id, every vertex
-/// is visited.
-struct MarksById {
-  TraversalScratch &s;
-  TraversalScratch::VertexMarks *operator()(uint32_t v) const { return &s.marks[v]; }
-};
-
-/// Where a cluster's traversal keeps them: by rank in the cluster, for the cluster's own
-/// vertices; nullptr for the others, which it neither visits nor splits.
-struct MarksInCluster {
-  TraversalScratch &s;
-  const LevelMesh::Lineage *lineage;
-  uint32_t cluster;
-  TraversalScratch::VertexMarks *operator()(uint32_t v) const {
-    const LevelMesh::Lineage &l = lineage[v];
-    return l.cluster == cluster ? &s.local_mark(l.local) : nullptr;
-  }
-};
-
 /// s_v context from what the decoder already knows at v: how many of v's faces earlier
 /// patches of this level hold (0..3+), how many neighbours were split (0..2+), and v's
 /// valence (<=5, 6, 7, 8+: a v_to gained the valence of the vertex it absorbed).
 /// Returns -1 when every face is held: v cannot be split, s_v is not coded at all.
 /// `split_neighbours` counts the ring's entries split earlier in this traversal
 /// (queue_neighbours counts them).
-inline int sv_context(const TraversalScratch &s, const Ring &ring, uint32_t split_neighbours) {
+template <class Marks>
+int sv_context(const Marks &marks, const Ring &ring, uint32_t split_neighbours) {
   // Every patch face contains its v_to: without a split neighbour no face is held.
   uint32_t claimed = 0;
   if (split_neighbours) {
     for (uint32_t c : ring.corner)
-      claimed += s.claimed[c / 3] == s.stamp;
+      claimed += marks.claimed(c / 3);
     if (claimed == ring.faces())
       return -1;
   }
@@ -167,9 +110,14 @@ inline uint32_t view_of(const LevelMesh::Lineage *lineage, uint32_t v, const Lev
 /// Like get_ring, naming the neighbours through view_of: the faces that collapse in the
 /// view (two neighbours with one name) are left out.
 inline void get_view_ring(const LevelMesh &mesh, uint32_t v, const LevelView &level, Ring &view) {
-  // (What view_of reads, copied: kept in registers through the walk.)
-  const auto name = [lineage = mesh.lineage.data(), level](uint32_t n) {
-    return view_of(lineage, n, level);
+  // (What view_of reads, copied: kept in registers through the walk. The neighbour's
+  // lineage and position are fetched as soon as it is named: the cluster's marks read
+  // the first next, code_vertex the second if the vertex is split.)
+  const auto name = [lineage = mesh.lineage.data(), q = mesh.q.data(), level](uint32_t n) {
+    const uint32_t v = view_of(lineage, n, level);
+    __builtin_prefetch(&lineage[v]);
+    __builtin_prefetch(&q[3 * size_t(v)]);
+    return v;
   };
   get_named_ring(mesh.ct, v, name, view);
 }
@@ -235,14 +183,14 @@ struct SelectsSplitEdge<Codec, std::enable_if_t<Codec::kSelectsSplitEdge>> : std
 
 /// Code (or decode) s_v at v and, for a split vertex, the split: symbols, patch, claim of
 /// its faces, prediction and position. `ring` is v's ring as the level sees it.
-template <class Codec, class Key, class MarksOf>
+template <class Codec, class Key, class Marks>
 void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v, const Ring &ring,
-                 uint32_t level, const Key &key, const MarksOf &marks_of,
-                 uint32_t split_neighbours, SplitList &splits) {
-  const int context = sv_context(s, ring, split_neighbours);
+                 uint32_t level, const Key &key, const Marks &marks, uint32_t split_neighbours,
+                 SplitList &splits) {
+  const int context = sv_context(marks, ring, split_neighbours);
   if (context < 0 || !codec.split_flag(v, context))
     return;
-  marks_of(v)->split = s.stamp;
+  marks.vertex(v)->split = s.stamp;
   load_spokes(mesh.q, v, ring, s.spokes);
   SplitSymbols sym;
   uint32_t j = kNone; // the ring index of edge v_to-v_ref (rank s_e)
@@ -268,11 +216,11 @@ void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v,
   const uint32_t m = ring.size();
   for (uint32_t t = 0, i = p.first_face; t < p.faces; ++t, i = i + 1 == m ? 0 : i + 1) {
     const uint32_t f = ring.corner[i] / 3;
-    if (mesh.face_claim[f] == level || s.claimed[f] == s.stamp)
+    if (mesh.face_claim[f] == level || marks.claimed(f))
       codec.corrupt(kSharedFace);
     if (!s.defer_claims)
       mesh.face_claim[f] = static_cast<uint16_t>(level);
-    s.claimed[f] = s.stamp;
+    marks.claim(f);
     s.claims.push_back(f);
   }
   // The split walks the patch faces counter-clockwise in the actual mesh: they must be the
@@ -304,11 +252,11 @@ void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v,
 /// Queue v's neighbours clockwise, starting with the one back to `from`; returns how many
 /// of them were split earlier in this traversal (for sv_context: one pass over the ring's
 /// marks; v's own coding, which follows, changes neither the queue nor those marks).
-/// `marks_of(n)` is where n's marks are, nullptr for a vertex the traversal does not visit
-/// (another cluster's: never queued nor split here).
-template <class MarksOf>
+/// `marks.vertex(n)` is where n's marks are, nullptr for a vertex the traversal does not
+/// visit (another cluster's: never queued nor split here).
+template <class Marks>
 uint32_t queue_neighbours(TraversalScratch &s, uint32_t v, uint32_t from, const Ring &ring,
-                          const MarksOf &marks_of) {
+                          const Marks &marks) {
   const uint32_t m = ring.size(), stamp = s.stamp; // (a local: the mark stores could alias it)
   if (m == 0)
     return 0;
@@ -316,12 +264,12 @@ uint32_t queue_neighbours(TraversalScratch &s, uint32_t v, uint32_t from, const 
   const uint32_t start = at < 0 ? 0 : uint32_t(at);
   uint32_t split = 0;
   const auto visit = [&](uint32_t n) {
-    TraversalScratch::VertexMarks *marks = marks_of(n);
-    if (!marks)
+    VertexMarks *mark = marks.vertex(n);
+    if (!mark)
       return;
-    split += marks->split == stamp;
-    if (marks->queued != stamp) {
-      marks->queued = stamp;
+    split += mark->split == stamp;
+    if (mark->queued != stamp) {
+      mark->queued = stamp;
       s.queue.emplace_back(n, v);
     }
   };
@@ -335,31 +283,27 @@ uint32_t queue_neighbours(TraversalScratch &s, uint32_t v, uint32_t from, const 
 
 /// The walks are memory bound: fetch the corner reference of the vertex 16 places ahead in
 /// the queue, the corners of its first face 8 places ahead, and 4 places ahead the two
-/// faces next to that one in its fan (their O entries have arrived by then).
+/// faces next to that one in its fan (their O entries have arrived by then). (A further
+/// stage, the next face on either side 2 places ahead, gained nothing: walk_fan has
+/// fetched most of those as the faces beyond an earlier fan.)
 inline void prefetch_ahead(const LevelMesh &mesh, const TraversalScratch &s, size_t head) {
   const CornerTable &ct = mesh.ct;
   const size_t n = s.queue.size();
+  const auto fetch_face = [&](uint32_t corner) {
+    if (corner != kNone) {
+      __builtin_prefetch(&ct.O[corner]);
+      __builtin_prefetch(&ct.V[corner]);
+    }
+  };
   if (head + 4 < n) {
     const uint32_t c = ct.VC[s.queue[head + 4].first];
     if (c != kNone) {
-      const uint32_t a = ct.O[CornerTable::next(c)], b = ct.O[CornerTable::prev(c)];
-      if (a != kNone) {
-        __builtin_prefetch(&ct.O[a]);
-        __builtin_prefetch(&ct.V[a]);
-      }
-      if (b != kNone) {
-        __builtin_prefetch(&ct.O[b]);
-        __builtin_prefetch(&ct.V[b]);
-      }
+      fetch_face(ct.O[CornerTable::next(c)]);
+      fetch_face(ct.O[CornerTable::prev(c)]);
     }
   }
-  if (head + 8 < n) {
-    const uint32_t ahead = ct.VC[s.queue[head + 8].first];
-    if (ahead != kNone) {
-      __builtin_prefetch(&ct.O[ahead]);
-      __builtin_prefetch(&ct.V[ahead]);
-    }
-  }
+  if (head + 8 < n)
+    fetch_face(ct.VC[s.queue[head + 8].first]);
   if (head + 16 < n)
     __builtin_prefetch(&ct.VC[s.queue[head + 16].first]);
 }
@@ -370,20 +314,21 @@ template <class Codec>
 void traverse_level(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t level,
                     SplitList &splits) {
   const auto id = [](uint32_t v) { return uint64_t(v); };
-  const MarksById marks_of{s};
+  const GlobalMarks marks{s};
   size_t head = 0;
   for (uint32_t f = 0; f < mesh.seed_faces; ++f) {
     const uint32_t a = mesh.ct.V[3 * f], b = mesh.ct.V[3 * f + 1];
-    if (s.queued(b))
+    VertexMarks &mark = *marks.vertex(b);
+    if (mark.queued == s.stamp)
       continue;
-    s.marks[b].queued = s.stamp;
+    mark.queued = s.stamp;
     s.queue.emplace_back(b, a);
     while (head < s.queue.size()) {
       prefetch_ahead(mesh, s, head);
       const auto [v, from] = s.queue[head++];
       get_ring(mesh.ct, v, s.ring);
-      const uint32_t split = queue_neighbours(s, v, from, s.ring, marks_of);
-      code_vertex(mesh, codec, s, v, s.ring, level, id, marks_of, split, splits);
+      const uint32_t split = queue_neighbours(s, v, from, s.ring, marks);
+      code_vertex(mesh, codec, s, v, s.ring, level, id, marks, split, splits);
     }
   }
 }
@@ -398,7 +343,7 @@ void traverse_cluster(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32
                       const LevelView &level, SplitList &splits) {
   const uint32_t cluster = mesh.cluster_of(root);
   const auto key = [&](uint32_t v) { return mesh.key(v); };
-  const MarksInCluster marks_of{s, mesh.lineage.data(), cluster};
+  const ClusterMarks marks{s, mesh.lineage.data(), cluster};
   get_view_ring(mesh, root, level, s.ring);
   if (s.ring.neighbour.empty())
     return;
@@ -406,14 +351,18 @@ void traverse_cluster(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32
   for (uint32_t n : s.ring.neighbour)
     if (mesh.key(n) < mesh.key(from))
       from = n;
-  marks_of(root)->queued = s.stamp;
+  marks.vertex(root)->queued = s.stamp;
   s.queue.emplace_back(root, from);
   for (size_t head = 0; head < s.queue.size();) {
     prefetch_ahead(mesh, s, head);
     const auto [v, came_from] = s.queue[head++];
     get_view_ring(mesh, v, level, s.ring);
-    const uint32_t split = queue_neighbours(s, v, came_from, s.ring, marks_of);
-    code_vertex(mesh, codec, s, v, s.ring, level.level, key, marks_of, split, splits);
+    for (uint32_t c : s.ring.corner) { // (read by sv_context and code_vertex)
+      __builtin_prefetch(&s.claimed[c / 3]);
+      __builtin_prefetch(&mesh.face_claim[c / 3]);
+    }
+    const uint32_t split = queue_neighbours(s, v, came_from, s.ring, marks);
+    code_vertex(mesh, codec, s, v, s.ring, level.level, key, marks, split, splits);
   }
 }
 
