@@ -33,7 +33,7 @@ struct TraversalScratch {
   // entries as the largest cluster has vertices.
   std::vector<VertexMarks> local_marks;
   std::vector<uint32_t> claimed; // by face id: the stamp of the traversal that claimed it
-  std::vector<uint32_t> claims; // the faces this traversal's patches hold, in claim order
+  std::vector<uint32_t> claims;  // the faces this traversal's patches hold, in claim order
   // Leave LevelMesh::face_claim to the caller (clusters traversed in parallel: the caller
   // checks and writes their claims in cluster order, refine/level_step.h).
   bool defer_claims = false;
