@@ -11,7 +11,14 @@ namespace {
 
 using frenet_detail::apply;
 
-int64_t fixed_round(double x) { return static_cast<int64_t>(std::floor(x * 65536.0 + 0.5)); }
+/// floor(x * 2^16 + 0.5) as an integer, for |x| <= 1 (the coefficients: a tangent of at
+/// most 45 degrees, a sine): truncation toward zero, one down if that went up, is floor
+/// exactly, without libm's call.
+int64_t fixed_round(double x) {
+  const double y = x * 65536.0 + 0.5;
+  const int64_t t = static_cast<int64_t>(y);
+  return static_cast<double>(t) > y ? t - 1 : t;
+}
 
 /// Rotation in plane (i,j) that maps direction (a,b) onto the positive i axis.
 Givens givens_from_pair(int i, int j, double a, double b) {
@@ -26,11 +33,7 @@ Givens givens_from_pair(int i, int j, double a, double b) {
     k = a >= 0 ? 0 : 2;
   else
     k = b > 0 ? 1 : 3;
-  for (int q = 0; q < k; ++q) { // same map as quarter_turn, in doubles (exact: sign swaps)
-    const double t = a;
-    a = b;
-    b = -t;
-  }
+  frenet_detail::quarter_turns(k, a, b); // (in doubles: exact, sign changes and a swap)
   g.quarter_turns = static_cast<uint8_t>(k);
   if (b == 0.0)
     return g;

@@ -42,13 +42,23 @@ constexpr int64_t kHalf = int64_t(1) << (kShift - 1);
 /// round(c * y / 2^16) with floor semantics on the shifted sum, identical on both sides.
 inline int64_t shear(int64_t c, int64_t y) { return (c * y + kHalf) >> kShift; }
 
-inline void apply(const Givens &g, int64_t v[3]) {
-  int64_t &x = v[g.i], &y = v[g.j];
-  for (int q = 0; q < g.quarter_turns; ++q) { // (x,y) -> (y,-x)
-    const int64_t t = x;
+/// `turns` quarter turns (x,y) -> (y,-x) at once: one turn swaps and negates, two negate
+/// both (no loop: the count changes from split to split and a loop mispredicted).
+template <class T> inline void quarter_turns(int turns, T &x, T &y) {
+  if (turns & 1) {
+    const T t = x;
     x = y;
     y = -t;
   }
+  if (turns & 2) {
+    x = -x;
+    y = -y;
+  }
+}
+
+inline void apply(const Givens &g, int64_t v[3]) {
+  int64_t &x = v[g.i], &y = v[g.j];
+  quarter_turns(g.quarter_turns, x, y);
   if (g.active) {
     x += shear(g.t, y);
     y += shear(g.s, x);
@@ -63,11 +73,7 @@ inline void unapply(const Givens &g, int64_t v[3]) {
     y -= shear(g.s, x);
     x -= shear(g.t, y);
   }
-  for (int q = 0; q < g.quarter_turns; ++q) { // (x,y) -> (-y,x)
-    const int64_t t = x;
-    x = -y;
-    y = t;
-  }
+  quarter_turns(4 - g.quarter_turns, x, y); // (4 - k turns undo k)
 }
 } // namespace frenet_detail
 

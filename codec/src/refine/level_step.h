@@ -172,6 +172,11 @@ private:
     mesh.face_claim.resize(faces, 0);
     const uint32_t codes = mesh.attr_codes;
     for (uint32_t i = 0; i < n; ++i) {
+      if (i + 4 < n) { // (the first face of a split ahead: the swings start there)
+        const uint32_t c = splits.split[i + 4].op.first_corner;
+        __builtin_prefetch(&ct.O[c]);
+        __builtin_prefetch(&ct.V[c]);
+      }
       const PendingSplit &ps = splits.split[i];
       const uint32_t v_from = v0 + i;
       face += apply_split(ct, ps.op, v_from, face);
