@@ -172,11 +172,7 @@ private:
     mesh.face_claim.resize(faces, 0);
     const uint32_t codes = mesh.attr_codes;
     for (uint32_t i = 0; i < n; ++i) {
-      if (i + 4 < n) { // (the first face of a split ahead: the swings start there)
-        const uint32_t c = splits.split[i + 4].op.first_corner;
-        __builtin_prefetch(&ct.O[c]);
-        __builtin_prefetch(&ct.V[c]);
-      }
+      prefetch_split(ct, splits, i, n);
       const PendingSplit &ps = splits.split[i];
       const uint32_t v_from = v0 + i;
       face += apply_split(ct, ps.op, v_from, face);
@@ -185,6 +181,28 @@ private:
       std::copy(codes_i, codes_i + codes, mesh.attr.data() + size_t(v_from) * codes);
       mesh.lineage[v_from] = {cluster, ps.op.v_to, next_local ? (*next_local)++ : 0,
                               static_cast<uint16_t>(level)};
+    }
+  }
+
+  /// Applying the splits is memory bound (with threads, another core traversed their
+  /// faces): fetch the first face of the split 4 ahead, and 2 ahead the faces the split
+  /// reads next from there, the second of its range and the one across its left edge.
+  static void prefetch_split(const CornerTable &ct, const SplitList &splits, uint32_t i,
+                             uint32_t n) {
+    if (i + 4 < n) {
+      const uint32_t c = splits.split[i + 4].op.first_corner;
+      __builtin_prefetch(&ct.O[c]);
+      __builtin_prefetch(&ct.V[c]);
+    }
+    if (i + 2 < n) {
+      const uint32_t c = splits.split[i + 2].op.first_corner;
+      const uint32_t second = ct.O[CornerTable::next(c)], left = ct.O[CornerTable::prev(c)];
+      if (second != kNone) {
+        __builtin_prefetch(&ct.O[second]);
+        __builtin_prefetch(&ct.V[second]);
+      }
+      if (left != kNone)
+        __builtin_prefetch(&ct.O[left]);
     }
   }
 
