@@ -44,18 +44,19 @@ namespace {
 //
 // Encode, per input format (EncodeInput; measured 2026-12-02 in the fourth session, again
 // in the fifth after the faster readers, two encoding threads): peaks of `pomar encode` on
-// noisy spheres (F = 2V) of 100k, 300k and 1M vertices and 2-row strips (F = V) of 100k,
-// 300k and 1M, each as binary and ASCII PLY, OBJ, OFF, binary and ASCII STL, and tori
-// (F = 2V) with attributes (bench/README.md, "Memory", per input format). Lines through the
-// 300k and 1M peaks, raised and rounded so that every peak of 300k vertices and more is
-// 10-25% below its estimate.
+// noisy spheres (F = 2V) of 100k, 300k, 1M and 3M vertices and 2-row strips (F = V) of
+// 100k, 300k and 1M, each as binary and ASCII PLY, OBJ, OFF, binary and ASCII STL, and tori
+// (F = 2V) with attributes (bench/README.md, "Memory", per input format and "After the
+// faster readers"). Lines through the 300k and 1M peaks, raised and rounded so that every
+// peak of 300k vertices and more is 10-25% below its estimate.
 //   - Binary and ASCII PLY, OFF, binary and ASCII STL (read in 4 MiB chunks) and plain OBJ
-//     (pomar's own reader: the text and the flat arrays) peak within 3% of each other: the
-//     encoder's own peak is the maximum. One row, which is also the estimate for a mesh
-//     already in memory (EncodeInput::Mesh, the library's check): 12 MiB + 200 B/vertex +
-//     36 B/face (fourth session's least squares: 6.3 MiB + 170 + 29; fifth session: 0.75-0.83
-//     of it). ASCII STL was 6 MiB + 370 B/face (its whole text held, 3.4 times its peak
-//     now), plain OBJ the tinyobjloader row below (2.4 times its peak now).
+//     (pomar's own reader: the text and the flat arrays) peak within 3% of each other at
+//     300k and 1M (STL 9-11% more at 3M: the weld's table): the encoder's own peak is the
+//     maximum. One row, which is also the estimate for a mesh already in memory
+//     (EncodeInput::Mesh, the library's check): 12 MiB + 200 B/vertex + 36 B/face (fourth
+//     session's least squares: 6.3 MiB + 170 + 29; fifth session: 0.75-0.83 of it). ASCII
+//     STL was 6 MiB + 370 B/face (its whole text held: 3.4 times its peak now), plain OBJ
+//     the tinyobjloader row below (2.4 times its peak now).
 //   - OBJ through tinyobjloader, positions and faces only (relative or slashed indices,
 //     materials, ...): its arrays (an index triple of 12 bytes per corner, ...) and the text
 //     peak above the encoder: 16 MiB + 24 B/vertex + 244 B/face (least squares: 16 MiB - 3
@@ -63,9 +64,10 @@ namespace {
 //   - OBJ through tinyobjloader with normals, texture coordinates or colours: their lines
 //     and per-corner indices ("f 1/1/1 ...") held too. Normals and texture coordinates per
 //     vertex, tori and strips: least squares about 13 MiB + 23 B/vertex + 285 B/face; 16 MiB
-//     + 32 B/vertex + 330 B/face (the row above was 1.02-1.15 times too low for them).
-//     Files with more normals or texture coordinates than vertices (per-corner values) hold
-//     more than this.
+//     + 32 B/vertex + 330 B/face, 0.84-0.88 of it (the row above was 1.02-1.18 times too
+//     low for them). Normals only ("f a//a"), colours only, one normal per face (flat
+//     shading: twice as many normals as vertices): 0.67-0.85 of it. Files with still more
+//     values (one per corner) hold more than this.
 // STL's size check sees half a vertex per facet (a closed mesh once welded). For an open
 // STL mesh (the strips: one vertex per facet) the check before reading is too low by the
 // encoder's per-vertex part (binary and ASCII STL strips peak at 1.28-1.34 times it); the
