@@ -55,11 +55,13 @@ struct LoadReport {
 /// Called by load_mesh as soon as the file tells how large the mesh is, before the large
 /// allocations: PLY and OFF header counts (PLY again after its structure walk if polygons
 /// or strips make more triangles), binary STL facet count, OBJ 'v' lines and triangles
-/// (after a line scan, before the parser), ASCII STL facets (counted in the text before it
-/// is parsed). STL passes half a vertex per facet (what a closed mesh keeps once identical
-/// corners are welded). LoadReport::format, text, plain_obj and obj_attributes are set when
-/// it is called, so that the check can allow for the format's reader. It may throw pomar::Error to
-/// refuse the file (load_mesh prefixes the path), e.g. for a memory limit:
+/// (after a line scan, before tinyobjloader; a plain OBJ once pomar's reader has read it,
+/// its flat arrays being smaller than the text already held), ASCII STL facets (counted in
+/// the text before it is parsed). STL passes half a vertex per facet (what a closed mesh
+/// keeps once identical corners are welded). LoadReport::format, text, plain_obj and
+/// obj_attributes are set when it is called, so that the check can allow for the reader
+/// that takes the file. It may throw pomar::Error to refuse the file (load_mesh prefixes
+/// the path), e.g. for a memory limit:
 ///   [&](uint64_t v, uint64_t f) {
 ///     pomar::check_encode_memory(v, f, limit, 0, 0, 1, pomar::encode_input(report));
 ///   }
