@@ -87,6 +87,25 @@ TEST_F(SizeCheckTest, ObjEstimateFollowsTheReaderThatTakesTheFile) {
   EXPECT_EQ(estimates[0], encode_memory_estimate(4, 4, EncodeInput::PlyBinary));
   EXPECT_LT(estimates[0], estimates[1]);
   EXPECT_LT(estimates[1], estimates[2]);
+  // So a limit that fits the plain file's estimate loads it and refuses the others.
+  for (size_t i = 0; i < 3; ++i) {
+    LoadReport report;
+    const auto load = [&] {
+      load_mesh(path(cases[i].name), &report, [&](uint64_t nv, uint64_t nf) {
+        check_encode_memory(nv, nf, estimates[0], 0, 0, 1, encode_input(report));
+      });
+    };
+    if (i == 0) {
+      EXPECT_NO_THROW(load());
+    } else {
+      try {
+        load();
+        ADD_FAILURE() << cases[i].name << " fits";
+      } catch (const Error &e) {
+        EXPECT_EQ(e.kind(), Error::Kind::MemoryLimit) << e.what();
+      }
+    }
+  }
 }
 
 TEST_F(SizeCheckTest, PolygonsAreCheckedAgainWithTheirTriangles) {
