@@ -69,9 +69,10 @@ namespace {
 //     shading: twice as many normals as vertices): 0.67-0.85 of it. Files with still more
 //     values (one per corner) hold more than this.
 // STL's size check sees half a vertex per facet (a closed mesh once welded). For an open
-// STL mesh (the strips: one vertex per facet) the check before reading is too low by the
-// encoder's per-vertex part (binary and ASCII STL strips peak at 1.28-1.34 times it); the
-// encoder's own check, with the welded counts (EncodeInput::Mesh), holds them (0.80-0.83).
+// STL mesh (the strips: one vertex per facet) it is too low for the whole encode (binary and
+// ASCII STL strips peak at 1.28-1.34 times it) but not for the reading (0.76-0.79); the
+// encoder's own check, with the welded counts (EncodeInput::Mesh), comes before its
+// allocations and holds them (0.80-0.83).
 struct Fit {
   uint64_t fixed, per_vertex, per_face;
 };
