@@ -471,7 +471,7 @@ TEST(AttributeRoundTrip, MemoryLimitsCountTheAttributes) {
   const Mesh m = with_attributes(plain, kAll);
   const uint64_t v = m.vertex_count(), f = m.triangle_count();
   const uint64_t per_vertex = encode_attribute_bytes_per_vertex(m, AttributeOptions());
-  EXPECT_EQ(per_vertex, 32u + 84u * 10); // RGBA 4 + normal 2 + 2 scalars + UV 2 = 10 codes
+  EXPECT_EQ(per_vertex, 16u + 34u * 10); // RGBA 4 + normal 2 + 2 scalars + UV 2 = 10 codes
   EncodeOptions o;
   o.threads = 1; // (each further thread adds decode_thread_memory: not what this tests)
   o.memory_limit = encode_memory_estimate(v, f) + v * per_vertex / 2;

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "pomar/limits.h"
+#include "pomar/mesh_io.h"
 #include "pomar/pomar.h"
 #include "pomar/random_access.h"
 #include "support/mesh_gen.h"
@@ -71,9 +72,9 @@ TEST(MemorySize, FormatsWithBinaryUnits) {
 
 TEST(MemoryEstimate, IsAboveTheMeasuredPeaks) {
   // Peak RSS (KiB) of `pomar encode` / `pomar decode` measured with /usr/bin/time
-  // (bench/README.md, "Memory", 2026-12-02): vertices, faces, encode (two threads), decode
-  // random access on one thread and on two, decode progressive. The estimates must stay
-  // above them with some margin.
+  // (bench/README.md, "Memory", 2026-12-02; the last one in the fifth session): vertices,
+  // faces, encode (two threads), decode random access on one thread and on two, decode
+  // progressive. The estimates must stay above them with some margin.
   struct Peak {
     uint64_t v, f, enc, dec_ra, dec_ra2, dec_prog;
   } peaks[] = {{34834, 69451, 19072, 8896, 9860, 8776},            // bunny
@@ -82,7 +83,8 @@ TEST(MemoryEstimate, IsAboveTheMeasuredPeaks) {
                {1998092, 3996180, 424220, 212296, 244276, 227340}, // noisy sphere 2M
                {437645, 871414, 104304, 51032, 61612, 53456},      // dragon
                {1000000, 999998, 169612, 79888, 99856, 88148},     // 2-row strip
-               {900000, 1199996, 170616, 79132, 91064, 88208}};    // 3-row strip
+               {900000, 1199996, 170616, 79132, 91064, 88208},     // 3-row strip
+               {1000000, 999998, 194376, 85388, 108464, 92172}};   // 2-row strip, 3D serpentine
   for (const Peak &p : peaks) {
     EXPECT_GT(encode_memory_estimate(p.v, p.f), p.enc * 1024 * 11 / 10) << p.v;
     EXPECT_GT(decode_memory_estimate(p.v, p.f, true), p.dec_ra * 1024 * 11 / 10) << p.v;
@@ -95,30 +97,70 @@ TEST(MemoryEstimate, IsAboveTheMeasuredPeaks) {
 
 TEST(MemoryEstimate, EachInputFormatIsTenToTwentyFivePercentAboveItsPeaks) {
   // Peak RSS (KiB) of `pomar encode` (two threads) by input format, measured with
-  // /usr/bin/time (bench/README.md, "Memory", per input format, 2026-12-02): noisy spheres
-  // and 2-row strips; PLY "general" = a face property more, read through vcglib.
+  // /usr/bin/time (bench/README.md, "Memory", per input format, fifth session of
+  // 2026-12-02): noisy spheres (F = 2V), 2-row strips (F = V) and, for OBJ with normals
+  // and texture coordinates ("f a/a/a"), a torus (F = 2V) and strips.
   using In = EncodeInput;
   struct Peak {
     uint64_t v, f;
     In input;
     uint64_t kib;
-  } peaks[] = {
-      {100002, 200000, In::PlyBinary, 27336},   {100002, 200000, In::PlyAscii, 27824},
-      {100002, 200000, In::Obj, 49208},         {100002, 200000, In::Off, 28544},
-      {100002, 200000, In::StlBinary, 27748},   {100002, 200000, In::StlAscii, 68076},
-      {299292, 598580, In::PlyBinary, 72104},   {299292, 598580, In::PlyAscii, 71972},
-      {299292, 598580, In::Obj, 145880},        {299292, 598580, In::Off, 72336},
-      {299292, 598580, In::StlBinary, 71232},   {299292, 598580, In::StlAscii, 194900},
-      {299292, 598580, In::PlyBinary, 72260},   {299292, 598580, In::PlyAscii, 71948}, // general
-      {998562, 1997120, In::PlyBinary, 209840}, {998562, 1997120, In::PlyAscii, 214140},
-      {998562, 1997120, In::Obj, 435668},       {998562, 1997120, In::Off, 209712},
-      {998562, 1997120, In::StlBinary, 230176}, {998562, 1997120, In::StlAscii, 640192},
-      {998562, 1997120, In::PlyBinary, 218660}, {998562, 1997120, In::PlyAscii, 210792}, // general
-      {300000, 299998, In::PlyBinary, 65240},   {300000, 299998, In::PlyAscii, 66064},
-      {300000, 299998, In::Obj, 75808},         {300000, 299998, In::Off, 65256},
-      {300000, 299998, In::StlAscii, 86640},    {1000000, 999998, In::PlyBinary, 195064},
-      {1000000, 999998, In::PlyAscii, 200884},  {1000000, 999998, In::Obj, 226408},
-      {1000000, 999998, In::Off, 194036},       {1000000, 999998, In::StlAscii, 278792},
+  };
+  const uint64_t sv1 = 100002, sf1 = 200000, sv3 = 299292, sf3 = 598580, sv10 = 998562,
+                 sf10 = 1997120;
+  const Peak peaks[] = {
+      // spheres
+      {sv1, sf1, In::PlyBinary, 27964},
+      {sv1, sf1, In::PlyAscii, 28052},
+      {sv1, sf1, In::ObjPlain, 28656},
+      {sv1, sf1, In::Obj, 49856},
+      {sv1, sf1, In::Off, 28132},
+      {sv1, sf1, In::StlBinary, 28152},
+      {sv1, sf1, In::StlAscii, 32332},
+      {sv3, sf3, In::PlyBinary, 71168},
+      {sv3, sf3, In::PlyAscii, 71136},
+      {sv3, sf3, In::ObjPlain, 71448},
+      {sv3, sf3, In::Obj, 147720},
+      {sv3, sf3, In::Off, 72468},
+      {sv3, sf3, In::StlBinary, 71320},
+      {sv3, sf3, In::StlAscii, 73468},
+      {sv10, sf10, In::PlyBinary, 209684},
+      {sv10, sf10, In::PlyAscii, 210448},
+      {sv10, sf10, In::ObjPlain, 209412},
+      {sv10, sf10, In::Obj, 441544},
+      {sv10, sf10, In::Off, 209400},
+      {sv10, sf10, In::StlBinary, 213496},
+      {sv10, sf10, In::StlAscii, 212760},
+      // strips (STL: below)
+      {100000, 99998, In::PlyBinary, 25952},
+      {100000, 99998, In::PlyAscii, 25920},
+      {100000, 99998, In::ObjPlain, 26148},
+      {100000, 99998, In::Obj, 27432},
+      {100000, 99998, In::Off, 25796},
+      {300000, 299998, In::PlyBinary, 67108},
+      {300000, 299998, In::PlyAscii, 67240},
+      {300000, 299998, In::ObjPlain, 67520},
+      {300000, 299998, In::Obj, 76556},
+      {300000, 299998, In::Off, 65960},
+      {1000000, 999998, In::PlyBinary, 194376},
+      {1000000, 999998, In::PlyAscii, 194004},
+      {1000000, 999998, In::ObjPlain, 194436},
+      {1000000, 999998, In::Obj, 229088},
+      {1000000, 999998, In::Off, 194484},
+      // 3M: spheres of 3,003,042 vertices and 6,006,080 faces (one run each)
+      {3003042, 6006080, In::PlyBinary, 608380},
+      {3003042, 6006080, In::ObjPlain, 609344},
+      {3003042, 6006080, In::Obj, 1320796},
+      {3003042, 6006080, In::Off, 606820},
+      {3003042, 6006080, In::StlBinary, 665348},
+      {3003042, 6006080, In::StlAscii, 673648},
+      // OBJ with normals and texture coordinates: tori, then strips
+      {99856, 199712, In::ObjAttributes, 63788},
+      {300304, 600608, In::ObjAttributes, 191972},
+      {1000000, 2000000, In::ObjAttributes, 583508},
+      {2999824, 5999648, In::ObjAttributes, 1792236},
+      {300000, 299998, In::ObjAttributes, 103532},
+      {1000000, 999998, In::ObjAttributes, 313824},
   };
   for (const Peak &p : peaks) {
     const bool stl = p.input == In::StlBinary || p.input == In::StlAscii;
@@ -126,39 +168,66 @@ TEST(MemoryEstimate, EachInputFormatIsTenToTwentyFivePercentAboveItsPeaks) {
     const double ratio =
         double(p.kib * 1024) / double(encode_memory_estimate(checked_v, p.f, p.input));
     EXPECT_LE(ratio, 0.90) << p.v << " " << int(p.input);
-    EXPECT_GE(ratio, p.v >= 300000 ? 0.75 : 0.70) << p.v << " " << int(p.input);
+    EXPECT_GE(ratio, p.v >= 299000 ? 0.74 : 0.60) << p.v << " " << int(p.input); // 3M OFF: 0.749
   }
-  // Binary STL strips (open: one vertex per facet, the size check assumes half): the
-  // encoder's own check, with the welded counts, holds them.
+  // OBJ with normals only ("f a//a"), vertex colours or one normal per face ("f a//k b//k
+  // c//k"; tori, 300k and 1M): below the row fitted on normals and texture coordinates.
+  for (const Peak &p : {Peak{300304, 600608, In::ObjAttributes, 172832},
+                        Peak{300304, 600608, In::ObjAttributes, 155404},
+                        Peak{1000000, 2000000, In::ObjAttributes, 526392},
+                        Peak{1000000, 2000000, In::ObjAttributes, 466492},
+                        Peak{300304, 600608, In::ObjAttributes, 186764},
+                        Peak{1000000, 2000000, In::ObjAttributes, 575124}})
+    EXPECT_LE(double(p.kib * 1024) / double(encode_memory_estimate(p.v, p.f, p.input)), 0.90)
+        << p.v;
+  // Binary and ASCII STL strips (open: one vertex per facet, the size check assumes half):
+  // the encoder's own check, with the welded counts, holds them.
   for (const Peak &p :
-       {Peak{300000, 299998, In::StlBinary, 64868}, Peak{1000000, 999998, In::StlBinary, 201228}}) {
+       {Peak{300000, 299998, In::StlBinary, 66896}, Peak{1000000, 999998, In::StlBinary, 193868},
+        Peak{300000, 299998, In::StlAscii, 67284}, Peak{1000000, 999998, In::StlAscii, 194348}}) {
     const double ratio = double(p.kib * 1024) / double(encode_memory_estimate(p.v, p.f));
     EXPECT_LE(ratio, 0.90) << p.v;
     EXPECT_GE(ratio, 0.75) << p.v;
   }
-  // The estimate for a mesh in memory is the light readers' (PLY, OFF, binary STL).
+  // The estimate for a mesh in memory is the light readers' (PLY, OFF, STL, plain OBJ);
+  // tinyobjloader needs more, and more again with attributes.
   EXPECT_EQ(encode_memory_estimate(1000, 2000), encode_memory_estimate(1000, 2000, In::PlyBinary));
+  EXPECT_EQ(encode_memory_estimate(1000, 2000, In::ObjPlain),
+            encode_memory_estimate(1000, 2000, In::Off));
   EXPECT_GT(encode_memory_estimate(1000000, 2000000, In::Obj),
-            encode_memory_estimate(1000000, 2000000, In::Off));
-  EXPECT_GT(encode_memory_estimate(1000000, 2000000, In::StlAscii),
-            encode_memory_estimate(1000000, 2000000, In::StlBinary));
+            encode_memory_estimate(1000000, 2000000, In::ObjPlain));
+  EXPECT_GT(encode_memory_estimate(1000000, 2000000, In::ObjAttributes),
+            encode_memory_estimate(1000000, 2000000, In::Obj));
 }
 
 TEST(MemoryEstimate, InputFormatFromTheLoadReport) {
-  EXPECT_EQ(encode_input("ply", false), EncodeInput::PlyBinary);
-  EXPECT_EQ(encode_input("ply", true), EncodeInput::PlyAscii);
-  EXPECT_EQ(encode_input("obj", true), EncodeInput::Obj);
-  EXPECT_EQ(encode_input("off", true), EncodeInput::Off);
-  EXPECT_EQ(encode_input("stl", false), EncodeInput::StlBinary);
-  EXPECT_EQ(encode_input("stl", true), EncodeInput::StlAscii);
-  EXPECT_EQ(encode_input("", false), EncodeInput::Mesh);
+  auto input = [](const char *format, bool text, bool plain_obj = false,
+                  bool obj_attributes = false) {
+    LoadReport r;
+    r.format = format;
+    r.text = text;
+    r.plain_obj = plain_obj;
+    r.obj_attributes = obj_attributes;
+    return encode_input(r);
+  };
+  EXPECT_EQ(input("ply", false), EncodeInput::PlyBinary);
+  EXPECT_EQ(input("ply", true), EncodeInput::PlyAscii);
+  EXPECT_EQ(input("obj", true), EncodeInput::Obj);
+  EXPECT_EQ(input("obj", true, true), EncodeInput::ObjPlain);
+  EXPECT_EQ(input("obj", true, false, true), EncodeInput::ObjAttributes);
+  EXPECT_EQ(input("off", true), EncodeInput::Off);
+  EXPECT_EQ(input("stl", false), EncodeInput::StlBinary);
+  EXPECT_EQ(input("stl", true), EncodeInput::StlAscii);
+  EXPECT_EQ(input("", false), EncodeInput::Mesh);
 }
 
 TEST(MemoryEstimate, AttributesAreAboveTheMeasuredPeaks) {
-  // bench/README.md, "Memory", per-vertex attributes: a 1M-vertex torus (2M faces) and a
-  // 490k one with RGB colour, normal, quality and UV (8 codes), and the 1M one with quality
-  // only (1 code); peak RSS in KiB (decode: binary PLY out).
-  Mesh eight, one;
+  // bench/README.md, "Memory", per-vertex attributes; peak RSS in KiB. Encoding (fifth
+  // session, two threads): tori of 300k, 1M and 3M vertices (F = 2V, binary PLY) with RGB colour,
+  // normal, quality and UV (8 codes), colour only (3) or quality only (1). Decoding (binary
+  // PLY out, one thread): a 1M-vertex torus and a 490k one with the 8 codes, the 1M one
+  // with quality only.
+  Mesh eight, three, one;
   auto add = [](Mesh &m, AttributeKind kind, uint32_t components) {
     VertexAttribute a;
     a.kind = kind;
@@ -169,25 +238,38 @@ TEST(MemoryEstimate, AttributesAreAboveTheMeasuredPeaks) {
   add(eight, AttributeKind::Normal, 3);
   add(eight, AttributeKind::Scalar, 1);
   add(eight, AttributeKind::TexCoord, 2);
+  add(three, AttributeKind::Colour, 3);
   add(one, AttributeKind::Scalar, 1);
+  struct EncodePeak {
+    uint64_t v, f;
+    const Mesh *mesh;
+    uint64_t kib;
+  } encode_peaks[] = {{300304, 600608, &eight, 141392},    {1000000, 2000000, &eight, 429012},
+                      {2999824, 5999648, &eight, 1115632}, {300304, 600608, &three, 97152},
+                      {1000000, 2000000, &three, 280816},  {300304, 600608, &one, 81996},
+                      {1000000, 2000000, &one, 238604}};
+  for (const EncodePeak &p : encode_peaks) {
+    const uint64_t per_vertex = encode_attribute_bytes_per_vertex(*p.mesh, AttributeOptions());
+    const double ratio =
+        double(p.kib * 1024) / double(encode_memory_estimate(p.v, p.f) + p.v * per_vertex);
+    EXPECT_LE(ratio, 0.90) << p.v << " " << p.mesh->attributes.size();
+    EXPECT_GE(ratio, 0.65) << p.v << " " << p.mesh->attributes.size(); // 3M: 0.675
+  }
   FileInfo eight_info, one_info;
   for (const VertexAttribute &a : eight.attributes)
     eight_info.attributes.push_back(
         {a.kind, "", a.components, a.kind == AttributeKind::Colour ? 0 : 9});
   one_info.attributes.push_back({AttributeKind::Scalar, "", 1, 16});
-  struct Peak {
+  struct DecodePeak {
     uint64_t v, f;
-    const Mesh *mesh;
     const FileInfo *info;
-    uint64_t enc, dec;
-  } peaks[] = {{1000000, 2000000, &eight, &eight_info, 455352, 187320},
-               {490000, 980000, &eight, &eight_info, 223228, 94468},
-               {1000000, 2000000, &one, &one_info, 245208, 120740}};
-  for (const Peak &p : peaks) {
-    const uint64_t enc = encode_attribute_bytes_per_vertex(*p.mesh, AttributeOptions());
+    uint64_t kib;
+  } decode_peaks[] = {{1000000, 2000000, &eight_info, 187320},
+                      {490000, 980000, &eight_info, 94468},
+                      {1000000, 2000000, &one_info, 120740}};
+  for (const DecodePeak &p : decode_peaks) {
     const uint64_t dec = decode_attribute_bytes_per_vertex(*p.info, AttributeMask());
-    EXPECT_GT(encode_memory_estimate(p.v, p.f) + p.v * enc, p.enc * 1024 * 11 / 10) << p.v;
-    EXPECT_GT(decode_memory_estimate(p.v, p.f, true) + p.v * dec, p.dec * 1024 * 11 / 10) << p.v;
+    EXPECT_GT(decode_memory_estimate(p.v, p.f, true) + p.v * dec, p.kib * 1024 * 11 / 10) << p.v;
   }
   EXPECT_EQ(decode_attribute_bytes_per_vertex(eight_info, AttributeMask::none()), 0u);
   AttributeOptions dropped;

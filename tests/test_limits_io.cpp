@@ -54,6 +54,60 @@ TEST_F(SizeCheckTest, SeesTheCountsOfEveryFormat) {
   }
 }
 
+TEST_F(SizeCheckTest, ObjEstimateFollowsTheReaderThatTakesTheFile) {
+  // One tetrahedron as plain OBJ (pomar's own reader), with relative indices and with a
+  // normal per corner (both tinyobjloader's): the check sees the reader's decision, and with
+  // it the estimate of that reader's peak.
+  const std::string v = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n";
+  struct Case {
+    const char *name, *text;
+    EncodeInput expected;
+  } cases[] = {
+      {"plain.obj", "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n", EncodeInput::ObjPlain},
+      {"relative.obj", "f -4 -2 -3\nf -4 -3 -1\nf -3 -2 -1\nf -2 -4 -1\n", EncodeInput::Obj},
+      {"normals.obj",
+       "vn 0 0 1\nf 1//1 3//1 2//1\nf 1//1 2//1 4//1\nf 2//1 3//1 4//1\n"
+       "f 3//1 1//1 4//1\n",
+       EncodeInput::ObjAttributes},
+  };
+  std::vector<uint64_t> estimates;
+  for (const Case &c : cases) {
+    LoadReport report;
+    EncodeInput seen = EncodeInput::Mesh;
+    uint64_t estimate = 0;
+    const Mesh m = load_mesh(write(c.name, v + c.text), &report, [&](uint64_t nv, uint64_t nf) {
+      seen = encode_input(report);
+      estimate = encode_memory_estimate(nv, nf, seen);
+    });
+    EXPECT_EQ(m.triangle_count(), 4u) << c.name;
+    EXPECT_EQ(seen, c.expected) << c.name;
+    estimates.push_back(estimate);
+  }
+  // Plain OBJ has the light readers' estimate (as PLY), tinyobjloader's are larger.
+  EXPECT_EQ(estimates[0], encode_memory_estimate(4, 4, EncodeInput::PlyBinary));
+  EXPECT_LT(estimates[0], estimates[1]);
+  EXPECT_LT(estimates[1], estimates[2]);
+  // So a limit that fits the plain file's estimate loads it and refuses the others.
+  for (size_t i = 0; i < 3; ++i) {
+    LoadReport report;
+    const auto load = [&] {
+      load_mesh(path(cases[i].name), &report, [&](uint64_t nv, uint64_t nf) {
+        check_encode_memory(nv, nf, estimates[0], 0, 0, 1, encode_input(report));
+      });
+    };
+    if (i == 0) {
+      EXPECT_NO_THROW(load());
+    } else {
+      try {
+        load();
+        ADD_FAILURE() << cases[i].name << " fits";
+      } catch (const Error &e) {
+        EXPECT_EQ(e.kind(), Error::Kind::MemoryLimit) << e.what();
+      }
+    }
+  }
+}
+
 TEST_F(SizeCheckTest, PolygonsAreCheckedAgainWithTheirTriangles) {
   const std::string ply =
       write("quads.ply", "ply\nformat ascii 1.0\nelement vertex 5\n"

@@ -157,8 +157,7 @@ int run_encode(const EncodeArgs &a) {
   // Refused as soon as the file's header tells the mesh size, before it is read, with the
   // estimate for the file's format (its reader's own peak).
   pomar::Mesh mesh = pomar::load_mesh(a.in, &load, [&](uint64_t v, uint64_t f) {
-    pomar::check_encode_memory(v, f, memory_limit, 0, 0, 1,
-                               pomar::encode_input(load.format, load.text));
+    pomar::check_encode_memory(v, f, memory_limit, 0, 0, 1, pomar::encode_input(load));
   });
   if (!a.quiet)
     warn_dropped(a.in, load.ignored_attributes, "has",

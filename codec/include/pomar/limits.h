@@ -19,26 +19,31 @@
 
 namespace pomar {
 
+struct LoadReport; // pomar/mesh_io.h
+
 /// The memory limit meaning "do not check".
 constexpr uint64_t kNoMemoryLimit = UINT64_MAX;
 
 /// Where an encode's mesh comes from: the mesh readers hold different amounts on the way
-/// (tinyobjloader's arrays, the whole text of an ASCII STL file), so the peak of loading and
-/// encoding depends on the input format (bench/README.md, "Memory", per input format).
+/// (tinyobjloader's arrays and the whole OBJ text), so the peak of loading and encoding
+/// depends on the input format and, for OBJ, on the reader that takes the file
+/// (bench/README.md, "Memory", per input format).
 enum class EncodeInput {
-  Mesh,      ///< a pomar::Mesh in memory, or a reader that holds little more (the default)
-  PlyBinary, ///< binary PLY
-  PlyAscii,  ///< ASCII PLY
-  Obj,       ///< OBJ, through tinyobjloader
-  Off,       ///< OFF
-  StlBinary, ///< binary STL
-  StlAscii,  ///< ASCII STL: its whole text is held while it is parsed
+  Mesh,          ///< a pomar::Mesh in memory, or a reader that holds little more (the default)
+  PlyBinary,     ///< binary PLY
+  PlyAscii,      ///< ASCII PLY
+  ObjPlain,      ///< OBJ of plain "v" and "f" lines only, through pomar's own reader
+  Obj,           ///< OBJ through tinyobjloader, without per-vertex attributes
+  ObjAttributes, ///< OBJ through tinyobjloader, with normals, texture coordinates or colours
+  Off,           ///< OFF
+  StlBinary,     ///< binary STL
+  StlAscii,      ///< ASCII STL (read in chunks)
 };
 
-/// The EncodeInput of a mesh file from LoadReport::format ("ply", "obj", "off", "stl") and
-/// LoadReport::text (set by load_mesh before its size check); EncodeInput::Mesh for any
-/// other format name.
-EncodeInput encode_input(const std::string &format, bool text);
+/// The EncodeInput of a mesh file from what load_mesh has set in its LoadReport when it
+/// calls its size check: `format` ("ply", "obj", "off", "stl"), `text`, `plain_obj` and
+/// `obj_attributes`; EncodeInput::Mesh for any other format name.
+EncodeInput encode_input(const LoadReport &report);
 
 /// Peak resident memory of loading a mesh file and encoding it (`pomar encode`), for a mesh
 /// of this many vertices and faces read from `input`. Conservative: 10-25% above the

@@ -34,6 +34,14 @@ struct LoadReport {
   /// Whether the file is text (ASCII PLY or STL; OBJ and OFF always): set before the size
   /// check is called, for a per-format memory estimate (pomar::encode_input).
   bool text = false;
+  /// OBJ, set before the size check like `text`: the file has only "v x y z" and plain-index
+  /// "f" lines (and comments, "o", "g", "s") and pomar's own reader reads it; false:
+  /// tinyobjloader reads it (normals, texture coordinates, colours, materials, slashed or
+  /// relative indices, ...), whose arrays need more memory.
+  bool plain_obj = false;
+  /// OBJ read by tinyobjloader, set before the size check: the file has normals, texture
+  /// coordinates or vertex colours, whose lines and per-corner indices it holds too.
+  bool obj_attributes = false;
   size_t file_vertices = 0;         ///< vertices stored in the file (STL: 3 per facet)
   size_t file_faces = 0;            ///< faces/polygons in the file (PLY tristrips: triangles)
   size_t unreferenced_vertices = 0; ///< vertices no face uses (kept: pomar::encode stores them)
@@ -47,14 +55,15 @@ struct LoadReport {
 /// Called by load_mesh as soon as the file tells how large the mesh is, before the large
 /// allocations: PLY and OFF header counts (PLY again after its structure walk if polygons
 /// or strips make more triangles), binary STL facet count, OBJ 'v' lines and triangles
-/// (after a line scan, before the parser), ASCII STL facets (counted in the text before it
-/// is parsed). STL passes half a vertex per facet (what a closed mesh keeps once identical
-/// corners are welded). LoadReport::format and LoadReport::text are set when it is called,
-/// so that the check can allow for the format's reader. It may throw pomar::Error to
-/// refuse the file (load_mesh prefixes the path), e.g. for a memory limit:
+/// (after a line scan, before tinyobjloader; a plain OBJ once pomar's reader has read it,
+/// its flat arrays being smaller than the text already held), ASCII STL facets (counted in
+/// the text before it is parsed). STL passes half a vertex per facet (what a closed mesh
+/// keeps once identical corners are welded). LoadReport::format, text, plain_obj and
+/// obj_attributes are set when it is called, so that the check can allow for the reader
+/// that takes the file. It may throw pomar::Error to refuse the file (load_mesh prefixes
+/// the path), e.g. for a memory limit:
 ///   [&](uint64_t v, uint64_t f) {
-///     pomar::check_encode_memory(v, f, limit, 0, 0, 1,
-///                                pomar::encode_input(report.format, report.text));
+///     pomar::check_encode_memory(v, f, limit, 0, 0, 1, pomar::encode_input(report));
 ///   }
 using SizeCheck = std::function<void(uint64_t vertices, uint64_t faces)>;
 

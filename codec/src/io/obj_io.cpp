@@ -421,6 +421,7 @@ bool read_simple_obj(const std::vector<uint8_t> &bytes, const std::string &path,
   for (const uint32_t v : mesh.triangles)
     if (v >= vertices)
       return false;
+  report.plain_obj = true; // the check's memory estimate is this reader's
   run_size_check(check, path, vertices, mesh.triangles.size() / 3);
   report.file_vertices = vertices;
   report.file_faces = faces;
@@ -438,6 +439,7 @@ Mesh load_obj(const std::string &path, LoadReport &report, const SizeCheck &chec
   if (read_simple_obj(bytes, path, check, fast, report))
     return fast;
   const ObjScan scan = scan_obj(bytes, path);
+  report.obj_attributes = scan.normals || scan.texcoords || scan.colors; // for the check
   run_size_check(check, path, scan.vertices, scan.triangles);
 
   MemoryBuffer buffer(bytes.data(), bytes.size());

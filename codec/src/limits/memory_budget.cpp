@@ -1,6 +1,7 @@
 // Memory limits (pomar/limits.h): estimates from measured peaks, the memory available to
 // the process, and the check that refuses a mesh before the large allocations.
 #include "pomar/limits.h"
+#include "pomar/mesh_io.h"
 
 #include "attributes/attribute_quantize.h"
 
@@ -33,49 +34,66 @@ namespace {
 // 5.0 MiB + 45 B/vertex + 31 B/face (random access), 5.4 MiB + 56 B/vertex + 29 B/face
 // (progressive), rounded up so that every peak of 300k vertices and more is 17-21% below
 // the estimate. Each further decoding thread: 13.6-28 B/vertex measured (small meshes:
-// the thread's allocator arena), estimated at 2 MiB + 16 B/vertex + 4 B/face.
+// the thread's allocator arena), estimated at 2 MiB + 16 B/vertex + 4 B/face. Checked
+// again in the fifth session (2026-12-02, two threads, every output format: binary and
+// ASCII PLY, OBJ, OFF, binary and ASCII STL, at 300k and 1M vertices): spheres and tori
+// with attributes 0.76-0.85 of the estimates, but an open strip (F = V, 1M vertices, 24,614
+// clusters) 0.91 on one thread and 0.94 on two (its second thread: 24 B/vertex): random
+// access raised from 52 to 56 B/vertex (0.87 and 0.91; the thread's part is kept, since
+// the encoder's check adds it too and the encode rows already cover a second thread).
 //
-// Encode, per input format (EncodeInput; measured 2026-12-02, two encoding threads): peaks
-// of `pomar encode` on noisy spheres (F = 2V) of 100k, 300k and 1M vertices and 2-row
-// strips (F = V) of 300k and 1M, each as binary and ASCII PLY, OBJ, OFF, binary and ASCII
-// STL (bench/README.md, "Memory", per input format). Least-squares lines through the 300k
-// and 1M peaks, raised and rounded so that every peak of 300k vertices and more is 10-25%
-// below its estimate (100k: 15-30%).
-//   - Binary and ASCII PLY, OFF and binary STL peak within 10% of each other: their readers
-//     fill the flat arrays directly (PLY files with more properties or polygons go through
-//     vcglib, 0-4% more), and the encoder's own peak is the maximum. One row, which is
-//     also the estimate for a mesh already in memory (EncodeInput::Mesh, the library's
-//     check): 12 MiB + 200 B/vertex + 36 B/face (the least-squares line: 6.3 MiB + 170 +
-//     29). It was 24 MiB + 300 + 150 for every format until then.
-//   - OBJ: tinyobjloader's arrays (an index triple of 12 bytes per corner, ...) peak above
-//     the encoder: 16 MiB + 24 B/vertex + 244 B/face (least squares: 16 MiB - 3 + 217).
-//   - ASCII STL: fitted when the whole text (about 280 bytes a facet) was held while it
-//     was parsed: 6 MiB + 370 B/face (on the spheres: 4.2 MiB + 326 B/face). The reader
-//     now reads it in 4 MiB chunks and peaks as binary STL does (1M sphere: 212 MB, this
-//     estimate 711 MB): kept, not refitted, so it refuses early but never too late.
+// Encode, per input format (EncodeInput; measured 2026-12-02 in the fourth session, again
+// in the fifth after the faster readers, two encoding threads): peaks of `pomar encode` on
+// noisy spheres (F = 2V) of 100k, 300k, 1M and 3M vertices and 2-row strips (F = V) of
+// 100k, 300k and 1M, each as binary and ASCII PLY, OBJ, OFF, binary and ASCII STL, and tori
+// (F = 2V) with attributes (bench/README.md, "Memory", per input format and "After the
+// faster readers"). Lines through the 300k and 1M peaks, raised and rounded so that every
+// peak of 300k vertices and more is 10-25% below its estimate.
+//   - Binary and ASCII PLY, OFF, binary and ASCII STL (read in 4 MiB chunks) and plain OBJ
+//     (pomar's own reader: the text and the flat arrays) peak within 3% of each other at
+//     300k and 1M (STL 9-11% more at 3M: the weld's table): the encoder's own peak is the
+//     maximum. One row, which is also the estimate for a mesh already in memory
+//     (EncodeInput::Mesh, the library's check): 12 MiB + 200 B/vertex + 36 B/face (fourth
+//     session's least squares: 6.3 MiB + 170 + 29; fifth session: 0.75-0.83 of it). ASCII
+//     STL was 6 MiB + 370 B/face (its whole text held: 3.4 times its peak now), plain OBJ
+//     the tinyobjloader row below (2.4 times its peak now).
+//   - OBJ through tinyobjloader, positions and faces only (relative or slashed indices,
+//     materials, ...): its arrays (an index triple of 12 bytes per corner, ...) and the text
+//     peak above the encoder: 16 MiB + 24 B/vertex + 244 B/face (least squares: 16 MiB - 3
+//     + 217; fifth session: 0.81-0.89 of it).
+//   - OBJ through tinyobjloader with normals, texture coordinates or colours: their lines
+//     and per-corner indices ("f 1/1/1 ...") held too. Normals and texture coordinates per
+//     vertex, tori and strips: least squares about 13 MiB + 23 B/vertex + 285 B/face; 16 MiB
+//     + 32 B/vertex + 330 B/face, 0.84-0.88 of it (the row above was 1.02-1.18 times too
+//     low for them). Normals only ("f a//a"), colours only, one normal per face (flat
+//     shading: twice as many normals as vertices): 0.67-0.85 of it. Files with still more
+//     values (one per corner) hold more than this.
 // STL's size check sees half a vertex per facet (a closed mesh once welded). For an open
-// STL mesh (the strips: one vertex per facet) the check before reading is too low by the
-// encoder's per-vertex part (binary STL strips peak at 1.24-1.39 times it); the encoder's
-// own check, with the welded counts (EncodeInput::Mesh), holds them (0.80-0.83).
+// STL mesh (the strips: one vertex per facet) it is too low for the whole encode (binary and
+// ASCII STL strips peak at 1.28-1.34 times it) but not for the reading (0.76-0.79); the
+// encoder's own check, with the welded counts (EncodeInput::Mesh), comes before its
+// allocations and holds them (0.80-0.83).
 struct Fit {
   uint64_t fixed, per_vertex, per_face;
 };
 constexpr Fit kLightReaders = {12ull << 20, 200, 36};
-constexpr Fit kEncodeFits[] = {
-    kLightReaders,          // Mesh
-    kLightReaders,          // PlyBinary
-    kLightReaders,          // PlyAscii
-    {16ull << 20, 24, 244}, // Obj
-    kLightReaders,          // Off
-    kLightReaders,          // StlBinary
-    {6ull << 20, 0, 370},   // StlAscii
-};
-static_assert(sizeof kEncodeFits / sizeof kEncodeFits[0] ==
-                  static_cast<size_t>(EncodeInput::StlAscii) + 1,
-              "one fit per EncodeInput");
+constexpr Fit kTinyobjloader = {16ull << 20, 24, 244};
+constexpr Fit kTinyobjloaderAttributes = {16ull << 20, 32, 330};
+
+/// The fit of loading `input` and encoding it.
+Fit encode_fit(EncodeInput input) {
+  switch (input) {
+  case EncodeInput::Obj:
+    return kTinyobjloader;
+  case EncodeInput::ObjAttributes:
+    return kTinyobjloaderAttributes;
+  default: // the encoder's own peak is the maximum
+    return kLightReaders;
+  }
+}
 
 constexpr uint64_t kDecodeFixed = 8ull << 20;
-constexpr uint64_t kClusteredDecodePerVertex = 52;
+constexpr uint64_t kClusteredDecodePerVertex = 56;
 constexpr uint64_t kClusteredDecodePerFace = 36;
 constexpr uint64_t kProgressiveDecodePerVertex = 64;
 constexpr uint64_t kProgressiveDecodePerFace = 34;
@@ -83,15 +101,17 @@ constexpr uint64_t kThreadFixed = 2ull << 20;
 constexpr uint64_t kThreadPerVertex = 16;
 constexpr uint64_t kThreadPerFace = 4;
 
-// Per-vertex attributes (bench/README.md, "Memory", attributes): a 1M-vertex torus (2M
-// faces) with 8 codes per vertex (RGB, normal, quality, UV) peaked 611 B/vertex above the
-// same mesh without attributes when encoding (241 B/vertex since 2026-12-02: the encoder
-// frees its input once quantized), with 1 code (quality) 96 B/vertex (31): about 22 + 74 B
-// per code, kept (not refitted with the per-format estimates above). Decoding: 81 B/vertex (8
-// codes, 27 bytes of values) and 12 B/vertex (1 code, 4 bytes): the codes (8 B each) plus the
-// values, plus slack.
-constexpr uint64_t kEncodeAttributeFixed = 32;
-constexpr uint64_t kEncodePerAttributeCode = 84;
+// Per-vertex attributes (bench/README.md, "Memory", attributes): encoding, what tori (F =
+// 2V, binary PLY) with colour, normal, quality and UV (8 codes), colour (3) or quality (1)
+// peak above the same torus without attributes, refitted in the fifth session (2026-12-02;
+// until then 32 + 84 B per code, fitted before the encoder freed its input once quantized:
+// about three times these peaks): 226-243 B/vertex (8 codes), 74-93 (3), 31-41 (1) at 300k
+// and 1M vertices (100k: 262, 94, 40). 16 + 34 B per code: each part 0.62-0.85 of its
+// estimate at 300k and 1M, each whole peak 0.71-0.80 of the PLY row plus the part.
+// Decoding: 81 B/vertex (8 codes, 27 bytes of values) and 12 B/vertex (1 code, 4 bytes): the
+// codes (8 B each) plus the values, plus slack.
+constexpr uint64_t kEncodeAttributeFixed = 16;
+constexpr uint64_t kEncodePerAttributeCode = 34;
 constexpr uint64_t kDecodePerAttributeCode = 8;
 constexpr uint64_t kDecodeAttributeFixed = 16;
 
@@ -257,20 +277,22 @@ std::string lower(std::string s) {
 
 } // namespace
 
-EncodeInput encode_input(const std::string &format, bool text) {
-  if (format == "ply")
-    return text ? EncodeInput::PlyAscii : EncodeInput::PlyBinary;
-  if (format == "stl")
-    return text ? EncodeInput::StlAscii : EncodeInput::StlBinary;
-  if (format == "obj")
-    return EncodeInput::Obj;
-  if (format == "off")
+EncodeInput encode_input(const LoadReport &report) {
+  if (report.format == "ply")
+    return report.text ? EncodeInput::PlyAscii : EncodeInput::PlyBinary;
+  if (report.format == "stl")
+    return report.text ? EncodeInput::StlAscii : EncodeInput::StlBinary;
+  if (report.format == "obj")
+    return report.plain_obj        ? EncodeInput::ObjPlain
+           : report.obj_attributes ? EncodeInput::ObjAttributes
+                                   : EncodeInput::Obj;
+  if (report.format == "off")
     return EncodeInput::Off;
   return EncodeInput::Mesh;
 }
 
 uint64_t encode_memory_estimate(uint64_t vertices, uint64_t faces, EncodeInput input) {
-  const Fit &fit = kEncodeFits[static_cast<size_t>(input)];
+  const Fit fit = encode_fit(input);
   return add_mul(add_mul(fit.fixed, vertices, fit.per_vertex), faces, fit.per_face);
 }
 
