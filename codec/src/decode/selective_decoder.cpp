@@ -168,6 +168,8 @@ void SelectiveDecoder::State::decode_batch(const uint32_t *batch, size_t n, int 
     const uint32_t c = batch[i];
     Cluster &k = clusters[c];
     decoding = c;
+    if (i + 1 < n)
+      LevelStep::prefetch_cluster(mesh, traversed[i + 1]);
     try {
       DecoderCodec codec(layout.header.grid.bits); // (names the cluster in errors)
       codec.set(nullptr, nullptr, nullptr, l, c);

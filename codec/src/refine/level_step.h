@@ -123,6 +123,20 @@ public:
     apply_splits(mesh, in.splits, where.level, where.cluster, &next_local);
   }
 
+  /// Fetch what apply_cluster_level reads first of a cluster traversed by
+  /// traverse_cluster_level (another core traversed it): the claims of its patch faces and
+  /// the first faces of its first splits. Call it for the next cluster before applying one.
+  static void prefetch_cluster(const LevelMesh &mesh, const TraversedCluster &next) {
+    for (uint32_t f : next.claims)
+      __builtin_prefetch(&mesh.face_claim[f]);
+    const size_t n = std::min<size_t>(next.splits.size(), 4);
+    for (size_t i = 0; i < n; ++i) {
+      const uint32_t c = next.splits.split[i].op.first_corner;
+      __builtin_prefetch(&mesh.ct.O[c]);
+      __builtin_prefetch(&mesh.ct.V[c]);
+    }
+  }
+
 private:
   /// (`by_id`: a global level, whose traversal marks vertices by id,
   /// TraversalScratch::begin.)
