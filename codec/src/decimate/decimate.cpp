@@ -127,7 +127,10 @@ public:
 private:
   bool allowed_direction(uint32_t i) const;
   void collect_options();
+  void gather_positions();
+  void farthest_apart();
   bool normals_ok(uint32_t i);
+  void normals_before();
   bool best_option(Candidate &out);
   const int32_t *at(uint32_t k) const { return &pos_[3 * size_t(k)]; } // from_.neighbour[k]
   const double *at_d(uint32_t k) const { return &pos_d_[3 * size_t(k)]; }
@@ -136,8 +139,8 @@ private:
   const std::vector<int32_t> &q_;
   const DecimationOptions &opt_;
   uint32_t v_from_ = kNone;
-  std::vector<int32_t> pos_;       // positions of from_.neighbour, gathered once
-  std::vector<double> pos_d_;      // the same as doubles, then v_from's
+  std::vector<int32_t> pos_;       // positions of from_.neighbour, gathered once (grow only)
+  std::vector<double> pos_d_;      // the same as doubles, then v_from's (grow only)
   std::vector<int64_t> farthest_;  // per neighbour: its largest distance^2 to a non-adjacent one
   std::vector<double> before_;     // per face of from_: its normal and the normal's length^2
   bool have_normals_ = false;      // before_ is v_from_'s
@@ -190,25 +193,8 @@ void Evaluator::collect_options() {
   const uint32_t m = from_.size();
   if (m < 3)
     return;
-  pos_.resize(3 * size_t(m));
-  pos_d_.resize(3 * size_t(m + 1));
-  for (uint32_t k = 0; k <= m; ++k) {
-    const int32_t *p = &q_[3 * size_t(k < m ? from_.neighbour[k] : v_from_)];
-    for (int j = 0; j < 3; ++j) {
-      if (k < m)
-        pos_[3 * size_t(k) + j] = p[j];
-      pos_d_[3 * size_t(k) + j] = double(p[j]);
-    }
-  }
-  farthest_.assign(m, -1);
-  for (uint32_t i = 0; i < m; ++i)
-    for (uint32_t k = i + 2; k < m; ++k) {
-      if (from_.closed && i == 0 && k == m - 1)
-        continue; // adjacent across the start of a closed ring
-      const int64_t d = dist2(at(i), at(k));
-      farthest_[i] = std::max(farthest_[i], d);
-      farthest_[k] = std::max(farthest_[k], d);
-    }
+  gather_positions();
+  farthest_apart();
   for (uint32_t i = 0; i < m; ++i) {
     if (!allowed_direction(i))
       continue;
@@ -216,6 +202,48 @@ void Evaluator::collect_options() {
     const int64_t metric =
         farthest_[i] >= 0 ? farthest_[i] : dist2(at(i), at(il != kNone ? il : v_r_index(i)));
     options_.push_back({metric, i});
+  }
+}
+
+// pos_ / pos_d_ := the positions of from_'s neighbours, then (pos_d_ only) v_from's. The
+// arrays only grow: their tails past the ring are stale.
+void Evaluator::gather_positions() {
+  const uint32_t m = from_.size();
+  if (pos_d_.size() < 3 * size_t(m + 1)) {
+    pos_.resize(3 * size_t(m + 1));
+    pos_d_.resize(3 * size_t(m + 1));
+    farthest_.resize(m);
+  }
+  const int32_t *q = q_.data();
+  const uint32_t *neighbour = from_.neighbour.data();
+  int32_t *p = pos_.data();
+  double *d = pos_d_.data();
+  for (uint32_t k = 0; k < m; ++k, p += 3, d += 3) {
+    const int32_t *s = q + 3 * size_t(neighbour[k]);
+    p[0] = s[0], p[1] = s[1], p[2] = s[2];
+    d[0] = s[0], d[1] = s[1], d[2] = s[2];
+  }
+  const int32_t *s = q + 3 * size_t(v_from_);
+  d[0] = s[0], d[1] = s[1], d[2] = s[2];
+}
+
+// farthest_[k] := the largest distance^2 from neighbour k to a neighbour not adjacent to it
+// in the ring (-1 if none). Distances are symmetric: each pair is measured once, for both.
+void Evaluator::farthest_apart() {
+  const uint32_t m = from_.size();
+  int64_t *far = farthest_.data();
+  std::fill_n(far, m, int64_t(-1));
+  for (uint32_t i = 0; i < m; ++i) {
+    const int32_t *a = at(i);
+    // (in a closed ring neighbours 0 and m-1 are adjacent across its start)
+    const uint32_t end = from_.closed && i == 0 ? m - 1 : m;
+    int64_t far_i = far[i];
+    for (uint32_t k = i + 2; k < end; ++k) {
+      const int64_t d = dist2(a, at(k));
+      far_i = std::max(far_i, d);
+      far[k] = std::max(far[k], d);
+    }
+    far[i] = far_i;
   }
 }
 
@@ -237,16 +265,28 @@ bool Evaluator::link_ok(uint32_t i) {
     ++size;
     shared += n != v_from_ && nb_stamp_[n] == nb_counter_;
   };
+  const uint32_t *V = ct_.V.data(), *O = ct_.O.data();
   const uint32_t start = ct_.VC[from_.neighbour[i]]; // v_to has faces: it is in a face of v_from
-  uint32_t c = start, last = start;
-  do {
-    visit(ct_.V[Corner::next(c)]);
-    last = c;
-    c = ct_.swing_ccw(c);
-  } while (c != kNone && c != start);
-  const bool to_closed = c == start;
+  // Counter-clockwise from start: face c = (v_to, a, b) gives a = V[next(c)]; the next face
+  // is the one across (v_to, a), its corner next(o) for o = O[next(c)], and that corner's
+  // next is prev(o) (one `% 3` a face, as in walk_fan).
+  uint32_t c = start, c_next = Corner::next(start);
+  bool to_closed = true;
+  for (;;) {
+    visit(V[c_next]);
+    const uint32_t o = O[c_next];
+    if (o == kNone) {
+      to_closed = false;
+      break;
+    }
+    const uint32_t k = o % 3;
+    c = k == 2 ? o - 2 : o + 1;
+    if (c == start)
+      break;
+    c_next = k == 0 ? o + 2 : o - 1;
+  }
   if (!to_closed) { // the far end of the last face, then the faces clockwise of start
-    visit(ct_.V[Corner::prev(last)]);
+    visit(V[Corner::prev(c)]);
     for (uint32_t b = ct_.swing_cw(start); b != kNone; b = ct_.swing_cw(b))
       visit(ct_.V[Corner::next(b)]);
   }
@@ -260,24 +300,18 @@ bool Evaluator::link_ok(uint32_t i) {
 // before the collapse do not depend on v_to: computed once per v_from.
 bool Evaluator::normals_ok(uint32_t i) {
   const uint32_t m = from_.size(), faces = from_.faces();
-  if (!have_normals_) {
-    before_.resize(4 * size_t(faces));
-    for (uint32_t k = 0; k < faces; ++k) {
-      double *n = &before_[4 * size_t(k)];
-      normal(at_d(m), at_d(k), at_d(k + 1 == m ? 0 : k + 1), n); // at_d(m): v_from
-      n[3] = dot(n, n);
-    }
-    have_normals_ = true;
-  }
+  if (!have_normals_)
+    normals_before();
   const double c2 = opt_.normal_cosine * opt_.normal_cosine;
   const uint32_t gone_r = from_.closed && i == 0 ? m - 1 : i - 1; // face (v_from, v_r, v_to)
-  for (uint32_t k = 0; k < faces; ++k) {
-    const double *before = &before_[4 * size_t(k)];
+  const double *to = at_d(i);
+  const double *before = before_.data();
+  for (uint32_t k = 0; k < faces; ++k, before += 4) {
     const double lb = before[3];
     if (k == i || k == gone_r || lb == 0.0)
       continue; // a zero-area face has no orientation to preserve
     double after[3];
-    normal(at_d(i), at_d(k), at_d(k + 1 == m ? 0 : k + 1), after);
+    normal(to, at_d(k), at_d(k + 1 == m ? 0 : k + 1), after);
     const double la = dot(after, after);
     if (la == 0.0)
       return false; // would create a zero-area face
@@ -286,6 +320,20 @@ bool Evaluator::normals_ok(uint32_t i) {
       return false;
   }
   return true;
+}
+
+// before_ := per face of from_, its normal and the normal's length^2 (grows only).
+void Evaluator::normals_before() {
+  const uint32_t m = from_.size(), faces = from_.faces();
+  if (before_.size() < 4 * size_t(faces))
+    before_.resize(4 * size_t(faces));
+  const double *from = at_d(m);
+  double *n = before_.data();
+  for (uint32_t k = 0; k < faces; ++k, n += 4) {
+    normal(from, at_d(k), at_d(k + 1 == m ? 0 : k + 1), n);
+    n[3] = dot(n, n);
+  }
+  have_normals_ = true;
 }
 
 // The admissible halfedge of v_from with the smallest (metric, index). The options are
