@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
-#include <exception>
-#include <mutex>
-#include <thread>
+#include <memory>
+
+#include "parallel/thread_pool.h"
 
 namespace pomar {
 namespace {
@@ -123,6 +123,7 @@ public:
   bool link_ok(uint32_t i);
 
   Ring from_;
+  std::vector<Candidate> found; // scratch of the parallel evaluation (Decimator::candidates)
 
 private:
   bool allowed_direction(uint32_t i) const;
@@ -154,8 +155,9 @@ class Decimator {
 public:
   Decimator(CornerTable &ct, const std::vector<int32_t> &q, const DecimationOptions &opt)
       : ct_(ct), target_mark_(ct.vertex_count(), 0), dirty_(ct.vertex_count(), 0) {
-    const unsigned threads = std::max(1u, opt.threads);
-    for (unsigned t = 0; t < threads; ++t)
+    if (opt.threads > 1 && ct.vertex_count() >= 2 * kSlice)
+      pool_ = std::make_unique<ThreadPool>(opt.threads);
+    for (unsigned t = 0; t < (pool_ ? pool_->size() : 1); ++t)
       eval_.emplace_back(ct, q, opt);
   }
 
@@ -170,7 +172,12 @@ private:
   std::vector<uint32_t> target_mark_; // level stamp of vertices already used as v_to
   std::vector<uint32_t> dirty_;       // level stamp of vertices whose ring changed
   uint32_t level_stamp_ = 0;
-  std::deque<Evaluator> eval_; // eval_[0]: also the greedy pass's
+  // Candidate evaluation: slices of kSlice alive vertices (a few ms of work each, far more
+  // than handing one to a thread costs).
+  static constexpr size_t kSlice = 2048;
+  std::unique_ptr<ThreadPool> pool_;          // none with one thread or a small mesh
+  std::deque<Evaluator> eval_;                // per pool thread; eval_[0]: also the greedy pass's
+  std::vector<std::vector<Candidate>> slice_; // per slice: its candidates
   std::vector<Candidate> sort_scratch_;
 };
 
@@ -401,43 +408,32 @@ Collapse Decimator::collapse(uint32_t v_from, uint32_t i) {
   return op;
 }
 
-// Every alive vertex's best collapse. Evaluation only reads the mesh: with several threads
-// each evaluates one contiguous slice of `alive`, and the slices are joined in order, so
-// the list is the same whatever the thread count.
+// Every alive vertex's best collapse. Evaluation only reads the mesh: `alive` is cut into
+// slices of kSlice vertices, the pool's threads evaluate them (each with its own
+// Evaluator, taking the next slice when done: a thread slowed down by a busy machine just
+// takes fewer), and the slices are joined in order, so the list is the same whatever the
+// thread count.
 std::vector<Candidate> Decimator::candidates(const std::vector<uint32_t> &alive) {
-  constexpr size_t kMinSlice = 16384; // below this a thread costs more than it saves
-  const size_t n = alive.size();
-  const size_t threads = std::min<size_t>(eval_.size(), std::max<size_t>(1, n / kMinSlice));
-  std::vector<std::vector<Candidate>> part(threads);
-  const auto slice = [&](size_t t) {
-    // (Filled in a local vector: the threads' push_backs would otherwise write the
-    // adjacent headers of part[], one cache line, all the time.)
-    std::vector<Candidate> mine;
-    mine.reserve(n / threads + 1);
-    eval_[t].evaluate(alive.data() + n * t / threads, alive.data() + n * (t + 1) / threads, mine);
-    part[t] = std::move(mine);
-  };
-  std::vector<std::thread> pool;
-  std::exception_ptr error;
-  std::mutex error_mutex;
-  const auto guarded_slice = [&](size_t t) {
-    try {
-      slice(t);
-    } catch (...) {
-      const std::lock_guard<std::mutex> lock(error_mutex);
-      error = std::current_exception();
-    }
-  };
-  for (size_t t = 1; t < threads; ++t)
-    pool.emplace_back(guarded_slice, t);
-  guarded_slice(0);
-  for (std::thread &th : pool)
-    th.join();
-  if (error)
-    std::rethrow_exception(error);
-  for (size_t t = 1; t < threads; ++t)
-    part[0].insert(part[0].end(), part[t].begin(), part[t].end());
-  return std::move(part[0]);
+  const size_t n = alive.size(), slices = (n + kSlice - 1) / kSlice;
+  std::vector<Candidate> out;
+  out.reserve(n);
+  if (!pool_ || slices < 2) {
+    eval_[0].evaluate(alive.data(), alive.data() + n, out);
+    return out;
+  }
+  if (slice_.size() < slices)
+    slice_.resize(slices);
+  pool_->run(slices, [&](size_t i, unsigned t) {
+    // (Filled in the thread's own Evaluator, then copied: the threads' push_backs would
+    // otherwise write the adjacent headers of slice_[], one cache line, all the time.)
+    Evaluator &e = eval_[t];
+    e.found.clear();
+    e.evaluate(alive.data() + i * kSlice, alive.data() + std::min(n, (i + 1) * kSlice), e.found);
+    slice_[i].assign(e.found.begin(), e.found.end());
+  });
+  for (size_t i = 0; i < slices; ++i)
+    out.insert(out.end(), slice_[i].begin(), slice_[i].end());
+  return out;
 }
 
 std::vector<Collapse> Decimator::run_level(std::vector<uint32_t> &alive) {
