@@ -17,15 +17,17 @@ int64_t dist2(const int32_t *a, const int32_t *b) {
   return dx * dx + dy * dy + dz * dz;
 }
 
-/// Unnormalised normal of triangle (a,b,c) in doubles (decimation decisions only; the
-/// decoder never repeats them, so they need not be bit-exact across machines). The
-/// coordinates are quantized integers converted exactly.
-inline void normal(const double a[3], const double b[3], const double c[3], double n[3]) {
-  double u[3], v[3];
-  for (int k = 0; k < 3; ++k) {
-    u[k] = b[k] - a[k];
-    v[k] = c[k] - a[k];
-  }
+/// The edge from a to b, b - a (exact: the coordinates are quantized integers).
+inline void edge(const double a[3], const double b[3], double e[3]) {
+  e[0] = b[0] - a[0];
+  e[1] = b[1] - a[1];
+  e[2] = b[2] - a[2];
+}
+
+/// u x v: the unnormalised normal of a triangle (a, b, c) with u = b - a, v = c - a, in
+/// doubles (decimation decisions only; the decoder never repeats them, so they need not be
+/// bit-exact across machines). The fans below pass each edge on to the next face.
+inline void cross(const double u[3], const double v[3], double n[3]) {
   n[0] = u[1] * v[2] - u[2] * v[1];
   n[1] = u[2] * v[0] - u[0] * v[2];
   n[2] = u[0] * v[1] - u[1] * v[0];
@@ -313,18 +315,27 @@ bool Evaluator::normals_ok(uint32_t i) {
   const uint32_t gone_r = from_.closed && i == 0 ? m - 1 : i - 1; // face (v_from, v_r, v_to)
   const double *to = at_d(i);
   const double *before = before_.data();
+  double u[3], v[3];   // the edges from v_to to the face's two neighbours
+  bool have_u = false; // u is face k's (the previous face's v)
   for (uint32_t k = 0; k < faces; ++k, before += 4) {
     const double lb = before[3];
-    if (k == i || k == gone_r || lb == 0.0)
+    if (k == i || k == gone_r || lb == 0.0) {
+      have_u = false;
       continue; // a zero-area face has no orientation to preserve
+    }
+    if (!have_u)
+      edge(to, at_d(k), u);
+    edge(to, at_d(k + 1 == m ? 0 : k + 1), v);
     double after[3];
-    normal(to, at_d(k), at_d(k + 1 == m ? 0 : k + 1), after);
+    cross(u, v, after);
     const double la = dot(after, after);
     if (la == 0.0)
       return false; // would create a zero-area face
     const double d = dot(before, after);
     if (d <= 0.0 || d * d < c2 * la * lb)
       return false;
+    std::copy_n(v, 3, u);
+    have_u = true;
   }
   return true;
 }
@@ -336,9 +347,13 @@ void Evaluator::normals_before() {
     before_.resize(4 * size_t(faces));
   const double *from = at_d(m);
   double *n = before_.data();
+  double u[3], v[3]; // the edges from v_from to the face's two neighbours
+  edge(from, at_d(0), u);
   for (uint32_t k = 0; k < faces; ++k, n += 4) {
-    normal(from, at_d(k), at_d(k + 1 == m ? 0 : k + 1), n);
+    edge(from, at_d(k + 1 == m ? 0 : k + 1), v);
+    cross(u, v, n);
     n[3] = dot(n, n);
+    std::copy_n(v, 3, u);
   }
   have_normals_ = true;
 }
