@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <functional>
 #include <memory>
 
 #include "entropy/static_tables.h"
@@ -52,6 +53,7 @@ public:
     }
     traversed_.resize(kBatch);
     numbered_.resize(kBatch);
+    counts_.resize(pool_->size());
   }
   bool on() const { return pool_ != nullptr; }
 
@@ -84,12 +86,34 @@ public:
       codec.add_emitted(w);
   }
 
+  /// How often each symbol of the level was recorded (count_symbols over every cluster),
+  /// the clusters spread over the threads, each adding into its own counts (integer sums:
+  /// the same totals in any order).
+  std::vector<uint32_t> count(const std::vector<SymbolRecorder> &recordings,
+                              const ModelSlots &slots) {
+    for (std::vector<uint32_t> &c : counts_)
+      c.assign(slots.symbols(), 0);
+    pool_->run(recordings.size(), [&](size_t c, unsigned t) {
+      count_symbols(recordings[c], slots, counts_[t].data());
+    });
+    std::vector<uint32_t> total = counts_[0];
+    for (size_t t = 1; t < counts_.size(); ++t)
+      for (size_t s = 0; s < total.size(); ++s)
+        total[s] += counts_[t][s];
+    return total;
+  }
+
   /// Range-code every cluster's recording of the level into its own coder, the clusters
-  /// spread over the threads (the models are frozen: coding only reads them).
+  /// spread over the threads (the models are frozen: coding only reads them), while one
+  /// thread runs `alongside` (the sequential sums of the ideal code lengths).
   void code(const std::vector<SymbolRecorder> &recordings, const ModelSlots &slots,
-            std::vector<RangeEncoder> &coders) {
-    pool_->run(recordings.size(),
-               [&](size_t c, unsigned) { code_recording(recordings[c], slots, coders[c]); });
+            std::vector<RangeEncoder> &coders, const std::function<void()> &alongside) {
+    pool_->run(recordings.size() + 1, [&](size_t i, unsigned) {
+      if (i == 0)
+        alongside();
+      else
+        code_recording(recordings[i - 1], slots, coders[i - 1]);
+    });
   }
 
 private:
@@ -101,6 +125,7 @@ private:
   std::deque<EncoderCodec<RecorderStream>> workers_; // (their addresses must not move)
   std::vector<TraversedCluster> traversed_;
   std::vector<std::vector<uint32_t>> numbered_; // per batch cluster: its v_from, in order
+  std::vector<std::vector<uint32_t>> counts_;   // per thread: symbol counts (count())
 };
 
 } // namespace
@@ -158,17 +183,28 @@ ClusteredLevels encode_clustered_levels(Rebuild &rb, size_t global, FileHeader &
     }
     codec.end_level();
     add_level_entry(header, lm, 0, 0);
-    freezer.freeze(models, slots, recordings);
+    if (threaded) {
+      freezer.freeze(models, slots, parallel.count(recordings, slots));
+    } else {
+      std::vector<uint32_t> counts(slots.symbols(), 0);
+      for (const SymbolRecorder &recording : recordings)
+        count_symbols(recording, slots, counts.data());
+      freezer.freeze(models, slots, std::move(counts));
+    }
     // The ideal code lengths summed in cluster order (the same sums for any thread count),
-    // then each cluster's symbols coded into its own coder.
+    // and each cluster's symbols coded into its own coder.
     const std::vector<double> costs = symbol_costs(slots, freezer.counts());
-    for (const SymbolRecorder &recording : recordings)
-      add_recording_bits(recording, slots, costs, bits);
-    if (threaded)
-      parallel.code(recordings, slots, block_coders);
-    else
+    const auto sum_bits = [&] {
+      for (const SymbolRecorder &recording : recordings)
+        add_recording_bits(recording, slots, costs, bits);
+    };
+    if (threaded) {
+      parallel.code(recordings, slots, block_coders, sum_bits);
+    } else {
+      sum_bits();
       for (uint32_t c = 0; c < clusters; ++c)
         code_recording(recordings[c], slots, block_coders[c]);
+    }
     for (SymbolRecorder &recording : recordings)
       recording.events.clear(); // keeps its capacity for the next, larger level
     if (progress)
