@@ -12,8 +12,10 @@ namespace {
 
 using Corner = CornerTable;
 
-int64_t dist2(const int32_t *a, const int32_t *b) {
-  const int64_t dx = int64_t(a[0]) - b[0], dy = int64_t(a[1]) - b[1], dz = int64_t(a[2]) - b[2];
+/// Squared distance of two quantized positions held as doubles: exact, since grids have at
+/// most 24 bits (differences < 2^24, squares < 2^48, their sum < 2^50 < 2^53).
+double dist2(const double *a, const double *b) {
+  const double dx = a[0] - b[0], dy = a[1] - b[1], dz = a[2] - b[2];
   return dx * dx + dy * dy + dz * dz;
 }
 
@@ -135,16 +137,14 @@ private:
   bool normals_ok(uint32_t i);
   void normals_before();
   bool best_option(Candidate &out);
-  const int32_t *at(uint32_t k) const { return &pos_[3 * size_t(k)]; } // from_.neighbour[k]
   const double *at_d(uint32_t k) const { return &pos_d_[3 * size_t(k)]; }
 
   const CornerTable &ct_;
   const std::vector<int32_t> &q_;
   const DecimationOptions &opt_;
   uint32_t v_from_ = kNone;
-  std::vector<int32_t> pos_;       // positions of from_.neighbour, gathered once (grow only)
-  std::vector<double> pos_d_;      // the same as doubles, then v_from's (grow only)
-  std::vector<int64_t> farthest_;  // per neighbour: its largest distance^2 to a non-adjacent one
+  std::vector<double> pos_d_;      // positions of from_.neighbour, then v_from's (grow only)
+  std::vector<double> farthest_;   // per neighbour: its largest distance^2 to a non-adjacent one
   std::vector<double> before_;     // per face of from_: its normal and the normal's length^2
   bool have_normals_ = false;      // before_ is v_from_'s
   std::vector<uint32_t> nb_stamp_; // scratch marks for the link condition
@@ -208,47 +208,43 @@ void Evaluator::collect_options() {
     if (!allowed_direction(i))
       continue;
     const uint32_t il = v_l_index(i);
-    const int64_t metric =
-        farthest_[i] >= 0 ? farthest_[i] : dist2(at(i), at(il != kNone ? il : v_r_index(i)));
+    const int64_t metric = int64_t(
+        farthest_[i] >= 0 ? farthest_[i] : dist2(at_d(i), at_d(il != kNone ? il : v_r_index(i))));
     options_.push_back({metric, i});
   }
 }
 
-// pos_ / pos_d_ := the positions of from_'s neighbours, then (pos_d_ only) v_from's. The
-// arrays only grow: their tails past the ring are stale.
+// pos_d_ := the positions of from_'s neighbours, then v_from's; farthest_ := -1 (none yet)
+// for every neighbour. The arrays only grow: their tails past the ring are stale.
 void Evaluator::gather_positions() {
   const uint32_t m = from_.size();
   if (pos_d_.size() < 3 * size_t(m + 1)) {
-    pos_.resize(3 * size_t(m + 1));
     pos_d_.resize(3 * size_t(m + 1));
     farthest_.resize(m);
   }
   const int32_t *q = q_.data();
   const uint32_t *neighbour = from_.neighbour.data();
-  int32_t *p = pos_.data();
-  double *d = pos_d_.data();
-  for (uint32_t k = 0; k < m; ++k, p += 3, d += 3) {
+  double *d = pos_d_.data(), *far = farthest_.data();
+  for (uint32_t k = 0; k < m; ++k, d += 3) {
     const int32_t *s = q + 3 * size_t(neighbour[k]);
-    p[0] = s[0], p[1] = s[1], p[2] = s[2];
     d[0] = s[0], d[1] = s[1], d[2] = s[2];
+    far[k] = -1;
   }
   const int32_t *s = q + 3 * size_t(v_from_);
   d[0] = s[0], d[1] = s[1], d[2] = s[2];
 }
 
 // farthest_[k] := the largest distance^2 from neighbour k to a neighbour not adjacent to it
-// in the ring (-1 if none). Distances are symmetric: each pair is measured once, for both.
+// in the ring (stays -1 if none). Distances are symmetric: each pair is measured once.
 void Evaluator::farthest_apart() {
   const uint32_t m = from_.size();
-  int64_t *far = farthest_.data();
-  std::fill_n(far, m, int64_t(-1));
-  for (uint32_t i = 0; i < m; ++i) {
-    const int32_t *a = at(i);
-    // (in a closed ring neighbours 0 and m-1 are adjacent across its start)
-    const uint32_t end = from_.closed && i == 0 ? m - 1 : m;
-    int64_t far_i = far[i];
+  double *far = farthest_.data();
+  // (in a closed ring neighbours 0 and m-1 are adjacent across its start)
+  for (uint32_t i = 0, end = from_.closed ? m - 1 : m; i + 2 < end; ++i, end = m) {
+    const double *a = at_d(i);
+    double far_i = far[i];
     for (uint32_t k = i + 2; k < end; ++k) {
-      const int64_t d = dist2(a, at(k));
+      const double d = dist2(a, at_d(k));
       far_i = std::max(far_i, d);
       far[k] = std::max(far[k], d);
     }
