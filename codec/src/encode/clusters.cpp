@@ -57,11 +57,15 @@ public:
   }
   bool on() const { return pool_ != nullptr; }
 
-  /// Record every cluster's splits of `where.level` (where.cluster is ignored).
+  /// Record every cluster's splits of `where.level` (where.cluster is ignored), and count
+  /// the symbols recorded (counts()).
   void level(EncoderCodec<RecorderStream> &codec, std::vector<SymbolRecorder> &recordings,
              ClusterLevel where, std::vector<uint32_t> &next_local) {
     for (auto &w : workers_)
       w.work_for(codec);
+    const ModelSlots &slots = *recordings[0].slots; // (the level's, shared by every cluster)
+    for (std::vector<uint32_t> &c : counts_)
+      c.assign(slots.symbols(), 0);
     const uint32_t clusters = static_cast<uint32_t>(recordings.size());
     for (uint32_t first = 0; first < clusters; first += kBatch) {
       const uint32_t n = std::min(kBatch, clusters - first);
@@ -72,6 +76,7 @@ public:
         workers_[t].set_sinks(&conn, &geom);
         steps_[t].traverse_cluster_level(rb_.mesh, workers_[t], at, NoCheck{}, traversed_[i]);
         workers_[t].take_deferred(numbered_[i]);
+        count_symbols(recordings[at.cluster], slots, counts_[t].data());
       });
       for (uint32_t i = 0; i < n; ++i) {
         ClusterLevel at = where;
@@ -86,16 +91,9 @@ public:
       codec.add_emitted(w);
   }
 
-  /// How often each symbol of the level was recorded (count_symbols over every cluster),
-  /// the clusters spread over the threads, each adding into its own counts (integer sums:
-  /// the same totals in any order).
-  std::vector<uint32_t> count(const std::vector<SymbolRecorder> &recordings,
-                              const ModelSlots &slots) {
-    for (std::vector<uint32_t> &c : counts_)
-      c.assign(slots.symbols(), 0);
-    pool_->run(recordings.size(), [&](size_t c, unsigned t) {
-      count_symbols(recordings[c], slots, counts_[t].data());
-    });
+  /// How often each symbol of the last level() was recorded: the threads' counts summed
+  /// (integers: the same totals whichever thread counted which cluster).
+  std::vector<uint32_t> counts() const {
     std::vector<uint32_t> total = counts_[0];
     for (size_t t = 1; t < counts_.size(); ++t)
       for (size_t s = 0; s < total.size(); ++s)
@@ -125,7 +123,7 @@ private:
   std::deque<EncoderCodec<RecorderStream>> workers_; // (their addresses must not move)
   std::vector<TraversedCluster> traversed_;
   std::vector<std::vector<uint32_t>> numbered_; // per batch cluster: its v_from, in order
-  std::vector<std::vector<uint32_t>> counts_;   // per thread: symbol counts (count())
+  std::vector<std::vector<uint32_t>> counts_;   // per thread: symbol counts of level()
 };
 
 } // namespace
@@ -184,7 +182,7 @@ ClusteredLevels encode_clustered_levels(Rebuild &rb, size_t global, FileHeader &
     codec.end_level();
     add_level_entry(header, lm, 0, 0);
     if (threaded) {
-      freezer.freeze(models, slots, parallel.count(recordings, slots));
+      freezer.freeze(models, slots, parallel.counts());
     } else {
       std::vector<uint32_t> counts(slots.symbols(), 0);
       for (const SymbolRecorder &recording : recordings)
