@@ -1,11 +1,15 @@
 // Ring walks (mesh/corner_table.h): get_ring on fans larger than a ring's first storage
-// (32 corners), closed and open, whatever corner the walk starts from.
+// (32 corners), closed and open, whatever corner the walk starts from. And the encoder's
+// face renumbering (mesh/reorder.h): a table built on the faces then renumbered is the
+// table built on the renumbered faces.
 #include <gtest/gtest.h>
 
 #include <cstdint>
 #include <vector>
 
 #include "mesh/corner_table.h"
+#include "mesh/reorder.h"
+#include "support/mesh_gen.h"
 
 namespace pomar {
 namespace {
@@ -74,6 +78,37 @@ TEST(Ring, VertexWithoutFacesHasAnEmptyRing) {
   EXPECT_EQ(ring.size(), 0u);
   EXPECT_EQ(ring.faces(), 0u);
   EXPECT_TRUE(ring.closed);
+}
+
+/// reorder_faces(table of t, order) == table of t's faces taken in `order`.
+void expect_reorder_matches_build(const std::vector<uint32_t> &t, uint32_t vertices,
+                                  const std::vector<uint32_t> &order) {
+  const uint32_t nf = static_cast<uint32_t>(t.size() / 3);
+  CornerTable renumbered;
+  build_corner_table(t.data(), nf, vertices, renumbered);
+  reorder_faces(renumbered, order);
+  std::vector<uint32_t> sorted;
+  for (uint32_t f : order)
+    sorted.insert(sorted.end(), &t[3 * size_t(f)], &t[3 * size_t(f)] + 3);
+  CornerTable built;
+  build_corner_table(sorted.data(), nf, vertices, built);
+  EXPECT_EQ(renumbered.V, built.V);
+  EXPECT_EQ(renumbered.O, built.O);
+  EXPECT_EQ(renumbered.VC, built.VC);
+}
+
+TEST(Reorder, RenumberedTableIsTheSortedFacesTable) {
+  // A closed sphere and a grid with holes (boundary corners: O = kNone), with the encoder's
+  // face order and with a scrambled one; an unreferenced vertex keeps VC = kNone.
+  for (const Mesh &m : {gen::icosphere(3), gen::grid_with_holes(12, 3)}) {
+    const uint32_t nv = static_cast<uint32_t>(m.vertex_count()) + 1;
+    expect_reorder_matches_build(m.triangles, nv, face_order(m.triangles));
+    std::vector<uint32_t> scrambled(m.triangle_count());
+    for (uint32_t i = 0; i < scrambled.size(); ++i)
+      scrambled[i] = static_cast<uint32_t>((uint64_t(i) * 7919) % scrambled.size());
+    ASSERT_NE(scrambled.size() % 7919, 0u); // 7919 is prime: i -> 7919 i mod n permutes
+    expect_reorder_matches_build(m.triangles, nv, scrambled);
+  }
 }
 
 } // namespace

@@ -3,29 +3,33 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
-#include <exception>
-#include <mutex>
-#include <thread>
+#include <memory>
+
+#include "parallel/thread_pool.h"
 
 namespace pomar {
 namespace {
 
 using Corner = CornerTable;
 
-int64_t dist2(const int32_t *a, const int32_t *b) {
-  const int64_t dx = int64_t(a[0]) - b[0], dy = int64_t(a[1]) - b[1], dz = int64_t(a[2]) - b[2];
+/// Squared distance of two quantized positions held as doubles: exact, since grids have at
+/// most 24 bits (differences < 2^24, squares < 2^48, their sum < 2^50 < 2^53).
+double dist2(const double *a, const double *b) {
+  const double dx = a[0] - b[0], dy = a[1] - b[1], dz = a[2] - b[2];
   return dx * dx + dy * dy + dz * dz;
 }
 
-/// Unnormalised normal of triangle (a,b,c) in doubles (decimation decisions only; the
-/// decoder never repeats them, so they need not be bit-exact across machines). The
-/// coordinates are quantized integers converted exactly.
-inline void normal(const double a[3], const double b[3], const double c[3], double n[3]) {
-  double u[3], v[3];
-  for (int k = 0; k < 3; ++k) {
-    u[k] = b[k] - a[k];
-    v[k] = c[k] - a[k];
-  }
+/// The edge from a to b, b - a (exact: the coordinates are quantized integers).
+inline void edge(const double a[3], const double b[3], double e[3]) {
+  e[0] = b[0] - a[0];
+  e[1] = b[1] - a[1];
+  e[2] = b[2] - a[2];
+}
+
+/// u x v: the unnormalised normal of a triangle (a, b, c) with u = b - a, v = c - a, in
+/// doubles (decimation decisions only; the decoder never repeats them, so they need not be
+/// bit-exact across machines). The fans below pass each edge on to the next face.
+inline void cross(const double u[3], const double v[3], double n[3]) {
   n[0] = u[1] * v[2] - u[2] * v[1];
   n[1] = u[2] * v[0] - u[0] * v[2];
   n[2] = u[0] * v[1] - u[1] * v[0];
@@ -123,22 +127,24 @@ public:
   bool link_ok(uint32_t i);
 
   Ring from_;
+  std::vector<Candidate> found; // scratch of the parallel evaluation (Decimator::candidates)
 
 private:
   bool allowed_direction(uint32_t i) const;
   void collect_options();
+  void gather_positions();
+  void farthest_apart();
   bool normals_ok(uint32_t i);
+  void normals_before();
   bool best_option(Candidate &out);
-  const int32_t *at(uint32_t k) const { return &pos_[3 * size_t(k)]; } // from_.neighbour[k]
   const double *at_d(uint32_t k) const { return &pos_d_[3 * size_t(k)]; }
 
   const CornerTable &ct_;
   const std::vector<int32_t> &q_;
   const DecimationOptions &opt_;
   uint32_t v_from_ = kNone;
-  std::vector<int32_t> pos_;       // positions of from_.neighbour, gathered once
-  std::vector<double> pos_d_;      // the same as doubles, then v_from's
-  std::vector<int64_t> farthest_;  // per neighbour: its largest distance^2 to a non-adjacent one
+  std::vector<double> pos_d_;      // positions of from_.neighbour, then v_from's (grow only)
+  std::vector<double> farthest_;   // per neighbour: its largest distance^2 to a non-adjacent one
   std::vector<double> before_;     // per face of from_: its normal and the normal's length^2
   bool have_normals_ = false;      // before_ is v_from_'s
   std::vector<uint32_t> nb_stamp_; // scratch marks for the link condition
@@ -151,8 +157,9 @@ class Decimator {
 public:
   Decimator(CornerTable &ct, const std::vector<int32_t> &q, const DecimationOptions &opt)
       : ct_(ct), target_mark_(ct.vertex_count(), 0), dirty_(ct.vertex_count(), 0) {
-    const unsigned threads = std::max(1u, opt.threads);
-    for (unsigned t = 0; t < threads; ++t)
+    if (opt.threads > 1 && ct.vertex_count() >= 2 * kSlice)
+      pool_ = std::make_unique<ThreadPool>(opt.threads);
+    for (unsigned t = 0; t < (pool_ ? pool_->size() : 1); ++t)
       eval_.emplace_back(ct, q, opt);
   }
 
@@ -167,7 +174,12 @@ private:
   std::vector<uint32_t> target_mark_; // level stamp of vertices already used as v_to
   std::vector<uint32_t> dirty_;       // level stamp of vertices whose ring changed
   uint32_t level_stamp_ = 0;
-  std::deque<Evaluator> eval_; // eval_[0]: also the greedy pass's
+  // Candidate evaluation: slices of kSlice alive vertices (a few ms of work each, far more
+  // than handing one to a thread costs).
+  static constexpr size_t kSlice = 2048;
+  std::unique_ptr<ThreadPool> pool_;          // none with one thread or a small mesh
+  std::deque<Evaluator> eval_;                // per pool thread; eval_[0]: also the greedy pass's
+  std::vector<std::vector<Candidate>> slice_; // per slice: its candidates
   std::vector<Candidate> sort_scratch_;
 };
 
@@ -190,32 +202,53 @@ void Evaluator::collect_options() {
   const uint32_t m = from_.size();
   if (m < 3)
     return;
-  pos_.resize(3 * size_t(m));
-  pos_d_.resize(3 * size_t(m + 1));
-  for (uint32_t k = 0; k <= m; ++k) {
-    const int32_t *p = &q_[3 * size_t(k < m ? from_.neighbour[k] : v_from_)];
-    for (int j = 0; j < 3; ++j) {
-      if (k < m)
-        pos_[3 * size_t(k) + j] = p[j];
-      pos_d_[3 * size_t(k) + j] = double(p[j]);
-    }
-  }
-  farthest_.assign(m, -1);
-  for (uint32_t i = 0; i < m; ++i)
-    for (uint32_t k = i + 2; k < m; ++k) {
-      if (from_.closed && i == 0 && k == m - 1)
-        continue; // adjacent across the start of a closed ring
-      const int64_t d = dist2(at(i), at(k));
-      farthest_[i] = std::max(farthest_[i], d);
-      farthest_[k] = std::max(farthest_[k], d);
-    }
+  gather_positions();
+  farthest_apart();
   for (uint32_t i = 0; i < m; ++i) {
     if (!allowed_direction(i))
       continue;
     const uint32_t il = v_l_index(i);
-    const int64_t metric =
-        farthest_[i] >= 0 ? farthest_[i] : dist2(at(i), at(il != kNone ? il : v_r_index(i)));
+    const int64_t metric = int64_t(
+        farthest_[i] >= 0 ? farthest_[i] : dist2(at_d(i), at_d(il != kNone ? il : v_r_index(i))));
     options_.push_back({metric, i});
+  }
+}
+
+// pos_d_ := the positions of from_'s neighbours, then v_from's; farthest_ := -1 (none yet)
+// for every neighbour. The arrays only grow: their tails past the ring are stale.
+void Evaluator::gather_positions() {
+  const uint32_t m = from_.size();
+  if (pos_d_.size() < 3 * size_t(m + 1)) {
+    pos_d_.resize(3 * size_t(m + 1));
+    farthest_.resize(m);
+  }
+  const int32_t *q = q_.data();
+  const uint32_t *neighbour = from_.neighbour.data();
+  double *d = pos_d_.data(), *far = farthest_.data();
+  for (uint32_t k = 0; k < m; ++k, d += 3) {
+    const int32_t *s = q + 3 * size_t(neighbour[k]);
+    d[0] = s[0], d[1] = s[1], d[2] = s[2];
+    far[k] = -1;
+  }
+  const int32_t *s = q + 3 * size_t(v_from_);
+  d[0] = s[0], d[1] = s[1], d[2] = s[2];
+}
+
+// farthest_[k] := the largest distance^2 from neighbour k to a neighbour not adjacent to it
+// in the ring (stays -1 if none). Distances are symmetric: each pair is measured once.
+void Evaluator::farthest_apart() {
+  const uint32_t m = from_.size();
+  double *far = farthest_.data();
+  // (in a closed ring neighbours 0 and m-1 are adjacent across its start)
+  for (uint32_t i = 0, end = from_.closed ? m - 1 : m; i + 2 < end; ++i, end = m) {
+    const double *a = at_d(i);
+    double far_i = far[i];
+    for (uint32_t k = i + 2; k < end; ++k) {
+      const double d = dist2(a, at_d(k));
+      far_i = std::max(far_i, d);
+      far[k] = std::max(far[k], d);
+    }
+    far[i] = far_i;
   }
 }
 
@@ -237,16 +270,28 @@ bool Evaluator::link_ok(uint32_t i) {
     ++size;
     shared += n != v_from_ && nb_stamp_[n] == nb_counter_;
   };
+  const uint32_t *V = ct_.V.data(), *O = ct_.O.data();
   const uint32_t start = ct_.VC[from_.neighbour[i]]; // v_to has faces: it is in a face of v_from
-  uint32_t c = start, last = start;
-  do {
-    visit(ct_.V[Corner::next(c)]);
-    last = c;
-    c = ct_.swing_ccw(c);
-  } while (c != kNone && c != start);
-  const bool to_closed = c == start;
+  // Counter-clockwise from start: face c = (v_to, a, b) gives a = V[next(c)]; the next face
+  // is the one across (v_to, a), its corner next(o) for o = O[next(c)], and that corner's
+  // next is prev(o) (one `% 3` a face, as in walk_fan).
+  uint32_t c = start, c_next = Corner::next(start);
+  bool to_closed = true;
+  for (;;) {
+    visit(V[c_next]);
+    const uint32_t o = O[c_next];
+    if (o == kNone) {
+      to_closed = false;
+      break;
+    }
+    const uint32_t k = o % 3;
+    c = k == 2 ? o - 2 : o + 1;
+    if (c == start)
+      break;
+    c_next = k == 0 ? o + 2 : o - 1;
+  }
   if (!to_closed) { // the far end of the last face, then the faces clockwise of start
-    visit(ct_.V[Corner::prev(last)]);
+    visit(V[Corner::prev(c)]);
     for (uint32_t b = ct_.swing_cw(start); b != kNone; b = ct_.swing_cw(b))
       visit(ct_.V[Corner::next(b)]);
   }
@@ -260,32 +305,53 @@ bool Evaluator::link_ok(uint32_t i) {
 // before the collapse do not depend on v_to: computed once per v_from.
 bool Evaluator::normals_ok(uint32_t i) {
   const uint32_t m = from_.size(), faces = from_.faces();
-  if (!have_normals_) {
-    before_.resize(4 * size_t(faces));
-    for (uint32_t k = 0; k < faces; ++k) {
-      double *n = &before_[4 * size_t(k)];
-      normal(at_d(m), at_d(k), at_d(k + 1 == m ? 0 : k + 1), n); // at_d(m): v_from
-      n[3] = dot(n, n);
-    }
-    have_normals_ = true;
-  }
+  if (!have_normals_)
+    normals_before();
   const double c2 = opt_.normal_cosine * opt_.normal_cosine;
   const uint32_t gone_r = from_.closed && i == 0 ? m - 1 : i - 1; // face (v_from, v_r, v_to)
-  for (uint32_t k = 0; k < faces; ++k) {
-    const double *before = &before_[4 * size_t(k)];
+  const double *to = at_d(i);
+  const double *before = before_.data();
+  double u[3], v[3];   // the edges from v_to to the face's two neighbours
+  bool have_u = false; // u is face k's (the previous face's v)
+  for (uint32_t k = 0; k < faces; ++k, before += 4) {
     const double lb = before[3];
-    if (k == i || k == gone_r || lb == 0.0)
+    if (k == i || k == gone_r || lb == 0.0) {
+      have_u = false;
       continue; // a zero-area face has no orientation to preserve
+    }
+    if (!have_u)
+      edge(to, at_d(k), u);
+    edge(to, at_d(k + 1 == m ? 0 : k + 1), v);
     double after[3];
-    normal(at_d(i), at_d(k), at_d(k + 1 == m ? 0 : k + 1), after);
+    cross(u, v, after);
     const double la = dot(after, after);
     if (la == 0.0)
       return false; // would create a zero-area face
     const double d = dot(before, after);
     if (d <= 0.0 || d * d < c2 * la * lb)
       return false;
+    std::copy_n(v, 3, u);
+    have_u = true;
   }
   return true;
+}
+
+// before_ := per face of from_, its normal and the normal's length^2 (grows only).
+void Evaluator::normals_before() {
+  const uint32_t m = from_.size(), faces = from_.faces();
+  if (before_.size() < 4 * size_t(faces))
+    before_.resize(4 * size_t(faces));
+  const double *from = at_d(m);
+  double *n = before_.data();
+  double u[3], v[3]; // the edges from v_from to the face's two neighbours
+  edge(from, at_d(0), u);
+  for (uint32_t k = 0; k < faces; ++k, n += 4) {
+    edge(from, at_d(k + 1 == m ? 0 : k + 1), v);
+    cross(u, v, n);
+    n[3] = dot(n, n);
+    std::copy_n(v, 3, u);
+  }
+  have_normals_ = true;
 }
 
 // The admissible halfedge of v_from with the smallest (metric, index). The options are
@@ -353,43 +419,32 @@ Collapse Decimator::collapse(uint32_t v_from, uint32_t i) {
   return op;
 }
 
-// Every alive vertex's best collapse. Evaluation only reads the mesh: with several threads
-// each evaluates one contiguous slice of `alive`, and the slices are joined in order, so
-// the list is the same whatever the thread count.
+// Every alive vertex's best collapse. Evaluation only reads the mesh: `alive` is cut into
+// slices of kSlice vertices, the pool's threads evaluate them (each with its own
+// Evaluator, taking the next slice when done: a thread slowed down by a busy machine just
+// takes fewer), and the slices are joined in order, so the list is the same whatever the
+// thread count.
 std::vector<Candidate> Decimator::candidates(const std::vector<uint32_t> &alive) {
-  constexpr size_t kMinSlice = 16384; // below this a thread costs more than it saves
-  const size_t n = alive.size();
-  const size_t threads = std::min<size_t>(eval_.size(), std::max<size_t>(1, n / kMinSlice));
-  std::vector<std::vector<Candidate>> part(threads);
-  const auto slice = [&](size_t t) {
-    // (Filled in a local vector: the threads' push_backs would otherwise write the
-    // adjacent headers of part[], one cache line, all the time.)
-    std::vector<Candidate> mine;
-    mine.reserve(n / threads + 1);
-    eval_[t].evaluate(alive.data() + n * t / threads, alive.data() + n * (t + 1) / threads, mine);
-    part[t] = std::move(mine);
-  };
-  std::vector<std::thread> pool;
-  std::exception_ptr error;
-  std::mutex error_mutex;
-  const auto guarded_slice = [&](size_t t) {
-    try {
-      slice(t);
-    } catch (...) {
-      const std::lock_guard<std::mutex> lock(error_mutex);
-      error = std::current_exception();
-    }
-  };
-  for (size_t t = 1; t < threads; ++t)
-    pool.emplace_back(guarded_slice, t);
-  guarded_slice(0);
-  for (std::thread &th : pool)
-    th.join();
-  if (error)
-    std::rethrow_exception(error);
-  for (size_t t = 1; t < threads; ++t)
-    part[0].insert(part[0].end(), part[t].begin(), part[t].end());
-  return std::move(part[0]);
+  const size_t n = alive.size(), slices = (n + kSlice - 1) / kSlice;
+  std::vector<Candidate> out;
+  out.reserve(n);
+  if (!pool_ || slices < 2) {
+    eval_[0].evaluate(alive.data(), alive.data() + n, out);
+    return out;
+  }
+  if (slice_.size() < slices)
+    slice_.resize(slices);
+  pool_->run(slices, [&](size_t i, unsigned t) {
+    // (Filled in the thread's own Evaluator, then copied: the threads' push_backs would
+    // otherwise write the adjacent headers of slice_[], one cache line, all the time.)
+    Evaluator &e = eval_[t];
+    e.found.clear();
+    e.evaluate(alive.data() + i * kSlice, alive.data() + std::min(n, (i + 1) * kSlice), e.found);
+    slice_[i].assign(e.found.begin(), e.found.end());
+  });
+  for (size_t i = 0; i < slices; ++i)
+    out.insert(out.end(), slice_[i].begin(), slice_[i].end());
+  return out;
 }
 
 std::vector<Collapse> Decimator::run_level(std::vector<uint32_t> &alive) {

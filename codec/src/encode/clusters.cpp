@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <functional>
 #include <memory>
 
 #include "entropy/static_tables.h"
@@ -52,14 +53,19 @@ public:
     }
     traversed_.resize(kBatch);
     numbered_.resize(kBatch);
+    counts_.resize(pool_->size());
   }
   bool on() const { return pool_ != nullptr; }
 
-  /// Record every cluster's splits of `where.level` (where.cluster is ignored).
+  /// Record every cluster's splits of `where.level` (where.cluster is ignored), and count
+  /// the symbols recorded (counts()).
   void level(EncoderCodec<RecorderStream> &codec, std::vector<SymbolRecorder> &recordings,
              ClusterLevel where, std::vector<uint32_t> &next_local) {
     for (auto &w : workers_)
       w.work_for(codec);
+    const ModelSlots &slots = *recordings[0].slots; // (the level's, shared by every cluster)
+    for (std::vector<uint32_t> &c : counts_)
+      c.assign(slots.symbols(), 0);
     const uint32_t clusters = static_cast<uint32_t>(recordings.size());
     for (uint32_t first = 0; first < clusters; first += kBatch) {
       const uint32_t n = std::min(kBatch, clusters - first);
@@ -70,6 +76,7 @@ public:
         workers_[t].set_sinks(&conn, &geom);
         steps_[t].traverse_cluster_level(rb_.mesh, workers_[t], at, NoCheck{}, traversed_[i]);
         workers_[t].take_deferred(numbered_[i]);
+        count_symbols(recordings[at.cluster], slots, counts_[t].data());
       });
       for (uint32_t i = 0; i < n; ++i) {
         ClusterLevel at = where;
@@ -84,12 +91,27 @@ public:
       codec.add_emitted(w);
   }
 
+  /// How often each symbol of the last level() was recorded: the threads' counts summed
+  /// (integers: the same totals whichever thread counted which cluster).
+  std::vector<uint32_t> counts() const {
+    std::vector<uint32_t> total = counts_[0];
+    for (size_t t = 1; t < counts_.size(); ++t)
+      for (size_t s = 0; s < total.size(); ++s)
+        total[s] += counts_[t][s];
+    return total;
+  }
+
   /// Range-code every cluster's recording of the level into its own coder, the clusters
-  /// spread over the threads (the models are frozen: coding only reads them).
+  /// spread over the threads (the models are frozen: coding only reads them), while one
+  /// thread runs `alongside` (the sequential sums of the ideal code lengths).
   void code(const std::vector<SymbolRecorder> &recordings, const ModelSlots &slots,
-            std::vector<RangeEncoder> &coders) {
-    pool_->run(recordings.size(),
-               [&](size_t c, unsigned) { code_recording(recordings[c], slots, coders[c]); });
+            std::vector<RangeEncoder> &coders, const std::function<void()> &alongside) {
+    pool_->run(recordings.size() + 1, [&](size_t i, unsigned) {
+      if (i == 0)
+        alongside();
+      else
+        code_recording(recordings[i - 1], slots, coders[i - 1]);
+    });
   }
 
 private:
@@ -101,6 +123,7 @@ private:
   std::deque<EncoderCodec<RecorderStream>> workers_; // (their addresses must not move)
   std::vector<TraversedCluster> traversed_;
   std::vector<std::vector<uint32_t>> numbered_; // per batch cluster: its v_from, in order
+  std::vector<std::vector<uint32_t>> counts_;   // per thread: symbol counts of level()
 };
 
 } // namespace
@@ -158,17 +181,28 @@ ClusteredLevels encode_clustered_levels(Rebuild &rb, size_t global, FileHeader &
     }
     codec.end_level();
     add_level_entry(header, lm, 0, 0);
-    freezer.freeze(models, slots, recordings);
+    if (threaded) {
+      freezer.freeze(models, slots, parallel.counts());
+    } else {
+      std::vector<uint32_t> counts(slots.symbols(), 0);
+      for (const SymbolRecorder &recording : recordings)
+        count_symbols(recording, slots, counts.data());
+      freezer.freeze(models, slots, std::move(counts));
+    }
     // The ideal code lengths summed in cluster order (the same sums for any thread count),
-    // then each cluster's symbols coded into its own coder.
+    // and each cluster's symbols coded into its own coder.
     const std::vector<double> costs = symbol_costs(slots, freezer.counts());
-    for (const SymbolRecorder &recording : recordings)
-      add_recording_bits(recording, slots, costs, bits);
-    if (threaded)
-      parallel.code(recordings, slots, block_coders);
-    else
+    const auto sum_bits = [&] {
+      for (const SymbolRecorder &recording : recordings)
+        add_recording_bits(recording, slots, costs, bits);
+    };
+    if (threaded) {
+      parallel.code(recordings, slots, block_coders, sum_bits);
+    } else {
+      sum_bits();
       for (uint32_t c = 0; c < clusters; ++c)
         code_recording(recordings[c], slots, block_coders[c]);
+    }
     for (SymbolRecorder &recording : recordings)
       recording.events.clear(); // keeps its capacity for the next, larger level
     if (progress)

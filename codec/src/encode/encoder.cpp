@@ -113,13 +113,23 @@ PreparedInput prepare_input(const Mesh &mesh, const EncodeOptions &options,
     in.grid = hook ? hook->grid : make_quantizer(positions, nv, options.bits);
     in.q = quantize(in.grid, positions, nv);
   }
-  // Renumber for memory locality, then build (and validate) the connectivity.
-  const std::vector<uint32_t> old_to_new = reorder_for_locality(in.q, triangles);
+  // Renumber for memory locality, then build (and validate) the connectivity: the table
+  // is built on the renamed faces while another thread sorts them, then takes their order.
+  const std::vector<uint32_t> old_to_new = reorder_vertices(in.q, triangles);
   in.to_input.resize(nv);
   for (uint32_t v = 0; v < nv; ++v)
     in.to_input[old_to_new[v]] = compact_to_input[v];
   try {
-    build_corner_table(triangles.data(), nf, nv, in.ct);
+    std::vector<uint32_t> order;
+    constexpr uint32_t kMinParallelFaces = 16384; // fewer: a thread costs more than it saves
+    ThreadPool pool(nf >= kMinParallelFaces ? std::min(2u, resolve_threads(options.threads)) : 1);
+    pool.run(2, [&](size_t task, unsigned) {
+      if (task == 0)
+        order = face_order(triangles);
+      else
+        build_corner_table(triangles.data(), nf, nv, in.ct);
+    });
+    reorder_faces(in.ct, order);
   } catch (const Error &) {
     // An invalid mesh is validated again in the caller's numbering (its face order too) so
     // that the message names its indices.

@@ -102,19 +102,21 @@ void ModelSlots::outside_level() {
   throw Error(Error::Kind::Internal, "internal encoder error: a model outside its level");
 }
 
-void LevelFreezer::freeze(Models &m, const ModelSlots &slots,
-                          const std::vector<SymbolRecorder> &recordings) {
-  // How often each symbol of each model was recorded, and which models were used at all.
-  std::vector<uint32_t> &counts = counts_;
-  counts.assign(slots.symbols(), 0);
-  std::vector<uint8_t> used(slots.slots(), 0);
-  for (const SymbolRecorder &r : recordings)
-    for (const SymbolRecorder::Event &e : r.events) {
-      if (e.kind() == 2)
-        continue;
+void count_symbols(const SymbolRecorder &r, const ModelSlots &slots, uint32_t *counts) {
+  for (const SymbolRecorder::Event &e : r.events)
+    if (e.kind() != 2)
       ++counts[slots.first_symbol(e.model) + e.value()];
-      used[e.model] = 1;
-    }
+}
+
+void LevelFreezer::freeze(Models &m, const ModelSlots &slots, std::vector<uint32_t> &&counted) {
+  // Which models were used at all: those with a symbol counted (each event counts one).
+  counts_ = std::move(counted);
+  const std::vector<uint32_t> &counts = counts_;
+  std::vector<uint8_t> used(slots.slots(), 0);
+  for (uint32_t slot = 0; slot < slots.slots(); ++slot) {
+    const uint32_t *c = &counts[slots.first_symbol(slot)];
+    used[slot] = std::any_of(c, c + slots.symbols(slot), [](uint32_t n) { return n != 0; });
+  }
   // A model whose previous-level table codes this level's symbols nearly as well as its
   // own would (within what storing its own costs) reuses it.
   std::vector<std::vector<uint16_t>> &previous = previous_;

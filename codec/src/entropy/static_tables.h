@@ -109,14 +109,20 @@ struct RecorderStream {
   void finish() {}
 };
 
+/// Add to `counts` (ModelSlots::symbols() of them) how often `recording` recorded each
+/// symbol, at first_symbol(slot) + symbol (bypass bits are not counted).
+void count_symbols(const SymbolRecorder &recording, const ModelSlots &slots, uint32_t *counts);
+
 /// Freezes the models of the clustered levels, level after level, each on the symbols its
 /// level recorded (so the encoder can code and forget a level before recording the next).
 /// A model whose previous-level frequencies code this level nearly as well as its own
 /// would (within what storing its own costs) reuses them: call freeze() in level order.
 class LevelFreezer {
 public:
-  void freeze(Models &level, const ModelSlots &slots,
-              const std::vector<SymbolRecorder> &recordings);
+  /// Freeze the level's models on how often each of their symbols was recorded: `counts`
+  /// (at ModelSlots::first_symbol(slot) + symbol: count_symbols over the level's
+  /// recordings, in any order).
+  void freeze(Models &level, const ModelSlots &slots, std::vector<uint32_t> &&counts);
   /// How often each symbol was recorded in the level last frozen (at first_symbol + symbol).
   const std::vector<uint32_t> &counts() const { return counts_; }
 

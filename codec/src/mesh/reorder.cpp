@@ -43,33 +43,9 @@ void sort_by_key(std::vector<Keyed> &a) {
   }
 }
 
-/// The order std::sort gives the faces `t` (renamed by old_to_new) when comparing them by
-/// their smallest vertex. std::sort's moves depend only on its comparisons' results, so
-/// sorting (smallest vertex, face) pairs with the same comparison gives the same order
-/// (ties included) while each comparison reads one number instead of six.
-std::vector<uint32_t> face_order(const std::vector<uint32_t> &t,
-                                 const std::vector<uint32_t> &old_to_new) {
-  struct Face {
-    uint32_t lowest, f;
-  };
-  const size_t nf = t.size() / 3;
-  std::vector<Face> faces(nf);
-  for (size_t f = 0; f < nf; ++f)
-    faces[f] = {
-        std::min({old_to_new[t[3 * f]], old_to_new[t[3 * f + 1]], old_to_new[t[3 * f + 2]]}),
-        static_cast<uint32_t>(f)};
-  std::sort(faces.begin(), faces.end(),
-            [](const Face &a, const Face &b) { return a.lowest < b.lowest; });
-  std::vector<uint32_t> order(nf);
-  for (size_t i = 0; i < nf; ++i)
-    order[i] = faces[i].f;
-  return order;
-}
-
 } // namespace
 
-std::vector<uint32_t> reorder_for_locality(std::vector<int32_t> &q,
-                                           std::vector<uint32_t> &triangles) {
+std::vector<uint32_t> reorder_vertices(std::vector<int32_t> &q, std::vector<uint32_t> &triangles) {
   const uint32_t nv = static_cast<uint32_t>(q.size() / 3);
   // Morton key from the top 21 bits of each coordinate (grids have at most 24 bits).
   std::vector<Keyed> key(nv);
@@ -87,14 +63,57 @@ std::vector<uint32_t> reorder_for_locality(std::vector<int32_t> &q,
     std::copy(&q[3 * v], &q[3 * v] + 3, &nq[3 * i]);
   }
   q.swap(nq);
-  // Faces: rename, then sort by their smallest vertex (rotation and orientation kept).
-  const std::vector<uint32_t> order = face_order(triangles, old_to_new);
-  std::vector<uint32_t> sorted(triangles.size());
-  for (size_t i = 0; i < order.size(); ++i)
-    for (int k = 0; k < 3; ++k)
-      sorted[3 * i + k] = old_to_new[triangles[3 * size_t(order[i]) + k]];
-  triangles.swap(sorted);
+  for (uint32_t &v : triangles)
+    v = old_to_new[v];
   return old_to_new;
+}
+
+std::vector<uint32_t> face_order(const std::vector<uint32_t> &t) {
+  // std::sort's moves depend only on its comparisons' results, so sorting (smallest vertex,
+  // face) pairs with the same comparison gives the order sorting the faces does (ties
+  // included) while each comparison reads one number instead of six.
+  struct Face {
+    uint32_t lowest, f;
+  };
+  const size_t nf = t.size() / 3;
+  std::vector<Face> faces(nf);
+  for (size_t f = 0; f < nf; ++f)
+    faces[f] = {std::min({t[3 * f], t[3 * f + 1], t[3 * f + 2]}), static_cast<uint32_t>(f)};
+  std::sort(faces.begin(), faces.end(),
+            [](const Face &a, const Face &b) { return a.lowest < b.lowest; });
+  std::vector<uint32_t> order(nf);
+  for (size_t i = 0; i < nf; ++i)
+    order[i] = faces[i].f;
+  return order;
+}
+
+void reorder_faces(CornerTable &ct, const std::vector<uint32_t> &order) {
+  const size_t nf = order.size();
+  std::vector<uint32_t> new_corner(nf); // old face -> the first corner of its new place
+  for (size_t i = 0; i < nf; ++i)
+    new_corner[order[i]] = static_cast<uint32_t>(3 * i);
+  { // corner 3*i+k of the new table is corner 3*order[i]+k of the old one
+    std::vector<uint32_t> V(3 * nf);
+    const uint32_t *old = ct.V.data();
+    for (size_t i = 0; i < nf; ++i)
+      std::copy_n(old + 3 * size_t(order[i]), 3, &V[3 * i]);
+    ct.V.swap(V);
+  }
+  {
+    std::vector<uint32_t> O(3 * nf);
+    const uint32_t *old = ct.O.data();
+    for (size_t i = 0; i < nf; ++i) {
+      const uint32_t *o = old + 3 * size_t(order[i]);
+      for (uint32_t k = 0; k < 3; ++k)
+        O[3 * i + k] = o[k] == kNone ? kNone : new_corner[o[k] / 3] + o[k] % 3;
+    }
+    ct.O.swap(O);
+  }
+  // As build_corner_table sets it: each vertex's last corner.
+  const uint32_t *V = ct.V.data();
+  uint32_t *VC = ct.VC.data();
+  for (uint32_t c = 0, n = static_cast<uint32_t>(3 * nf); c < n; ++c)
+    VC[V[c]] = c;
 }
 
 } // namespace pomar
