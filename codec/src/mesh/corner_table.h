@@ -35,6 +35,13 @@ struct CornerTable {
     const uint32_t o = O[prev(c)];
     return o == kNone ? kNone : prev(o);
   }
+  /// Start fetching corner c's entries of V and O into the cache (nothing for kNone).
+  void prefetch(uint32_t c) const {
+    if (c != kNone) {
+      __builtin_prefetch(&V[c]);
+      __builtin_prefetch(&O[c]);
+    }
+  }
   /// Link c and d as opposite corners (either may be kNone).
   void link(uint32_t c, uint32_t d) {
     if (c != kNone)
@@ -128,11 +135,7 @@ bool walk_fan(const CornerTable &ct, uint32_t first, const Name &name, Ring &rin
     }
     // The face beyond edge (a, b) is in the fans of a and b, which a breadth-first walk
     // visits soon: fetch it now.
-    const uint32_t across = O[c];
-    if (across != kNone) {
-      __builtin_prefetch(&V[across]);
-      __builtin_prefetch(&O[across]);
-    }
+    ct.prefetch(O[c]);
     const uint32_t after = name(b);
     if (after != before) {
       corner[kept++] = c;

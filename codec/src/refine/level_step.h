@@ -130,11 +130,8 @@ public:
     for (uint32_t f : next.claims)
       __builtin_prefetch(&mesh.face_claim[f]);
     const size_t n = std::min<size_t>(next.splits.size(), 4);
-    for (size_t i = 0; i < n; ++i) {
-      const uint32_t c = next.splits.split[i].op.first_corner;
-      __builtin_prefetch(&mesh.ct.O[c]);
-      __builtin_prefetch(&mesh.ct.V[c]);
-    }
+    for (size_t i = 0; i < n; ++i)
+      mesh.ct.prefetch(next.splits.split[i].op.first_corner);
   }
 
 private:
@@ -203,18 +200,12 @@ private:
   /// reads next from there, the second of its range and the one across its left edge.
   static void prefetch_split(const CornerTable &ct, const SplitList &splits, uint32_t i,
                              uint32_t n) {
-    if (i + 4 < n) {
-      const uint32_t c = splits.split[i + 4].op.first_corner;
-      __builtin_prefetch(&ct.O[c]);
-      __builtin_prefetch(&ct.V[c]);
-    }
+    if (i + 4 < n)
+      ct.prefetch(splits.split[i + 4].op.first_corner);
     if (i + 2 < n) {
       const uint32_t c = splits.split[i + 2].op.first_corner;
-      const uint32_t second = ct.O[CornerTable::next(c)], left = ct.O[CornerTable::prev(c)];
-      if (second != kNone) {
-        __builtin_prefetch(&ct.O[second]);
-        __builtin_prefetch(&ct.V[second]);
-      }
+      ct.prefetch(ct.O[CornerTable::next(c)]);
+      const uint32_t left = ct.O[CornerTable::prev(c)];
       if (left != kNone)
         __builtin_prefetch(&ct.O[left]);
     }

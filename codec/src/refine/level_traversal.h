@@ -289,21 +289,15 @@ uint32_t queue_neighbours(TraversalScratch &s, uint32_t v, uint32_t from, const 
 inline void prefetch_ahead(const LevelMesh &mesh, const TraversalScratch &s, size_t head) {
   const CornerTable &ct = mesh.ct;
   const size_t n = s.queue.size();
-  const auto fetch_face = [&](uint32_t corner) {
-    if (corner != kNone) {
-      __builtin_prefetch(&ct.O[corner]);
-      __builtin_prefetch(&ct.V[corner]);
-    }
-  };
   if (head + 4 < n) {
     const uint32_t c = ct.VC[s.queue[head + 4].first];
     if (c != kNone) {
-      fetch_face(ct.O[CornerTable::next(c)]);
-      fetch_face(ct.O[CornerTable::prev(c)]);
+      ct.prefetch(ct.O[CornerTable::next(c)]);
+      ct.prefetch(ct.O[CornerTable::prev(c)]);
     }
   }
   if (head + 8 < n)
-    fetch_face(ct.VC[s.queue[head + 8].first]);
+    ct.prefetch(ct.VC[s.queue[head + 8].first]);
   if (head + 16 < n)
     __builtin_prefetch(&ct.VC[s.queue[head + 16].first]);
 }

@@ -61,26 +61,27 @@ struct TraversalScratch {
   }
 };
 
-/// A global level's marks: by id (every vertex is visited).
-struct GlobalMarks {
+/// The claims of a traversal, by face id (both kinds of marks below).
+struct FaceClaims {
   TraversalScratch &s;
-  VertexMarks *vertex(uint32_t v) const { return &s.marks[v]; }
   bool claimed(uint32_t f) const { return s.claimed[f] == s.stamp; }
   void claim(uint32_t f) const { s.claimed[f] = s.stamp; }
 };
 
+/// A global level's marks: by id (every vertex is visited).
+struct GlobalMarks : FaceClaims {
+  VertexMarks *vertex(uint32_t v) const { return &s.marks[v]; }
+};
+
 /// A cluster's marks: by rank in the cluster for the cluster's own vertices, nullptr for
 /// the others (never queued nor split by this traversal).
-struct ClusterMarks {
-  TraversalScratch &s;
+struct ClusterMarks : FaceClaims {
   const LevelMesh::Lineage *lineage;
   uint32_t cluster;
   VertexMarks *vertex(uint32_t v) const {
     const LevelMesh::Lineage &l = lineage[v];
     return l.cluster == cluster ? &s.local_mark(l.local) : nullptr;
   }
-  bool claimed(uint32_t f) const { return s.claimed[f] == s.stamp; }
-  void claim(uint32_t f) const { s.claimed[f] = s.stamp; }
 };
 
 } // namespace pomar
