@@ -2,9 +2,10 @@
 // and limited around damage (decode/level_map.cpp) -> the missing cluster levels, level by
 // level, each through the per-level step (refine/level_step.h) on the cluster's stream
 // (decode/cluster_stream.cpp); coarsening re-decodes from the base clustered mesh.
-// With several threads, the clusters of a level are traversed in parallel in batches and
-// applied in cluster order (LevelStep::traverse_cluster_level / apply_cluster_level): the
-// mesh is the same for any thread count.
+// With several threads, the clusters of a level are traversed ahead on every thread and
+// applied in cluster order on the calling thread, the two overlapping (decode/
+// level_schedule.h, LevelStep::traverse_cluster_level / apply_cluster_level): the mesh is
+// the same for any thread count.
 #include <algorithm>
 
 #include "attributes/attribute_section.h"
@@ -13,6 +14,7 @@
 #include "decode/decoder_codec.h"
 #include "decode/global_levels.h"
 #include "decode/level_map.h"
+#include "decode/level_schedule.h"
 #include "entropy/static_tables.h"
 #include "format/file_format.h"
 #include "geometry/quantize.h"
@@ -78,8 +80,10 @@ struct SelectiveDecoder::State {
   void reset_to_snapshot();
   void back_to_base(); // after take_mesh(): the base (clustered) mesh, requests kept
   void decode_cluster_level(uint32_t c, int level, uint32_t older_than);
-  void decode_batch(const uint32_t *batch, size_t n, int level, uint32_t older_than,
-                    const std::function<void()> &applied, uint32_t &decoding);
+  void decode_level_parallel(const std::vector<uint32_t> &refine, int level, uint32_t older_than,
+                             const std::function<void()> &applied, uint32_t &decoding);
+  bool apply_grows(const TraversedCluster &t) const;
+  LevelSchedule schedule;
   DecoderCodec cluster_codec(uint32_t c, int level);
   void decode_target(const Progress &progress, uint32_t &decoding);
   void check_cluster_data();
@@ -137,23 +141,44 @@ void SelectiveDecoder::State::decode_cluster_level(uint32_t c, int level, uint32
   k.level = level;
 }
 
-/// The data of `level` of clusters batch[0..n), in increasing order: traversed in parallel,
-/// applied in order. Throws what decode_cluster_level would throw for the first cluster
-/// that fails (`decoding` names it), with the clusters before it applied and the others as
-/// they were (their streams put back).
-void SelectiveDecoder::State::decode_batch(const uint32_t *batch, size_t n, int level,
-                                           uint32_t older_than,
-                                           const std::function<void()> &applied,
-                                           uint32_t &decoding) {
-  if (traversed.size() < n) {
-    traversed.resize(n);
-    stream_before.resize(n);
+/// Whether applying `t` grows a mesh array past its capacity (it would move: no traversal
+/// may run then).
+bool SelectiveDecoder::State::apply_grows(const TraversedCluster &t) const {
+  uint64_t faces = mesh.ct.face_count();
+  for (const PendingSplit &ps : t.splits.split)
+    faces += uint64_t(ps.op.has_l) + uint64_t(ps.op.has_r);
+  const uint64_t vertices = uint64_t(mesh.vertex_count()) + t.splits.size();
+  const CornerTable &ct = mesh.ct;
+  return 3 * faces > ct.V.capacity() || 3 * faces > ct.O.capacity() ||
+         vertices > ct.VC.capacity() || 3 * vertices > mesh.q.capacity() ||
+         mesh.attr_codes * vertices > mesh.attr.capacity() || vertices > mesh.lineage.capacity() ||
+         faces > mesh.face_claim.capacity();
+}
+
+/// The data of `level` of the clusters `refine` (increasing), on the pool's threads:
+/// traversed ahead on every thread, applied in order on this one (decode/level_schedule.h).
+/// Throws what decode_cluster_level would throw for the first cluster that fails
+/// (`decoding` names it), with the clusters before it applied and the others as they were
+/// (their streams put back).
+void SelectiveDecoder::State::decode_level_parallel(const std::vector<uint32_t> &refine, int level,
+                                                    uint32_t older_than,
+                                                    const std::function<void()> &applied,
+                                                    uint32_t &decoding) {
+  // The traversed clusters waiting to be applied, at most kWindow (1024 clusters of a
+  // 1M-vertex file's finest level hold about 1 MB of splits); the window does not depend
+  // on the thread count (neither does anything else the decoder does).
+  constexpr size_t kWindow = 1024;
+  const size_t window = std::min(kWindow, refine.size());
+  if (traversed.size() < window) {
+    traversed.resize(window);
+    stream_before.resize(window);
   }
   const uint32_t l = static_cast<uint32_t>(level);
-  pool->run(n, [&](size_t i, unsigned thread) {
-    const uint32_t c = batch[i];
-    TraversedCluster &out = traversed[i];
-    stream_before[i] = clusters[c].stream.decoder();
+  LevelSchedule::Steps work;
+  work.traverse = [&](size_t i, unsigned thread) {
+    const uint32_t c = refine[i];
+    TraversedCluster &out = traversed[i % window];
+    stream_before[i % window] = clusters[c].stream.decoder();
     try {
       DecoderCodec codec = cluster_codec(c, level);
       steps[thread].traverse_cluster_level(mesh, codec, {c, l, older_than},
@@ -163,26 +188,23 @@ void SelectiveDecoder::State::decode_batch(const uint32_t *batch, size_t n, int 
       out.claims.clear();
       out.error = std::current_exception();
     }
-  });
-  for (size_t i = 0; i < n; ++i) {
-    const uint32_t c = batch[i];
+  };
+  work.alone = [&](size_t i) { return apply_grows(traversed[i % window]); };
+  work.apply = [&](size_t i) {
+    const uint32_t c = refine[i];
     Cluster &k = clusters[c];
     decoding = c;
-    if (i + 1 < n)
-      LevelStep::prefetch_cluster(mesh, traversed[i + 1]);
-    try {
-      DecoderCodec codec(layout.header.grid.bits); // (names the cluster in errors)
-      codec.set(nullptr, nullptr, nullptr, l, c);
-      steps[0].apply_cluster_level(mesh, codec, {c, l, older_than}, k.next_local, traversed[i]);
-    } catch (...) {
-      for (size_t j = i + 1; j < n; ++j)
-        clusters[batch[j]].stream.decoder() = stream_before[j];
-      throw;
-    }
+    DecoderCodec codec(layout.header.grid.bits); // (names the cluster in errors)
+    codec.set(nullptr, nullptr, nullptr, l, c);
+    steps[0].apply_cluster_level(mesh, codec, {c, l, older_than}, k.next_local,
+                                 traversed[i % window]);
     k.level = level;
     decoding = kNone;
     applied();
-  }
+  };
+  work.rewind = [&](size_t j) { clusters[refine[j]].stream.decoder() = stream_before[j % window]; };
+  work.prefetch = [&](size_t i) { LevelStep::prefetch_cluster(mesh, traversed[i % window]); };
+  schedule.run(*pool, graph, refine.data(), refine.size(), window, work);
 }
 
 /// After `e` while decoding cluster `c` (kNone: not in a cluster): with skip_damaged,
@@ -514,15 +536,7 @@ void SelectiveDecoder::State::decode_target(const Progress &progress, uint32_t &
       steps.resize(pool->size());
     }
     if (parallel && pool->size() > 1) {
-      // Batches bound the splits held at once (1024 clusters of a 1M-vertex file's finest
-      // level: about 1 MB); their size does not depend on the thread count (neither does
-      // anything else the decoder does). Each batch ends in a wait for the threads and a
-      // sequential apply: 256 clusters a batch woke the threads 4 times as often, which
-      // cost on a loaded machine.
-      constexpr size_t kBatch = 1024;
-      for (size_t b = 0; b < refine.size(); b += kBatch)
-        decode_batch(&refine[b], std::min(kBatch, refine.size() - b), level, older_than, applied,
-                     decoding);
+      decode_level_parallel(refine, level, older_than, applied, decoding);
       continue;
     }
     for (uint32_t c : refine) {

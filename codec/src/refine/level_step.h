@@ -67,7 +67,7 @@ public:
   /// Refine the whole mesh by global level `level` (vertices get cluster 0).
   template <class Codec, class Check = NoCheck>
   void global_level(LevelMesh &mesh, Codec &codec, uint32_t level, const Check &check = {}) {
-    traverse_and_check(mesh, level, true, check,
+    traverse_and_check(mesh, level, true, now(mesh), mesh.ct.face_count(), check,
                        [&] { traverse_level(mesh, codec, scratch_, level, splits_); });
     apply_splits(mesh, splits_, level, 0, nullptr);
   }
@@ -78,7 +78,7 @@ public:
   void cluster_level(LevelMesh &mesh, Codec &codec, const ClusterLevel &where, uint32_t &next_local,
                      const Check &check = {}) {
     const LevelView view{where.level, where.older_than};
-    traverse_and_check(mesh, where.level, false, check, [&] {
+    traverse_and_check(mesh, where.level, false, now(mesh), mesh.ct.face_count(), check, [&] {
       traverse_cluster(mesh, codec, scratch_, where.cluster, view, splits_);
     });
     apply_splits(mesh, splits_, where.level, where.cluster, &next_local);
@@ -86,15 +86,21 @@ public:
 
   /// Steps 1 and 2 of cluster_level, leaving the mesh as it is (other LevelSteps may
   /// traverse other clusters of the level on the same mesh at the same time): the splits,
-  /// the claims and what the traversal or the check threw go to `out`.
+  /// the claims and what the traversal or the check threw go to `out`. Another thread may
+  /// meanwhile apply clusters that are not next to this one (decode/level_schedule.h),
+  /// within the arrays' capacity: this reads no array's size, and the check sees the
+  /// counts this cluster's splits add (from zero).
   template <class Codec, class Check = NoCheck>
   void traverse_cluster_level(LevelMesh &mesh, Codec &codec, const ClusterLevel &where,
                               const Check &check, TraversedCluster &out) {
     const LevelView view{where.level, where.older_than};
     scratch_.defer_claims = true;
     out.error = nullptr;
+    // (The face ids it meets are below the corner table's capacity, which only changes
+    // while no traversal runs.)
+    const uint32_t face_room = static_cast<uint32_t>(mesh.ct.V.capacity() / 3);
     try {
-      traverse_and_check(mesh, where.level, false, check, [&] {
+      traverse_and_check(mesh, where.level, false, StepCounts{}, face_room, check, [&] {
         traverse_cluster(mesh, codec, scratch_, where.cluster, view, splits_);
       });
     } catch (...) {
@@ -135,16 +141,21 @@ public:
   }
 
 private:
+  static StepCounts now(const LevelMesh &mesh) {
+    return {mesh.vertex_count(), mesh.ct.face_count()};
+  }
+
   /// (`by_id`: a global level, whose traversal marks vertices by id,
-  /// TraversalScratch::begin.)
+  /// TraversalScratch::begin; `now`: the counts the check adds the splits to; face ids
+  /// met are below `face_room`.)
   template <class Check, class Traverse>
-  void traverse_and_check(LevelMesh &mesh, uint32_t level, bool by_id, const Check &check,
-                          const Traverse &traverse) {
-    scratch_.begin(by_id ? mesh.vertex_count() : 0, mesh.ct.face_count());
+  void traverse_and_check(LevelMesh &mesh, uint32_t level, bool by_id, StepCounts now,
+                          uint32_t face_room, const Check &check, const Traverse &traverse) {
+    scratch_.begin(by_id ? mesh.vertex_count() : 0, face_room);
     splits_.clear();
     try {
       traverse();
-      StepCounts n{mesh.vertex_count() + splits_.size(), mesh.ct.face_count()};
+      StepCounts n{now.vertices + splits_.size(), now.faces};
       for (const PendingSplit &ps : splits_.split)
         n.faces += uint64_t(ps.op.has_l) + uint64_t(ps.op.has_r);
       check(n);

@@ -1,0 +1,193 @@
+// The pipelined decoding of one clustered level; see level_schedule.h.
+#include "decode/level_schedule.h"
+
+#include <algorithm>
+#include <exception>
+
+namespace pomar {
+
+namespace {
+constexpr uint32_t kNoCluster = 0xFFFFFFFFu;
+// A traverser that found the window full waits for this many applies (one wake-up per
+// cluster applied would cost more than the traversals it starts).
+constexpr size_t kWakeAfter = 32;
+constexpr size_t kAhead = 128;
+} // namespace
+
+void LevelSchedule::run(ThreadPool &pool, const ClusterGraph &graph, const uint32_t *order,
+                        size_t n, size_t window, const Steps &steps) {
+  graph_ = &graph;
+  order_ = order;
+  steps_ = &steps;
+  n_ = n;
+  window_ = std::max<size_t>(window, 1);
+  state_.assign(n, Untraversed);
+  const size_t clusters = graph.start.empty() ? 0 : graph.start.size() - 1;
+  traversed_now_.assign(clusters, 0);
+  applying_ = kNoCluster;
+  next_apply_ = scan_from_ = traversing_ = 0;
+  stop_ = false;
+  wake_at_ = 0;
+  waiting_ = 0;
+  main_waiting_ = false;
+  bool applier_ran = false; // (a pool whose threads did not start hands their items to us)
+  std::exception_ptr error;
+  pool.run(pool.size(), [&](size_t, unsigned thread) {
+    if (thread != 0) {
+      traverse_loop(thread);
+    } else if (!applier_ran) {
+      applier_ran = true;
+      try {
+        apply_loop();
+      } catch (...) {
+        error = std::current_exception();
+      }
+    }
+  });
+  if (error)
+    std::rethrow_exception(error);
+}
+
+/// Under mutex_: index i (order_[i]) has a neighbour in the cluster graph being applied.
+bool LevelSchedule::next_to_applying(uint32_t cluster) const {
+  if (applying_ == kNoCluster)
+    return false;
+  if (applying_ == kAll || applying_ == cluster)
+    return true;
+  for (uint32_t k = graph_->start[cluster]; k < graph_->start[cluster + 1]; ++k)
+    if (graph_->adj[k] == applying_)
+      return true;
+  return false;
+}
+
+/// Under mutex_: a neighbour of `cluster` is being traversed.
+bool LevelSchedule::neighbour_traversing(uint32_t cluster) const {
+  for (uint32_t k = graph_->start[cluster]; k < graph_->start[cluster + 1]; ++k)
+    if (traversed_now_[graph_->adj[k]])
+      return true;
+  return false;
+}
+
+/// Under mutex_: take the lowest untraversed index of the window that may be traversed
+/// now (`applier`: the calling thread, which is not applying: any). Sets wake_at_ for a
+/// traverser that finds none.
+bool LevelSchedule::take(size_t &i, bool applier) {
+  while (scan_from_ < n_ && state_[scan_from_] != Untraversed)
+    ++scan_from_;
+  const size_t end = std::min(n_, next_apply_ + window_);
+  bool blocked = false;
+  // The other threads start kAhead indices past the next apply, the applying thread at
+  // the front: their traversals then touch other cache lines than the applies, and the
+  // applying thread applies clusters it traversed itself.
+  const size_t ahead =
+      applier ? scan_from_ : std::max(scan_from_, std::min(end, next_apply_ + kAhead));
+  for (size_t pass = 0; pass < 2; ++pass) {
+    const size_t from = pass == 0 ? ahead : scan_from_, to = pass == 0 ? end : ahead;
+    for (size_t j = from; j < to; ++j) {
+      if (state_[j] != Untraversed)
+        continue;
+      if (!applier && next_to_applying(order_[j])) {
+        blocked = true;
+        continue;
+      }
+      state_[j] = Traversing;
+      traversed_now_[order_[j]] = 1;
+      ++traversing_;
+      i = j;
+      return true;
+    }
+  }
+  if (!applier) {
+    // Blocked by the apply: the next apply frees it; a full window: some applies later.
+    const size_t want = next_apply_ + (blocked ? 1 : kWakeAfter);
+    wake_at_ = waiting_ == 0 ? want : std::min(wake_at_, want);
+  }
+  return false;
+}
+
+/// Under mutex_: index i has been traversed.
+void LevelSchedule::finish_traversal(size_t i) {
+  state_[i] = Traversed;
+  traversed_now_[order_[i]] = 0;
+  --traversing_;
+  if (main_waiting_)
+    main_wait_.notify_one();
+}
+
+void LevelSchedule::traverse_loop(unsigned thread) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  for (;;) {
+    if (stop_ || next_apply_ >= n_)
+      return;
+    size_t i;
+    if (take(i, false)) {
+      lock.unlock();
+      steps_->traverse(i, thread);
+      lock.lock();
+      finish_traversal(i);
+      continue;
+    }
+    ++waiting_;
+    wait_.wait(lock);
+    --waiting_;
+  }
+}
+
+void LevelSchedule::apply_loop() {
+  for (size_t a = 0; a < n_; ++a) {
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      for (;;) {
+        if (state_[a] == Traversed) {
+          // Reserve the apply first (no new traversal next to it, or none at all), then
+          // wait for the ones running to end, traversing meanwhile if there is work.
+          if (applying_ == kNoCluster)
+            applying_ = steps_->alone(a) ? kAll : order_[a];
+          if (applying_ == kAll ? traversing_ == 0 : !neighbour_traversing(order_[a]))
+            break;
+        }
+        size_t i;
+        if (applying_ != kAll && take(i, true)) {
+          lock.unlock();
+          steps_->traverse(i, 0);
+          lock.lock();
+          finish_traversal(i);
+          continue;
+        }
+        main_waiting_ = true;
+        main_wait_.wait(lock);
+        main_waiting_ = false;
+      }
+      if (steps_->prefetch && a + 1 < n_ && state_[a + 1] == Traversed)
+        steps_->prefetch(a + 1);
+    }
+    try {
+      steps_->apply(a);
+    } catch (...) {
+      // Stop the traversers, wait for the running ones, then put back the streams of the
+      // clusters traversed past a (the state they had before this level).
+      std::unique_lock<std::mutex> lock(mutex_);
+      stop_ = true;
+      applying_ = kNoCluster;
+      wait_.notify_all();
+      while (traversing_ > 0) {
+        main_waiting_ = true;
+        main_wait_.wait(lock);
+        main_waiting_ = false;
+      }
+      lock.unlock();
+      for (size_t j = a + 1; j < n_; ++j)
+        if (state_[j] == Traversed)
+          steps_->rewind(j);
+      throw;
+    }
+    const std::lock_guard<std::mutex> lock(mutex_);
+    state_[a] = Applied;
+    applying_ = kNoCluster;
+    next_apply_ = a + 1;
+    if (waiting_ > 0 && (next_apply_ >= wake_at_ || next_apply_ == n_))
+      wait_.notify_all();
+  }
+}
+
+} // namespace pomar
