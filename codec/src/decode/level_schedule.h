@@ -84,6 +84,7 @@ private:
   uint32_t applying_ = 0xFFFFFFFFu;
   size_t next_apply_ = 0;     // the index applied next
   size_t scan_from_ = 0;      // no untraversed index below it
+  size_t ahead_from_ = 0;     // nor in [next_apply_ + kAhead, ahead_from_) (other threads)
   size_t traversing_ = 0;     // traversals running
   bool stop_ = false;         // an apply threw: take no more
   size_t wake_at_ = 0;        // the waiting traversers want next_apply_ >= wake_at_
