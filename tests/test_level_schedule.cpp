@@ -7,7 +7,8 @@
 //     apply that must be alone;
 //   - no traversal starts more than `window` indices past the next apply;
 //   - an apply that throws: run() rethrows it, nothing after it is applied, and exactly the
-//     clusters traversed past it are rewound.
+//     clusters traversed past it are rewound; a traversal that throws: the same at its
+//     turn to be applied.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -111,7 +112,7 @@ struct ScheduleRun {
 };
 
 ScheduleRun run_schedule(Recorder &r, ThreadPool &pool, uint32_t seed, size_t throw_at,
-                         const std::vector<bool> &alone) {
+                         const std::vector<bool> &alone, size_t traverse_throws_at = kNone) {
   LevelSchedule schedule;
   std::vector<std::mt19937> rngs;
   for (unsigned t = 0; t < pool.size(); ++t)
@@ -133,6 +134,8 @@ ScheduleRun run_schedule(Recorder &r, ThreadPool &pool, uint32_t seed, size_t th
     --r.traversing[c];
     --r.running;
     r.traversed_done[i] = 1;
+    if (i == traverse_throws_at)
+      throw std::runtime_error("damaged block");
   };
   steps.alone = [&](size_t i) { return bool(alone[i]); };
   steps.apply = [&](size_t i) {
@@ -158,7 +161,7 @@ ScheduleRun run_schedule(Recorder &r, ThreadPool &pool, uint32_t seed, size_t th
     r.applied = i + 1;
   };
   steps.rewind = [&](size_t j) {
-    if (j <= throw_at)
+    if (j <= std::min(throw_at, traverse_throws_at))
       r.fail("rewind of index " + std::to_string(j) + ", not past the failed apply");
     ++out.rewound[j];
   };
@@ -223,6 +226,27 @@ TEST(LevelSchedule, AFailedApplyStopsTheLevelAndRewindsWhatWasTraversedPastIt) {
       // Rewound: exactly the indices past the failure that were traversed.
       EXPECT_EQ(run.rewound[j], j > throw_at ? traversed : 0) << where << ", index " << j;
     }
+    EXPECT_EQ(r.violations.load(), 0) << where << ": " << (r.messages.empty() ? "" : r.messages[0]);
+  }
+}
+
+TEST(LevelSchedule, AFailedTraversalFailsAtItsTurnToBeApplied) {
+  ThreadPool pool(2);
+  for (uint32_t seed = 1; seed <= 8; ++seed) {
+    std::mt19937 rng(seed + 200);
+    const ClusterGraph graph = random_graph(200, rng);
+    std::vector<uint32_t> order(200);
+    for (uint32_t c = 0; c < 200; ++c)
+      order[c] = c;
+    const size_t fails = rng() % 200;
+    Recorder r(graph, order, 1 + rng() % 50);
+    const ScheduleRun run =
+        run_schedule(r, pool, seed, kNone, std::vector<bool>(200, false), fails);
+    const std::string where = "seed " + std::to_string(seed);
+    EXPECT_TRUE(run.threw) << where;
+    EXPECT_EQ(run.applied, fails) << where; // the clusters before it, not it
+    for (size_t j = 0; j < order.size(); ++j)
+      EXPECT_EQ(run.rewound[j], j > fails ? r.traversals[j].load() : 0) << where << ", " << j;
     EXPECT_EQ(r.violations.load(), 0) << where << ": " << (r.messages.empty() ? "" : r.messages[0]);
   }
 }

@@ -11,6 +11,7 @@ constexpr uint32_t kNoCluster = 0xFFFFFFFFu;
 // A traverser that found the window full waits for this many applies (one wake-up per
 // cluster applied would cost more than the traversals it starts).
 constexpr size_t kWakeAfter = 32;
+// The other threads take clusters from this many past the next apply (see take()).
 constexpr size_t kAhead = 128;
 /// Lock `lock` (unlocked), spinning a little first: the critical sections here last well
 /// under a microsecond and both threads take the lock every few microseconds, so a
@@ -36,6 +37,7 @@ void LevelSchedule::run(ThreadPool &pool, const ClusterGraph &graph, const uint3
   n_ = n;
   window_ = std::max<size_t>(window, 1);
   state_.assign(n, Untraversed);
+  traverse_error_.assign(n, nullptr);
   const size_t clusters = graph.start.empty() ? 0 : graph.start.size() - 1;
   traversed_now_.assign(clusters, 0);
   applying_ = kNoCluster;
@@ -124,6 +126,16 @@ bool LevelSchedule::take(size_t &i, bool applier) {
   return false;
 }
 
+/// Traverse index i on `thread` (not under mutex_); what the traversal throws is kept for
+/// index i's turn to be applied.
+void LevelSchedule::traverse(size_t i, unsigned thread) {
+  try {
+    steps_->traverse(i, thread);
+  } catch (...) {
+    traverse_error_[i] = std::current_exception();
+  }
+}
+
 /// Under mutex_: index i has been traversed.
 void LevelSchedule::finish_traversal(size_t i) {
   state_[i] = Traversed;
@@ -142,7 +154,7 @@ void LevelSchedule::traverse_loop(unsigned thread) {
     size_t i;
     if (take(i, false)) {
       lock.unlock();
-      steps_->traverse(i, thread);
+      traverse(i, thread);
       spin_lock(lock);
       finish_traversal(i);
       continue;
@@ -173,7 +185,7 @@ void LevelSchedule::apply_loop() {
       size_t i;
       if (applying_ != kAll && take(i, true)) {
         lock.unlock();
-        steps_->traverse(i, 0);
+        traverse(i, 0);
         spin_lock(lock);
         finish_traversal(i);
         continue;
@@ -187,6 +199,8 @@ void LevelSchedule::apply_loop() {
     if (next_ready && steps_->prefetch)
       steps_->prefetch(a + 1);
     try {
+      if (traverse_error_[a])
+        std::rethrow_exception(traverse_error_[a]);
       steps_->apply(a);
     } catch (...) {
       // Stop the traversers, wait for the running ones, then put back the streams of the

@@ -28,6 +28,7 @@
 #include <condition_variable>
 #include <cstddef>
 #include <cstdint>
+#include <exception>
 #include <functional>
 #include <mutex>
 #include <vector>
@@ -40,14 +41,15 @@ namespace pomar {
 class LevelSchedule {
 public:
   struct Steps {
-    /// Traverse index i (order[i]) on `thread`; must not throw (keep the error for apply).
+    /// Traverse index i (order[i]) on `thread`. What it throws is thrown when index i's
+    /// turn to be applied comes, in place of apply(i).
     std::function<void(size_t i, unsigned thread)> traverse;
     /// Whether applying index i must run with no traversal at all (it grows the arrays).
     std::function<bool(size_t i)> alone;
     /// Apply index i (calling thread, increasing i); may throw.
     std::function<void(size_t i)> apply;
-    /// After apply(i) threw: index j > i was traversed and will not be applied (put its
-    /// stream back). Called once the other threads have stopped.
+    /// After apply(i) (or the traversal of i) threw: index j > i was traversed and will not
+    /// be applied (put its stream back). Called once the other threads have stopped.
     std::function<void(size_t j)> rewind;
     /// Optional: index i, traversed, is applied next after the current one (fetch what
     /// its apply reads first).
@@ -56,8 +58,9 @@ public:
 
   /// Decode the clusters order[0..n) of one level (increasing ids, `graph`'s clusters) on
   /// `pool`'s threads, traversing at most `window` indices ahead of the next apply (the
-  /// traversed clusters' splits wait in `window` slots: slot i % window). Rethrows what an
-  /// apply threw, after rewinding the clusters traversed past it.
+  /// traversed clusters' splits wait in `window` slots: slot i % window). Rethrows what the first
+  /// failing apply (or traversal, at its turn) threw, after rewinding the clusters
+  /// traversed past it.
   void run(ThreadPool &pool, const ClusterGraph &graph, const uint32_t *order, size_t n,
            size_t window, const Steps &steps);
 
@@ -70,6 +73,7 @@ private:
   bool take(size_t &i, bool applier);
   bool next_to_applying(uint32_t cluster) const;
   bool neighbour_traversing(uint32_t cluster) const;
+  void traverse(size_t i, unsigned thread);
   void finish_traversal(size_t i);
 
   // The level being run (under mutex_).
@@ -77,8 +81,9 @@ private:
   const uint32_t *order_ = nullptr;
   const Steps *steps_ = nullptr;
   size_t n_ = 0, window_ = 0;
-  std::vector<State> state_;           // by index
-  std::vector<uint8_t> traversed_now_; // by cluster id: a thread is traversing it
+  std::vector<State> state_;                       // by index
+  std::vector<std::exception_ptr> traverse_error_; // by index: what its traversal threw
+  std::vector<uint8_t> traversed_now_;             // by cluster id: a thread is traversing it
   // The cluster being applied, or reserved for the next apply (no traversal next to it
   // starts); kAll: no traversal at all; 0xFFFFFFFF: none.
   uint32_t applying_ = 0xFFFFFFFFu;
