@@ -203,65 +203,57 @@ TEST(LevelSchedule, TraversalsNeverMeetTheApplyAndAppliesStayInOrder) {
   }
 }
 
+std::vector<uint32_t> all_clusters(uint32_t n) {
+  std::vector<uint32_t> order(n);
+  for (uint32_t c = 0; c < n; ++c)
+    order[c] = c;
+  return order;
+}
+
+/// A level of `n` clusters whose apply (or traversal: `in_traversal`) of one index throws:
+/// run() rethrows, the indices before it are applied (each traversed once), not it nor any
+/// after it, and exactly the indices past it that were traversed are rewound.
+void expect_stops_at_the_failure(ThreadPool &pool, uint32_t seed, uint32_t n, bool in_traversal) {
+  std::mt19937 rng(seed);
+  const ClusterGraph graph = random_graph(n, rng);
+  const size_t fails = rng() % n, window = 1 + rng() % 80;
+  Recorder r(graph, all_clusters(n), window);
+  const ScheduleRun run = run_schedule(r, pool, seed, in_traversal ? kNone : fails,
+                                       std::vector<bool>(n, false), in_traversal ? fails : kNone);
+  const std::string where = "seed " + std::to_string(seed);
+  EXPECT_TRUE(run.threw) << where;
+  EXPECT_EQ(run.applied, fails) << where;
+  for (size_t j = 0; j < n; ++j) {
+    const int traversed = r.traversals[j].load();
+    EXPECT_LE(traversed, 1) << where << ", index " << j;
+    if (j <= fails) {
+      EXPECT_EQ(traversed, 1) << where << ", index " << j;
+    }
+    EXPECT_EQ(run.rewound[j], j > fails ? traversed : 0) << where << ", index " << j;
+  }
+  EXPECT_EQ(r.violations.load(), 0) << where << ": " << (r.messages.empty() ? "" : r.messages[0]);
+}
+
 TEST(LevelSchedule, AFailedApplyStopsTheLevelAndRewindsWhatWasTraversedPastIt) {
   ThreadPool pool(3);
-  for (uint32_t seed = 1; seed <= 12; ++seed) {
-    std::mt19937 rng(seed + 100);
-    const ClusterGraph graph = random_graph(300, rng);
-    std::vector<uint32_t> order(300);
-    for (uint32_t c = 0; c < 300; ++c)
-      order[c] = c;
-    const size_t throw_at = rng() % 300, window = 1 + rng() % 80;
-    Recorder r(graph, order, window);
-    const ScheduleRun run = run_schedule(r, pool, seed, throw_at, std::vector<bool>(300, false));
-    const std::string where = "seed " + std::to_string(seed);
-    EXPECT_TRUE(run.threw) << where;
-    EXPECT_EQ(run.applied, throw_at) << where;
-    for (size_t j = 0; j < order.size(); ++j) {
-      const int traversed = r.traversals[j].load();
-      EXPECT_LE(traversed, 1) << where << ", index " << j;
-      if (j <= throw_at) {
-        EXPECT_EQ(traversed, 1) << where << ", index " << j;
-      }
-      // Rewound: exactly the indices past the failure that were traversed.
-      EXPECT_EQ(run.rewound[j], j > throw_at ? traversed : 0) << where << ", index " << j;
-    }
-    EXPECT_EQ(r.violations.load(), 0) << where << ": " << (r.messages.empty() ? "" : r.messages[0]);
-  }
+  for (uint32_t seed = 101; seed <= 112; ++seed)
+    expect_stops_at_the_failure(pool, seed, 300, false);
 }
 
 TEST(LevelSchedule, AFailedTraversalFailsAtItsTurnToBeApplied) {
   ThreadPool pool(2);
-  for (uint32_t seed = 1; seed <= 8; ++seed) {
-    std::mt19937 rng(seed + 200);
-    const ClusterGraph graph = random_graph(200, rng);
-    std::vector<uint32_t> order(200);
-    for (uint32_t c = 0; c < 200; ++c)
-      order[c] = c;
-    const size_t fails = rng() % 200;
-    Recorder r(graph, order, 1 + rng() % 50);
-    const ScheduleRun run =
-        run_schedule(r, pool, seed, kNone, std::vector<bool>(200, false), fails);
-    const std::string where = "seed " + std::to_string(seed);
-    EXPECT_TRUE(run.threw) << where;
-    EXPECT_EQ(run.applied, fails) << where; // the clusters before it, not it
-    for (size_t j = 0; j < order.size(); ++j)
-      EXPECT_EQ(run.rewound[j], j > fails ? r.traversals[j].load() : 0) << where << ", " << j;
-    EXPECT_EQ(r.violations.load(), 0) << where << ": " << (r.messages.empty() ? "" : r.messages[0]);
-  }
+  for (uint32_t seed = 201; seed <= 208; ++seed)
+    expect_stops_at_the_failure(pool, seed, 200, true);
 }
 
 TEST(LevelSchedule, APoolOfOneThreadDoesEverythingOnTheCaller) {
   ThreadPool pool(1);
   std::mt19937 rng(7);
   const ClusterGraph graph = random_graph(50, rng);
-  std::vector<uint32_t> order(50);
-  for (uint32_t c = 0; c < 50; ++c)
-    order[c] = c;
-  Recorder r(graph, order, 4);
+  Recorder r(graph, all_clusters(50), 4);
   const ScheduleRun run = run_schedule(r, pool, 7, kNone, std::vector<bool>(50, true));
   EXPECT_EQ(run.applied, 50u);
-  for (size_t i = 0; i < order.size(); ++i)
+  for (size_t i = 0; i < 50; ++i)
     EXPECT_EQ(r.traversals[i].load(), 1);
   EXPECT_EQ(r.violations.load(), 0) << (r.messages.empty() ? "" : r.messages[0]);
 }
