@@ -276,6 +276,7 @@ private:
   std::string target_;
   TempFile tmp_;
   int fd_ = -1;
+  uint64_t written_ = 0; // bytes written so far
 };
 
 /// Writes a file atomically from pieces, through a 1 MiB buffer: put() / reserve() fill
