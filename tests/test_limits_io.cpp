@@ -108,6 +108,70 @@ TEST_F(SizeCheckTest, ObjEstimateFollowsTheReaderThatTakesTheFile) {
   }
 }
 
+TEST_F(SizeCheckTest, ObjNormalsPerCornerAddToTheEstimate) {
+  // One tetrahedron with a normal and a texture coordinate per vertex, and with one of each
+  // per corner (12 of each: the values the reader holds beyond its row).
+  const std::string v = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n";
+  std::string per_vertex = v, per_corner = v;
+  for (int i = 0; i < 4; ++i)
+    per_vertex += "vn 0 0 1\nvt 0 0\n";
+  for (int i = 0; i < 12; ++i)
+    per_corner += "vn 0 0 1\nvt 0 0\n";
+  const int tris[4][3] = {{1, 3, 2}, {1, 2, 4}, {2, 3, 4}, {3, 1, 4}};
+  for (int t = 0; t < 4; ++t) {
+    per_vertex += "f";
+    per_corner += "f";
+    for (int k = 0; k < 3; ++k) {
+      const std::string a = std::to_string(tris[t][k]), c = std::to_string(3 * t + k + 1);
+      per_vertex += " " + a + "/" + a + "/" + a;
+      per_corner += " " + a + "/" + c + "/" + c;
+    }
+    per_vertex += "\n";
+    per_corner += "\n";
+  }
+  uint64_t extra[2] = {0, 0}, lines[2] = {0, 0};
+  const std::string names[2] = {"per_vertex.obj", "per_corner.obj"};
+  const std::string texts[2] = {per_vertex, per_corner};
+  for (int i = 0; i < 2; ++i) {
+    LoadReport report;
+    load_mesh(write(names[i], texts[i]), &report, [&](uint64_t nv, uint64_t) {
+      EXPECT_EQ(encode_input(report), EncodeInput::ObjAttributes) << names[i];
+      lines[i] = report.obj_value_lines;
+      extra[i] = encode_input_extra(report, nv);
+    });
+  }
+  EXPECT_EQ(lines[0], 8u);
+  EXPECT_EQ(lines[1], 24u);
+  EXPECT_EQ(extra[0], 0u); // one of each per vertex: the row holds them
+  EXPECT_EQ(extra[1], (24u - 8u) * 32u);
+  // A limit at the row's estimate takes the per-vertex file and refuses the other.
+  const uint64_t limit = encode_memory_estimate(4, 4, EncodeInput::ObjAttributes);
+  for (int i = 0; i < 2; ++i) {
+    LoadReport report;
+    const auto load = [&] {
+      load_mesh(path(names[i]), &report, [&](uint64_t nv, uint64_t nf) {
+        check_encode_memory(nv, nf, limit, 0, 0, 1, encode_input(report),
+                            encode_input_extra(report, nv));
+      });
+    };
+    if (i == 0) {
+      EXPECT_NO_THROW(load());
+    } else {
+      try {
+        load();
+        ADD_FAILURE() << names[i] << " fits";
+      } catch (const Error &e) {
+        EXPECT_EQ(e.kind(), Error::Kind::MemoryLimit) << e.what();
+      }
+    }
+  }
+  // Other readers hold nothing beyond their rows.
+  LoadReport ply;
+  ply.format = "ply";
+  ply.obj_value_lines = 1000;
+  EXPECT_EQ(encode_input_extra(ply, 4), 0u);
+}
+
 TEST_F(SizeCheckTest, PolygonsAreCheckedAgainWithTheirTriangles) {
   const std::string ply =
       write("quads.ply", "ply\nformat ascii 1.0\nelement vertex 5\n"

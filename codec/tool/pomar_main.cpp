@@ -157,7 +157,8 @@ int run_encode(const EncodeArgs &a) {
   // Refused as soon as the file's header tells the mesh size, before it is read, with the
   // estimate for the file's format (its reader's own peak).
   pomar::Mesh mesh = pomar::load_mesh(a.in, &load, [&](uint64_t v, uint64_t f) {
-    pomar::check_encode_memory(v, f, memory_limit, 0, 0, 1, pomar::encode_input(load));
+    pomar::check_encode_memory(v, f, memory_limit, 0, 0, 1, pomar::encode_input(load),
+                               pomar::encode_input_extra(load, v));
   });
   if (!a.quiet)
     warn_dropped(a.in, load.ignored_attributes, "has",
@@ -666,7 +667,8 @@ bool verify_attributes(const pomar::Mesh &ref, const pomar::Mesh &out, const pom
                        const pomar::AttributeMask &keep) {
   std::map<Point, std::vector<uint32_t>> at;
   for (uint32_t v = 0; v < ref.vertex_count(); ++v)
-    at[Point{ref.positions[3 * v], ref.positions[3 * v + 1], ref.positions[3 * v + 2]}].push_back(v);
+    at[Point{ref.positions[3 * v], ref.positions[3 * v + 1], ref.positions[3 * v + 2]}].push_back(
+        v);
   bool ok = true;
   for (const pomar::VertexAttribute &a : ref.attributes) {
     if (!keep.keeps(a.kind))
@@ -687,8 +689,8 @@ bool verify_attributes(const pomar::Mesh &ref, const pomar::Mesh &out, const pom
     const bool exact = stored->bits == 0;
     double worst = 0;
     for (uint32_t v = 0; v < out.vertex_count(); ++v) {
-      const auto it = at.find(Point{out.positions[3 * v], out.positions[3 * v + 1],
-                                    out.positions[3 * v + 2]});
+      const auto it =
+          at.find(Point{out.positions[3 * v], out.positions[3 * v + 1], out.positions[3 * v + 2]});
       if (it == at.end())
         continue; // the geometry check reports it
       double best = HUGE_VAL;
@@ -739,7 +741,8 @@ int run_verify(const std::string &original, const std::string &file, const std::
   }
   // STL stores triangles only (no vertex shared or unused): the triangles are compared.
   std::string ext = decoded.size() >= 4 ? decoded.substr(decoded.size() - 4) : "";
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
   const bool triangles_only = ext == ".stl";
   const bool same = triangle_multiset(ref) == triangle_multiset(out) &&
                     (triangles_only || (ref.vertex_count() == out.vertex_count() &&

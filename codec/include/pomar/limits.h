@@ -45,6 +45,13 @@ enum class EncodeInput {
 /// `obj_attributes`; EncodeInput::Mesh for any other format name.
 EncodeInput encode_input(const LoadReport &report);
 
+/// What reading the file of `report` (with `vertices` vertices) holds beyond its
+/// EncodeInput's estimate: for an OBJ read by tinyobjloader, 32 bytes per normal or texture
+/// coordinate line past one of each per vertex (the values and their text: a file with one
+/// of each per corner, 3 of each per face, peaks 1.3 times the row without this). 0 for the
+/// other readers.
+uint64_t encode_input_extra(const LoadReport &report, uint64_t vertices);
+
 /// Peak resident memory of loading a mesh file and encoding it (`pomar encode`), for a mesh
 /// of this many vertices and faces read from `input`. Conservative: 10-25% above the
 /// measured peaks.
@@ -98,13 +105,14 @@ std::string format_memory_size(uint64_t bytes);
 void check_memory(const char *action, uint64_t vertices, uint64_t faces, uint64_t needed,
                   uint64_t held, uint64_t limit);
 
-/// check_memory with encode_memory_estimate for `input` plus `attribute_bytes` per vertex
+/// check_memory with encode_memory_estimate for `input` plus `input_extra` bytes
+/// (encode_input_extra), plus `attribute_bytes` per vertex
 /// (encode_attribute_bytes_per_vertex), plus decode_thread_memory per thread past the first
 /// recording the clustered levels (`threads`: EncodeOptions::threads resolved and capped
 /// like the decoder's, decode_threads) (action "encode").
 void check_encode_memory(uint64_t vertices, uint64_t faces, uint64_t limit, uint64_t held = 0,
                          uint64_t attribute_bytes = 0, unsigned threads = 1,
-                         EncodeInput input = EncodeInput::Mesh);
+                         EncodeInput input = EncodeInput::Mesh, uint64_t input_extra = 0);
 
 /// What each decoding thread past the first adds to decode_memory_estimate for a clustered
 /// file (and each encoding thread to encode_memory_estimate): its traversal marks, pending

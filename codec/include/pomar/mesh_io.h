@@ -42,6 +42,9 @@ struct LoadReport {
   /// OBJ read by tinyobjloader, set before the size check: the file has normals, texture
   /// coordinates or vertex colours, whose lines and per-corner indices it holds too.
   bool obj_attributes = false;
+  /// OBJ read by tinyobjloader, set before the size check: its 'vn' and 'vt' lines (one
+  /// normal and one texture coordinate per corner: 3 of each per face).
+  size_t obj_value_lines = 0;
   size_t file_vertices = 0;         ///< vertices stored in the file (STL: 3 per facet)
   size_t file_faces = 0;            ///< faces/polygons in the file (PLY tristrips: triangles)
   size_t unreferenced_vertices = 0; ///< vertices no face uses (kept: pomar::encode stores them)
@@ -58,12 +61,13 @@ struct LoadReport {
 /// (after a line scan, before tinyobjloader; a plain OBJ once pomar's reader has read it,
 /// its flat arrays being smaller than the text already held), ASCII STL facets (counted in
 /// the text before it is parsed). STL passes half a vertex per facet (what a closed mesh
-/// keeps once identical corners are welded). LoadReport::format, text, plain_obj and
-/// obj_attributes are set when it is called, so that the check can allow for the reader
-/// that takes the file. It may throw pomar::Error to refuse the file (load_mesh prefixes
-/// the path), e.g. for a memory limit:
+/// keeps once identical corners are welded). LoadReport::format, text, plain_obj,
+/// obj_attributes and obj_value_lines are set when it is called, so that the check can
+/// allow for the reader that takes the file. It may throw pomar::Error to refuse the file
+/// (load_mesh prefixes the path), e.g. for a memory limit:
 ///   [&](uint64_t v, uint64_t f) {
-///     pomar::check_encode_memory(v, f, limit, 0, 0, 1, pomar::encode_input(report));
+///     pomar::check_encode_memory(v, f, limit, 0, 0, 1, pomar::encode_input(report),
+///                                pomar::encode_input_extra(report, v));
 ///   }
 using SizeCheck = std::function<void(uint64_t vertices, uint64_t faces)>;
 

@@ -25,6 +25,7 @@ struct ObjScan {
   size_t vertices = 0, faces = 0, triangles = 0, polygons = 0;
   bool normals = false, texcoords = false, colors = false;
   bool mtllib = false, usemtl = false;
+  size_t value_lines = 0; // 'vn' and 'vt' lines
 };
 
 /// Splits at spaces and tabs (tinyobjloader's separators within a line).
@@ -91,11 +92,13 @@ ObjScan scan_obj(const std::vector<uint8_t> &bytes, const std::string &path) {
       scan_obj_vertex(tok, s, line, path);
     else if (key == "f")
       scan_obj_face(tok, s, line, path);
-    else if (key == "vn")
+    else if (key == "vn") {
       s.normals = true;
-    else if (key == "vt")
+      ++s.value_lines;
+    } else if (key == "vt") {
       s.texcoords = true;
-    else if (key == "mtllib")
+      ++s.value_lines;
+    } else if (key == "mtllib")
       s.mtllib = true;
     else if (key == "usemtl")
       s.usemtl = true;
@@ -440,6 +443,7 @@ Mesh load_obj(const std::string &path, LoadReport &report, const SizeCheck &chec
     return fast;
   const ObjScan scan = scan_obj(bytes, path);
   report.obj_attributes = scan.normals || scan.texcoords || scan.colors; // for the check
+  report.obj_value_lines = scan.value_lines;
   run_size_check(check, path, scan.vertices, scan.triangles);
 
   MemoryBuffer buffer(bytes.data(), bytes.size());

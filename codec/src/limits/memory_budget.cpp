@@ -67,12 +67,20 @@ namespace {
 //     + 32 B/vertex + 330 B/face, 0.84-0.88 of it (the row above was 1.02-1.18 times too
 //     low for them). Normals only ("f a//a"), colours only, one normal per face (flat
 //     shading: twice as many normals as vertices): 0.67-0.85 of it. Files with still more
-//     values (one per corner) hold more than this.
+//     values (one per corner) hold more than this: encode_input_extra (kObjValueLine).
 // STL's size check sees half a vertex per facet (a closed mesh once welded). For an open
 // STL mesh (the strips: one vertex per facet) it is too low for the whole encode (binary and
 // ASCII STL strips peak at 1.28-1.34 times it) but not for the reading (0.76-0.79); the
 // encoder's own check, with the welded counts (EncodeInput::Mesh), comes before its
 // allocations and holds them (0.80-0.83).
+// OBJ with more normals and texture coordinates than one of each per vertex (one of each
+// per corner: 3 'vn' and 3 'vt' lines per face, "f a/ta/na ..."; all of them left out of the
+// .pomar, which keeps per-vertex values) holds them beyond the ObjAttributes row: tori of
+// 100k, 300k and 1M vertices (F = 2V) peaked 93.5, 281.6 and 893.1 MiB against the row's
+// 81.9, 214.2 and 675.9 (1.14-1.32 times); 12-24 bytes per line past 2 per vertex. With 32
+// bytes per such line (encode_input_extra) the peaks are 0.83-0.92 of the estimate.
+constexpr uint64_t kObjValueLine = 32;
+
 struct Fit {
   uint64_t fixed, per_vertex, per_face;
 };
@@ -291,6 +299,15 @@ EncodeInput encode_input(const LoadReport &report) {
   return EncodeInput::Mesh;
 }
 
+uint64_t encode_input_extra(const LoadReport &report, uint64_t vertices) {
+  if (encode_input(report) != EncodeInput::ObjAttributes)
+    return 0;
+  const uint64_t counted = add_mul(0, vertices, 2); // one normal and one UV per vertex
+  return report.obj_value_lines > counted
+             ? add_mul(0, report.obj_value_lines - counted, kObjValueLine)
+             : 0;
+}
+
 uint64_t encode_memory_estimate(uint64_t vertices, uint64_t faces, EncodeInput input) {
   const Fit fit = encode_fit(input);
   return add_mul(add_mul(fit.fixed, vertices, fit.per_vertex), faces, fit.per_face);
@@ -412,9 +429,10 @@ void check_memory(const char *action, uint64_t vertices, uint64_t faces, uint64_
 }
 
 void check_encode_memory(uint64_t vertices, uint64_t faces, uint64_t limit, uint64_t held,
-                         uint64_t attribute_bytes, unsigned threads, EncodeInput input) {
-  uint64_t needed =
-      add_mul(encode_memory_estimate(vertices, faces, input), vertices, attribute_bytes);
+                         uint64_t attribute_bytes, unsigned threads, EncodeInput input,
+                         uint64_t input_extra) {
+  uint64_t needed = add_mul(add_mul(encode_memory_estimate(vertices, faces, input), 1, input_extra),
+                            vertices, attribute_bytes);
   if (threads > 1)
     needed = add_mul(needed, threads - 1, decode_thread_memory(vertices, faces));
   check_memory("encode", vertices, faces, needed, held, limit);
