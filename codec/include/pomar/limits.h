@@ -115,8 +115,9 @@ void check_encode_memory(uint64_t vertices, uint64_t faces, uint64_t limit, uint
                          EncodeInput input = EncodeInput::Mesh, uint64_t input_extra = 0);
 
 /// What each decoding thread past the first adds to decode_memory_estimate for a clustered
-/// file (and each encoding thread to encode_memory_estimate): its traversal marks, pending
-/// splits and allocator arena, 2 MiB + 16 bytes per vertex + 4 per face.
+/// file (and each encoding thread to encode_memory_estimate): its claim stamps, the
+/// traversed clusters waiting to be applied and its allocator arena, 6 MiB + 5 bytes per
+/// face (`vertices` is not used any more).
 uint64_t decode_thread_memory(uint64_t vertices, uint64_t faces);
 
 /// check_memory with decode_memory_estimate for the mesh of `level` (-1 = full resolution)

@@ -327,7 +327,7 @@ struct DecodeOptions {
   AttributeMask attributes;
   /// Threads for the clustered levels of a random-access file (their clusters are decoded
   /// in parallel); 0 = the cores this process may run on; at most 8 (each further one holds
-  /// about 16 bytes per vertex: pomar/limits.h decode_thread_memory). The mesh does not
+  /// about 5 bytes per face: pomar/limits.h decode_thread_memory). The mesh does not
   /// depend on it.
   /// Global levels, and so pure progressive files, are decoded on one thread.
   unsigned threads = 0;

@@ -33,14 +33,17 @@ namespace {
 // PLY, measured at 100k, 300k and 1M vertices): least-squares
 // 5.0 MiB + 45 B/vertex + 31 B/face (random access), 5.4 MiB + 56 B/vertex + 29 B/face
 // (progressive), rounded up so that every peak of 300k vertices and more is 17-21% below
-// the estimate. Each further decoding thread: 13.6-28 B/vertex measured (small meshes:
-// the thread's allocator arena), estimated at 2 MiB + 16 B/vertex + 4 B/face. Checked
+// the estimate. Each further decoding thread: 13.6-28 B/vertex measured then (small meshes:
+// the thread's allocator arena), estimated at 2 MiB + 16 B/vertex + 4 B/face (refitted in
+// the sixth session to 6 MiB + 5 B/face: kThreadFixed below). Checked
 // again in the fifth session (2026-12-02, two threads, every output format: binary and
 // ASCII PLY, OBJ, OFF, binary and ASCII STL, at 300k and 1M vertices): spheres and tori
 // with attributes 0.76-0.85 of the estimates, but an open strip (F = V, 1M vertices, 24,614
 // clusters) 0.91 on one thread and 0.94 on two (its second thread: 24 B/vertex): random
-// access raised from 52 to 56 B/vertex (0.87 and 0.91; the thread's part is kept, since
-// the encoder's check adds it too and the encode rows already cover a second thread).
+// access raised from 52 to 56 B/vertex (0.87 and 0.91; the thread's part was kept, since
+// the encoder's check adds it too and the encode rows already cover a second thread). Sixth
+// session, with the per-thread part refitted: 1M strips (F = V) 0.71-0.73 of the estimate
+// on one thread and on two, the 1M sphere 0.76 and 0.76.
 //
 // Encode, per input format (EncodeInput; measured 2026-12-02 in the fourth session, again
 // in the fifth after the faster readers, two encoding threads): peaks of `pomar encode` on
@@ -105,9 +108,19 @@ constexpr uint64_t kClusteredDecodePerVertex = 56;
 constexpr uint64_t kClusteredDecodePerFace = 36;
 constexpr uint64_t kProgressiveDecodePerVertex = 64;
 constexpr uint64_t kProgressiveDecodePerFace = 34;
-constexpr uint64_t kThreadFixed = 2ull << 20;
-constexpr uint64_t kThreadPerVertex = 16;
-constexpr uint64_t kThreadPerFace = 4;
+// Each thread past the first that walks the clustered levels: its claim stamps (4 bytes per
+// face), the pipeline's traversed clusters and its allocator arena. Measured in the sixth
+// session (decode --threads 1, 2 and 8, GNU time %M, the larger of 2-3 runs): the average
+// of the 7 extra threads of an 8-thread decode is 4.3-5.2 bytes per face (bunny 0.37 MiB,
+// noisy spheres 300k 2.76, 1M 8.14, 2M 15.86, dragon 3.98, 1M strips 4.28-5.03 MiB), the
+// first extra thread 2-4 MiB more (bunny 0.75, 300k 5.13, 1M 10.95, 2M 18.89, 10M 78.7,
+// dragon 7.20, strips 6.66-8.46 MiB; the encoder's at 1M 11.4). 6 MiB + 5 bytes per face:
+// the first extra thread 0.71-0.88 of it from 300k faces up. There is no per-vertex term
+// any more: the marks by vertex id are the global levels', on the calling thread only,
+// since a cluster keeps its marks by rank (fifth session); the 16 bytes per vertex it had
+// made the 1M sphere's extra thread 3 times its measure.
+constexpr uint64_t kThreadFixed = 6ull << 20;
+constexpr uint64_t kThreadPerFace = 5;
 
 // Per-vertex attributes (bench/README.md, "Memory", attributes): encoding, what tori (F =
 // 2V, binary PLY) with colour, normal, quality and UV (8 codes), colour (3) or quality (1)
@@ -439,7 +452,9 @@ void check_encode_memory(uint64_t vertices, uint64_t faces, uint64_t limit, uint
 }
 
 uint64_t decode_thread_memory(uint64_t vertices, uint64_t faces) {
-  return add_mul(add_mul(kThreadFixed, vertices, kThreadPerVertex), faces, kThreadPerFace);
+  (void)vertices; // (kept in the signature: the thread's cost was per vertex too until
+                  // the clusters' marks by rank)
+  return add_mul(kThreadFixed, faces, kThreadPerFace);
 }
 
 void check_decode_memory(const FileInfo &info, int level, uint64_t limit, const AttributeMask &keep,

@@ -23,9 +23,8 @@ unsigned available_cores();
 unsigned resolve_threads(unsigned threads);
 
 /// The decoder's threads for DecodeOptions/SelectiveOptions::threads: resolve_threads, at
-/// most kMaxDecodeThreads (each thread holds claim stamps of 4 bytes per face, and marks
-/// of 8 bytes per vertex of the global levels, pomar/limits.h decode_thread_memory; and
-/// applying the splits stays sequential).
+/// most kMaxDecodeThreads (each thread holds claim stamps of 4 bytes per face,
+/// pomar/limits.h decode_thread_memory; and applying the splits stays on one thread).
 constexpr unsigned kMaxDecodeThreads = 8;
 unsigned decode_threads(unsigned threads);
 
