@@ -84,26 +84,17 @@ bool LevelSchedule::neighbour_traversing(uint32_t cluster) const {
   return false;
 }
 
-/// Under mutex_: take the lowest untraversed index of the window that may be traversed
-/// now (`applier`: the calling thread, which is not applying: any). Sets wake_at_ for a
-/// traverser that finds none.
+/// Under mutex_: take an untraversed index of the window that may be traversed now. The
+/// applying thread (`applier`, not applying now: any index) takes the lowest; the other
+/// threads the lowest from kAhead past the next apply, else the lowest below that: their
+/// traversals then read other cache lines than the applies write, and the applying thread
+/// applies the clusters it traversed itself. Sets wake_at_ for a thread that finds none.
 bool LevelSchedule::take(size_t &i, bool applier) {
   while (scan_from_ < n_ && state_[scan_from_] != Untraversed)
     ++scan_from_;
   const size_t end = std::min(n_, next_apply_ + window_);
   bool blocked = false;
-  // The other threads start kAhead indices past the next apply, the applying thread at
-  // the front: their traversals then touch other cache lines than the applies, and the
-  // applying thread applies clusters it traversed itself.
-  // (ahead_from_ only moves forward, past indices taken already: the scan stays short.)
-  const size_t ahead =
-      applier ? scan_from_ : std::max(scan_from_, std::min(end, next_apply_ + kAhead));
-  ahead_from_ = std::max(ahead_from_, ahead);
-  while (ahead_from_ < end && state_[ahead_from_] != Untraversed)
-    ++ahead_from_;
-  for (size_t pass = 0; pass < 2; ++pass) {
-    const size_t from = pass == 0 ? (applier ? ahead : ahead_from_) : scan_from_;
-    const size_t to = pass == 0 ? end : ahead;
+  const auto take_in = [&](size_t from, size_t to) {
     for (size_t j = from; j < to; ++j) {
       if (state_[j] != Untraversed)
         continue;
@@ -117,12 +108,20 @@ bool LevelSchedule::take(size_t &i, bool applier) {
       i = j;
       return true;
     }
-  }
-  if (!applier) {
-    // Blocked by the apply: the next apply frees it; a full window: some applies later.
-    const size_t want = next_apply_ + (blocked ? 1 : kWakeAfter);
-    wake_at_ = waiting_ == 0 ? want : std::min(wake_at_, want);
-  }
+    return false;
+  };
+  if (applier)
+    return take_in(scan_from_, end);
+  // (ahead_from_ only moves forward, past indices taken already: the scan stays short.)
+  const size_t ahead = std::max(scan_from_, std::min(end, next_apply_ + kAhead));
+  ahead_from_ = std::max(ahead_from_, ahead);
+  while (ahead_from_ < end && state_[ahead_from_] != Untraversed)
+    ++ahead_from_;
+  if (take_in(ahead_from_, end) || take_in(scan_from_, ahead))
+    return true;
+  // Blocked by the apply: the next apply frees it; a full window: some applies later.
+  const size_t want = next_apply_ + (blocked ? 1 : kWakeAfter);
+  wake_at_ = waiting_ == 0 ? want : std::min(wake_at_, want);
   return false;
 }
 

@@ -451,9 +451,8 @@ void check_encode_memory(uint64_t vertices, uint64_t faces, uint64_t limit, uint
   check_memory("encode", vertices, faces, needed, held, limit);
 }
 
-uint64_t decode_thread_memory(uint64_t vertices, uint64_t faces) {
-  (void)vertices; // (kept in the signature: the thread's cost was per vertex too until
-                  // the clusters' marks by rank)
+uint64_t decode_thread_memory(uint64_t /*vertices: no per-vertex part since the sixth session*/,
+                              uint64_t faces) {
   return add_mul(kThreadFixed, faces, kThreadPerFace);
 }
 
