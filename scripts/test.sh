@@ -45,15 +45,21 @@ fi
 # -O1 -g1 (ASan's recommended level; line tables give file:line in reports) compiles in about half the
 # time of RelWithDebInfo's -O2 -g, and without -DNDEBUG the assert()s stay on as in the pass above.
 # Any sanitizer report aborts the process, which fails its test. POMAR_TEST_SANITIZE=0 skips the pass.
+# configure_sanitized DIR OPTION...: the tests in DIR at -O1 -g1, assertions on, no benchmarks,
+# with the sanitizer OPTIONs (this pass and the ThreadSanitizer one below).
+configure_sanitized() {
+  local dir="$1"
+  shift
+  cmake -S . -B "$dir" -G Ninja \
+    -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
+    -DPOMAR_BUILD_TESTS=ON \
+    -DPOMAR_BUILD_BENCH=OFF "$@"
+}
 if [ "${POMAR_TEST_SANITIZE:-1}" != 0 ]; then
   ASAN_BUILD=build-asan
   echo "test: configuring $ASAN_BUILD (ASan + UBSan, -O1, assertions on)"
-  cmake -S . -B "$ASAN_BUILD" -G Ninja \
-    -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
-    -DPOMAR_SANITIZE=ON \
-    -DPOMAR_BUILD_TESTS=ON \
-    -DPOMAR_BUILD_BENCH=OFF
+  configure_sanitized "$ASAN_BUILD" -DPOMAR_SANITIZE=ON
   echo "test: building $ASAN_BUILD"
   cmake --build "$ASAN_BUILD" -j "$JOBS"
 
@@ -73,13 +79,7 @@ fi
 if [ "${POMAR_TEST_TSAN:-1}" != 0 ]; then
   TSAN_BUILD=build-tsan
   echo "test: configuring $TSAN_BUILD (ThreadSanitizer, -O1)"
-  cmake -S . -B "$TSAN_BUILD" -G Ninja \
-    -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
-    -DCMAKE_CXX_FLAGS="-fsanitize=thread" \
-    -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=thread" \
-    -DPOMAR_BUILD_TESTS=ON -DPOMAR_BUILD_BENCH=OFF \
-    -DPOMAR_BUILD_MESHLAB_PLUGINS=OFF -DPOMAR_BUILD_PYTHON=OFF
+  configure_sanitized "$TSAN_BUILD" -DPOMAR_SANITIZE_THREAD=ON -DPOMAR_BUILD_MESHLAB_PLUGINS=OFF
   echo "test: building $TSAN_BUILD (pomar_tests)"
   cmake --build "$TSAN_BUILD" -j "$JOBS" --target pomar_tests
   echo "test: running the threaded tests under ThreadSanitizer"

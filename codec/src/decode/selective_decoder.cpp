@@ -82,7 +82,6 @@ struct SelectiveDecoder::State {
   void decode_cluster_level(uint32_t c, int level, uint32_t older_than);
   void decode_level_parallel(const std::vector<uint32_t> &refine, int level, uint32_t older_than,
                              const std::function<void()> &applied, uint32_t &decoding);
-  bool apply_grows(const TraversedCluster &t) const;
   LevelSchedule schedule;
   DecoderCodec cluster_codec(uint32_t c, int level);
   void decode_target(const Progress &progress, uint32_t &decoding);
@@ -141,20 +140,6 @@ void SelectiveDecoder::State::decode_cluster_level(uint32_t c, int level, uint32
   k.level = level;
 }
 
-/// Whether applying `t` grows a mesh array past its capacity (it would move: no traversal
-/// may run then).
-bool SelectiveDecoder::State::apply_grows(const TraversedCluster &t) const {
-  uint64_t faces = mesh.ct.face_count();
-  for (const PendingSplit &ps : t.splits.split)
-    faces += uint64_t(ps.op.has_l) + uint64_t(ps.op.has_r);
-  const uint64_t vertices = uint64_t(mesh.vertex_count()) + t.splits.size();
-  const CornerTable &ct = mesh.ct;
-  return 3 * faces > ct.V.capacity() || 3 * faces > ct.O.capacity() ||
-         vertices > ct.VC.capacity() || 3 * vertices > mesh.q.capacity() ||
-         mesh.attr_codes * vertices > mesh.attr.capacity() || vertices > mesh.lineage.capacity() ||
-         faces > mesh.face_claim.capacity();
-}
-
 /// The data of `level` of the clusters `refine` (increasing), on the pool's threads:
 /// traversed ahead on every thread, applied in order on this one (decode/level_schedule.h).
 /// Throws what decode_cluster_level would throw for the first cluster that fails
@@ -189,7 +174,10 @@ void SelectiveDecoder::State::decode_level_parallel(const std::vector<uint32_t> 
       out.error = std::current_exception();
     }
   };
-  work.alone = [&](size_t i) { return apply_grows(traversed[i % window]); };
+  work.alone = [&](size_t i) { // (applying it would move the arrays)
+    const StepCounts &adds = traversed[i % window].adds;
+    return !mesh.has_room(mesh.vertex_count() + adds.vertices, mesh.ct.face_count() + adds.faces);
+  };
   work.apply = [&](size_t i) {
     const uint32_t c = refine[i];
     Cluster &k = clusters[c];

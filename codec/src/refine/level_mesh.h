@@ -66,6 +66,13 @@ struct LevelMesh {
     lineage.reserve(vertices);
     face_claim.reserve(faces);
   }
+  /// Whether the arrays hold these counts without moving (within reserve_counts' room).
+  bool has_room(uint64_t vertices, uint64_t faces) const {
+    return 3 * faces <= ct.V.capacity() && 3 * faces <= ct.O.capacity() &&
+           vertices <= ct.VC.capacity() && 3 * vertices <= q.capacity() &&
+           attr_codes * vertices <= attr.capacity() && vertices <= lineage.capacity() &&
+           faces <= face_claim.capacity();
+  }
   /// Make the current mesh the base clustered mesh (paper section 5.2): each vertex
   /// roots the cluster with its id; vertices created later inherit their v_to's cluster.
   void root_clusters() {

@@ -57,6 +57,7 @@ struct NoCheck {
 struct alignas(64) TraversedCluster {
   SplitList splits;
   std::vector<uint32_t> claims; // the faces its patches hold, in claim order
+  StepCounts adds;              // the vertices and faces its splits add
   std::exception_ptr error;     // what its traversal or check threw (nothing to apply)
 };
 
@@ -96,11 +97,12 @@ public:
     const LevelView view{where.level, where.older_than};
     scratch_.defer_claims = true;
     out.error = nullptr;
+    out.adds = {};
     // (The face ids it meets are below the corner table's capacity, which only changes
     // while no traversal runs.)
     const uint32_t face_room = static_cast<uint32_t>(mesh.ct.V.capacity() / 3);
     try {
-      traverse_and_check(mesh, where.level, false, StepCounts{}, face_room, check, [&] {
+      out.adds = traverse_and_check(mesh, where.level, false, StepCounts{}, face_room, check, [&] {
         traverse_cluster(mesh, codec, scratch_, where.cluster, view, splits_);
       });
     } catch (...) {
@@ -145,12 +147,12 @@ private:
     return {mesh.vertex_count(), mesh.ct.face_count()};
   }
 
-  /// (`by_id`: a global level, whose traversal marks vertices by id,
-  /// TraversalScratch::begin; `now`: the counts the check adds the splits to; face ids
-  /// met are below `face_room`.)
+  /// Returns the counts checked. (`by_id`: a global level, whose traversal marks vertices
+  /// by id, TraversalScratch::begin; `now`: the counts the check adds the splits to; face
+  /// ids met are below `face_room`.)
   template <class Check, class Traverse>
-  void traverse_and_check(LevelMesh &mesh, uint32_t level, bool by_id, StepCounts now,
-                          uint32_t face_room, const Check &check, const Traverse &traverse) {
+  StepCounts traverse_and_check(LevelMesh &mesh, uint32_t level, bool by_id, StepCounts now,
+                                uint32_t face_room, const Check &check, const Traverse &traverse) {
     scratch_.begin(by_id ? mesh.vertex_count() : 0, face_room);
     splits_.clear();
     try {
@@ -159,6 +161,7 @@ private:
       for (const PendingSplit &ps : splits_.split)
         n.faces += uint64_t(ps.op.has_l) + uint64_t(ps.op.has_r);
       check(n);
+      return n;
     } catch (...) {
       release_claims(mesh, level);
       throw;
