@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "memory/prefault.h"
+
 namespace pomar {
 
 double Quantizer::step() const {
@@ -56,7 +58,10 @@ std::vector<int32_t> quantize(const Quantizer &g, const float *p, size_t n) {
 
 std::vector<float> dequantize(const Quantizer &g, const std::vector<int32_t> &q) {
   // Quantizer::dequantize for every coordinate, the step computed once (same floats).
-  std::vector<float> p(q.size());
+  std::vector<float> p;
+  p.reserve(q.size());
+  prefault_room(p); // (written whole: mapped first, in one call)
+  p.resize(q.size());
   const double step = g.step();
   const double origin[3] = {g.origin[0], g.origin[1], g.origin[2]};
   for (size_t i = 0; i < q.size(); ++i)

@@ -1,5 +1,6 @@
 // Shared helpers of the mesh readers and writers (declared in io_common.h).
 #include "io/io_common.h"
+#include "memory/prefault.h"
 
 #include <wrap/io_trimesh/io_mask.h>
 
@@ -219,6 +220,13 @@ void AtomicFile::commit() {
   if (::close(fd) != 0)
     fail_io(target_, "cannot write (close): " + errno_text(errno));
   tmp_.commit(false);
+}
+
+ChunkedFileWriter::ChunkedFileWriter(const std::string &target) : file_(target) {
+  constexpr size_t kChunk = size_t(1) << 20;
+  buf_.reserve(kChunk);
+  prefault_room(buf_); // (written whole: mapped first, in one call)
+  buf_.resize(kChunk);
 }
 
 void ChunkedFileWriter::flush() {

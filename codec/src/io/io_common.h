@@ -284,7 +284,7 @@ private:
 /// without commit(), it removes the temporary file.
 class ChunkedFileWriter {
 public:
-  explicit ChunkedFileWriter(const std::string &target) : file_(target), buf_(size_t(1) << 20) {}
+  explicit ChunkedFileWriter(const std::string &target);
   void put(const void *data, size_t size);
   /// Room for `size` (<= 4096) bytes at the end of the buffer, which the caller fills.
   char *reserve(size_t size) {

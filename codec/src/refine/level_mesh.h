@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "memory/prefault.h"
 #include "mesh/corner_table.h"
 
 namespace pomar {
@@ -65,6 +66,18 @@ struct LevelMesh {
     attr.reserve(attr_codes * vertices);
     lineage.reserve(vertices);
     face_claim.reserve(faces);
+    for_each_array([](auto &a) { prefault_ahead_start(a); });
+  }
+  /// Grow the arrays to these counts, the new entries zero for the caller to write (the
+  /// splits of a step: refine/level_step.h), keeping the room ahead of each end mapped.
+  void grow(uint64_t vertices, uint64_t faces) {
+    grow_array(ct.V, 3 * faces);
+    grow_array(ct.O, 3 * faces);
+    grow_array(ct.VC, vertices);
+    grow_array(q, 3 * vertices);
+    grow_array(attr, attr_codes * vertices);
+    grow_array(lineage, vertices);
+    grow_array(face_claim, faces);
   }
   /// Whether the arrays hold these counts without moving (within reserve_counts' room).
   bool has_room(uint64_t vertices, uint64_t faces) const {
@@ -72,6 +85,15 @@ struct LevelMesh {
            vertices <= ct.VC.capacity() && 3 * vertices <= q.capacity() &&
            attr_codes * vertices <= attr.capacity() && vertices <= lineage.capacity() &&
            faces <= face_claim.capacity();
+  }
+  /// Call f on each array reserve_counts and grow size.
+  template <class F> void for_each_array(const F &f) {
+    f(ct.V), f(ct.O), f(ct.VC), f(q), f(attr), f(lineage), f(face_claim);
+  }
+  template <class T> static void grow_array(std::vector<T> &a, uint64_t n) {
+    const size_t before = a.size();
+    a.resize(n);
+    prefault_ahead(a, before);
   }
   /// Make the current mesh the base clustered mesh (paper section 5.2): each vertex
   /// roots the cluster with its id; vertices created later inherit their v_to's cluster.

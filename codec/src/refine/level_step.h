@@ -187,14 +187,7 @@ private:
     uint32_t face = ct.face_count(), new_faces = 0;
     for (const PendingSplit &ps : splits.split)
       new_faces += uint32_t(ps.op.has_l) + uint32_t(ps.op.has_r);
-    const size_t vertices = size_t(v0) + n, faces = size_t(face) + new_faces;
-    ct.V.resize(3 * faces);
-    ct.O.resize(3 * faces);
-    ct.VC.resize(vertices);
-    mesh.q.resize(3 * vertices);
-    mesh.attr.resize(mesh.attr_codes * vertices);
-    mesh.lineage.resize(vertices);
-    mesh.face_claim.resize(faces, 0);
+    mesh.grow(size_t(v0) + n, size_t(face) + new_faces);
     const uint32_t codes = mesh.attr_codes;
     for (uint32_t i = 0; i < n; ++i) {
       prefetch_split(ct, splits, i, n);

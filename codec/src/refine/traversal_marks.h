@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "memory/prefault.h"
 #include "mesh/corner_table.h"
 #include "refine/level_mesh.h"
 #include "refine/patch.h"
@@ -46,8 +47,11 @@ struct TraversalScratch {
   void begin(uint32_t vertices, uint32_t faces) {
     if (marks.size() < vertices)
       marks.resize(vertices);
-    if (claimed.size() < faces)
+    if (claimed.size() < faces) { // (zeroed whole: mapped first, in one call)
+      claimed.reserve(faces);
+      prefault_room(claimed);
       claimed.resize(faces, 0);
+    }
     ++stamp;
     queue.clear();
     claims.clear();
