@@ -9,6 +9,7 @@
 
 #include "memory/prefault.h"
 #include "refine/level_mesh.h"
+#include "refine/traversal_marks.h"
 
 #if defined(__linux__)
 #include <sys/mman.h>
@@ -35,6 +36,24 @@ TEST(Prefault, ChangesNoByte) {
     ASSERT_EQ(v[i], 5u) << i;
   prefault(nullptr, 1 << 20); // nothing to map: no effect
   prefault(v.data(), 0);
+}
+
+// A cluster traversed on one thread begins with the mesh's face count, a few faces more
+// each time: the claim stamps must grow by doubling (reserving each exact count, as a first
+// version of the prefault did, copied them at every cluster: 14 times slower).
+TEST(Prefault, ClaimStampsGrowByDoubling) {
+  TraversalScratch s;
+  int moves = 0;
+  const uint32_t *at = nullptr;
+  for (uint32_t faces = 1000; faces < 1000000; faces += 37) {
+    s.begin(0, faces);
+    ASSERT_GE(s.claimed.size(), faces);
+    moves += s.claimed.data() != at;
+    at = s.claimed.data();
+  }
+  EXPECT_LE(moves, 12); // 1000 -> 1000000: 10 doublings
+  for (uint32_t c : s.claimed)
+    ASSERT_NE(c, s.stamp); // (new stamps are zero: no face claimed by this traversal)
 }
 
 #if defined(__linux__)

@@ -47,9 +47,13 @@ struct TraversalScratch {
   void begin(uint32_t vertices, uint32_t faces) {
     if (marks.size() < vertices)
       marks.resize(vertices);
-    if (claimed.size() < faces) { // (zeroed whole: mapped first, in one call)
-      claimed.reserve(faces);
-      prefault_room(claimed);
+    if (claimed.size() < faces) {
+      // Grown by doubling, the new room mapped in one call (memory/prefault.h): the zero
+      // fill reaches it as the traversals meet more faces.
+      if (claimed.capacity() < faces) {
+        claimed.reserve(std::max<size_t>(faces, 2 * claimed.capacity()));
+        prefault_room(claimed);
+      }
       claimed.resize(faces, 0);
     }
     ++stamp;
