@@ -16,6 +16,7 @@
 #include "format/file_format.h"
 #include "geometry/quantize.h"
 #include "lossless/lossless_stage.h"
+#include "memory/prefault.h"
 #include "mesh/reorder.h"
 #include "parallel/thread_pool.h"
 #include "pomar/limits.h"
@@ -31,7 +32,7 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 /// the others kept in input order); fills compact_to_input. Checks every index.
 std::vector<uint32_t> compact_triangles(const Mesh &mesh, std::vector<uint32_t> &compact_to_input) {
   const size_t nv = mesh.vertex_count();
-  std::vector<uint32_t> remap(nv, kNone);
+  std::vector<uint32_t> remap = filled_vector<uint32_t>(nv, kNone); // (memory/prefault.h)
   std::vector<uint32_t> triangles = mesh.triangles;
   for (uint32_t i : triangles) {
     if (i >= nv)
@@ -56,7 +57,7 @@ std::vector<uint32_t> compact_triangles(const Mesh &mesh, std::vector<uint32_t> 
 /// The positions of the vertices compact_to_input names, in that order (xyz floats).
 std::vector<float> gather_positions(const Mesh &mesh,
                                     const std::vector<uint32_t> &compact_to_input) {
-  std::vector<float> positions(3 * compact_to_input.size());
+  std::vector<float> positions = filled_vector<float>(3 * compact_to_input.size());
   for (size_t i = 0; i < compact_to_input.size(); ++i)
     std::copy_n(&mesh.positions[3 * size_t(compact_to_input[i])], 3, &positions[3 * i]);
   return positions;
@@ -116,6 +117,7 @@ PreparedInput prepare_input(const Mesh &mesh, const EncodeOptions &options,
   // Renumber for memory locality, then build (and validate) the connectivity: the table
   // is built on the renamed faces while another thread sorts them, then takes their order.
   const std::vector<uint32_t> old_to_new = reorder_vertices(in.q, triangles);
+  reserve_prefaulted(in.to_input, nv);
   in.to_input.resize(nv);
   for (uint32_t v = 0; v < nv; ++v)
     in.to_input[old_to_new[v]] = compact_to_input[v];

@@ -45,7 +45,7 @@ Quantizer make_quantizer(const float *p, size_t n, int bits) {
 std::vector<int32_t> quantize(const Quantizer &g, const float *p, size_t n) {
   // Quantizer::quantize for every coordinate, the step and the grid's top computed once
   // (the same doubles, so the same values).
-  std::vector<int32_t> q(3 * n);
+  std::vector<int32_t> q = filled_vector<int32_t>(3 * n);
   const double s = g.step();
   const double top = double((uint32_t(1) << g.bits) - 1);
   for (size_t i = 0; i < n; ++i)
@@ -58,10 +58,7 @@ std::vector<int32_t> quantize(const Quantizer &g, const float *p, size_t n) {
 
 std::vector<float> dequantize(const Quantizer &g, const std::vector<int32_t> &q) {
   // Quantizer::dequantize for every coordinate, the step computed once (same floats).
-  std::vector<float> p;
-  p.reserve(q.size());
-  prefault_room(p); // (written whole: mapped first, in one call)
-  p.resize(q.size());
+  std::vector<float> p = filled_vector<float>(q.size());
   const double step = g.step();
   const double origin[3] = {g.origin[0], g.origin[1], g.origin[2]};
   for (size_t i = 0; i < q.size(); ++i)

@@ -26,6 +26,22 @@ template <class T> void prefault_room(std::vector<T> &v) {
   prefault(v.data() + v.size(), (v.capacity() - v.size()) * sizeof(T));
 }
 
+/// Room for `n` elements with the room past the size mapped (for an assign or resize that
+/// writes it all next).
+template <class T, class A> void reserve_prefaulted(std::vector<T, A> &v, size_t n) {
+  v.reserve(n);
+  prefault_room(v);
+}
+
+/// `n` copies of `value`, the memory mapped in one call before the fill (a large array
+/// about to be written whole).
+template <class T> std::vector<T> filled_vector(size_t n, const T &value = T()) {
+  std::vector<T> v;
+  reserve_prefaulted(v, n);
+  v.resize(n, value);
+  return v;
+}
+
 /// A vector filled front to back within a room reserved from counts a file claims (a
 /// hostile header may claim more than its data makes): its room is mapped a stretch ahead
 /// of its end, never all at once. The mapped part ends at the stretch after the end's

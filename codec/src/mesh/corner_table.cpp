@@ -1,4 +1,5 @@
 #include "mesh/corner_table.h"
+#include "memory/prefault.h"
 
 #include <algorithm>
 #include <string>
@@ -18,7 +19,7 @@ std::string face_text(const uint32_t *t, size_t f) {
 // the two corners facing one edge can be matched in a short list.
 void match_opposites(const uint32_t *t, size_t nt, size_t nv, CornerTable &ct) {
   const size_t nc = 3 * nt;
-  std::vector<uint32_t> start(nv + 1, 0), order(nc);
+  std::vector<uint32_t> start(nv + 1, 0), order = filled_vector<uint32_t>(nc);
   auto edge = [&](uint32_t c, uint32_t &a, uint32_t &b) {
     a = t[CornerTable::next(c)];
     b = t[CornerTable::prev(c)];
@@ -68,8 +69,8 @@ void match_opposites(const uint32_t *t, size_t nt, size_t nv, CornerTable &ct) {
       edge(run[0].c, a, b);
       if (end - run > 2) {
         if (nonmanifold++ == 0)
-          nm_example = "edge (" + std::to_string(a) + ", " + std::to_string(b) +
-                       ") is shared by " + std::to_string(end - run) + " faces";
+          nm_example = "edge (" + std::to_string(a) + ", " + std::to_string(b) + ") is shared by " +
+                       std::to_string(end - run) + " faces";
       } else if (end - run == 2) {
         uint32_t a2, b2;
         edge(run[1].c, a2, b2);
@@ -153,10 +154,14 @@ void build_corner_table(const uint32_t *t, size_t nt, size_t nv, CornerTable &ct
     throw Error(Error::Kind::InvalidMesh, "degenerate faces: " + std::to_string(repeated) +
                                               " faces repeat a vertex; e.g. " +
                                               face_text(t, rep_example));
+  // (Large arrays written whole: their memory is mapped first, memory/prefault.h.)
+  reserve_prefaulted(ct.V, 3 * nt);
+  reserve_prefaulted(ct.O, 3 * nt);
+  reserve_prefaulted(ct.VC, nv);
   ct.V.assign(t, t + 3 * nt);
   ct.O.assign(3 * nt, kNone);
   ct.VC.assign(nv, kNone);
-  std::vector<uint32_t> faces_at(nv, 0);
+  std::vector<uint32_t> faces_at = filled_vector<uint32_t>(nv);
   for (uint32_t c = 0; c < 3 * nt; ++c) {
     ct.VC[t[c]] = c;
     ++faces_at[t[c]];

@@ -1,4 +1,5 @@
 #include "mesh/reorder.h"
+#include "memory/prefault.h"
 
 #include <algorithm>
 
@@ -27,7 +28,7 @@ struct Keyed {
 void sort_by_key(std::vector<Keyed> &a) {
   constexpr int kBits = 11;
   constexpr uint64_t kMask = (uint64_t(1) << kBits) - 1;
-  std::vector<Keyed> scratch(a.size());
+  std::vector<Keyed> scratch = filled_vector<Keyed>(a.size());
   std::vector<uint32_t> start(kMask + 2);
   for (int shift = 0; shift < 64; shift += kBits) {
     std::fill(start.begin(), start.end(), 0);
@@ -48,15 +49,15 @@ void sort_by_key(std::vector<Keyed> &a) {
 std::vector<uint32_t> reorder_vertices(std::vector<int32_t> &q, std::vector<uint32_t> &triangles) {
   const uint32_t nv = static_cast<uint32_t>(q.size() / 3);
   // Morton key from the top 21 bits of each coordinate (grids have at most 24 bits).
-  std::vector<Keyed> key(nv);
+  std::vector<Keyed> key = filled_vector<Keyed>(nv); // (mapped first: memory/prefault.h)
   for (uint32_t v = 0; v < nv; ++v) {
     const uint64_t x = uint64_t(q[3 * v]) >> 3, y = uint64_t(q[3 * v + 1]) >> 3,
                    z = uint64_t(q[3 * v + 2]) >> 3;
     key[v] = {spread3(x) | spread3(y) << 1 | spread3(z) << 2, v};
   }
   sort_by_key(key);
-  std::vector<uint32_t> old_to_new(nv);
-  std::vector<int32_t> nq(q.size());
+  std::vector<uint32_t> old_to_new = filled_vector<uint32_t>(nv);
+  std::vector<int32_t> nq = filled_vector<int32_t>(q.size());
   for (uint32_t i = 0; i < nv; ++i) {
     const uint32_t v = key[i].v;
     old_to_new[v] = i;
@@ -76,12 +77,12 @@ std::vector<uint32_t> face_order(const std::vector<uint32_t> &t) {
     uint32_t lowest, f;
   };
   const size_t nf = t.size() / 3;
-  std::vector<Face> faces(nf);
+  std::vector<Face> faces = filled_vector<Face>(nf);
   for (size_t f = 0; f < nf; ++f)
     faces[f] = {std::min({t[3 * f], t[3 * f + 1], t[3 * f + 2]}), static_cast<uint32_t>(f)};
   std::sort(faces.begin(), faces.end(),
             [](const Face &a, const Face &b) { return a.lowest < b.lowest; });
-  std::vector<uint32_t> order(nf);
+  std::vector<uint32_t> order = filled_vector<uint32_t>(nf);
   for (size_t i = 0; i < nf; ++i)
     order[i] = faces[i].f;
   return order;
@@ -89,18 +90,19 @@ std::vector<uint32_t> face_order(const std::vector<uint32_t> &t) {
 
 void reorder_faces(CornerTable &ct, const std::vector<uint32_t> &order) {
   const size_t nf = order.size();
-  std::vector<uint32_t> new_corner(nf); // old face -> the first corner of its new place
+  std::vector<uint32_t> new_corner =
+      filled_vector<uint32_t>(nf); // old face -> the first corner of its new place
   for (size_t i = 0; i < nf; ++i)
     new_corner[order[i]] = static_cast<uint32_t>(3 * i);
   { // corner 3*i+k of the new table is corner 3*order[i]+k of the old one
-    std::vector<uint32_t> V(3 * nf);
+    std::vector<uint32_t> V = filled_vector<uint32_t>(3 * nf);
     const uint32_t *old = ct.V.data();
     for (size_t i = 0; i < nf; ++i)
       std::copy_n(old + 3 * size_t(order[i]), 3, &V[3 * i]);
     ct.V.swap(V);
   }
   {
-    std::vector<uint32_t> O(3 * nf);
+    std::vector<uint32_t> O = filled_vector<uint32_t>(3 * nf);
     const uint32_t *old = ct.O.data();
     for (size_t i = 0; i < nf; ++i) {
       const uint32_t *o = old + 3 * size_t(order[i]);
