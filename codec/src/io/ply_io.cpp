@@ -3,6 +3,7 @@
 // (formatted here: vcglib prints only 7 significant digits) or binary (from the flat
 // arrays; vcglib's exporter as the reference and on big-endian hosts).
 #include "io/io_common.h"
+#include "memory/prefault.h"
 
 #include <pomar/vcg_adapter.h>
 
@@ -775,12 +776,14 @@ bool read_simple_binary(FileReader &in, uint64_t nv, uint64_t nf, Mesh &out,
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
   if (in.remaining() / 13 < nf || in.remaining() - 13 * nf < 12 * nv)
     return false;
+  reserve_prefaulted(out.positions, 3 * nv); // (written whole: memory/prefault.h)
   out.positions.resize(3 * nv);
   if (!in.read(out.positions.data(), 12 * nv))
     return false;
   for (uint64_t i = 0; i < 3 * nv; ++i)
     if (!std::isfinite(out.positions[i]))
       return false;
+  reserve_prefaulted(out.triangles, 3 * nf);
   out.triangles.resize(3 * nf);
   constexpr uint64_t kChunk = 65536;
   std::vector<unsigned char> buf(13 * kChunk);
@@ -878,6 +881,7 @@ bool read_simple_ascii(FileReader &in, uint64_t nv, uint64_t nf, Mesh &out,
     return false; // an ASCII vertex takes 6 bytes or more, a face 8
   AsciiTokens tokens(in);
   const char *b = nullptr, *e = nullptr;
+  reserve_prefaulted(out.positions, 3 * nv); // (written whole: memory/prefault.h)
   out.positions.resize(3 * nv);
   for (float &x : out.positions) {
     if (!tokens.next(b, e) || !plain_decimal(b, e))
@@ -886,6 +890,7 @@ bool read_simple_ascii(FileReader &in, uint64_t nv, uint64_t nf, Mesh &out,
     if (r.ec != std::errc() || r.ptr != e || !std::isfinite(x))
       return false;
   }
+  reserve_prefaulted(out.triangles, 3 * nf);
   out.triangles.resize(3 * nf);
   for (uint64_t f = 0; f < nf; ++f) {
     if (!tokens.next(b, e) || e - b != 1 || *b != '3')
@@ -911,7 +916,7 @@ bool read_simple_ply(FileReader &in, const PlyHeader &h, Mesh &out, size_t &unre
   const uint64_t nv = h.elements[0].count, nf = h.elements[1].count;
   if (nv == 0 || nf == 0 || nv >= UINT32_MAX || nf > UINT32_MAX / 3)
     return false;
-  std::vector<uint8_t> used(nv, 0);
+  std::vector<uint8_t> used = filled_vector<uint8_t>(nv);
   Mesh mesh;
   if (h.encoding == PlyHeader::BinaryLittle) {
     if (!read_simple_binary(in, nv, nf, mesh, used))
