@@ -222,25 +222,25 @@ void AtomicFile::commit() {
   tmp_.commit(false);
 }
 
-ChunkedFileWriter::ChunkedFileWriter(const std::string &target) : file_(target) {
-  constexpr size_t kChunk = size_t(1) << 20;
-  buf_.reserve(kChunk);
-  prefault_room(buf_); // (written whole: mapped first, in one call)
-  buf_.resize(kChunk);
+ChunkedFileWriter::ChunkedFileWriter(const std::string &target, uint64_t bytes) : file_(target) {
+  constexpr uint64_t kChunk = uint64_t(1) << 20;
+  capacity_ = static_cast<size_t>(std::clamp<uint64_t>(bytes, 8192, kChunk));
+  buf_.reset(new char[capacity_]);
+  prefault(buf_.get(), capacity_); // (written whole: mapped first, in one call)
 }
 
 void ChunkedFileWriter::flush() {
-  file_.write(buf_.data(), used_);
+  file_.write(buf_.get(), used_);
   used_ = 0;
 }
 
 void ChunkedFileWriter::put(const void *data, size_t size) {
   const char *p = static_cast<const char *>(data);
   while (size > 0) {
-    if (used_ == buf_.size())
+    if (used_ == capacity_)
       flush();
-    const size_t n = std::min(size, buf_.size() - used_);
-    std::memcpy(buf_.data() + used_, p, n);
+    const size_t n = std::min(size, capacity_ - used_);
+    std::memcpy(buf_.get() + used_, p, n);
     used_ += n, p += n, size -= n;
   }
 }
@@ -248,6 +248,11 @@ void ChunkedFileWriter::put(const void *data, size_t size) {
 void ChunkedFileWriter::commit() {
   flush();
   file_.commit();
+}
+
+TextFileWriter::TextFileWriter(const std::string &target) : target_(target) {
+  text_.reserve(kChunk + 4096);
+  prefault(text_.data(), text_.capacity()); // (written whole: mapped first, in one call)
 }
 
 void TextFileWriter::flush() {

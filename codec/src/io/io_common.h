@@ -284,13 +284,14 @@ private:
 /// without commit(), it removes the temporary file.
 class ChunkedFileWriter {
 public:
-  explicit ChunkedFileWriter(const std::string &target);
+  /// `bytes`: what the file will hold, if known (a small file gets a small buffer).
+  explicit ChunkedFileWriter(const std::string &target, uint64_t bytes = UINT64_MAX);
   void put(const void *data, size_t size);
   /// Room for `size` (<= 4096) bytes at the end of the buffer, which the caller fills.
   char *reserve(size_t size) {
-    if (used_ + size > buf_.size())
+    if (used_ + size > capacity_)
       flush();
-    char *p = buf_.data() + used_;
+    char *p = buf_.get() + used_;
     used_ += size;
     return p;
   }
@@ -299,8 +300,8 @@ public:
 private:
   void flush();
   AtomicFile file_;
-  std::vector<char> buf_;
-  size_t used_ = 0;
+  std::unique_ptr<char[]> buf_; // (not zeroed: every byte is written before it is flushed)
+  size_t capacity_ = 0, used_ = 0;
 };
 
 /// A file written atomically in chunks by the text writers (OBJ, OFF, ASCII PLY and STL,
@@ -312,9 +313,7 @@ private:
 class TextFileWriter {
 public:
   static constexpr size_t kChunk = size_t(1) << 20;
-  explicit TextFileWriter(const std::string &target) : target_(target) {
-    text_.reserve(kChunk + 4096);
-  }
+  explicit TextFileWriter(const std::string &target);
   std::string &text() { return text_; }
   void done() {
     if (text_.size() >= kChunk)

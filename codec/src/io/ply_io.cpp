@@ -1201,7 +1201,7 @@ void save_ply_binary(const std::string &path, const Mesh &mesh) {
                              "\nproperty float x\nproperty float y\nproperty float z\n"
                              "element face " +
                              num(nf) + "\nproperty list uchar int vertex_indices\nend_header\n";
-  ChunkedFileWriter out(path);
+  ChunkedFileWriter out(path, header.size() + 12 * nv + 13 * nf);
   out.put(header.data(), header.size());
   out.put(mesh.positions.data(), 12 * nv);
   for (uint64_t f = 0; f < nf; ++f) {

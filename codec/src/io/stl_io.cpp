@@ -344,7 +344,7 @@ void save_stl_binary(const std::string &path, const Mesh &mesh) {
   std::memcpy(header, "VCG", 3);
   const uint64_t nf = mesh.triangle_count();
   const int32_t count = static_cast<int32_t>(nf); // at most INT_MAX (check_mesh_for_save)
-  ChunkedFileWriter out(path);
+  ChunkedFileWriter out(path, 84 + 50 * nf);
   out.put(header, sizeof header);
   out.put(&count, 4);
   for (uint64_t t = 0; t < nf; ++t) {
