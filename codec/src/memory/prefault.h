@@ -33,9 +33,17 @@ template <class T, class A> void reserve_prefaulted(std::vector<T, A> &v, size_t
   prefault_room(v);
 }
 
-/// `n` copies of `value`, the memory mapped in one call before the fill (a large array
-/// about to be written whole).
-template <class T> std::vector<T> filled_vector(size_t n, const T &value = T()) {
+/// `n` value-initialised elements (zeros: a memset), the memory mapped in one call before
+/// the fill (a large array about to be written whole).
+template <class T> std::vector<T> filled_vector(size_t n) {
+  std::vector<T> v;
+  reserve_prefaulted(v, n);
+  v.resize(n);
+  return v;
+}
+
+/// `n` copies of `value`, the same way.
+template <class T> std::vector<T> filled_vector(size_t n, const T &value) {
   std::vector<T> v;
   reserve_prefaulted(v, n);
   v.resize(n, value);
