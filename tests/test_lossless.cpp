@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <numeric>
+#include <random>
 
 #include "format/file_format.h"
 #include "lossless/lossless_record.h"
@@ -422,6 +423,54 @@ TEST(Lossless, AttributesOfEveryVertexComeBackWithTheMessyMesh) {
       EXPECT_NEAR(q->values[i], quality.values[v], q->bound + 1e-7) << "vertex " << v;
     }
   }
+}
+
+} // namespace
+} // namespace pomar
+
+namespace pomar {
+namespace {
+
+/// The canonical order by its definition: face indices sorted by (rotated triple, index).
+std::vector<uint32_t> canonical_order_by_definition(const std::vector<uint32_t> &t) {
+  const uint32_t nf = static_cast<uint32_t>(t.size() / 3);
+  std::vector<std::array<uint32_t, 3>> key(nf);
+  for (uint32_t f = 0; f < nf; ++f) {
+    const uint32_t *v = &t[3 * size_t(f)];
+    // (Rotated to a smallest vertex; for a face repeating its smallest one, the rule of
+    // the record's format, which the decoder must follow too.)
+    const int k = v[0] < v[1] ? (v[0] < v[2] ? 0 : 2) : (v[1] < v[2] ? 1 : 2);
+    key[f] = {v[k], v[(k + 1) % 3], v[(k + 2) % 3]};
+  }
+  std::vector<uint32_t> order(nf);
+  std::iota(order.begin(), order.end(), 0u);
+  std::sort(order.begin(), order.end(),
+            [&](uint32_t a, uint32_t b) { return key[a] != key[b] ? key[a] < key[b] : a < b; });
+  return order;
+}
+
+// canonical_face_order packs the triple into one key for a radix sort when the vertex ids
+// fit in 21 bits, and sorts triples otherwise: both must give the defined order, duplicate
+// faces (same triple, any rotation) by index.
+TEST(Lossless, CanonicalFaceOrderIsTheSortedRotatedTriples) {
+  std::mt19937 rng(7);
+  for (uint32_t top : {3u, 1000u, (1u << 21) - 1, 1u << 21, 0xFFFFFFFEu}) {
+    std::uniform_int_distribution<uint32_t> id(0, top);
+    std::vector<uint32_t> t;
+    for (int f = 0; f < 5000; ++f) {
+      if (f % 7 == 3 && t.size() >= 3) { // a duplicate of an earlier face, rotated
+        const size_t g = 3 * (rng() % (t.size() / 3)), r = rng() % 3;
+        for (size_t k = 0; k < 3; ++k)
+          t.push_back(t[g + (k + r) % 3]);
+        continue;
+      }
+      for (int k = 0; k < 3; ++k)
+        t.push_back(id(rng));
+    }
+    t.push_back(top), t.push_back(0), t.push_back(top); // (the largest id is used)
+    EXPECT_EQ(canonical_face_order(t), canonical_order_by_definition(t)) << "ids up to " << top;
+  }
+  EXPECT_TRUE(canonical_face_order({}).empty());
 }
 
 } // namespace

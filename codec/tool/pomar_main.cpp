@@ -155,10 +155,13 @@ int run_encode(const EncodeArgs &a) {
   const uint64_t memory_limit = pomar::parse_memory_size(a.max_memory);
   pomar::LoadReport load;
   // Refused as soon as the file's header tells the mesh size, before it is read, with the
-  // estimate for the file's format (its reader's own peak).
+  // estimate for the file's format (its reader's own peak) and, with --keep-order, the
+  // lossless stage's part (a mesh that turns out to need cutting is checked for it by the
+  // encoder, before the encoding).
   pomar::Mesh mesh = pomar::load_mesh(a.in, &load, [&](uint64_t v, uint64_t f) {
+    const uint64_t lossless = a.keep_order ? pomar::lossless_encode_memory(f, true) : 0;
     pomar::check_encode_memory(v, f, memory_limit, 0, 0, 1, pomar::encode_input(load),
-                               pomar::encode_input_extra(load, v));
+                               pomar::encode_input_extra(load, v) + lossless);
   });
   if (!a.quiet)
     warn_dropped(a.in, load.ignored_attributes, "has",

@@ -62,6 +62,16 @@ uint64_t encode_memory_estimate(uint64_t vertices, uint64_t faces,
 /// decode`); `clustered` files (random access) need a little more than progressive ones.
 uint64_t decode_memory_estimate(uint64_t vertices, uint64_t faces, bool clustered);
 
+/// What the lossless stage adds to the encode peak (a mesh cut, or given with keep_order:
+/// the input and the cut mesh held together, the record's maps and the canonical face
+/// order): 88 bytes per face, 128 with keep_order (`faces`: the input's).
+uint64_t lossless_encode_memory(uint64_t faces, bool keep_order);
+
+/// What undoing the cut adds to a full-resolution decode of a file with a lossless record
+/// (the decoded and the output mesh held together, the canonical face order): 32 bytes
+/// per vertex and 28 per face.
+uint64_t lossless_decode_memory(uint64_t vertices, uint64_t faces);
+
 /// What per-vertex attributes add to the encode peak, per vertex, for the attributes
 /// `options` keeps of `mesh` (0 without): their integer codes (docs/format.md: colour 3-4,
 /// quantized normal 2, exact normal 3, scalar 1, texcoord 2) in the encoder's copies, and
@@ -123,7 +133,8 @@ uint64_t decode_thread_memory(uint64_t vertices, uint64_t faces);
 /// check_memory with decode_memory_estimate for the mesh of `level` (-1 = full resolution)
 /// of the file `info` describes, plus decode_attribute_bytes_per_vertex(info, keep) per
 /// vertex, plus decode_thread_memory per thread past the first of a clustered file's decode
-/// on `threads` threads (DecodeOptions::threads resolved) (action "decode").
+/// on `threads` threads (DecodeOptions::threads resolved), plus lossless_decode_memory for
+/// the full resolution of a file with a lossless record (action "decode").
 void check_decode_memory(const FileInfo &info, int level, uint64_t limit,
                          const AttributeMask &keep = AttributeMask(), unsigned threads = 1);
 

@@ -96,9 +96,11 @@ PreparedInput prepare_input(const Mesh &mesh, const EncodeOptions &options,
   uint64_t held = mesh.positions.size() * sizeof(float) + mesh.triangles.size() * sizeof(uint32_t);
   for (const VertexAttribute &a : mesh.attributes)
     held += a.colour.size() + a.values.size() * sizeof(float);
+  // (With a lossless record: the input, which the caller holds too, and the record's work.)
   check_encode_memory(mesh.vertex_count(), mesh.triangle_count(), options.memory_limit, held,
                       encode_attribute_bytes_per_vertex(mesh, options.attributes),
-                      decode_threads(options.threads));
+                      decode_threads(options.threads), EncodeInput::Mesh,
+                      hook ? lossless_encode_memory(mesh.triangle_count(), options.keep_order) : 0);
   PreparedInput in;
   std::vector<uint32_t> compact_to_input;
   std::vector<uint32_t> triangles = compact_triangles(mesh, compact_to_input);

@@ -131,6 +131,19 @@ constexpr uint64_t kThreadPerFace = 5;
 // estimate at 300k and 1M, each whole peak 0.71-0.80 of the PLY row plus the part.
 // Decoding: 81 B/vertex (8 codes, 27 bytes of values) and 12 B/vertex (1 code, 4 bytes): the
 // codes (8 B each) plus the values, plus slack.
+// The lossless stage (seventh session, bench/README.md "Memory of the lossless stage"):
+// noisy spheres of 300k and 1M vertices encoded with --keep-order (F = 2V) peaked 143 and
+// 414 MiB where the PLY row said 89.6 and 271.0; the same spheres with 10% of their faces
+// duplicated, shuffled, and 5% more vertices no face uses (cut and recorded) 131 and 361
+// MiB where it said 94.5 and 287.4 (input counts). 128 and 88 bytes per input face on top:
+// the peaks 0.80-0.88 and 0.77-0.87 of the sums. Their decodes (two threads) peaked 64 and
+// 198 MiB (keep-order) and 46 and 136 (messy) where the clustered row said 53.4 and 145.4:
+// 32 bytes per vertex and 28 per face on top, 0.81-0.86 (keep-order).
+constexpr uint64_t kLosslessEncodePerFace = 88;
+constexpr uint64_t kLosslessKeepOrderEncodePerFace = 128;
+constexpr uint64_t kLosslessDecodePerVertex = 32;
+constexpr uint64_t kLosslessDecodePerFace = 28;
+
 constexpr uint64_t kEncodeAttributeFixed = 16;
 constexpr uint64_t kEncodePerAttributeCode = 34;
 constexpr uint64_t kDecodePerAttributeCode = 8;
@@ -332,6 +345,14 @@ uint64_t decode_memory_estimate(uint64_t vertices, uint64_t faces, bool clustere
   return add_mul(add_mul(kDecodeFixed, vertices, per_vertex), faces, per_face);
 }
 
+uint64_t lossless_encode_memory(uint64_t faces, bool keep_order) {
+  return add_mul(0, faces, keep_order ? kLosslessKeepOrderEncodePerFace : kLosslessEncodePerFace);
+}
+
+uint64_t lossless_decode_memory(uint64_t vertices, uint64_t faces) {
+  return add_mul(add_mul(0, vertices, kLosslessDecodePerVertex), faces, kLosslessDecodePerFace);
+}
+
 uint64_t encode_attribute_bytes_per_vertex(const Mesh &mesh, const AttributeOptions &options) {
   uint64_t codes = 0;
   for (const VertexAttribute &a : mesh.attributes)
@@ -468,6 +489,9 @@ void check_decode_memory(const FileInfo &info, int level, uint64_t limit, const 
                             decode_attribute_bytes_per_vertex(info, keep));
   if (info.clustered() && threads > 1)
     needed = add_mul(needed, threads - 1, decode_thread_memory(v, f));
+  const bool full = level < 0 || static_cast<size_t>(level) >= info.levels.size();
+  if (full && info.lossless_bytes > 0) // the cut undone
+    needed = add_mul(needed, 1, lossless_decode_memory(info.input_vertices, info.input_faces));
   check_memory("decode", v, f, needed, 0, limit);
 }
 

@@ -2,11 +2,13 @@
 // one page fault per 4 KiB page as the writes reach it.
 //
 // A decode writes its mesh arrays (reserved from the level table's counts), the
-// dequantized positions and the output buffer once each, front to back. Each first write
-// to a page is a page fault; where faults are dear (virtual machines: about 7 us each on
-// the 2-core VM of bench/README.md, against 0.6 us for the same page in one madvise call)
-// they were a tenth of a 134k-vertex decode. Prefaulting changes no byte and no result;
-// the pages would be mapped a moment later anyway.
+// dequantized positions and the output buffer once each, front to back; an encode the
+// arrays of its input preparation (quantized positions, Morton keys, renumbered faces,
+// corner tables) and the PLY reader's. Each first write to a page is a page fault. Where
+// faults are dear (virtual machines: about 7 us each on the 2-core VM of bench/README.md,
+// "Page faults", against under 1 us a page in one madvise call) they were a seventh of
+// the CPU time of a 134k-vertex decode. Prefaulting changes no byte and no result: the
+// pages would be mapped a moment later anyway.
 #pragma once
 
 #include <algorithm>
@@ -28,7 +30,7 @@ template <class T> void prefault_room(std::vector<T> &v) {
 
 /// Room for `n` elements with the room past the size mapped (for an assign or resize that
 /// writes it all next).
-template <class T, class A> void reserve_prefaulted(std::vector<T, A> &v, size_t n) {
+template <class T> void reserve_prefaulted(std::vector<T> &v, size_t n) {
   v.reserve(n);
   prefault_room(v);
 }

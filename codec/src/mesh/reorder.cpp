@@ -1,5 +1,6 @@
 #include "mesh/reorder.h"
 #include "memory/prefault.h"
+#include "mesh/radix_sort.h"
 
 #include <algorithm>
 
@@ -17,39 +18,12 @@ uint64_t spread3(uint64_t x) {
   return x;
 }
 
-struct Keyed {
-  uint64_t key;
-  uint32_t v;
-};
-
-/// Sort by (key, v) when the entries arrive by increasing v: a stable least-significant-
-/// digit radix sort on the key alone, 11 bits a pass, skipping the digits every key shares
-/// (a 12-bit grid gives 27-bit keys: 3 passes instead of 6).
-void sort_by_key(std::vector<Keyed> &a) {
-  constexpr int kBits = 11;
-  constexpr uint64_t kMask = (uint64_t(1) << kBits) - 1;
-  std::vector<Keyed> scratch = filled_vector<Keyed>(a.size());
-  std::vector<uint32_t> start(kMask + 2);
-  for (int shift = 0; shift < 64; shift += kBits) {
-    std::fill(start.begin(), start.end(), 0);
-    for (const Keyed &x : a)
-      ++start[((x.key >> shift) & kMask) + 1];
-    if (std::count(start.begin(), start.end(), uint32_t(a.size())) == 1)
-      continue; // one digit for all: the pass would not move anything
-    for (size_t d = 1; d < start.size(); ++d)
-      start[d] += start[d - 1];
-    for (const Keyed &x : a)
-      scratch[start[(x.key >> shift) & kMask]++] = x;
-    a.swap(scratch);
-  }
-}
-
 } // namespace
 
 std::vector<uint32_t> reorder_vertices(std::vector<int32_t> &q, std::vector<uint32_t> &triangles) {
   const uint32_t nv = static_cast<uint32_t>(q.size() / 3);
   // Morton key from the top 21 bits of each coordinate (grids have at most 24 bits).
-  std::vector<Keyed> key = filled_vector<Keyed>(nv); // (mapped first: memory/prefault.h)
+  std::vector<Keyed> key = filled_vector<Keyed>(nv);
   for (uint32_t v = 0; v < nv; ++v) {
     const uint64_t x = uint64_t(q[3 * v]) >> 3, y = uint64_t(q[3 * v + 1]) >> 3,
                    z = uint64_t(q[3 * v + 2]) >> 3;
@@ -59,7 +33,7 @@ std::vector<uint32_t> reorder_vertices(std::vector<int32_t> &q, std::vector<uint
   std::vector<uint32_t> old_to_new = filled_vector<uint32_t>(nv);
   std::vector<int32_t> nq = filled_vector<int32_t>(q.size());
   for (uint32_t i = 0; i < nv; ++i) {
-    const uint32_t v = key[i].v;
+    const uint32_t v = key[i].id;
     old_to_new[v] = i;
     std::copy(&q[3 * v], &q[3 * v] + 3, &nq[3 * i]);
   }
@@ -90,8 +64,8 @@ std::vector<uint32_t> face_order(const std::vector<uint32_t> &t) {
 
 void reorder_faces(CornerTable &ct, const std::vector<uint32_t> &order) {
   const size_t nf = order.size();
-  std::vector<uint32_t> new_corner =
-      filled_vector<uint32_t>(nf); // old face -> the first corner of its new place
+  // Old face -> the first corner of its new place (arrays mapped first: memory/prefault.h).
+  std::vector<uint32_t> new_corner = filled_vector<uint32_t>(nf);
   for (size_t i = 0; i < nf; ++i)
     new_corner[order[i]] = static_cast<uint32_t>(3 * i);
   { // corner 3*i+k of the new table is corner 3*order[i]+k of the old one
