@@ -135,10 +135,12 @@ constexpr uint64_t kThreadPerFace = 5;
 // noisy spheres of 300k and 1M vertices encoded with --keep-order (F = 2V) peaked 143 and
 // 414 MiB where the PLY row said 89.6 and 271.0; the same spheres with 10% of their faces
 // duplicated, shuffled, and 5% more vertices no face uses (cut and recorded) 131 and 361
-// MiB where it said 94.5 and 287.4 (input counts). 128 and 88 bytes per input face on top:
-// the peaks 0.80-0.88 and 0.77-0.87 of the sums. Their decodes (two threads) peaked 64 and
-// 198 MiB (keep-order) and 46 and 136 (messy) where the clustered row said 53.4 and 145.4:
-// 32 bytes per vertex and 28 per face on top, 0.81-0.86 (keep-order).
+// MiB where it said 94.5 and 287.4 (the load check, input counts). 128 and 88 bytes per
+// face on top (the encoder's check: the cut mesh's faces; the load check with --keep-order:
+// the file's), two threads' part included: the peaks 0.81-0.86 and 0.77-0.87 of the sums
+// (MemoryEstimate.LosslessStageIsAboveTheMeasuredPeaks). Their decodes (two threads)
+// peaked 64 and 198 MiB (keep-order) and 46 and 136 (messy) where the clustered row said
+// 53.4 and 145.4: 32 bytes per vertex and 28 per face on top, 0.81-0.86 (keep-order).
 constexpr uint64_t kLosslessEncodePerFace = 88;
 constexpr uint64_t kLosslessKeepOrderEncodePerFace = 128;
 constexpr uint64_t kLosslessDecodePerVertex = 32;
