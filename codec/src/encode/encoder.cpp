@@ -119,8 +119,7 @@ PreparedInput prepare_input(const Mesh &mesh, const EncodeOptions &options,
   // Renumber for memory locality, then build (and validate) the connectivity: the table
   // is built on the renamed faces while another thread sorts them, then takes their order.
   const std::vector<uint32_t> old_to_new = reorder_vertices(in.q, triangles);
-  reserve_prefaulted(in.to_input, nv);
-  in.to_input.resize(nv);
+  resize_prefaulted(in.to_input, nv); // (memory/prefault.h)
   for (uint32_t v = 0; v < nv; ++v)
     in.to_input[old_to_new[v]] = compact_to_input[v];
   try {

@@ -115,10 +115,8 @@ std::vector<uint8_t> read_file(const std::string &path) {
   // A regular file is read into a buffer of its size (+1 to see the end): growing by
   // doubling would briefly hold 1.5 times a large file.
   std::vector<uint8_t> data;
-  if (have_stat && S_ISREG(st.st_mode)) {
-    reserve_prefaulted(data, static_cast<size_t>(st.st_size) + 1); // (memory/prefault.h)
-    data.resize(static_cast<size_t>(st.st_size) + 1);
-  }
+  if (have_stat && S_ISREG(st.st_mode)) // (mapped first: memory/prefault.h)
+    resize_prefaulted(data, static_cast<size_t>(st.st_size) + 1);
   size_t used = 0;
   for (;;) {
     if (used == data.size())

@@ -776,15 +776,13 @@ bool read_simple_binary(FileReader &in, uint64_t nv, uint64_t nf, Mesh &out,
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
   if (in.remaining() / 13 < nf || in.remaining() - 13 * nf < 12 * nv)
     return false;
-  reserve_prefaulted(out.positions, 3 * nv); // (written whole: memory/prefault.h)
-  out.positions.resize(3 * nv);
+  resize_prefaulted(out.positions, 3 * nv); // (written whole: memory/prefault.h)
   if (!in.read(out.positions.data(), 12 * nv))
     return false;
   for (uint64_t i = 0; i < 3 * nv; ++i)
     if (!std::isfinite(out.positions[i]))
       return false;
-  reserve_prefaulted(out.triangles, 3 * nf);
-  out.triangles.resize(3 * nf);
+  resize_prefaulted(out.triangles, 3 * nf);
   constexpr uint64_t kChunk = 65536;
   std::vector<unsigned char> buf(13 * kChunk);
   for (uint64_t f0 = 0; f0 < nf; f0 += kChunk) {
@@ -881,8 +879,7 @@ bool read_simple_ascii(FileReader &in, uint64_t nv, uint64_t nf, Mesh &out,
     return false; // an ASCII vertex takes 6 bytes or more, a face 8
   AsciiTokens tokens(in);
   const char *b = nullptr, *e = nullptr;
-  reserve_prefaulted(out.positions, 3 * nv); // (written whole: memory/prefault.h)
-  out.positions.resize(3 * nv);
+  resize_prefaulted(out.positions, 3 * nv); // (written whole: memory/prefault.h)
   for (float &x : out.positions) {
     if (!tokens.next(b, e) || !plain_decimal(b, e))
       return false;
@@ -890,8 +887,7 @@ bool read_simple_ascii(FileReader &in, uint64_t nv, uint64_t nf, Mesh &out,
     if (r.ec != std::errc() || r.ptr != e || !std::isfinite(x))
       return false;
   }
-  reserve_prefaulted(out.triangles, 3 * nf);
-  out.triangles.resize(3 * nf);
+  resize_prefaulted(out.triangles, 3 * nf);
   for (uint64_t f = 0; f < nf; ++f) {
     if (!tokens.next(b, e) || e - b != 1 || *b != '3')
       return false;

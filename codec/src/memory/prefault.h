@@ -35,12 +35,17 @@ template <class T> void reserve_prefaulted(std::vector<T> &v, size_t n) {
   prefault_room(v);
 }
 
+/// resize(n) with the new room mapped first (an array about to be written whole).
+template <class T> void resize_prefaulted(std::vector<T> &v, size_t n) {
+  reserve_prefaulted(v, n);
+  v.resize(n);
+}
+
 /// `n` value-initialised elements (zeros: a memset), the memory mapped in one call before
 /// the fill (a large array about to be written whole).
 template <class T> std::vector<T> filled_vector(size_t n) {
   std::vector<T> v;
-  reserve_prefaulted(v, n);
-  v.resize(n);
+  resize_prefaulted(v, n);
   return v;
 }
 

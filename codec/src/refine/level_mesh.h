@@ -57,43 +57,41 @@ struct LevelMesh {
       return;
     reserve_counts(vertices, faces);
   }
-  /// Room for these counts (the encoder's rebuild: the input's own, final counts).
+  /// Room for these counts (the encoder's rebuild: the input's own, final counts), mapped
+  /// a stretch ahead of each array's end (memory/prefault.h).
   void reserve_counts(uint64_t vertices, uint64_t faces) {
-    ct.V.reserve(3 * faces);
-    ct.O.reserve(3 * faces);
-    ct.VC.reserve(vertices);
-    q.reserve(3 * vertices);
-    attr.reserve(attr_codes * vertices);
-    lineage.reserve(vertices);
-    face_claim.reserve(faces);
-    for_each_array([](auto &a) { prefault_ahead_start(a); });
+    for_each_array(*this, vertices, faces, [](auto &a, uint64_t n) {
+      a.reserve(n);
+      prefault_ahead_start(a);
+    });
   }
   /// Grow the arrays to these counts, the new entries zero for the caller to write (the
   /// splits of a step: refine/level_step.h), keeping the room ahead of each end mapped.
   void grow(uint64_t vertices, uint64_t faces) {
-    grow_array(ct.V, 3 * faces);
-    grow_array(ct.O, 3 * faces);
-    grow_array(ct.VC, vertices);
-    grow_array(q, 3 * vertices);
-    grow_array(attr, attr_codes * vertices);
-    grow_array(lineage, vertices);
-    grow_array(face_claim, faces);
+    for_each_array(*this, vertices, faces, [](auto &a, uint64_t n) {
+      const size_t before = a.size();
+      a.resize(n);
+      prefault_ahead(a, before);
+    });
   }
   /// Whether the arrays hold these counts without moving (within reserve_counts' room).
   bool has_room(uint64_t vertices, uint64_t faces) const {
-    return 3 * faces <= ct.V.capacity() && 3 * faces <= ct.O.capacity() &&
-           vertices <= ct.VC.capacity() && 3 * vertices <= q.capacity() &&
-           attr_codes * vertices <= attr.capacity() && vertices <= lineage.capacity() &&
-           faces <= face_claim.capacity();
+    bool room = true;
+    for_each_array(*this, vertices, faces,
+                   [&](const auto &a, uint64_t n) { room = room && n <= a.capacity(); });
+    return room;
   }
-  /// Call f on each array reserve_counts and grow size.
-  template <class F> void for_each_array(const F &f) {
-    f(ct.V), f(ct.O), f(ct.VC), f(q), f(attr), f(lineage), f(face_claim);
-  }
-  template <class T> static void grow_array(std::vector<T> &a, uint64_t n) {
-    const size_t before = a.size();
-    a.resize(n);
-    prefault_ahead(a, before);
+  /// The arrays the splits grow, each with its size for these counts: the one list that
+  /// reserve_counts, grow and has_room go through.
+  template <class Mesh, class F>
+  static void for_each_array(Mesh &m, uint64_t vertices, uint64_t faces, const F &f) {
+    f(m.ct.V, 3 * faces);
+    f(m.ct.O, 3 * faces);
+    f(m.ct.VC, vertices);
+    f(m.q, 3 * vertices);
+    f(m.attr, m.attr_codes * vertices);
+    f(m.lineage, vertices);
+    f(m.face_claim, faces);
   }
   /// Make the current mesh the base clustered mesh (paper section 5.2): each vertex
   /// roots the cluster with its id; vertices created later inherit their v_to's cluster.
