@@ -3,6 +3,8 @@
 // encode(), decode() and SelectiveDecoder. Nothing here depends on this machine's memory.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -546,6 +548,128 @@ TEST(MemoryCheck, DecodeAndSelectiveDecoderRefuseAfterTheHeader) {
   SelectiveDecoder d(std::make_unique<MemorySource>(file.data(), file.size()),
                      {false, kNoMemoryLimit, {}});
   EXPECT_EQ(d.cluster_count(), info.clusters);
+}
+
+/// 1234567 as the messages write it: "1,234,567".
+std::string grouped_count(uint64_t n) {
+  std::string s = std::to_string(n);
+  for (int i = int(s.size()) - 3; i > 0; i -= 3)
+    s.insert(size_t(i), ",");
+  return s;
+}
+
+/// The error update() throws for a limit, with its kind ("" if it passes).
+template <class F> std::pair<std::string, Error::Kind> refusal_of(F f) {
+  try {
+    f();
+  } catch (const Error &e) {
+    return {e.what(), e.kind()};
+  }
+  return {"", Error::Kind::Internal};
+}
+
+TEST(MemoryCheck, SelectiveDecoderChecksEachLevelMapBeforeDecodingIt) {
+  const Mesh mesh = gen::icosphere(5);
+  EncodeOptions eo;
+  eo.clusters = 64;
+  const std::vector<uint8_t> file = encode(mesh, eo);
+  const FileInfo info = inspect(file.data(), file.size());
+  ASSERT_TRUE(info.clustered());
+  const int finest = int(info.levels.size());
+  const auto open = [&](uint64_t limit) {
+    SelectiveOptions o;
+    o.memory_limit = limit;
+    o.threads = 1;
+    return std::make_unique<SelectiveDecoder>(
+        std::make_unique<MemorySource>(file.data(), file.size()), o);
+  };
+  const auto needs = [&](uint64_t v, uint64_t f) { // what the check adds up (1 thread)
+    return decode_memory_estimate(v, f, true);
+  };
+  const LevelInfo &base = info.levels[info.global_levels - 1];
+  const uint64_t base_needs = needs(base.vertices, base.faces);
+  const uint64_t full = needs(info.vertices, info.faces);
+  ASSERT_LT(base_needs, full);
+
+  // The whole mesh at the finest level: the level table's counts exactly, refused one byte
+  // short, before anything is decoded.
+  auto d = open(full - 1);
+  const uint32_t before = d->mesh().vertex_count();
+  d->want_all(finest);
+  const auto [msg, kind] = refusal_of([&] { d->update(); });
+  EXPECT_EQ(kind, Error::Kind::MemoryLimit) << msg;
+  EXPECT_NE(msg.find("refine the clusters asked for to about " + grouped_count(info.vertices) +
+                     " vertices and " + grouped_count(info.faces) + " faces"),
+            std::string::npos)
+      << msg;
+  EXPECT_EQ(d->mesh().vertex_count(), before); // nothing decoded
+  EXPECT_EQ(d->clusters_decoded(), 0u);
+  d = open(full);
+  d->want_all(finest);
+  d->update();
+  EXPECT_EQ(d->mesh().vertex_count(), info.vertices);
+
+  // One cluster: its completed level map, each cluster at level t counted 1.3 times the
+  // average of level t (at most the whole mesh at the map's finest level).
+  auto probe = open(kNoMemoryLimit);
+  probe->want_cluster(0, finest);
+  probe->update();
+  const std::vector<int> map = probe->levels();
+  double sum_v = 0, sum_f = 0;
+  for (int t : map) {
+    sum_v += info.levels[size_t(t) - 1].vertices;
+    sum_f += info.levels[size_t(t) - 1].faces;
+  }
+  const uint64_t v =
+      std::min<uint64_t>(info.vertices, uint64_t(std::ceil(1.3 * sum_v / map.size())));
+  const uint64_t f = std::min<uint64_t>(info.faces, uint64_t(std::ceil(1.3 * sum_f / map.size())));
+  ASSERT_LT(v, info.vertices);                // a region, not the whole mesh
+  EXPECT_GE(v, probe->mesh().vertex_count()); // the estimate holds what was decoded
+  d = open(needs(v, f) - 1);
+  d->want_cluster(0, finest);
+  const auto [region_msg, region_kind] = refusal_of([&] { d->update(); });
+  EXPECT_EQ(region_kind, Error::Kind::MemoryLimit);
+  EXPECT_NE(region_msg.find("to about " + grouped_count(v) + " vertices and " + grouped_count(f) +
+                            " faces"),
+            std::string::npos)
+      << region_msg;
+  d = open(needs(v, f));
+  d->want_cluster(0, finest);
+  d->update();
+  EXPECT_EQ(d->levels(), map);
+
+  // Without a limit nothing is refused; a coarser request after a refusal still decodes.
+  d = open(base_needs);
+  d->want_cluster(0, finest);
+  EXPECT_THROW(d->update(), Error);
+  d->clear_wanted();
+  d->want_cluster(0, info.global_levels + 1);
+  EXPECT_EQ(refusal_of([&] { d->update(); }).first.empty(), needs(v, f) <= base_needs);
+  d = open(kNoMemoryLimit);
+  d->want_all(finest);
+  d->update();
+  EXPECT_EQ(d->mesh().vertex_count(), info.vertices);
+}
+
+TEST(MemoryCheck, SelectiveDecoderChecksAProgressiveFilesLevel) {
+  const Mesh mesh = gen::icosphere(4);
+  EncodeOptions eo;
+  eo.progressive = true;
+  const std::vector<uint8_t> file = encode(mesh, eo);
+  const FileInfo info = inspect(file.data(), file.size());
+  ASSERT_FALSE(info.clustered());
+  const uint64_t full = decode_memory_estimate(info.vertices, info.faces, false);
+  SelectiveOptions o;
+  o.memory_limit = full - 1;
+  SelectiveDecoder d(std::make_unique<MemorySource>(file.data(), file.size()), o);
+  d.want_all(int(info.levels.size()));
+  const auto [msg, kind] = refusal_of([&] { d.update(); });
+  EXPECT_EQ(kind, Error::Kind::MemoryLimit) << msg;
+  EXPECT_EQ(d.mesh().vertex_count(), info.base_vertices);
+  d.clear_wanted();
+  d.want_all(1); // the level table's counts of level 1 fit
+  d.update();
+  EXPECT_EQ(d.mesh().vertex_count(), info.levels[0].vertices);
 }
 
 } // namespace

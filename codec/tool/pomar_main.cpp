@@ -877,7 +877,7 @@ int main(int argc, char **argv) {
                 "denormals, zero normals included); colour is always exact. Without it a NaN "
                 "or infinite value or a zero-length normal is an error");
   enc->add_option("--max-memory", ea.max_memory,
-                  "Refuse (exit 1, no output file) a mesh whose loading and encoding would need "
+                  "Refuse (exit 7, no output file) a mesh whose loading and encoding would need "
                   "more than SIZE of memory, checked from the file's header before reading it: "
                   "bytes or a number with K, M, G, T (powers of 1024), e.g. 512M, 2G, 1.5GiB; "
                   "'none' = no check. Default 'auto': the memory available (the smallest of "
@@ -930,10 +930,11 @@ int main(int argc, char **argv) {
                 "texture coordinates (their codes, interleaved with the positions, are read "
                 "past without being decoded into values: less memory, a little less time)");
   dec->add_option("--max-memory", da.max_memory,
-                  "Refuse (exit 1, no output file) a file whose decoding would need more than "
-                  "SIZE of memory, checked from its header (with --cluster/--sphere/--box: for "
-                  "the base clustered mesh): as for encode, e.g. 512M, 2G, 'none'; default "
-                  "'auto' = the memory available")
+                  "Refuse (exit 7, no output file) a file whose decoding would need more than "
+                  "SIZE of memory, checked from its header (with --cluster/--sphere/--box: the "
+                  "base clustered mesh, then the clusters asked for, estimated from the level "
+                  "table): as for encode, e.g. 512M, 2G, 'none'; default 'auto' = the memory "
+                  "available")
       ->type_name("SIZE")
       ->capture_default_str();
 

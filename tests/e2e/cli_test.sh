@@ -601,6 +601,19 @@ done
 run decode "$WORK/mem/bunny.pomar" "$WORK/mem/out.ply" --max-memory 64M -q
 expect_rc 0
 expect_file "$WORK/mem/out.ply"
+rm -f "$WORK/mem/out.ply"
+
+section "decode --sphere/--cluster --max-memory: the region asked for is checked too"
+# 16M holds the base clustered mesh (14.0 MiB on two threads) and one cluster's
+# neighbourhood, not the whole mesh at full resolution (21.5 MiB).
+run decode "$WORK/mem/bunny.pomar" "$WORK/mem/out.ply" --sphere 0,0,0,10 --max-memory 16M --threads 2
+expect_rc 7
+expect_one_line_error
+expect_contains "$ERR" "not enough memory to refine the clusters asked for to about 34,834 vertices" "stderr"
+expect_no_file "$WORK/mem/out.ply"
+run decode "$WORK/mem/bunny.pomar" "$WORK/mem/out.ply" --cluster 0 --max-memory 16M --threads 2 -q
+expect_rc 0
+expect_file "$WORK/mem/out.ply"
 
 section "a PLY header claiming 2^31 (or 2^31 - 1) vertices with a tiny body"
 for count in 2147483648 2147483647; do

@@ -138,4 +138,14 @@ uint64_t decode_thread_memory(uint64_t vertices, uint64_t faces);
 void check_decode_memory(const FileInfo &info, int level, uint64_t limit,
                          const AttributeMask &keep = AttributeMask(), unsigned threads = 1);
 
+/// check_decode_memory for a selective decode's level map (SelectiveDecoder::update) of
+/// about `vertices` and `faces` (the decoder's estimate), of which `held` bytes are held
+/// already (the mesh decoded so far: what an automatic limit does not count again), plus
+/// lossless_decode_memory when the map is the full resolution (`full`) of a file with a
+/// lossless record (SelectiveDecoder::exact_mesh undoes the cut), with the action "refine
+/// the clusters asked for to about".
+void check_refine_memory(const FileInfo &info, uint64_t vertices, uint64_t faces, bool full,
+                         uint64_t held, uint64_t limit, const AttributeMask &keep = AttributeMask(),
+                         unsigned threads = 1);
+
 } // namespace pomar

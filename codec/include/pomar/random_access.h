@@ -72,8 +72,12 @@ struct SelectiveOptions {
   /// SelectiveDecoder::damaged()); the file may be truncated after its global part; every
   /// block is read whole so that its check is verified before it is decoded.
   bool skip_damaged = false;
-  /// Bytes the base clustered mesh may need (0 = automatic, UINT64_MAX = do not check; see
-  /// pomar/limits.h). Later refinement is not checked: it decodes what is asked for.
+  /// Bytes the decoding may need (0 = automatic, UINT64_MAX = do not check; see
+  /// pomar/limits.h): the constructor checks the base clustered mesh (progressive files:
+  /// the base mesh), update() each level map before decoding it (pomar::Error with
+  /// Kind::MemoryLimit, the mesh as it was). A map's counts are estimated from the level
+  /// table: exact when every cluster is at one level, for a region 1.3 times the average
+  /// cluster of each level (the clusters of a scan differ), at most the whole mesh.
   uint64_t memory_limit = 0;
   /// Which stored attributes mesh() returns (AttributeMask::none(): none). Their codes
   /// come with the positions, block by block: with none kept they are read past (no
@@ -128,7 +132,9 @@ public:
 
   /// Complete the level map (at most one level between neighbouring clusters, section 6)
   /// and bring the mesh to it: decode what is missing on top of the current state, or
-  /// re-decode from the base clustered mesh when some cluster must get coarser.
+  /// re-decode from the base clustered mesh when some cluster must get coarser. Throws
+  /// (Kind::MemoryLimit) before decoding anything if the map would need more memory than
+  /// SelectiveOptions::memory_limit.
   void update(const Progress &progress = {});
 
   /// The level map after update(): the level of every cluster.

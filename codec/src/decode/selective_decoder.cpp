@@ -7,6 +7,7 @@
 // level_schedule.h, LevelStep::traverse_cluster_level / apply_cluster_level): the mesh is
 // the same for any thread count.
 #include <algorithm>
+#include <cmath>
 
 #include "attributes/attribute_section.h"
 #include "decode/cluster_stream.h"
@@ -67,6 +68,7 @@ struct SelectiveDecoder::State {
   // the traversals of the batch being decoded.
   unsigned threads = 1;
   uint32_t min_parallel_vertices = 0; // SelectiveOptions::min_parallel_vertices
+  uint64_t memory_limit = 0;          // SelectiveOptions::memory_limit
   std::unique_ptr<ThreadPool> pool;
   std::vector<LevelStep> steps{1};
   std::vector<TraversedCluster> traversed;
@@ -85,6 +87,7 @@ struct SelectiveDecoder::State {
   LevelSchedule schedule;
   DecoderCodec cluster_codec(uint32_t c, int level);
   void decode_target(const Progress &progress, uint32_t &decoding);
+  void check_target_memory() const;
   void check_cluster_data();
   bool skip_cluster(uint32_t c, const Error &e);
   std::vector<int> target; // the level map being decoded
@@ -240,6 +243,7 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   s.skip_damaged = options.skip_damaged;
   s.threads = decode_threads(options.threads);
   s.min_parallel_vertices = options.min_parallel_vertices;
+  s.memory_limit = options.memory_limit;
   s.attribute_mask = options.attributes;
   const uint64_t file_size = s.source->size();
   // Header: the fixed part, then as much more as header_size() asks for (version 4 needs
@@ -442,6 +446,9 @@ void SelectiveDecoder::update(const Progress &progress) {
     int have = 0;
     for (const LevelMesh::Lineage &t : s.mesh.lineage)
       have = std::max(have, int(t.level));
+    const int want_now = std::min(s.uniform_level, s.uniform_cap);
+    if (want_now > have) // (before anything changes; exact counts: the level table's)
+      check_decode_memory(s.info, want_now, s.memory_limit, s.attribute_mask, 1);
     if (s.uniform_level < have) {
       s.mesh = s.snapshot;
       s.global_models = Models();
@@ -449,7 +456,7 @@ void SelectiveDecoder::update(const Progress &progress) {
         s.global_models.attr = attribute_models(*s.attributes);
       have = 0;
     }
-    const size_t want = size_t(std::min(s.uniform_level, s.uniform_cap));
+    const size_t want = size_t(want_now);
     const size_t reached =
         decode_global_levels(s.global.data(), s.layout, size_t(have), want, s.mesh, s.global_models,
                              progress, s.skip_damaged ? &s.damaged : nullptr);
@@ -482,6 +489,7 @@ void SelectiveDecoder::State::decode_target(const Progress &progress, uint32_t &
     for (size_t c = 0; c < target.size(); ++c)
       target[c] = std::min(target[c], limit[c]);
   }
+  check_target_memory();
   bool coarser = false;
   for (size_t c = 0; c < target.size(); ++c)
     coarser = coarser || target[c] < clusters[c].level;
@@ -536,6 +544,42 @@ void SelectiveDecoder::State::decode_target(const Progress &progress, uint32_t &
   }
   levels = target;
   check_cluster_data();
+}
+
+/// Refuse (pomar::Error, Kind::MemoryLimit) a level map `target` that would need more
+/// memory than the limit, before anything is decoded (the mesh stays as it is). Its counts
+/// are estimated from the level table: each cluster at level t holds the average of level
+/// t (its vertices and faces over the clusters). That is exact for a whole-mesh level; for
+/// a region the clusters differ (the dragon: regions of 1,600-2,500 clusters held 1.12-1.31
+/// times the average, a region of almost every cluster 0.90 times), so a region's average
+/// is taken 1.3 times, at most the whole mesh at the map's finest level (which holds more
+/// than any region at that level or below).
+void SelectiveDecoder::State::check_target_memory() const {
+  bool finer = false; // (nothing to decode: nothing to check)
+  for (size_t c = 0; c < target.size(); ++c)
+    finer = finer || target[c] > clusters[c].level;
+  if (memory_limit == kNoMemoryLimit || !finer)
+    return;
+  const auto counts = [&](int level) { // of the whole mesh at `level`
+    return level == 0 ? std::pair<double, double>(info.base_vertices, info.base_faces)
+                      : std::pair<double, double>(info.levels[size_t(level) - 1].vertices,
+                                                  info.levels[size_t(level) - 1].faces);
+  };
+  const auto [lo, hi] = std::minmax_element(target.begin(), target.end());
+  auto [v, f] = counts(*hi); // a whole-mesh level: exact
+  if (*lo != *hi) {
+    double sum_v = 0, sum_f = 0;
+    for (int t : target) {
+      sum_v += counts(t).first;
+      sum_f += counts(t).second;
+    }
+    const double n = double(target.size());
+    v = std::min(v, std::ceil(1.3 * sum_v / n));
+    f = std::min(f, std::ceil(1.3 * sum_f / n));
+  }
+  const uint64_t held = decode_memory_estimate(mesh.vertex_count(), mesh.ct.face_count(), true);
+  check_refine_memory(info, uint64_t(v), uint64_t(f), *lo == finest, held, memory_limit,
+                      attribute_mask, threads);
 }
 
 /// Once every block has been read whole (a full decode), check them together against the
