@@ -609,22 +609,34 @@ TEST(MemoryCheck, SelectiveDecoderChecksEachLevelMapBeforeDecodingIt) {
   d->update();
   EXPECT_EQ(d->mesh().vertex_count(), info.vertices);
 
-  // One cluster: its completed level map, each cluster at level t counted 1.3 times the
-  // average of level t (at most the whole mesh at the map's finest level).
-  auto probe = open(kNoMemoryLimit);
-  probe->want_cluster(0, finest);
-  probe->update();
-  const std::vector<int> map = probe->levels();
-  double sum_v = 0, sum_f = 0;
-  for (int t : map) {
-    sum_v += info.levels[size_t(t) - 1].vertices;
-    sum_f += info.levels[size_t(t) - 1].faces;
-  }
-  const uint64_t v =
-      std::min<uint64_t>(info.vertices, uint64_t(std::ceil(1.3 * sum_v / map.size())));
-  const uint64_t f = std::min<uint64_t>(info.faces, uint64_t(std::ceil(1.3 * sum_f / map.size())));
-  ASSERT_LT(v, info.vertices);                // a region, not the whole mesh
-  EXPECT_GE(v, probe->mesh().vertex_count()); // the estimate holds what was decoded
+  // A region: the base clustered mesh plus, per cluster at a finer level t, 1.3 times the
+  // average growth of a cluster from the base clustered level to t (at most the whole mesh
+  // at the map's finest level), for the map completed around the request.
+  const auto estimate = [&](const std::vector<int> &map) {
+    double grow_v = 0, grow_f = 0;
+    for (int t : map) {
+      grow_v += double(info.levels[size_t(t) - 1].vertices) - base.vertices;
+      grow_f += double(info.levels[size_t(t) - 1].faces) - base.faces;
+    }
+    const int top = *std::max_element(map.begin(), map.end());
+    const LevelInfo &at_top = info.levels[size_t(top) - 1];
+    return std::pair<uint64_t, uint64_t>(
+        std::min<uint64_t>(at_top.vertices,
+                           base.vertices + uint64_t(std::ceil(1.3 * grow_v / map.size()))),
+        std::min<uint64_t>(at_top.faces,
+                           base.faces + uint64_t(std::ceil(1.3 * grow_f / map.size()))));
+  };
+  const auto map_of = [&](uint32_t cluster, int level) { // decoded without a limit
+    auto probe = open(kNoMemoryLimit);
+    probe->want_cluster(cluster, level);
+    probe->update();
+    return std::make_pair(probe->levels(), probe->mesh().vertex_count());
+  };
+  const auto [map, decoded] = map_of(0, finest);
+  const auto [v, f] = estimate(map);
+  ASSERT_LT(v, info.vertices); // a region, not the whole mesh
+  EXPECT_GE(v, decoded);       // the estimate holds what was decoded
+  EXPECT_LT(v, 2 * decoded);   // and not much more (icosphere clusters are even)
   d = open(needs(v, f) - 1);
   d->want_cluster(0, finest);
   const auto [region_msg, region_kind] = refusal_of([&] { d->update(); });
@@ -633,18 +645,25 @@ TEST(MemoryCheck, SelectiveDecoderChecksEachLevelMapBeforeDecodingIt) {
                             " faces"),
             std::string::npos)
       << region_msg;
+  EXPECT_EQ(d->clusters_decoded(), 0u);
   d = open(needs(v, f));
   d->want_cluster(0, finest);
   d->update();
   EXPECT_EQ(d->levels(), map);
 
-  // Without a limit nothing is refused; a coarser request after a refusal still decodes.
-  d = open(base_needs);
+  // After a refusal, a smaller request that fits decodes; without a limit nothing is
+  // refused.
+  const auto [near_map, near_decoded] = map_of(0, info.global_levels + 2);
+  const auto [near_v, near_f] = estimate(near_map);
+  ASSERT_LT(needs(near_v, near_f), needs(v, f));
+  d = open(needs(near_v, near_f));
   d->want_cluster(0, finest);
-  EXPECT_THROW(d->update(), Error);
+  EXPECT_EQ(refusal_of([&] { d->update(); }).second, Error::Kind::MemoryLimit);
   d->clear_wanted();
-  d->want_cluster(0, info.global_levels + 1);
-  EXPECT_EQ(refusal_of([&] { d->update(); }).first.empty(), needs(v, f) <= base_needs);
+  d->want_cluster(0, info.global_levels + 2);
+  d->update();
+  EXPECT_EQ(d->levels(), near_map);
+  EXPECT_EQ(d->mesh().vertex_count(), near_decoded);
   d = open(kNoMemoryLimit);
   d->want_all(finest);
   d->update();

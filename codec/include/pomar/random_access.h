@@ -76,8 +76,9 @@ struct SelectiveOptions {
   /// pomar/limits.h): the constructor checks the base clustered mesh (progressive files:
   /// the base mesh), update() each level map before decoding it (pomar::Error with
   /// Kind::MemoryLimit, the mesh as it was). A map's counts are estimated from the level
-  /// table: exact when every cluster is at one level, for a region 1.3 times the average
-  /// cluster of each level (the clusters of a scan differ), at most the whole mesh.
+  /// table: exact when every cluster is at one level; for a region, the base clustered
+  /// mesh plus 1.3 times the average growth of a cluster to each refined cluster's level
+  /// (the clusters of a scan differ), at most the whole mesh at the map's finest level.
   uint64_t memory_limit = 0;
   /// Which stored attributes mesh() returns (AttributeMask::none(): none). Their codes
   /// come with the positions, block by block: with none kept they are read past (no
