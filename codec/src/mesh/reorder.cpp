@@ -1,5 +1,6 @@
 #include "mesh/reorder.h"
 #include "memory/prefault.h"
+#include "mesh/introsort.h"
 #include "mesh/radix_sort.h"
 
 #include <algorithm>
@@ -44,9 +45,11 @@ std::vector<uint32_t> reorder_vertices(std::vector<int32_t> &q, std::vector<uint
 }
 
 std::vector<uint32_t> face_order(const std::vector<uint32_t> &t) {
-  // std::sort's moves depend only on its comparisons' results, so sorting (smallest vertex,
+  // A sort's moves depend only on its comparisons' results, so sorting (smallest vertex,
   // face) pairs with the same comparison gives the order sorting the faces does (ties
-  // included) while each comparison reads one number instead of six.
+  // included) while each comparison reads one number instead of six. Faces tie on their
+  // smallest vertex: introsort leaves them in one order on every platform (mesh/
+  // introsort.h).
   struct Face {
     uint32_t lowest, f;
   };
@@ -54,7 +57,7 @@ std::vector<uint32_t> face_order(const std::vector<uint32_t> &t) {
   std::vector<Face> faces = filled_vector<Face>(nf);
   for (size_t f = 0; f < nf; ++f)
     faces[f] = {std::min({t[3 * f], t[3 * f + 1], t[3 * f + 2]}), static_cast<uint32_t>(f)};
-  std::sort(faces.begin(), faces.end(),
+  introsort(faces.data(), faces.data() + faces.size(),
             [](const Face &a, const Face &b) { return a.lowest < b.lowest; });
   std::vector<uint32_t> order = filled_vector<uint32_t>(nf);
   for (size_t i = 0; i < nf; ++i)

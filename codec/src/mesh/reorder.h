@@ -18,8 +18,9 @@ namespace pomar {
 /// (their order unchanged).
 std::vector<uint32_t> reorder_vertices(std::vector<int32_t> &q, std::vector<uint32_t> &triangles);
 
-/// The faces of `triangles` sorted by their smallest vertex, as std::sort leaves them
-/// (ties included): order[i] is the face that goes i-th.
+/// The faces of `triangles` sorted by their smallest vertex, as introsort leaves them
+/// (ties included, the same on every platform: mesh/introsort.h): order[i] is the face
+/// that goes i-th.
 std::vector<uint32_t> face_order(const std::vector<uint32_t> &triangles);
 
 /// Renumber the faces of `ct` (built by build_corner_table) so that face order[i] becomes

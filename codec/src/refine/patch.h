@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "mesh/corner_table.h"
+#include "mesh/introsort.h"
 #include "refine/level_mesh.h"
 
 namespace pomar {
@@ -64,12 +65,12 @@ void rank_edges(const Ring &ring, const Spoke *spokes, std::vector<uint32_t> &ra
       return spokes[a].len2 > spokes[b].len2;
     return key(ring.neighbour[a]) < key(ring.neighbour[b]);
   };
-  if (m > 16) {
-    std::sort(r, r + m, before);
+  if (m > 16) { // (a view ring can name one neighbour twice: the tie's order is coded)
+    introsort(r, r + m, before);
     return;
   }
-  // What std::sort does with 16 elements or fewer, inlined: an insertion sort. (A view
-  // ring can name one neighbour twice: such ties must stay in std::sort's order.)
+  // What introsort does with 16 elements or fewer, inlined: an insertion sort. (A view
+  // ring can name one neighbour twice: such ties must stay in that order.)
   for (uint32_t i = 1; i < m; ++i) {
     const uint32_t x = r[i];
     uint32_t j = i;
