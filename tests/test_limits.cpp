@@ -511,11 +511,17 @@ TEST(MemoryCheck, EncodeRefusesBeforeWorkingAndHonoursNone) {
             std::string::npos);
 }
 
-TEST(MemoryCheck, DecodeAndSelectiveDecoderRefuseAfterTheHeader) {
-  const Mesh mesh = gen::icosphere(4);
+/// An icosphere of `subdivisions` encoded with about `clusters` clusters (0: pure
+/// progressive).
+std::vector<uint8_t> icosphere_file(int subdivisions, uint32_t clusters) {
   EncodeOptions eo;
-  eo.clusters = 8;
-  const std::vector<uint8_t> file = encode(mesh, eo);
+  eo.clusters = clusters;
+  eo.progressive = clusters == 0;
+  return encode(gen::icosphere(subdivisions), eo);
+}
+
+TEST(MemoryCheck, DecodeAndSelectiveDecoderRefuseAfterTheHeader) {
+  const std::vector<uint8_t> file = icosphere_file(4, 8);
   const FileInfo info = inspect(file.data(), file.size());
   ASSERT_TRUE(info.clustered());
   // Full resolution needs the full estimate; level 0 only the base mesh's.
@@ -569,10 +575,7 @@ template <class F> std::pair<std::string, Error::Kind> refusal_of(F f) {
 }
 
 TEST(MemoryCheck, SelectiveDecoderChecksEachLevelMapBeforeDecodingIt) {
-  const Mesh mesh = gen::icosphere(5);
-  EncodeOptions eo;
-  eo.clusters = 64;
-  const std::vector<uint8_t> file = encode(mesh, eo);
+  const std::vector<uint8_t> file = icosphere_file(5, 64);
   const FileInfo info = inspect(file.data(), file.size());
   ASSERT_TRUE(info.clustered());
   const int finest = int(info.levels.size());
@@ -671,10 +674,7 @@ TEST(MemoryCheck, SelectiveDecoderChecksEachLevelMapBeforeDecodingIt) {
 }
 
 TEST(MemoryCheck, SelectiveDecoderChecksAProgressiveFilesLevel) {
-  const Mesh mesh = gen::icosphere(4);
-  EncodeOptions eo;
-  eo.progressive = true;
-  const std::vector<uint8_t> file = encode(mesh, eo);
+  const std::vector<uint8_t> file = icosphere_file(4, 0);
   const FileInfo info = inspect(file.data(), file.size());
   ASSERT_FALSE(info.clustered());
   const uint64_t full = decode_memory_estimate(info.vertices, info.faces, false);
