@@ -480,14 +480,17 @@ uint64_t decode_thread_memory(uint64_t /*vertices: no per-vertex part since the 
 }
 
 namespace {
-/// What decoding a mesh of these counts from the file `info` describes needs, the lossless
-/// stage aside: the mesh, its attributes, the threads past the first.
-uint64_t decode_needs(const FileInfo &info, uint64_t v, uint64_t f, const AttributeMask &keep,
-                      unsigned threads) {
+/// What decoding a mesh of these counts from the file `info` describes needs: the mesh,
+/// its attributes, the threads past the first and, at full resolution (`full`) of a file
+/// with a lossless record, undoing the cut.
+uint64_t decode_needs(const FileInfo &info, uint64_t v, uint64_t f, bool full,
+                      const AttributeMask &keep, unsigned threads) {
   uint64_t needed = add_mul(decode_memory_estimate(v, f, info.clustered()), v,
                             decode_attribute_bytes_per_vertex(info, keep));
   if (info.clustered() && threads > 1)
     needed = add_mul(needed, threads - 1, decode_thread_memory(v, f));
+  if (full && info.lossless_bytes > 0)
+    needed = add_mul(needed, 1, lossless_decode_memory(info.input_vertices, info.input_faces));
   return needed;
 }
 } // namespace
@@ -500,20 +503,15 @@ void check_decode_memory(const FileInfo &info, int level, uint64_t limit, const 
   } else if (level > 0 && static_cast<size_t>(level) <= info.levels.size()) {
     v = info.levels[size_t(level) - 1].vertices, f = info.levels[size_t(level) - 1].faces;
   }
-  uint64_t needed = decode_needs(info, v, f, keep, threads);
   const bool full = level < 0 || static_cast<size_t>(level) >= info.levels.size();
-  if (full && info.lossless_bytes > 0) // the cut undone
-    needed = add_mul(needed, 1, lossless_decode_memory(info.input_vertices, info.input_faces));
-  check_memory("decode", v, f, needed, 0, limit);
+  check_memory("decode", v, f, decode_needs(info, v, f, full, keep, threads), 0, limit);
 }
 
 void check_refine_memory(const FileInfo &info, uint64_t vertices, uint64_t faces, bool full,
                          uint64_t held, uint64_t limit, const AttributeMask &keep,
                          unsigned threads) {
-  uint64_t needed = decode_needs(info, vertices, faces, keep, threads);
-  if (full && info.lossless_bytes > 0)
-    needed = add_mul(needed, 1, lossless_decode_memory(info.input_vertices, info.input_faces));
-  check_memory("refine the clusters asked for to about", vertices, faces, needed, held, limit);
+  check_memory("refine the clusters asked for to about", vertices, faces,
+               decode_needs(info, vertices, faces, full, keep, threads), held, limit);
 }
 
 } // namespace pomar
