@@ -179,6 +179,10 @@ class SelectiveDecoder(_pomar.SelectiveDecoder):
         part = d.mesh()                          # + d.vertex_cluster(), d.vertex_level()
         d.bytes_read
 
+    memory_limit (as for decode()) is checked by the constructor for the base clustered
+    mesh and by update() for each level map before it is decoded (pomar.Error, kind
+    "memory_limit", the mesh as it was).
+
     One thread at a time per decoder (calls from several threads wait for each other);
     update() decodes the clusters of a level on `threads` threads of its own (keyword of
     the constructor, 0 = every core this process may use; the mesh does not depend on it).

@@ -165,6 +165,25 @@ def test_selective_decoder(tmp_path, bunny):
         assert d.bytes_read == info["total_bytes"]
 
 
+def test_selective_decoder_checks_each_update_against_memory_limit(bunny):
+    data = pomar.encode(bunny)
+    # 12 MiB holds the base clustered mesh (8.0 MiB on one thread) and one cluster's
+    # neighbourhood, not the whole mesh at full resolution (15.2 MiB; the C++ tests check
+    # the estimates).
+    d = pomar.SelectiveDecoder(data, memory_limit="12M", threads=1)
+    base = len(d.mesh().vertices)
+    d.want_all()
+    with pytest.raises(pomar.Error) as e:
+        d.update()
+    assert e.value.kind == "memory_limit"
+    assert "refine the clusters asked for" in str(e.value)
+    assert len(d.mesh().vertices) == base  # nothing decoded
+    d = pomar.SelectiveDecoder(data, memory_limit="12M", threads=1)
+    d.want_cluster(0)
+    d.update()
+    assert len(d.mesh().vertices) > base
+
+
 def test_bad_arrays_raise_clear_errors():
     vertices, faces = torus()
     with pytest.raises(TypeError, match=r"vertices must have dtype float32, not float64.*astype"):
