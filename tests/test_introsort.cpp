@@ -87,7 +87,7 @@ TEST(Introsort, HeapSortIsGccsPartialSortOfTheWholeRange) {
   for (size_t n : {0, 1, 2, 3, 16, 17, 33, 64, 1000, 12345})
     for (const std::vector<uint32_t> &keys : inputs(n, rng)) {
       std::vector<Item> ours = items(keys), reference = ours;
-      introsort_heap_path(ours.data(), ours.data() + ours.size(), by_key);
+      introsort_detail::heap_sort(ours.data(), ours.data() + ours.size(), by_key);
       expect_sorted(ours);
 #ifdef __GLIBCXX__
       std::partial_sort(reference.begin(), reference.end(), reference.end(), by_key);

@@ -7,7 +7,6 @@
 // level_schedule.h, LevelStep::traverse_cluster_level / apply_cluster_level): the mesh is
 // the same for any thread count.
 #include <algorithm>
-#include <cmath>
 
 #include "attributes/attribute_section.h"
 #include "decode/cluster_stream.h"
@@ -547,41 +546,16 @@ void SelectiveDecoder::State::decode_target(const Progress &progress, uint32_t &
 }
 
 /// Refuse (pomar::Error, Kind::MemoryLimit) a level map `target` that would need more
-/// memory than the limit, before anything is decoded (the mesh stays as it is). Its counts
-/// are estimated from the level table. A whole-mesh level: that level's counts, exact.
-/// Otherwise the base clustered mesh (exact: one vertex per cluster) plus, for each
-/// cluster at a finer level t, 1.3 times the average growth of a cluster from the base
-/// clustered level to t (the clusters of a scan differ: on the dragon, regions of 1,600-
-/// 2,500 clusters grew 1.13-1.37 times the average, one of almost every cluster 0.89
-/// times), at most the whole mesh at the map's finest level (which holds more than any
-/// region at that level or below).
+/// memory than the limit (pomar/limits.h: check_level_map_memory), before anything is
+/// decoded (the mesh stays as it is).
 void SelectiveDecoder::State::check_target_memory() const {
   bool finer = false; // (nothing to decode: nothing to check)
   for (size_t c = 0; c < target.size(); ++c)
     finer = finer || target[c] > clusters[c].level;
   if (memory_limit == kNoMemoryLimit || !finer)
     return;
-  const auto counts = [&](int level) { // of the whole mesh at `level`
-    return level == 0 ? std::pair<double, double>(info.base_vertices, info.base_faces)
-                      : std::pair<double, double>(info.levels[size_t(level) - 1].vertices,
-                                                  info.levels[size_t(level) - 1].faces);
-  };
-  const auto [lo, hi] = std::minmax_element(target.begin(), target.end());
-  auto [v, f] = counts(*hi); // a whole-mesh level: exact
-  if (*lo != *hi) {
-    const auto [base_v, base_f] = counts(global_levels);
-    double grow_v = 0, grow_f = 0; // of the whole mesh, summed over the clusters' levels
-    for (int t : target) {
-      grow_v += counts(t).first - base_v;
-      grow_f += counts(t).second - base_f;
-    }
-    const double n = double(target.size());
-    v = std::min(v, base_v + std::ceil(1.3 * grow_v / n));
-    f = std::min(f, base_f + std::ceil(1.3 * grow_f / n));
-  }
   const uint64_t held = decode_memory_estimate(mesh.vertex_count(), mesh.ct.face_count(), true);
-  check_refine_memory(info, uint64_t(v), uint64_t(f), *lo == finest, held, memory_limit,
-                      attribute_mask, threads);
+  check_level_map_memory(info, target, global_levels, held, memory_limit, attribute_mask, threads);
 }
 
 /// Once every block has been read whole (a full decode), check them together against the

@@ -493,25 +493,47 @@ uint64_t decode_needs(const FileInfo &info, uint64_t v, uint64_t f, bool full,
     needed = add_mul(needed, 1, lossless_decode_memory(info.input_vertices, info.input_faces));
   return needed;
 }
+
+/// The whole mesh's vertex and face counts after `level` levels (0: the base mesh; out of
+/// range: full resolution).
+std::pair<uint64_t, uint64_t> counts_at(const FileInfo &info, int level) {
+  if (level == 0)
+    return {info.base_vertices, info.base_faces};
+  if (level > 0 && static_cast<size_t>(level) <= info.levels.size())
+    return {info.levels[size_t(level) - 1].vertices, info.levels[size_t(level) - 1].faces};
+  return {info.vertices, info.faces};
+}
 } // namespace
 
 void check_decode_memory(const FileInfo &info, int level, uint64_t limit, const AttributeMask &keep,
                          unsigned threads) {
-  uint64_t v = info.vertices, f = info.faces;
-  if (level == 0) {
-    v = info.base_vertices, f = info.base_faces;
-  } else if (level > 0 && static_cast<size_t>(level) <= info.levels.size()) {
-    v = info.levels[size_t(level) - 1].vertices, f = info.levels[size_t(level) - 1].faces;
-  }
+  const auto [v, f] = counts_at(info, level);
   const bool full = level < 0 || static_cast<size_t>(level) >= info.levels.size();
   check_memory("decode", v, f, decode_needs(info, v, f, full, keep, threads), 0, limit);
 }
 
-void check_refine_memory(const FileInfo &info, uint64_t vertices, uint64_t faces, bool full,
-                         uint64_t held, uint64_t limit, const AttributeMask &keep,
-                         unsigned threads) {
-  check_memory("refine the clusters asked for to about", vertices, faces,
-               decode_needs(info, vertices, faces, full, keep, threads), held, limit);
+void check_level_map_memory(const FileInfo &info, const std::vector<int> &levels, int base_level,
+                            uint64_t held, uint64_t limit, const AttributeMask &keep,
+                            unsigned threads) {
+  if (levels.empty())
+    return;
+  const auto [lo, hi] = std::minmax_element(levels.begin(), levels.end());
+  auto [v, f] = counts_at(info, *hi); // a whole-mesh level: exact
+  if (*lo != *hi) {
+    const auto [base_v, base_f] = counts_at(info, base_level);
+    double grow_v = 0, grow_f = 0; // (sums of 32-bit counts over the clusters: doubles)
+    for (int t : levels) {
+      const auto [tv, tf] = counts_at(info, t);
+      grow_v += double(tv) - double(base_v);
+      grow_f += double(tf) - double(base_f);
+    }
+    const double n = double(levels.size());
+    v = std::min(v, base_v + uint64_t(std::ceil(1.3 * grow_v / n)));
+    f = std::min(f, base_f + uint64_t(std::ceil(1.3 * grow_f / n)));
+  }
+  const bool full = static_cast<size_t>(*lo) >= info.levels.size();
+  check_memory("refine the clusters asked for to about", v, f,
+               decode_needs(info, v, f, full, keep, threads), held, limit);
 }
 
 } // namespace pomar

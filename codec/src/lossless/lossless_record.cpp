@@ -14,6 +14,7 @@
 #include "attributes/vertex_rows.h"
 #include "entropy/models.h"
 #include "entropy/range_coder.h"
+#include "memory/prefault.h"
 #include "mesh/corner_table.h"
 #include "mesh/radix_sort.h"
 
@@ -295,9 +296,9 @@ std::vector<uint32_t> canonical_face_order(const std::vector<uint32_t> &t) {
   int bits = 1;
   while (bits < 32 && (top >> bits) != 0)
     ++bits;
-  std::vector<uint32_t> order(nf);
+  std::vector<uint32_t> order = filled_vector<uint32_t>(nf); // (memory/prefault.h)
   if (3 * bits <= 64) {
-    std::vector<Keyed> key(nf);
+    std::vector<Keyed> key = filled_vector<Keyed>(nf);
     for (uint32_t f = 0; f < nf; ++f) {
       uint32_t k[3];
       rotated(f, k);

@@ -187,9 +187,4 @@ template <class T, class Less> void introsort(T *first, T *last, const Less &les
   }
 }
 
-/// The heap-sort fallback alone, for the tests (std::partial_sort over a whole range).
-template <class T, class Less> void introsort_heap_path(T *first, T *last, const Less &less) {
-  introsort_detail::heap_sort(first, last, less);
-}
-
 } // namespace pomar
