@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <numeric>
 #include <string>
 
 #include "format/file_format.h"
@@ -65,7 +66,8 @@ void usable_attributes_for_unused_vertices(Mesh &cut) {
   const size_t nv = cut.vertex_count();
   std::vector<uint8_t> used(nv, 0);
   for (uint32_t v : cut.triangles)
-    used[v] = 1;
+    if (v < nv) // (an index out of range is the manifold encoder's to name)
+      used[v] = 1;
   for (VertexAttribute &a : cut.attributes) {
     if (a.kind == AttributeKind::Colour || a.values.size() != nv * a.components)
       continue;
@@ -127,13 +129,9 @@ LosslessRecord build_lossless_record(const Mesh &input, const Mesh &cut, const R
   std::vector<uint32_t> first(nv, kNone), input_to_output(nv, kNone);
   std::vector<uint32_t> cut_to_decoded(cut.vertex_count(), kNone);
   output_to_input.clear();
-  decoded.positions.resize(3 * size_t(nd));
   for (uint32_t d = 0; d < nd; ++d) {
     const uint32_t c = decoded_to_cut[d], v = input_of_cut(c);
     cut_to_decoded[c] = d;
-    for (int k = 0; k < 3; ++k)
-      decoded.positions[3 * size_t(d) + k] =
-          grid.dequantize(k, grid.quantize(k, cut.positions[3 * size_t(c) + k]));
     if (first[v] != kNone) {
       r.copies.push_back({d, first[v]});
       continue;
@@ -176,11 +174,31 @@ LosslessRecord build_lossless_record(const Mesh &input, const Mesh &cut, const R
       r.extra_attributes.push_back(std::move(x));
     }
 
-  // Faces of D, and where each cut face comes in D's canonical order.
+  // D itself (what write_lossless_record reads of it: the positions to place vertex
+  // copies, the faces to apply the record before coding the input's order), and where
+  // each cut face comes in D's canonical order (to name flipped and duplicated faces). A
+  // cut that only left vertices unreferenced needs neither (a scan's stray points).
   const uint32_t nf = static_cast<uint32_t>(cut.triangle_count());
-  decoded.triangles.resize(cut.triangles.size());
-  for (size_t c = 0; c < cut.triangles.size(); ++c)
-    decoded.triangles[c] = cut_to_decoded[cut.triangles[c]];
+  const uint32_t input_faces = static_cast<uint32_t>(input.triangle_count());
+  const bool faces_changed =
+      nf != input_faces || std::find(map.flipped.begin(), map.flipped.end(), 1) != map.flipped.end();
+  if (!r.copies.empty() || keep_order) {
+    decoded.positions.resize(3 * size_t(nd));
+    for (uint32_t d = 0; d < nd; ++d)
+      for (int k = 0; k < 3; ++k)
+        decoded.positions[3 * size_t(d) + k] = grid.dequantize(
+            k, grid.quantize(k, cut.positions[3 * size_t(decoded_to_cut[d]) + k]));
+  }
+  if (faces_changed || keep_order) {
+    decoded.triangles.resize(cut.triangles.size());
+    for (size_t c = 0; c < cut.triangles.size(); ++c)
+      decoded.triangles[c] = cut_to_decoded[cut.triangles[c]];
+  }
+  if (!faces_changed) {
+    if (keep_order)
+      r.order = output_to_input;
+    return r;
+  }
   const std::vector<uint32_t> order = canonical_face_order(decoded.triangles);
   std::vector<uint32_t> rank(nf);
   for (uint32_t i = 0; i < nf; ++i)
@@ -192,7 +210,6 @@ LosslessRecord build_lossless_record(const Mesh &input, const Mesh &cut, const R
 
   // Removed input faces: repeating a vertex, or an exact duplicate of a kept face (the one
   // with the same rotated vertices in input numbering).
-  const uint32_t input_faces = static_cast<uint32_t>(input.triangle_count());
   std::vector<uint8_t> kept(input_faces, 0);
   std::vector<std::pair<Key, uint32_t>> kept_keys(nf);
   for (uint32_t f = 0; f < nf; ++f) {
@@ -242,6 +259,8 @@ std::vector<uint8_t> encode_any(const Mesh &mesh, const EncodeOptions &options,
   if (options.strict)
     return encode_manifold(mesh, options, report, nullptr, release);
 
+  // Whether the topology is known to be one the manifold encoder takes as it is.
+  bool valid = true;
   if (!options.keep_order && all_vertices_used(mesh)) {
     // Most meshes are clean: code them as they are (the file is then byte for byte what
     // strict gives). The manifold encoder checks the topology early (its corner table),
@@ -252,20 +271,15 @@ std::vector<uint8_t> encode_any(const Mesh &mesh, const EncodeOptions &options,
     } catch (const Error &) {
       if (released || mesh.triangles.size() % 3 || valid_topology(mesh))
         throw; // not a matter of topology: the error stands
+      valid = false;
     }
   }
 
   const size_t nv = mesh.vertex_count();
   check_encode_input(mesh, options); // unreferenced vertices included
-  Mesh cut = mesh;
+  Mesh cut;
   RepairMap map;
-  const RepairReport repair = make_manifold(cut, &map); // checks the indices
-  usable_attributes_for_unused_vertices(cut);
-  if (cut.triangle_count() == 0)
-    throw Error(Error::Kind::InvalidMesh, "the mesh has no valid triangle: all " +
-                                              std::to_string(mesh.triangle_count()) +
-                                              " faces repeat a vertex");
-
+  RepairReport repair;
   LosslessHook hook;
   hook.grid = make_quantizer(mesh.positions.data(), nv, options.bits);
   LosslessRecord record;
@@ -276,7 +290,42 @@ std::vector<uint8_t> encode_any(const Mesh &mesh, const EncodeOptions &options,
                                    decoded, output_to_input);
     return write_lossless_record(record, decoded);
   };
-  std::vector<uint8_t> file = encode_manifold(cut, options, report, &hook);
+  // The cut (make_manifold) and the record's coding. On a mesh whose topology may be valid
+  // (unreferenced vertices, or the order kept) the cut is first taken to be the mesh itself:
+  // make_manifold leaves such a mesh as it is, and the manifold encoder's corner table says
+  // whether it is (a scan's stray points then cost no topology analysis); if the encoder
+  // refuses it and the topology is the reason, the mesh is cut after all.
+  const auto cut_and_encode = [&](bool cut_needed) {
+    cut = mesh;
+    map = RepairMap();
+    repair = RepairReport();
+    decoded = Mesh();
+    if (cut_needed) {
+      repair = make_manifold(cut, &map); // checks the indices
+    } else {
+      map.face_origin.resize(mesh.triangle_count());
+      std::iota(map.face_origin.begin(), map.face_origin.end(), 0u);
+      map.flipped.assign(mesh.triangle_count(), 0);
+    }
+    usable_attributes_for_unused_vertices(cut);
+    if (cut.triangle_count() == 0)
+      throw Error(Error::Kind::InvalidMesh, "the mesh has no valid triangle: all " +
+                                                std::to_string(mesh.triangle_count()) +
+                                                " faces repeat a vertex");
+    return encode_manifold(cut, options, report, &hook);
+  };
+  std::vector<uint8_t> file;
+  if (valid) {
+    try {
+      file = cut_and_encode(false);
+    } catch (const Error &) {
+      if (mesh.triangles.size() % 3 || valid_topology(mesh))
+        throw; // not a matter of topology: the error stands
+      valid = false;
+    }
+  }
+  if (!valid)
+    file = cut_and_encode(true);
   if (report) {
     LosslessReport &l = report->lossless;
     l = LosslessReport();

@@ -38,7 +38,9 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
 void check_encode_input(const Mesh &mesh, const EncodeOptions &options);
 
 /// The record for `input` cut into `cut` by make_manifold (with `map`), when a full decode
-/// numbers cut vertex decoded_to_cut[i] as i. `decoded` receives that full decode (D) and
+/// numbers cut vertex decoded_to_cut[i] as i. `decoded` receives of that full decode (D)
+/// what write_lossless_record reads (positions if there are vertex copies or the order is
+/// kept, triangles if faces were flipped or removed or the order is kept) and
 /// `output_to_input` what input vertex each vertex of the decoded output is.
 LosslessRecord build_lossless_record(const Mesh &input, const Mesh &cut, const RepairMap &map,
                                      const std::vector<uint32_t> &decoded_to_cut,
