@@ -22,6 +22,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "io/io_common.h"
 #include "support/mesh_gen.h"
 #include "support/temp_dir.h"
 
@@ -630,6 +631,56 @@ void expect_same_load(const Mesh &fast, const LoadReport &fast_report, const Mes
 // here for the same data by an extra empty element) for every way of writing a number,
 // decline what it does not take ('+', hex, overflow, junk: the general path decides) and
 // count unreferenced vertices the same.
+// parse_float (every general reader's decimal numbers: PLY ASCII walk, OFF, ASCII STL)
+// takes plain decimal text through from_chars and the rest through strtof: it must give
+// strtof's float, bit for bit, and accept and refuse what strtof does, for every way of
+// writing a number (long mantissas, halfway cases, denormals, overflow, signs, hex, nan).
+TEST(ParseFloat, GivesStrtofsFloatBitForBit) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> mantissa(-1.0, 1.0);
+  std::uniform_int_distribution<int> exponent(-160, 130);
+  const char *formats[] = {"%.9g", "%.17g", "%.3f", "%e", "%.1e", "%g", "%.30e", "%.45f"};
+  std::vector<std::string> tokens = {"0",       "-0",        "0.0",     "5.",       ".5",
+                                     "-.5",     "1e39",      "-1e39",   "1e-46",    "1e-50",
+                                     "1e-40",   "3.4028235e38", "3.4028236e38", "+1",
+                                     "0x1p3",   "nan",       "inf",     "-inf",     "1.5f",
+                                     "1e",      "1e+",       "--1",     "1..2",     "e5",
+                                     "00012.50", "1E+0005",  "-2.50E+1", "."};
+  tokens.push_back(std::string("0.") + std::string(60, '0') + "1");
+  tokens.push_back(std::string(70, '9') + ".5");
+  char buf[128];
+  for (int i = 0; i < 20000; ++i) {
+    std::snprintf(buf, sizeof buf, formats[i % 8], std::ldexp(mantissa(rng), exponent(rng)));
+    tokens.push_back(buf);
+  }
+  for (int i = 0; i < 2000; ++i) { // halfway between two neighbouring floats, and next to it
+    const float f = std::ldexp(float(mantissa(rng)), exponent(rng) / 2);
+    const double half = (double(f) + double(std::nextafter(f, 2 * f + 1))) / 2;
+    std::snprintf(buf, sizeof buf, "%.40g", half);
+    tokens.push_back(buf);
+    std::snprintf(buf, sizeof buf, "%.17g", half);
+    tokens.push_back(buf);
+  }
+  size_t plain = 0;
+  for (const std::string &t : tokens) {
+    char *end = nullptr;
+    const float expected = std::strtof(t.c_str(), &end);
+    const bool expected_ok = !t.empty() && t.find_first_of("xX") == std::string::npos &&
+                             end == t.c_str() + t.size();
+    float got = 12345.f;
+    const bool ok = pomar::io::parse_float(t, got);
+    EXPECT_EQ(ok, expected_ok) << t;
+    if (ok && expected_ok) {
+      uint32_t a, b;
+      std::memcpy(&a, &got, 4);
+      std::memcpy(&b, &expected, 4);
+      EXPECT_EQ(a, b) << t;
+    }
+    plain += pomar::io::plain_decimal(t.data(), t.data() + t.size());
+  }
+  EXPECT_GT(plain, tokens.size() * 9 / 10); // the fast branch was what was tested
+}
+
 TEST_F(MeshIoTest, PlyAsciiFastPathReadsWhatVcglibReads) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> mantissa(-1.0, 1.0);

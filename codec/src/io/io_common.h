@@ -108,6 +108,8 @@ public:
     if (fd_ < 0)
       fail_io(path, "cannot open: " + errno_text(errno));
     buf_.resize(1 << 16);
+    for (int c = 0; c < 256; ++c) // (std::isspace, looked up once: the locale's spaces)
+      space_[c] = std::isspace(c) != 0;
   }
   ~FileReader() { ::close(fd_); }
   FileReader(const FileReader &) = delete;
@@ -164,17 +166,32 @@ public:
     return true;
   }
 
-  /// Next whitespace-separated token; false at the end of the file.
+  /// Next whitespace-separated token, the one whitespace byte after it consumed too;
+  /// false at the end of the file. (Scanned in the buffer, appended a run at a time.)
   bool token(std::string &out) {
     out.clear();
-    int c = get();
-    while (c >= 0 && std::isspace(c))
-      c = get();
-    if (c < 0)
-      return false;
-    for (; c >= 0 && !std::isspace(c); c = get())
-      out.push_back(static_cast<char>(c));
-    return true;
+    for (;;) { // skip whitespace
+      while (begin_ < end_ && is_space(buf_[begin_]))
+        ++begin_, ++pos_;
+      if (begin_ < end_)
+        break;
+      if (!fill())
+        return false;
+    }
+    for (;;) {
+      size_t i = begin_;
+      while (i < end_ && !is_space(buf_[i]))
+        ++i;
+      out.append(buf_.data() + begin_, i - begin_);
+      pos_ += i - begin_;
+      begin_ = i;
+      if (begin_ < end_) { // the whitespace byte that ends it
+        ++begin_, ++pos_;
+        return true;
+      }
+      if (!fill())
+        return true;
+    }
   }
 
 private:
@@ -195,6 +212,8 @@ private:
   uint64_t size_ = 0, pos_ = 0; // pos_: offset of the next byte handed out
   std::vector<char> buf_;
   size_t begin_ = 0, end_ = 0;
+  bool space_[256];
+  bool is_space(char c) const { return space_[static_cast<unsigned char>(c)]; }
 };
 
 /// A temporary file in the directory of `target`, removed again unless commit() renamed it
