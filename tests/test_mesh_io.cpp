@@ -904,11 +904,40 @@ TEST_F(MeshIoTest, OffFastPathReadsWhatVcglibReads) {
     body +=
         "3 " + std::to_string(f) + " " + std::to_string(f + 2) + " " + std::to_string(f + 1) + "\n";
   const std::string counts = std::to_string(nv) + " " + std::to_string(nf) + " 0\n";
+  // (The fast path declines a keyword line "OFF " with a space, which vcglib reads as "OFF":
+  // the general path then reads the same data.)
   LoadReport fast_report, general_report;
   const Mesh fast = pomar::load_mesh(write("fast.off", "OFF\n" + counts + body), &fast_report);
   const Mesh general =
-      pomar::load_mesh(write("general.off", "OFF\n# a comment\n" + counts + body), &general_report);
+      pomar::load_mesh(write("general.off", "OFF \n" + counts + body), &general_report);
   expect_same_load(fast, fast_report, general, general_report);
+  // Blank and comment lines anywhere before the faces end (skipped by vcglib's line reader,
+  // and by the fast path).
+  std::string spaced = "# made by hand\nOFF\n\n" + counts + "\n# vertices\n";
+  for (size_t at = 0, line = 0; at < body.size(); ++line) {
+    const size_t end = body.find('\n', at) + 1;
+    spaced += body.substr(at, end - at) + (line % 50 == 7 ? "\n#\n" : "");
+    at = end;
+  }
+  LoadReport spaced_report, spaced_general_report;
+  const Mesh spaced_fast = pomar::load_mesh(write("spaced.off", spaced), &spaced_report);
+  const Mesh spaced_general = pomar::load_mesh(
+      write("spaced_general.off", "# made by hand\nOFF \n" + spaced.substr(spaced.find("OFF") + 4)),
+      &spaced_general_report);
+  expect_same_load(spaced_fast, spaced_report, spaced_general, spaced_general_report);
+  expect_same_load(spaced_fast, spaced_report, fast, fast_report);
+  // CRLF line ends (and a last line of only CR), which the fast path takes too, read as
+  // vcglib reads them.
+  std::string crlf;
+  for (char c : "OFF\n" + counts + body)
+    crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+  LoadReport crlf_report, crlf_general_report;
+  const Mesh crlf_fast = pomar::load_mesh(write("crlf.off", crlf + "\r\n"), &crlf_report);
+  const Mesh crlf_general = pomar::load_mesh(
+      write("crlf_general.off", "OFF \r\n" + crlf.substr(5) + "\r\n"),
+      &crlf_general_report);
+  expect_same_load(crlf_fast, crlf_report, crlf_general, crlf_general_report);
+  expect_same_load(crlf_fast, crlf_report, fast, fast_report);
   // Doubles that round differently straight to float and through double (vcglib's way).
   const std::string tricky = "OFF\n3 1 0\n1.00000005960464477539062500000001 0 0\n"
                              "0 0.100000001490116119384765625000001 0\n0 0 1e-44\n3 0 1 2\n";

@@ -197,7 +197,9 @@ private:
 
 using OffImporter = vcg::tri::io::ImporterOFF<IoMesh>;
 
-/// The lines of a small file held in memory, split at '\n'.
+/// The lines of a small file held in memory, split at '\n', without the '\r' of a CRLF
+/// line end (vcglib's line reader reads "1 2 3\r" as "1 2 3": the '\r' ends the last
+/// number for atof and atoi, and a line of only "\r" is blank).
 class TextLines {
 public:
   explicit TextLines(std::string text) : text_(std::move(text)) {}
@@ -208,8 +210,18 @@ public:
     const size_t end = std::min(text_.find('\n', pos_), text_.size());
     b = text_.data() + pos_;
     e = text_.data() + end;
+    if (e != b && e[-1] == '\r')
+      --e;
     pos_ = end + 1;
     return true;
+  }
+  /// The next line that is not blank or a comment (what vcglib's line reader skips: an
+  /// empty line, one of only "\r", one starting with '#').
+  bool next_data(const char *&b, const char *&e) {
+    while (next(b, e))
+      if (b != e && *b != '#')
+        return true;
+    return false;
   }
 
 private:
@@ -245,8 +257,9 @@ bool parse_index(std::pair<const char *, const char *> t, uint64_t max, uint64_t
 
 /// The common case read straight into the flat arrays: "OFF", the counts line, one vertex
 /// of 3 plain decimal coordinates a line (atof then float, as vcglib reads them; all
-/// finite), one "3 a b c" triangle a line (distinct indices in range), nothing else (no
-/// comment, empty line, CR, colour or normal). Returns false for anything else, and the
+/// finite), one "3 a b c" triangle a line (distinct indices in range), LF or CRLF line
+/// ends, blank and comment lines between them, nothing else (no other CR, no colour or
+/// normal, nothing after the faces but one empty line). Returns false for anything else, and the
 /// walk and vcglib read the file; files over 256 MiB are left to them too (this path holds
 /// the text in memory).
 bool read_simple_off(const std::string &path, const SizeCheck &check, Mesh &out,
@@ -261,7 +274,7 @@ bool read_simple_off(const std::string &path, const SizeCheck &check, Mesh &out,
   const char *b = nullptr, *e = nullptr;
   std::pair<const char *, const char *> t[4];
   uint64_t nv = 0, nf = 0, edges = 0;
-  if (!lines.next(b, e) || std::string(b, e) != "OFF" || !lines.next(b, e) ||
+  if (!lines.next_data(b, e) || std::string(b, e) != "OFF" || !lines.next_data(b, e) ||
       !tokens_of(b, e, 3, t) || !parse_index(t[0], INT_MAX, nv) ||
       !parse_index(t[1], INT_MAX, nf) || !parse_index(t[2], UINT64_MAX, edges) || nv == 0 ||
       nf == 0)
@@ -270,7 +283,7 @@ bool read_simple_off(const std::string &path, const SizeCheck &check, Mesh &out,
   Mesh mesh;
   mesh.positions.resize(3 * nv);
   for (uint64_t v = 0; v < nv; ++v) {
-    if (!lines.next(b, e) || !tokens_of(b, e, 3, t))
+    if (!lines.next_data(b, e) || !tokens_of(b, e, 3, t))
       return false;
     for (int k = 0; k < 3; ++k) {
       double x = 0;
@@ -287,7 +300,7 @@ bool read_simple_off(const std::string &path, const SizeCheck &check, Mesh &out,
   std::vector<uint8_t> used(nv, 0);
   for (uint64_t f = 0; f < nf; ++f) {
     uint64_t count = 0, v[3];
-    if (!lines.next(b, e) || !tokens_of(b, e, 4, t) || !parse_index(t[0], 3, count) || count != 3)
+    if (!lines.next_data(b, e) || !tokens_of(b, e, 4, t) || !parse_index(t[0], 3, count) || count != 3)
       return false;
     for (int k = 0; k < 3; ++k) {
       if (!parse_index(t[k + 1], nv - 1, v[k]))
