@@ -89,7 +89,7 @@ struct PreparedInput {
 };
 
 PreparedInput prepare_input(const Mesh &mesh, const EncodeOptions &options,
-                            const LosslessHook *hook) {
+                            const LosslessHook *hook, bool name_refusal) {
   check_input(mesh, options);
   validate_attributes(mesh, !options.attributes.exact, options.attributes.keep);
   // The caller already holds the input mesh: an automatic check counts only the rest.
@@ -135,7 +135,9 @@ PreparedInput prepare_input(const Mesh &mesh, const EncodeOptions &options,
     reorder_faces(in.ct, order);
   } catch (const Error &) {
     // An invalid mesh is validated again in the caller's numbering (its face order too) so
-    // that the message names its indices.
+    // that the message names its indices (unless the caller cuts it anyway).
+    if (!name_refusal)
+      throw;
     const std::vector<uint32_t> input_triangles = compact_triangles(mesh, compact_to_input);
     build_corner_table(input_triangles.data(), nf, nv, in.ct); // throws with input indices
     throw;
@@ -208,9 +210,10 @@ void check_encode_input(const Mesh &mesh, const EncodeOptions &options) {
 
 std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &options,
                                      EncodeReport *report, const LosslessHook *hook,
-                                     const std::function<void()> &release_input) {
+                                     const std::function<void()> &release_input,
+                                     bool name_refusal) {
   auto t0 = std::chrono::steady_clock::now();
-  PreparedInput in = prepare_input(mesh, options, hook);
+  PreparedInput in = prepare_input(mesh, options, hook, name_refusal);
   const uint32_t nv = in.vertices, nf = in.faces;
   const double t_quantize = seconds_since(t0);
   // Attributes: codes of every vertex (prepared numbering); the base mesh's go to the ATTR

@@ -53,26 +53,30 @@ uint64_t get_u(RangeDecoder &rc, UintModel &m) {
   return (v << rest) | get_raw(rc, rest);
 }
 
-/// Position groups: group[v] numbers the distinct positions of `mesh` (exact float bits).
+/// Position groups: group[v] numbers the distinct positions of `mesh` (exact float bits)
+/// in the order of their bits (x, y, z as unsigned words). Two stable radix sorts, by z and
+/// then by (x, y): linear, where a comparison sort of the vertices through their positions
+/// took a twentieth of a messy mesh's decode.
 std::vector<uint32_t> position_groups(const Mesh &mesh) {
   const uint32_t n = static_cast<uint32_t>(mesh.vertex_count());
-  std::vector<uint32_t> order(n), group(n);
-  for (uint32_t v = 0; v < n; ++v)
-    order[v] = v;
-  auto key = [&](uint32_t v) {
-    uint32_t k[3];
-    std::memcpy(k, &mesh.positions[3 * size_t(v)], sizeof k);
-    return std::array<uint32_t, 3>{k[0], k[1], k[2]};
+  const auto word = [&](uint32_t v, int k) {
+    uint32_t w;
+    std::memcpy(&w, &mesh.positions[3 * size_t(v) + k], sizeof w);
+    return w;
   };
-  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
-    const auto ka = key(a), kb = key(b);
-    return ka != kb ? ka < kb : a < b;
-  });
+  std::vector<Keyed> by(n);
+  for (uint32_t v = 0; v < n; ++v)
+    by[v] = {word(v, 2), v};
+  sort_by_key(by); // by z
+  for (Keyed &e : by)
+    e.key = uint64_t(word(e.id, 0)) << 32 | word(e.id, 1);
+  sort_by_key(by); // by (x, y), stable: by (x, y, z)
+  std::vector<uint32_t> group(n);
   uint32_t g = 0;
   for (uint32_t i = 0; i < n; ++i) {
-    if (i > 0 && key(order[i]) != key(order[i - 1]))
+    if (i > 0 && (by[i].key != by[i - 1].key || word(by[i].id, 2) != word(by[i - 1].id, 2)))
       ++g;
-    group[order[i]] = g;
+    group[by[i].id] = g;
   }
   return group;
 }

@@ -11,6 +11,7 @@
 #include "format/file_format.h"
 #include "geometry/quantize.h"
 #include "mesh/corner_table.h"
+#include "repair/cut.h"
 
 namespace pomar {
 
@@ -259,15 +260,20 @@ std::vector<uint8_t> encode_any(const Mesh &mesh, const EncodeOptions &options,
   if (options.strict)
     return encode_manifold(mesh, options, report, nullptr, release);
 
-  // Whether the topology is known to be one the manifold encoder takes as it is.
+  // False once the topology is known to be one the manifold encoder does not take as it is.
   bool valid = true;
   if (!options.keep_order && all_vertices_used(mesh)) {
     // Most meshes are clean: code them as they are (the file is then byte for byte what
     // strict gives). The manifold encoder checks the topology early (its corner table),
-    // before it releases the mesh; only if it refuses is the topology checked here, and
-    // the mesh cut.
+    // before it releases the mesh: if the table refuses the mesh (TopologyError), the mesh
+    // is cut; if the encoder refuses it for another reason, the topology is checked here,
+    // and only an invalid one is cut.
     try {
-      return encode_manifold(mesh, options, report, nullptr, release);
+      return encode_manifold(mesh, options, report, nullptr, release, false);
+    } catch (const TopologyError &) { // (its corner table refused the mesh)
+      if (released)
+        throw;
+      valid = false;
     } catch (const Error &) {
       if (released || mesh.triangles.size() % 3 || valid_topology(mesh))
         throw; // not a matter of topology: the error stands
@@ -301,7 +307,7 @@ std::vector<uint8_t> encode_any(const Mesh &mesh, const EncodeOptions &options,
     repair = RepairReport();
     decoded = Mesh();
     if (cut_needed) {
-      repair = make_manifold(cut, &map); // checks the indices
+      repair = cut_to_manifold(cut, &map); // checks the indices
     } else {
       map.face_origin.resize(mesh.triangle_count());
       std::iota(map.face_origin.begin(), map.face_origin.end(), 0u);
@@ -312,12 +318,20 @@ std::vector<uint8_t> encode_any(const Mesh &mesh, const EncodeOptions &options,
       throw Error(Error::Kind::InvalidMesh, "the mesh has no valid triangle: all " +
                                                 std::to_string(mesh.triangle_count()) +
                                                 " faces repeat a vertex");
-    return encode_manifold(cut, options, report, &hook);
+    if (!cut_needed) // (the topology is not known to be valid: a refusal is not named)
+      return encode_manifold(cut, options, report, &hook, {}, false);
+    try { // (the encoder's corner table checks the cut, see repair/cut.h)
+      return encode_manifold(cut, options, report, &hook);
+    } catch (const TopologyError &e) {
+      throw still_invalid(e);
+    }
   };
   std::vector<uint8_t> file;
   if (valid) {
     try {
       file = cut_and_encode(false);
+    } catch (const TopologyError &) {
+      valid = false;
     } catch (const Error &) {
       if (mesh.triangles.size() % 3 || valid_topology(mesh))
         throw; // not a matter of topology: the error stands

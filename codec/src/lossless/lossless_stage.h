@@ -28,10 +28,13 @@ struct LosslessHook {
 /// The codec proper (codec/src/encode/encoder.cpp): a manifold, oriented mesh; unreferenced
 /// vertices are dropped. With a hook, the file is version 4 and carries the record.
 /// `release_input` (optional) is called once `mesh` is no longer read (quantized, its
-/// attributes coded): the caller may free it then.
+/// attributes coded): the caller may free it then. A topology the corner table refuses
+/// throws TopologyError, its message naming the mesh's own indices (`name_refusal`; false:
+/// the message of the renumbered mesh, for a caller that cuts such a mesh anyway).
 std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &options,
                                      EncodeReport *report, const LosslessHook *hook,
-                                     const std::function<void()> &release_input = {});
+                                     const std::function<void()> &release_input = {},
+                                     bool name_refusal = true);
 
 /// The manifold encoder's checks of the input that do not depend on its topology (bits,
 /// array sizes, no triangle, NaN/Inf); throws pomar::Error.

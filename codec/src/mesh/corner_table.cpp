@@ -87,11 +87,11 @@ void match_opposites(const uint32_t *t, size_t nt, size_t nv, CornerTable &ct) {
     }
   }
   if (nonmanifold)
-    throw Error(Error::Kind::InvalidMesh, "non-manifold mesh: " + std::to_string(nonmanifold) +
+    throw TopologyError(Error::Kind::InvalidMesh, "non-manifold mesh: " + std::to_string(nonmanifold) +
                                               " edges are shared by more than two faces; e.g. " +
                                               nm_example);
   if (flipped)
-    throw Error(Error::Kind::InvalidMesh,
+    throw TopologyError(Error::Kind::InvalidMesh,
                 "inconsistently oriented mesh: " + std::to_string(flipped) +
                     " edges are used twice in the same direction; e.g. " + flip_example);
 }
@@ -121,7 +121,7 @@ void check_vertex_fans(const CornerTable &ct, const std::vector<uint32_t> &faces
       example = v;
   }
   if (bad)
-    throw Error(Error::Kind::InvalidMesh,
+    throw TopologyError(Error::Kind::InvalidMesh,
                 "non-manifold mesh: " + std::to_string(bad) +
                     " vertices join separate fans of faces; e.g. vertex " +
                     std::to_string(example) + " (" + std::to_string(faces_at[example]) + " faces)");
@@ -131,9 +131,9 @@ void check_vertex_fans(const CornerTable &ct, const std::vector<uint32_t> &faces
 
 void build_corner_table(const uint32_t *t, size_t nt, size_t nv, CornerTable &ct) {
   if (nt == 0)
-    throw Error(Error::Kind::InvalidMesh, "the mesh contains no triangles");
+    throw TopologyError(Error::Kind::InvalidMesh, "the mesh contains no triangles");
   if (nt > (size_t(1) << 30) || nv >= kNone)
-    throw Error(Error::Kind::InvalidMesh,
+    throw TopologyError(Error::Kind::InvalidMesh,
                 "the mesh is too large (" + std::to_string(nt) + " triangles)");
   size_t repeated = 0, out_of_range = 0, rep_example = 0, oor_example = 0;
   for (size_t f = 0; f < nt; ++f) {
@@ -147,11 +147,11 @@ void build_corner_table(const uint32_t *t, size_t nt, size_t nv, CornerTable &ct
     }
   }
   if (out_of_range)
-    throw Error(Error::Kind::InvalidMesh,
+    throw TopologyError(Error::Kind::InvalidMesh,
                 std::to_string(out_of_range) + " faces use a vertex index >= the vertex count " +
                     std::to_string(nv) + "; e.g. " + face_text(t, oor_example));
   if (repeated)
-    throw Error(Error::Kind::InvalidMesh, "degenerate faces: " + std::to_string(repeated) +
+    throw TopologyError(Error::Kind::InvalidMesh, "degenerate faces: " + std::to_string(repeated) +
                                               " faces repeat a vertex; e.g. " +
                                               face_text(t, rep_example));
   // (Large arrays written whole: their memory is mapped first, memory/prefault.h.)

@@ -11,6 +11,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "pomar/pomar.h"
+
 namespace pomar {
 
 constexpr uint32_t kNone = 0xFFFFFFFFu;
@@ -187,9 +189,18 @@ inline void get_ring(const CornerTable &ct, uint32_t v, Ring &ring) {
       ct, v, [](uint32_t n) { return n; }, ring);
 }
 
+/// What build_corner_table throws (kind InvalidMesh): a topology the corner table cannot
+/// hold. The lossless stage cuts such a mesh instead of refusing it, and knows from this type
+/// that the manifold encoder refused the topology, not something else.
+class TopologyError : public Error {
+public:
+  using Error::Error;
+};
+
 /// Build the corner table of `triangle_count` triangles over `vertex_count` vertices.
-/// Throws pomar::Error naming the problem (with counts and one example) when the mesh is
-/// not a manifold, consistently oriented triangle mesh or a face repeats a vertex.
+/// Throws TopologyError naming the problem (with counts and one example) when the mesh is
+/// not a manifold, consistently oriented triangle mesh, a face repeats a vertex or uses an
+/// index out of range, or there is no triangle.
 void build_corner_table(const uint32_t *triangles, size_t triangle_count, size_t vertex_count,
                         CornerTable &ct);
 

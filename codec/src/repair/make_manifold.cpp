@@ -10,7 +10,8 @@
 //                     in opposite directions (the others are cut);
 //   split_fans        union-find of the corners of each vertex across glued edges: one
 //                     output vertex per class (= per fan of faces).
-// The result is checked with the codec's own build_corner_table().
+// The result is checked with the codec's own build_corner_table() (make_manifold; the
+// lossless stage calls cut_to_manifold, repair/cut.h, and its encoder's table is the check).
 //
 // Why no face ever needs to be detached after split_fans: take two faces f, g that still
 // share an edge (a, b) after the split. Their corners at a are in one class, so a chain of
@@ -21,6 +22,7 @@
 // Hence at most two faces share an output edge, in opposite directions; and a vertex
 // class connected through edges of at most two faces is a single fan.
 #include "pomar/repair.h"
+#include "repair/cut.h"
 
 #include <algorithm>
 #include <string>
@@ -352,7 +354,7 @@ std::string RepairReport::summary() const {
 
 // ------------------------------------------------------------------ make_manifold
 
-RepairReport make_manifold(Mesh &mesh, RepairMap *map) {
+RepairReport cut_to_manifold(Mesh &mesh, RepairMap *map) {
   RepairReport r;
   const size_t nv = mesh.vertex_count();
   if (mesh.positions.size() % 3 != 0 || mesh.triangles.size() % 3 != 0)
@@ -419,7 +421,19 @@ RepairReport make_manifold(Mesh &mesh, RepairMap *map) {
           attr.values.push_back(attr.values[n * v + k]);
       }
   }
+  return r;
+}
 
+Error still_invalid(const Error &e) {
+  return Error(Error::Kind::Internal,
+               std::string("internal repair error: the repaired mesh is still invalid: ") +
+                   e.what());
+}
+
+RepairReport make_manifold(Mesh &mesh, RepairMap *map) {
+  const RepairReport r = cut_to_manifold(mesh, map);
+  if (!r.changed())
+    return r;
   // The codec's own check must accept the result (see the argument at the top of this
   // file); if it ever does not, say so rather than hand back a wrong mesh.
   try {
@@ -427,9 +441,7 @@ RepairReport make_manifold(Mesh &mesh, RepairMap *map) {
     build_corner_table(mesh.triangles.data(), mesh.triangle_count(), mesh.vertex_count(), ct);
   } catch (const Error &e) {
     if (mesh.triangle_count() != 0)
-      throw Error(Error::Kind::Internal,
-                  std::string("internal repair error: the repaired mesh is still invalid: ") +
-                      e.what());
+      throw still_invalid(e);
   }
   return r;
 }
