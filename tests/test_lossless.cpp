@@ -449,12 +449,14 @@ std::vector<uint32_t> canonical_order_by_definition(const std::vector<uint32_t> 
   return order;
 }
 
-// canonical_face_order packs the triple into one key for a radix sort when the vertex ids
-// fit in 21 bits, and sorts triples otherwise: both must give the defined order, duplicate
-// faces (same triple, any rotation) by index.
+// canonical_face_order buckets the faces by smallest vertex when the ids are about as many
+// as the faces (buckets of many faces, 3 and 100; of a few, 1000 and 4000), packs the triple
+// into one key for a radix sort when the vertex ids fit in 21 bits, and sorts triples
+// otherwise: each must give the defined order, duplicate faces (same triple, any rotation)
+// by index.
 TEST(Lossless, CanonicalFaceOrderIsTheSortedRotatedTriples) {
   std::mt19937 rng(7);
-  for (uint32_t top : {3u, 1000u, (1u << 21) - 1, 1u << 21, 0xFFFFFFFEu}) {
+  for (uint32_t top : {3u, 100u, 1000u, 4000u, (1u << 21) - 1, 1u << 21, 0xFFFFFFFEu}) {
     std::uniform_int_distribution<uint32_t> id(0, top);
     std::vector<uint32_t> t;
     for (int f = 0; f < 5000; ++f) {
