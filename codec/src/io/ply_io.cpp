@@ -367,7 +367,7 @@ PlyVertexPlan plan_vertex_attributes(const PlyElement *vertex, std::vector<std::
     const std::string p = prefix;
     const int r = index((p + "red").c_str()), g = index((p + "green").c_str()),
               b = index((p + "blue").c_str()), a = index((p + "alpha").c_str());
-    if (r < 0 || g < 0 || b < 0 || (taken[r] | taken[g] | taken[b]))
+    if (r < 0 || g < 0 || b < 0 || taken[r] || taken[g] || taken[b])
       continue;
     std::vector<int> props = {r, g, b};
     if (a >= 0)

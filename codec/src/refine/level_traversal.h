@@ -308,7 +308,7 @@ template <class Codec>
 void traverse_level(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t level,
                     SplitList &splits) {
   const auto id = [](uint32_t v) { return uint64_t(v); };
-  const GlobalMarks marks{s};
+  const GlobalMarks marks{{s}};
   size_t head = 0;
   for (uint32_t f = 0; f < mesh.seed_faces; ++f) {
     const uint32_t a = mesh.ct.V[3 * f], b = mesh.ct.V[3 * f + 1];
@@ -337,7 +337,7 @@ void traverse_cluster(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32
                       const LevelView &level, SplitList &splits) {
   const uint32_t cluster = mesh.cluster_of(root);
   const auto key = [&](uint32_t v) { return mesh.key(v); };
-  const ClusterMarks marks{s, mesh.lineage.data(), cluster};
+  const ClusterMarks marks{{s}, mesh.lineage.data(), cluster};
   get_view_ring(mesh, root, level, s.ring);
   if (s.ring.neighbour.empty())
     return;
