@@ -640,12 +640,11 @@ TEST(ParseFloat, GivesStrtofsFloatBitForBit) {
   std::uniform_real_distribution<double> mantissa(-1.0, 1.0);
   std::uniform_int_distribution<int> exponent(-160, 130);
   const char *formats[] = {"%.9g", "%.17g", "%.3f", "%e", "%.1e", "%g", "%.30e", "%.45f"};
-  std::vector<std::string> tokens = {"0",       "-0",        "0.0",     "5.",       ".5",
-                                     "-.5",     "1e39",      "-1e39",   "1e-46",    "1e-50",
-                                     "1e-40",   "3.4028235e38", "3.4028236e38", "+1",
-                                     "0x1p3",   "nan",       "inf",     "-inf",     "1.5f",
-                                     "1e",      "1e+",       "--1",     "1..2",     "e5",
-                                     "00012.50", "1E+0005",  "-2.50E+1", "."};
+  std::vector<std::string> tokens = {
+      "0",     "-0",    "0.0",   "5.",       ".5",           "-.5",          "1e39",
+      "-1e39", "1e-46", "1e-50", "1e-40",    "3.4028235e38", "3.4028236e38", "+1",
+      "0x1p3", "nan",   "inf",   "-inf",     "1.5f",         "1e",           "1e+",
+      "--1",   "1..2",  "e5",    "00012.50", "1E+0005",      "-2.50E+1",     "."};
   tokens.push_back(std::string("0.") + std::string(60, '0') + "1");
   tokens.push_back(std::string(70, '9') + ".5");
   char buf[128];
@@ -665,8 +664,8 @@ TEST(ParseFloat, GivesStrtofsFloatBitForBit) {
   for (const std::string &t : tokens) {
     char *end = nullptr;
     const float expected = std::strtof(t.c_str(), &end);
-    const bool expected_ok = !t.empty() && t.find_first_of("xX") == std::string::npos &&
-                             end == t.c_str() + t.size();
+    const bool expected_ok =
+        !t.empty() && t.find_first_of("xX") == std::string::npos && end == t.c_str() + t.size();
     float got = 12345.f;
     const bool ok = pomar::io::parse_float(t, got);
     EXPECT_EQ(ok, expected_ok) << t;
@@ -934,8 +933,7 @@ TEST_F(MeshIoTest, OffFastPathReadsWhatVcglibReads) {
   LoadReport crlf_report, crlf_general_report;
   const Mesh crlf_fast = pomar::load_mesh(write("crlf.off", crlf + "\r\n"), &crlf_report);
   const Mesh crlf_general = pomar::load_mesh(
-      write("crlf_general.off", "OFF \r\n" + crlf.substr(5) + "\r\n"),
-      &crlf_general_report);
+      write("crlf_general.off", "OFF \r\n" + crlf.substr(5) + "\r\n"), &crlf_general_report);
   expect_same_load(crlf_fast, crlf_report, crlf_general, crlf_general_report);
   expect_same_load(crlf_fast, crlf_report, fast, fast_report);
   // Doubles that round differently straight to float and through double (vcglib's way).

@@ -300,7 +300,8 @@ bool read_simple_off(const std::string &path, const SizeCheck &check, Mesh &out,
   std::vector<uint8_t> used(nv, 0);
   for (uint64_t f = 0; f < nf; ++f) {
     uint64_t count = 0, v[3];
-    if (!lines.next_data(b, e) || !tokens_of(b, e, 4, t) || !parse_index(t[0], 3, count) || count != 3)
+    if (!lines.next_data(b, e) || !tokens_of(b, e, 4, t) || !parse_index(t[0], 3, count) ||
+        count != 3)
       return false;
     for (int k = 0; k < 3; ++k) {
       if (!parse_index(t[k + 1], nv - 1, v[k]))

@@ -283,6 +283,62 @@ LosslessCounts read_lossless_counts(const uint8_t *data, size_t size) {
   return read_counts(data, size, rc, m);
 }
 
+namespace {
+
+/// The rotation of face f of `t` that starts at its smallest vertex (the first of them if
+/// it repeats one): k = (v[s], v[s+1], v[s+2]); returns s.
+int rotated(const uint32_t *t, uint32_t f, uint32_t k[3]) {
+  const uint32_t *v = &t[3 * size_t(f)];
+  const int s = v[0] < v[1] ? (v[0] < v[2] ? 0 : 2) : (v[1] < v[2] ? 1 : 2);
+  k[0] = v[s], k[1] = v[(s + 1) % 3], k[2] = v[(s + 2) % 3];
+  return s;
+}
+
+/// Whether canonical_buckets takes `t` (ids up to `top`): ids about as many as the faces (a
+/// mesh's own), fewer than 2^30 faces.
+bool dense_ids(const std::vector<uint32_t> &t, uint32_t top) {
+  const uint64_t nf = t.size() / 3;
+  return top < 4 * nf + 1024 && nf < (uint64_t(1) << 30);
+}
+
+/// The canonical order as buckets: the faces counted by smallest vertex k0 (a counting
+/// sort, faces in index order, so stable), then each bucket, a few faces, sorted by the
+/// rest. by[i] = (k1 << 32 | k2, f << 2 | s) for the i-th face f in canonical order, s its
+/// rotation (rotated()); bucket k0 ends at end[k0].
+void canonical_buckets(const std::vector<uint32_t> &t, uint32_t top, std::vector<uint32_t> &end,
+                       std::vector<Keyed> &by) {
+  const uint32_t nf = static_cast<uint32_t>(t.size() / 3);
+  end.assign(size_t(top) + 2, 0);
+  for (uint32_t f = 0; f < nf; ++f) {
+    const uint32_t *v = &t[3 * size_t(f)];
+    ++end[std::min(v[0], std::min(v[1], v[2])) + 1];
+  }
+  for (size_t v = 0; v + 1 < end.size(); ++v)
+    end[v + 1] += end[v];
+  by = filled_vector<Keyed>(nf); // (memory/prefault.h)
+  for (uint32_t f = 0; f < nf; ++f) {
+    uint32_t k[3];
+    const int s = rotated(t.data(), f, k);
+    by[end[k[0]]++] = {uint64_t(k[1]) << 32 | k[2], f << 2 | uint32_t(s)};
+  }
+  // (end[v] is now the end of bucket v.)
+  const auto less = [](const Keyed &a, const Keyed &b) {
+    return a.key != b.key ? a.key < b.key : a.id < b.id;
+  };
+  for (size_t v = 0, first = 0; v <= top; first = end[v++]) {
+    Keyed *b = by.data() + first, *e = by.data() + end[v];
+    if (e - b > 16) {
+      std::sort(b, e, less);
+      continue;
+    }
+    for (Keyed *i = b + 1; i < e; ++i) // insertion sort by key, stable: faces stay in order
+      for (Keyed *j = i; j > b && j[-1].key > j->key; --j)
+        std::swap(j[-1], j[0]);
+  }
+}
+
+} // namespace
+
 std::vector<uint32_t> canonical_face_order(const std::vector<uint32_t> &t) {
   // Each face's vertices rotated to start at the smallest; the faces sorted by that triple,
   // equal triples (duplicate faces) by face index. Ids up to a few times the face count (a
@@ -292,55 +348,24 @@ std::vector<uint32_t> canonical_face_order(const std::vector<uint32_t> &t) {
   // sixth of a 35k-vertex decode's CPU time; the buckets take half the radix sort's time);
   // larger ids sort the triples themselves.
   const uint32_t nf = static_cast<uint32_t>(t.size() / 3);
-  const auto rotated = [&](uint32_t f, uint32_t k[3]) {
-    const uint32_t *v = &t[3 * size_t(f)];
-    const int s = v[0] < v[1] ? (v[0] < v[2] ? 0 : 2) : (v[1] < v[2] ? 1 : 2);
-    k[0] = v[s], k[1] = v[(s + 1) % 3], k[2] = v[(s + 2) % 3];
-  };
   const uint32_t top = t.empty() ? 0 : *std::max_element(t.begin(), t.end());
   int bits = 1;
   while (bits < 32 && (top >> bits) != 0)
     ++bits;
   std::vector<uint32_t> order = filled_vector<uint32_t>(nf); // (memory/prefault.h)
-  if (top < 4 * uint64_t(nf) + 1024) {
-    // Ids about as many as the faces (a mesh's own): a counting sort by the smallest vertex
-    // (faces in index order, so stable), then each bucket, a few faces, by the rest.
-    std::vector<uint32_t> start(size_t(top) + 2, 0);
-    for (uint32_t f = 0; f < nf; ++f) {
-      const uint32_t *v = &t[3 * size_t(f)];
-      ++start[std::min(v[0], std::min(v[1], v[2])) + 1];
-    }
-    for (size_t v = 0; v + 1 < start.size(); ++v)
-      start[v + 1] += start[v];
-    std::vector<Keyed> by = filled_vector<Keyed>(nf);
-    for (uint32_t f = 0; f < nf; ++f) {
-      uint32_t k[3];
-      rotated(f, k);
-      by[start[k[0]]++] = {uint64_t(k[1]) << 32 | k[2], f};
-    }
-    // (start[v] is now the end of bucket v.)
-    const auto less = [](const Keyed &a, const Keyed &b) {
-      return a.key != b.key ? a.key < b.key : a.id < b.id;
-    };
-    for (size_t v = 0, first = 0; v <= top; first = start[v++]) {
-      Keyed *b = by.data() + first, *e = by.data() + start[v];
-      if (e - b > 16) {
-        std::sort(b, e, less);
-        continue;
-      }
-      for (Keyed *i = b + 1; i < e; ++i) // insertion sort by key, stable: ids stay in order
-        for (Keyed *j = i; j > b && j[-1].key > j->key; --j)
-          std::swap(j[-1], j[0]);
-    }
+  if (dense_ids(t, top)) {
+    std::vector<uint32_t> end;
+    std::vector<Keyed> by;
+    canonical_buckets(t, top, end, by);
     for (uint32_t i = 0; i < nf; ++i)
-      order[i] = by[i].id;
+      order[i] = by[i].id >> 2;
     return order;
   }
   if (3 * bits <= 64) {
     std::vector<Keyed> key = filled_vector<Keyed>(nf);
     for (uint32_t f = 0; f < nf; ++f) {
       uint32_t k[3];
-      rotated(f, k);
+      rotated(t.data(), f, k);
       key[f] = {uint64_t(k[0]) << (2 * bits) | uint64_t(k[1]) << bits | k[2], f};
     }
     sort_by_key(key);
@@ -353,7 +378,7 @@ std::vector<uint32_t> canonical_face_order(const std::vector<uint32_t> &t) {
   };
   std::vector<Face> faces(nf);
   for (uint32_t f = 0; f < nf; ++f) {
-    rotated(f, faces[f].k);
+    rotated(t.data(), f, faces[f].k);
     faces[f].f = f;
   }
   std::sort(faces.begin(), faces.end(), [](const Face &a, const Face &b) {
@@ -631,7 +656,7 @@ LosslessRecord read_lossless_record(const uint8_t *data, size_t size, const Mesh
     Mesh shape;
     shape.positions = decoded.positions;
     shape.triangles = decoded.triangles;
-    const Mesh mesh = apply_lossless_record(shape, r, Quantizer());
+    const Mesh mesh = apply_lossless_record(std::move(shape), r, Quantizer());
     const uint32_t n = static_cast<uint32_t>(mesh.vertex_count());
     const Neighbours nb(mesh.triangles, n);
     UnusedSet unused(n);
@@ -666,36 +691,52 @@ LosslessRecord read_lossless_record(const uint8_t *data, size_t size, const Mesh
   return r;
 }
 
-Mesh apply_lossless_record(const Mesh &decoded, const LosslessRecord &r, const Quantizer &grid,
+Mesh apply_lossless_record(Mesh decoded, const LosslessRecord &r, const Quantizer &grid,
                            std::vector<uint32_t> *source) {
+  // Worked in place on D's own arrays (a full decode hands its mesh over): the output
+  // vertices are D's less the copies, then the extra vertices; the faces D's in canonical
+  // order, written where D's were once bucketed.
   const uint32_t nv = static_cast<uint32_t>(decoded.vertex_count());
-  std::vector<uint32_t> out_of(nv, kNone);
-  Mesh out;
   const size_t extra = r.extra_q.size() / 3;
-  out.positions.reserve(3 * (nv - r.copies.size() + extra));
-  size_t next_copy = 0;
-  uint32_t next = 0;
-  for (uint32_t v = 0; v < nv; ++v) {
-    if (next_copy < r.copies.size() && r.copies[next_copy].first == v) {
-      out_of[v] = out_of[r.copies[next_copy++].second];
-      continue;
-    }
-    out_of[v] = next++;
-    out.positions.insert(out.positions.end(), &decoded.positions[3 * size_t(v)],
-                         &decoded.positions[3 * size_t(v)] + 3);
+  std::vector<uint32_t> out_of; // D's vertex -> output vertex (when there are copies)
+  if (!r.copies.empty() || source) {
+    out_of.assign(nv, kNone);
+    size_t next_copy = 0;
+    uint32_t next = 0;
+    for (uint32_t v = 0; v < nv; ++v)
+      if (next_copy < r.copies.size() && r.copies[next_copy].first == v)
+        out_of[v] = out_of[r.copies[next_copy++].second];
+      else
+        out_of[v] = next++;
   }
-  for (size_t i = 0; i < r.extra_q.size(); ++i)
-    out.positions.push_back(grid.dequantize(static_cast<int>(i % 3), uint32_t(r.extra_q[i])));
+  Mesh out;
+  out.positions = std::move(decoded.positions);
+  { // the copies dropped (kept rows move down, in place), the extra vertices appended
+    size_t c = 0, kept = 0;
+    for (uint32_t v = 0; v < nv && !r.copies.empty(); ++v) {
+      if (c < r.copies.size() && r.copies[c].first == v) {
+        ++c;
+        continue;
+      }
+      std::copy(&out.positions[3 * size_t(v)], &out.positions[3 * size_t(v)] + 3,
+                &out.positions[3 * kept++]);
+    }
+    if (!r.copies.empty())
+      out.positions.resize(3 * kept);
+    out.positions.reserve(out.positions.size() + 3 * extra);
+    for (size_t i = 0; i < r.extra_q.size(); ++i)
+      out.positions.push_back(grid.dequantize(static_cast<int>(i % 3), uint32_t(r.extra_q[i])));
+  }
 
-  const std::vector<uint32_t> order = canonical_face_order(decoded.triangles);
-  size_t faces = order.size() + r.degenerate.size();
+  // Faces: for the i-th face of D in canonical order, its flip and its extra copies.
+  const uint32_t nf = static_cast<uint32_t>(decoded.triangle_count());
+  size_t faces = size_t(nf) + r.degenerate.size();
   for (const auto &d : r.duplicates)
     faces += d.second;
-  out.triangles.reserve(3 * faces);
-  size_t flip = 0, dup = 0;
-  for (uint32_t i = 0; i < order.size(); ++i) {
-    const uint32_t *t = &decoded.triangles[3 * size_t(order[i])];
-    uint32_t f[3] = {out_of[t[0]], out_of[t[1]], out_of[t[2]]};
+  const auto map = [&](uint32_t v) { return out_of.empty() ? v : out_of[v]; };
+  size_t flip = 0, dup = 0, at = 0;
+  const auto put = [&](uint32_t i, uint32_t a, uint32_t b, uint32_t c) {
+    uint32_t f[3] = {map(a), map(b), map(c)};
     if (flip < r.flipped.size() && r.flipped[flip] == i) {
       std::swap(f[1], f[2]);
       ++flip;
@@ -703,20 +744,49 @@ Mesh apply_lossless_record(const Mesh &decoded, const LosslessRecord &r, const Q
     uint32_t n = 1;
     if (dup < r.duplicates.size() && r.duplicates[dup].first == i)
       n += r.duplicates[dup++].second;
-    for (uint32_t k = 0; k < n; ++k)
-      out.triangles.insert(out.triangles.end(), f, f + 3);
+    for (uint32_t k = 0; k < n; ++k, at += 3)
+      std::copy(f, f + 3, &out.triangles[at]);
+  };
+  const uint32_t top = decoded.triangles.empty()
+                           ? 0
+                           : *std::max_element(decoded.triangles.begin(), decoded.triangles.end());
+  if (dense_ids(decoded.triangles, top)) {
+    std::vector<uint32_t> end;
+    std::vector<Keyed> by;
+    canonical_buckets(decoded.triangles, top, end, by);
+    out.triangles = std::move(decoded.triangles); // (read no more: `by` holds the faces)
+    out.triangles.resize(3 * faces);
+    for (uint32_t k0 = 0, i = 0; i < nf; ++i) {
+      while (end[k0] == i)
+        ++k0;
+      const uint32_t k1 = uint32_t(by[i].key >> 32), k2 = uint32_t(by[i].key);
+      const uint32_t s = by[i].id & 3; // the face as D has it: (k0, k1, k2) rotated back
+      if (s == 0)
+        put(i, k0, k1, k2);
+      else if (s == 1)
+        put(i, k2, k0, k1);
+      else
+        put(i, k1, k2, k0);
+    }
+  } else {
+    const std::vector<uint32_t> order = canonical_face_order(decoded.triangles);
+    out.triangles.resize(3 * faces);
+    for (uint32_t i = 0; i < nf; ++i) {
+      const uint32_t *t = &decoded.triangles[3 * size_t(order[i])];
+      put(i, t[0], t[1], t[2]);
+    }
   }
   for (const auto &d : r.degenerate) {
     const uint32_t f[3] = {d[0], d[0], d[1]};
-    out.triangles.insert(out.triangles.end(), f, f + 3);
+    std::copy(f, f + 3, &out.triangles[at]);
+    at += 3;
   }
 
   // Attributes: an output vertex has those of the decoded vertex it comes from (its copies
   // carry the same values: the cut copies attributes); the extra vertices, those the record
   // stores (bit for bit).
-  out.texture_files = decoded.texture_files;
-  for (const VertexAttribute &a : decoded.attributes) {
-    VertexAttribute b = a;
+  out.texture_files = std::move(decoded.texture_files);
+  for (VertexAttribute &a : decoded.attributes) {
     // The extra vertices' values of this attribute (none: a record without attributes,
     // e.g. written for a mesh that had none).
     const VertexAttribute *x = nullptr;
@@ -728,14 +798,16 @@ Mesh apply_lossless_record(const Mesh &decoded, const LosslessRecord &r, const Q
               "' for the vertices no face uses");
     if (a.vertex_count() != nv)
       damaged("attribute '" + a.name + "' does not fit the decoded mesh");
+    VertexAttribute b = std::move(a);
     size_t c = 0; // the copies, in increasing vertex order, are dropped
-    keep_vertex_rows(b, nv, [&](size_t v) {
-      if (c < r.copies.size() && r.copies[c].first == v) {
-        ++c;
-        return false;
-      }
-      return true;
-    });
+    if (!r.copies.empty())
+      keep_vertex_rows(b, nv, [&](size_t v) {
+        if (c < r.copies.size() && r.copies[c].first == v) {
+          ++c;
+          return false;
+        }
+        return true;
+      });
     if (x != nullptr && extra != 0) {
       b.colour.insert(b.colour.end(), x->colour.begin(), x->colour.end());
       b.values.insert(b.values.end(), x->values.begin(), x->values.end());

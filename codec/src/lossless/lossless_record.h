@@ -75,10 +75,11 @@ std::vector<uint8_t> write_lossless_record(const LosslessRecord &record, const M
 LosslessRecord read_lossless_record(const uint8_t *data, size_t size, const Mesh &decoded,
                                     int bits);
 
-/// D with the record undone: the input mesh (positions on the grid). `source` (optional)
+/// D with the record undone: the input mesh (positions on the grid), made in D's own arrays
+/// (pass D moved when it is not needed after). `source` (optional)
 /// receives for each vertex of the result the vertex of D it comes from (kNone: a vertex no
 /// face of D uses).
-Mesh apply_lossless_record(const Mesh &decoded, const LosslessRecord &record, const Quantizer &grid,
+Mesh apply_lossless_record(Mesh decoded, const LosslessRecord &record, const Quantizer &grid,
                            std::vector<uint32_t> *source = nullptr);
 
 } // namespace pomar

@@ -75,8 +75,7 @@ void usable_attributes_for_unused_vertices(Mesh &cut) {
     for (size_t v = 0; v < nv; ++v)
       if (!used[v])
         for (uint32_t k = 0; k < a.components; ++k)
-          a.values[v * a.components + k] =
-              a.kind == AttributeKind::Normal && k == 2 ? 1.0f : 0.0f;
+          a.values[v * a.components + k] = a.kind == AttributeKind::Normal && k == 2 ? 1.0f : 0.0f;
   }
 }
 
@@ -181,14 +180,14 @@ LosslessRecord build_lossless_record(const Mesh &input, const Mesh &cut, const R
   // cut that only left vertices unreferenced needs neither (a scan's stray points).
   const uint32_t nf = static_cast<uint32_t>(cut.triangle_count());
   const uint32_t input_faces = static_cast<uint32_t>(input.triangle_count());
-  const bool faces_changed =
-      nf != input_faces || std::find(map.flipped.begin(), map.flipped.end(), 1) != map.flipped.end();
+  const bool faces_changed = nf != input_faces || std::find(map.flipped.begin(), map.flipped.end(),
+                                                            1) != map.flipped.end();
   if (!r.copies.empty() || keep_order) {
     decoded.positions.resize(3 * size_t(nd));
     for (uint32_t d = 0; d < nd; ++d)
       for (int k = 0; k < 3; ++k)
-        decoded.positions[3 * size_t(d) + k] = grid.dequantize(
-            k, grid.quantize(k, cut.positions[3 * size_t(decoded_to_cut[d]) + k]));
+        decoded.positions[3 * size_t(d) + k] =
+            grid.dequantize(k, grid.quantize(k, cut.positions[3 * size_t(decoded_to_cut[d]) + k]));
   }
   if (faces_changed || keep_order) {
     decoded.triangles.resize(cut.triangles.size());
@@ -414,7 +413,7 @@ void undo_cut(const uint8_t *data, const FileLayout &layout, Mesh &decoded,
   uint64_t bytes = 0;
   if (const uint8_t *body = lossless_body(data, layout, bytes)) {
     const LosslessRecord r = read_lossless_record(body, bytes, decoded, layout.header.grid.bits);
-    decoded = apply_lossless_record(decoded, r, layout.header.grid, source);
+    decoded = apply_lossless_record(std::move(decoded), r, layout.header.grid, source);
   } else if (source) {
     source->resize(decoded.vertex_count());
     for (uint32_t v = 0; v < source->size(); ++v)

@@ -87,13 +87,13 @@ void match_opposites(const uint32_t *t, size_t nt, size_t nv, CornerTable &ct) {
     }
   }
   if (nonmanifold)
-    throw TopologyError(Error::Kind::InvalidMesh, "non-manifold mesh: " + std::to_string(nonmanifold) +
-                                              " edges are shared by more than two faces; e.g. " +
-                                              nm_example);
+    throw TopologyError(Error::Kind::InvalidMesh,
+                        "non-manifold mesh: " + std::to_string(nonmanifold) +
+                            " edges are shared by more than two faces; e.g. " + nm_example);
   if (flipped)
     throw TopologyError(Error::Kind::InvalidMesh,
-                "inconsistently oriented mesh: " + std::to_string(flipped) +
-                    " edges are used twice in the same direction; e.g. " + flip_example);
+                        "inconsistently oriented mesh: " + std::to_string(flipped) +
+                            " edges are used twice in the same direction; e.g. " + flip_example);
 }
 
 /// The faces of v's fan, counted as get_ring walks them (without storing the ring).
@@ -122,9 +122,10 @@ void check_vertex_fans(const CornerTable &ct, const std::vector<uint32_t> &faces
   }
   if (bad)
     throw TopologyError(Error::Kind::InvalidMesh,
-                "non-manifold mesh: " + std::to_string(bad) +
-                    " vertices join separate fans of faces; e.g. vertex " +
-                    std::to_string(example) + " (" + std::to_string(faces_at[example]) + " faces)");
+                        "non-manifold mesh: " + std::to_string(bad) +
+                            " vertices join separate fans of faces; e.g. vertex " +
+                            std::to_string(example) + " (" + std::to_string(faces_at[example]) +
+                            " faces)");
 }
 
 } // namespace
@@ -134,7 +135,7 @@ void build_corner_table(const uint32_t *t, size_t nt, size_t nv, CornerTable &ct
     throw TopologyError(Error::Kind::InvalidMesh, "the mesh contains no triangles");
   if (nt > (size_t(1) << 30) || nv >= kNone)
     throw TopologyError(Error::Kind::InvalidMesh,
-                "the mesh is too large (" + std::to_string(nt) + " triangles)");
+                        "the mesh is too large (" + std::to_string(nt) + " triangles)");
   size_t repeated = 0, out_of_range = 0, rep_example = 0, oor_example = 0;
   for (size_t f = 0; f < nt; ++f) {
     const uint32_t a = t[3 * f], b = t[3 * f + 1], c = t[3 * f + 2];
@@ -148,12 +149,13 @@ void build_corner_table(const uint32_t *t, size_t nt, size_t nv, CornerTable &ct
   }
   if (out_of_range)
     throw TopologyError(Error::Kind::InvalidMesh,
-                std::to_string(out_of_range) + " faces use a vertex index >= the vertex count " +
-                    std::to_string(nv) + "; e.g. " + face_text(t, oor_example));
+                        std::to_string(out_of_range) +
+                            " faces use a vertex index >= the vertex count " + std::to_string(nv) +
+                            "; e.g. " + face_text(t, oor_example));
   if (repeated)
     throw TopologyError(Error::Kind::InvalidMesh, "degenerate faces: " + std::to_string(repeated) +
-                                              " faces repeat a vertex; e.g. " +
-                                              face_text(t, rep_example));
+                                                      " faces repeat a vertex; e.g. " +
+                                                      face_text(t, rep_example));
   // (Large arrays written whole: their memory is mapped first, memory/prefault.h.)
   reserve_prefaulted(ct.V, 3 * nt);
   reserve_prefaulted(ct.O, 3 * nt);

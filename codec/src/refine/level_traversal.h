@@ -171,8 +171,7 @@ constexpr const char *kSharedFace = "two vertex splits of one level share a face
 /// Whether a Codec can read past attribute codes (the decoder's skip_attributes).
 template <class Codec, class = void> struct SkipsAttributes : std::false_type {};
 template <class Codec>
-struct SkipsAttributes<Codec,
-                       std::void_t<decltype(std::declval<Codec &>().skip_attributes(0u))>>
+struct SkipsAttributes<Codec, std::void_t<decltype(std::declval<Codec &>().skip_attributes(0u))>>
     : std::true_type {};
 
 /// Whether a Codec's split_symbols ignores the ranked edges (the decoder: it reads s_e and
