@@ -35,6 +35,27 @@ void expect_consistent(const CornerTable &ct, const Ring &ring) {
   }
 }
 
+// Every refusal of build_corner_table is a TopologyError (kind InvalidMesh): the lossless
+// stage cuts the mesh on that type alone, without building the table again to check.
+TEST(CornerTable, EveryRefusalIsATopologyError) {
+  Mesh out_of_range = gen::tetrahedron();
+  out_of_range.triangles[5] = 99;
+  for (const Mesh &m : {gen::nonmanifold_edge(), gen::nonmanifold_vertex(), gen::flipped_face(),
+                        gen::repeated_vertex_face(), out_of_range, Mesh{}}) {
+    CornerTable ct;
+    try {
+      build_corner_table(m.triangles.data(), m.triangle_count(), m.vertex_count(), ct);
+      ADD_FAILURE() << "accepted a mesh of " << m.triangle_count() << " faces";
+    } catch (const TopologyError &e) {
+      EXPECT_EQ(e.kind(), Error::Kind::InvalidMesh) << e.what();
+    }
+  }
+  CornerTable ct;
+  const Mesh valid = gen::tetrahedron();
+  EXPECT_NO_THROW(
+      build_corner_table(valid.triangles.data(), valid.triangle_count(), valid.vertex_count(), ct));
+}
+
 TEST(Ring, LargeClosedFanFromEveryCorner) {
   for (uint32_t n : {3u, 31u, 32u, 33u, 100u}) {
     CornerTable ct = fan(n, true);

@@ -203,6 +203,40 @@ TEST(Lossless, RandomSoupsAndGluedDisksRoundTripExactly) {
   }
 }
 
+// Stray points (or --keep-order) on a valid surface: the lossless stage codes the mesh as it
+// is, with no cut; on a messy one, or one whose only stray point is a vertex a degenerate
+// face uses, it cuts. Both ways the decode is the input, and each kind of change is counted
+// where the cut made it.
+TEST(Lossless, StrayPointsOnValidAndMessySurfacesRoundTripExactly) {
+  Mesh clean = gen::icosphere(3);
+  add_vertex(clean, 4.0, -1.0, 0.5);
+  add_vertex(clean, 0.0, 0.0, 0.0);
+  for (bool keep_order : {false, true}) {
+    EncodeOptions o;
+    o.keep_order = keep_order;
+    const EncodeReport r = expect_exact(clean, o);
+    EXPECT_EQ(r.lossless.unreferenced_vertices, 2u) << keep_order;
+    EXPECT_EQ(r.lossless.vertices_split + r.lossless.edges_cut + r.lossless.faces_flipped +
+                  r.lossless.duplicate_faces + r.lossless.degenerate_faces,
+              0u)
+        << keep_order;
+  }
+  EncodeOptions keep;
+  keep.keep_order = true;
+  const EncodeReport kept = expect_exact(gen::icosphere(2), keep); // no stray point at all
+  EXPECT_EQ(kept.lossless.unreferenced_vertices + kept.lossless.vertices_split, 0u);
+  Mesh messy = clean;
+  std::swap(messy.triangles[4], messy.triangles[5]); // one face flipped
+  const EncodeReport flipped = expect_exact(messy, keep);
+  EXPECT_EQ(flipped.lossless.faces_flipped, 1u);
+  EXPECT_EQ(flipped.lossless.unreferenced_vertices, 2u);
+  Mesh degenerate = clean; // the second stray point used by a face repeating a vertex
+  add_face(degenerate, uint32_t(clean.vertex_count() - 1), 0, uint32_t(clean.vertex_count() - 1));
+  const EncodeReport d = expect_exact(degenerate);
+  EXPECT_EQ(d.lossless.degenerate_faces, 1u);
+  EXPECT_EQ(d.lossless.unreferenced_vertices, 2u);
+}
+
 TEST(Lossless, KeepOrderRestoresTheInputNumbering) {
   Mesh clean = gen::icosphere(4);
   EncodeOptions keep;
