@@ -568,10 +568,24 @@ private:
   /// else skipped.
   void vertex_element(const PlyElement &e) {
     const bool capturing = capture_vertices(e);
-    if (capturing || !plan_->attributes.empty())
+    if (capturing || !plan_->attributes.empty()) {
+      // Room for the values the file can hold (binary: the element's stride per vertex,
+      // ASCII: two bytes or more per value): appending would otherwise copy each array
+      // several times as it grows.
+      uint64_t bytes = 0;
+      for (const PlyProperty &p : e.props)
+        bytes += p.is_list ? 1 : h_.encoding == PlyHeader::Ascii ? 2 : type_size(p.type);
+      const size_t vertices =
+          size_t(std::min<uint64_t>(e.count, in_.remaining() / std::max<uint64_t>(bytes, 1)));
+      for (VertexAttribute &a : plan_->attributes)
+        if (a.kind == AttributeKind::Colour)
+          a.colour.reserve(a.components * vertices);
+        else
+          a.values.reserve(a.components * vertices);
       read_vertices(e, capturing);
-    else
+    } else {
       skip_element(e);
+    }
   }
 
   /// Whether the positions of vertex element `e` are captured: float x, y, z, scalar
@@ -640,6 +654,12 @@ private:
 
   /// Reads every item of the connectivity element and checks its index list.
   void walk(const PlyElement &e, bool strips) {
+    if (capture_ && capture_->ok && conn_prop_ && !strips) {     // room for the file's triangles
+      const uint64_t bytes = h_.encoding == PlyHeader::Ascii ? 8 // "3 a b c" and a line end
+                                                             : type_size(conn_prop_->count_type) +
+                                                                   3 * type_size(conn_prop_->type);
+      capture_->triangles.reserve(3 * size_t(std::min<uint64_t>(e.count, in_.remaining() / bytes)));
+    }
     for (uint64_t i = 0; i < e.count; ++i)
       for (const auto &p : e.props) {
         if (&p != conn_prop_) {
