@@ -388,10 +388,41 @@ TEST(Lossless, RecordReaderRejectsGarbage) {
       const LosslessRecord r = read_lossless_record(body.data(), body.size(), d, 12);
       Quantizer g;
       g.bits = 12;
-      apply_lossless_record(d, r, g);
+      apply_lossless_record(Mesh(d), r, g);
     } catch (const Error &) {
     }
   }
+}
+
+// apply_lossless_record works in the decoded mesh's own arrays, so it checks what a record
+// can get wrong before it touches them: a record that does not fit throws with the mesh as
+// it was (a skip_damaged decode then gives that mesh, the cut one).
+TEST(Lossless, ARecordThatDoesNotFitLeavesTheDecodedMeshAsItWas) {
+  Mesh d = gen::icosphere(1);
+  VertexAttribute scalar;
+  scalar.kind = AttributeKind::Scalar;
+  scalar.name = "quality";
+  scalar.components = 1;
+  scalar.values.assign(d.vertex_count(), 0.5f);
+  d.attributes.push_back(scalar);
+  Quantizer g;
+  g.bits = 12;
+  LosslessRecord extra_without_values; // a vertex no face uses, and no value of `quality`
+  extra_without_values.extra_q = {1, 2, 3};
+  LosslessRecord short_order; // an order of the wrong length
+  short_order.order = {0, 1};
+  for (const LosslessRecord &r : {extra_without_values, short_order}) {
+    Mesh decoded = d;
+    EXPECT_THROW(apply_lossless_record(std::move(decoded), r, g), Error);
+    EXPECT_EQ(decoded.positions, d.positions);
+    EXPECT_EQ(decoded.triangles, d.triangles);
+    ASSERT_EQ(decoded.attributes.size(), 1u);
+    EXPECT_EQ(decoded.attributes[0].values, scalar.values);
+  }
+  Mesh decoded = d; // and a record that fits consumes it
+  const Mesh out = apply_lossless_record(std::move(decoded), LosslessRecord(), g);
+  EXPECT_EQ(out.positions, d.positions);
+  EXPECT_EQ(out.triangle_count(), d.triangle_count());
 }
 
 } // namespace

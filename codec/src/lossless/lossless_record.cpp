@@ -345,8 +345,7 @@ std::vector<uint32_t> canonical_face_order(const std::vector<uint32_t> &t) {
   // mesh's): bucketed by the smallest vertex, the buckets sorted. Otherwise the triple packs
   // into one 64-bit key when the ids fit in 21 bits, and a stable radix sort of the faces in
   // index order gives that order (a comparison sort of indices through the triples took a
-  // sixth of a 35k-vertex decode's CPU time; the buckets take half the radix sort's time);
-  // larger ids sort the triples themselves.
+  // sixth of a 35k-vertex decode's CPU time); larger ids sort the triples themselves.
   const uint32_t nf = static_cast<uint32_t>(t.size() / 3);
   const uint32_t top = t.empty() ? 0 : *std::max_element(t.begin(), t.end());
   int bits = 1;
@@ -532,7 +531,7 @@ std::vector<uint8_t> write_lossless_record(const LosslessRecord &r, const Mesh &
   if (!r.order.empty()) {
     LosslessRecord without = r;
     without.order.clear();
-    const Mesh mesh = apply_lossless_record(decoded, without, Quantizer());
+    const Mesh mesh = apply_lossless_record(Mesh(decoded), without, Quantizer());
     const uint32_t n = static_cast<uint32_t>(mesh.vertex_count());
     if (r.order.size() != n)
       throw Error(Error::Kind::Internal,
@@ -691,13 +690,31 @@ LosslessRecord read_lossless_record(const uint8_t *data, size_t size, const Mesh
   return r;
 }
 
-Mesh apply_lossless_record(Mesh decoded, const LosslessRecord &r, const Quantizer &grid,
+Mesh apply_lossless_record(Mesh &&decoded, const LosslessRecord &r, const Quantizer &grid,
                            std::vector<uint32_t> *source) {
   // Worked in place on D's own arrays (a full decode hands its mesh over): the output
   // vertices are D's less the copies, then the extra vertices; the faces D's in canonical
-  // order, written where D's were once bucketed.
+  // order, written where D's were once bucketed. What can be wrong is checked first: a
+  // damaged record throws with D untouched (skip_damaged keeps it, the cut mesh).
   const uint32_t nv = static_cast<uint32_t>(decoded.vertex_count());
   const size_t extra = r.extra_q.size() / 3;
+  // Per attribute of D, the extra vertices' values of it (none: a record without
+  // attributes, e.g. written for a mesh that had none).
+  std::vector<const VertexAttribute *> extra_of;
+  for (const VertexAttribute &a : decoded.attributes) {
+    const VertexAttribute *x = nullptr;
+    for (const VertexAttribute &e : r.extra_attributes)
+      if (e.kind == a.kind && e.name == a.name && e.components == a.components)
+        x = &e;
+    if (extra != 0 && (x == nullptr || x->vertex_count() != extra))
+      damaged("no " + std::string(kind_name(a.kind)) + " '" + a.name +
+              "' for the vertices no face uses");
+    if (a.vertex_count() != nv)
+      damaged("attribute '" + a.name + "' does not fit the decoded mesh");
+    extra_of.push_back(x);
+  }
+  if (!r.order.empty() && r.order.size() != nv - r.copies.size() + extra)
+    damaged("the vertex order does not fit the mesh");
   std::vector<uint32_t> out_of; // D's vertex -> output vertex (when there are copies)
   if (!r.copies.empty() || source) {
     out_of.assign(nv, kNone);
@@ -786,19 +803,9 @@ Mesh apply_lossless_record(Mesh decoded, const LosslessRecord &r, const Quantize
   // carry the same values: the cut copies attributes); the extra vertices, those the record
   // stores (bit for bit).
   out.texture_files = std::move(decoded.texture_files);
-  for (VertexAttribute &a : decoded.attributes) {
-    // The extra vertices' values of this attribute (none: a record without attributes,
-    // e.g. written for a mesh that had none).
-    const VertexAttribute *x = nullptr;
-    for (const VertexAttribute &e : r.extra_attributes)
-      if (e.kind == a.kind && e.name == a.name && e.components == a.components)
-        x = &e;
-    if (extra != 0 && (x == nullptr || x->vertex_count() != extra))
-      damaged("no " + std::string(kind_name(a.kind)) + " '" + a.name +
-              "' for the vertices no face uses");
-    if (a.vertex_count() != nv)
-      damaged("attribute '" + a.name + "' does not fit the decoded mesh");
-    VertexAttribute b = std::move(a);
+  for (size_t i = 0; i < decoded.attributes.size(); ++i) {
+    const VertexAttribute *x = extra_of[i];
+    VertexAttribute b = std::move(decoded.attributes[i]);
     size_t c = 0; // the copies, in increasing vertex order, are dropped
     if (!r.copies.empty())
       keep_vertex_rows(b, nv, [&](size_t v) {
@@ -816,9 +823,7 @@ Mesh apply_lossless_record(Mesh decoded, const LosslessRecord &r, const Quantize
   }
 
   if (!r.order.empty()) {
-    // Output vertex o is input vertex order[o]: renumber.
-    if (r.order.size() != out.vertex_count())
-      damaged("the vertex order does not fit the mesh");
+    // Output vertex o is input vertex order[o]: renumber (its size checked above).
     std::vector<float> p(out.positions.size());
     for (size_t o = 0; o < r.order.size(); ++o)
       std::copy(&out.positions[3 * o], &out.positions[3 * o] + 3, &p[3 * size_t(r.order[o])]);

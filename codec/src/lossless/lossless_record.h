@@ -76,10 +76,10 @@ LosslessRecord read_lossless_record(const uint8_t *data, size_t size, const Mesh
                                     int bits);
 
 /// D with the record undone: the input mesh (positions on the grid), made in D's own arrays
-/// (pass D moved when it is not needed after). `source` (optional)
+/// (D is left empty; a damaged record throws before D is touched). `source` (optional)
 /// receives for each vertex of the result the vertex of D it comes from (kNone: a vertex no
 /// face of D uses).
-Mesh apply_lossless_record(Mesh decoded, const LosslessRecord &record, const Quantizer &grid,
+Mesh apply_lossless_record(Mesh &&decoded, const LosslessRecord &record, const Quantizer &grid,
                            std::vector<uint32_t> *source = nullptr);
 
 } // namespace pomar
