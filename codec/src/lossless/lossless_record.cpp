@@ -457,7 +457,7 @@ std::vector<VertexAttribute> read_extra_attributes(RangeDecoder &rc, uint64_t ex
   return out;
 }
 
-std::vector<uint8_t> write_lossless_record(const LosslessRecord &r, const Mesh &decoded) {
+std::vector<uint8_t> write_lossless_record(const LosslessRecord &r, Mesh &&decoded) {
   std::vector<uint8_t> out;
   out.push_back(uint8_t((r.order.empty() ? 0 : kHasOrder) |
                         (r.extra_attributes.empty() ? 0 : kHasAttributes)));
@@ -531,7 +531,7 @@ std::vector<uint8_t> write_lossless_record(const LosslessRecord &r, const Mesh &
   if (!r.order.empty()) {
     LosslessRecord without = r;
     without.order.clear();
-    const Mesh mesh = apply_lossless_record(Mesh(decoded), without, Quantizer());
+    const Mesh mesh = apply_lossless_record(std::move(decoded), without, Quantizer());
     const uint32_t n = static_cast<uint32_t>(mesh.vertex_count());
     if (r.order.size() != n)
       throw Error(Error::Kind::Internal,

@@ -67,8 +67,10 @@ LosslessCounts read_lossless_counts(const uint8_t *data, size_t size);
 /// D's faces in canonical order: face indices sorted by (rotated) vertex triple.
 std::vector<uint32_t> canonical_face_order(const std::vector<uint32_t> &triangles);
 
-/// The section body. `decoded` is D (the full decode of the cut mesh).
-std::vector<uint8_t> write_lossless_record(const LosslessRecord &record, const Mesh &decoded);
+/// The section body. `decoded` is D (the full decode of the cut mesh), as far as the record
+/// needs it (build_lossless_record); consumed (a kept order is coded on D with the record
+/// undone, made in D's arrays).
+std::vector<uint8_t> write_lossless_record(const LosslessRecord &record, Mesh &&decoded);
 
 /// Reads a section body against D (`bits`: the grid's); every count and index is checked
 /// (pomar::Error naming the part of the record that is damaged).

@@ -283,6 +283,8 @@ std::vector<uint8_t> encode_any(const Mesh &mesh, const EncodeOptions &options,
   const size_t nv = mesh.vertex_count();
   check_encode_input(mesh, options); // unreferenced vertices included
   Mesh cut;
+  const Mesh *coded = &cut; // what the manifold encoder codes: the cut (the mesh itself if
+                            // no cut and no attribute to neutralise: no copy)
   RepairMap map;
   RepairReport repair;
   LosslessHook hook;
@@ -291,9 +293,9 @@ std::vector<uint8_t> encode_any(const Mesh &mesh, const EncodeOptions &options,
   Mesh decoded;
   std::vector<uint32_t> output_to_input;
   hook.record = [&](const std::vector<uint32_t> &decoded_to_cut) {
-    record = build_lossless_record(mesh, cut, map, decoded_to_cut, hook.grid, options.keep_order,
+    record = build_lossless_record(mesh, *coded, map, decoded_to_cut, hook.grid, options.keep_order,
                                    decoded, output_to_input);
-    return write_lossless_record(record, decoded);
+    return write_lossless_record(record, std::move(decoded));
   };
   // The cut (make_manifold) and the record's coding. On a mesh whose topology may be valid
   // (unreferenced vertices, or the order kept) the cut is first taken to be the mesh itself:
@@ -301,24 +303,30 @@ std::vector<uint8_t> encode_any(const Mesh &mesh, const EncodeOptions &options,
   // whether it is (a scan's stray points then cost no topology analysis); if the encoder
   // refuses it and the topology is the reason, the mesh is cut after all.
   const auto cut_and_encode = [&](bool cut_needed) {
-    cut = mesh;
     map = RepairMap();
     repair = RepairReport();
     decoded = Mesh();
+    coded = &cut;
     if (cut_needed) {
+      cut = mesh;
       repair = cut_to_manifold(cut, &map); // checks the indices
     } else {
       map.face_origin.resize(mesh.triangle_count());
       std::iota(map.face_origin.begin(), map.face_origin.end(), 0u);
       map.flipped.assign(mesh.triangle_count(), 0);
+      if (mesh.attributes.empty())
+        coded = &mesh;
+      else
+        cut = mesh;
     }
-    usable_attributes_for_unused_vertices(cut);
-    if (cut.triangle_count() == 0)
+    if (coded == &cut)
+      usable_attributes_for_unused_vertices(cut);
+    if (coded->triangle_count() == 0)
       throw Error(Error::Kind::InvalidMesh, "the mesh has no valid triangle: all " +
                                                 std::to_string(mesh.triangle_count()) +
                                                 " faces repeat a vertex");
     if (!cut_needed) // (the topology is not known to be valid: a refusal is not named)
-      return encode_manifold(cut, options, report, &hook, {}, false);
+      return encode_manifold(*coded, options, report, &hook, {}, false);
     try { // (the encoder's corner table checks the cut, see repair/cut.h)
       return encode_manifold(cut, options, report, &hook);
     } catch (const TopologyError &e) {
