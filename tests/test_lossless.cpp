@@ -515,8 +515,7 @@ std::vector<uint32_t> canonical_order_by_definition(const std::vector<uint32_t> 
 }
 
 // canonical_face_order buckets the faces by smallest vertex when the ids are about as many
-// as the faces (buckets of many faces, 3 and 100; of a few, 1000 and 4000), packs the triple
-// into one key for a radix sort when the vertex ids fit in 21 bits, and sorts triples
+// as the faces (buckets of many faces, 3 and 100; of a few, 1000 and 4000) and sorts triples
 // otherwise: each must give the defined order, duplicate faces (same triple, any rotation)
 // by index.
 TEST(Lossless, CanonicalFaceOrderIsTheSortedRotatedTriples) {

@@ -342,15 +342,11 @@ void canonical_buckets(const std::vector<uint32_t> &t, uint32_t top, std::vector
 std::vector<uint32_t> canonical_face_order(const std::vector<uint32_t> &t) {
   // Each face's vertices rotated to start at the smallest; the faces sorted by that triple,
   // equal triples (duplicate faces) by face index. Ids up to a few times the face count (a
-  // mesh's): bucketed by the smallest vertex, the buckets sorted. Otherwise the triple packs
-  // into one 64-bit key when the ids fit in 21 bits, and a stable radix sort of the faces in
-  // index order gives that order (a comparison sort of indices through the triples took a
-  // sixth of a 35k-vertex decode's CPU time); larger ids sort the triples themselves.
+  // mesh's own, every caller's): bucketed by the smallest vertex, the buckets sorted (a
+  // comparison sort of indices through the triples took a sixth of a 35k-vertex decode's
+  // CPU time). Sparse ids (only a test makes them) sort the triples themselves.
   const uint32_t nf = static_cast<uint32_t>(t.size() / 3);
   const uint32_t top = t.empty() ? 0 : *std::max_element(t.begin(), t.end());
-  int bits = 1;
-  while (bits < 32 && (top >> bits) != 0)
-    ++bits;
   std::vector<uint32_t> order = filled_vector<uint32_t>(nf); // (memory/prefault.h)
   if (dense_ids(t, top)) {
     std::vector<uint32_t> end;
@@ -358,18 +354,6 @@ std::vector<uint32_t> canonical_face_order(const std::vector<uint32_t> &t) {
     canonical_buckets(t, top, end, by);
     for (uint32_t i = 0; i < nf; ++i)
       order[i] = by[i].id >> 2;
-    return order;
-  }
-  if (3 * bits <= 64) {
-    std::vector<Keyed> key = filled_vector<Keyed>(nf);
-    for (uint32_t f = 0; f < nf; ++f) {
-      uint32_t k[3];
-      rotated(t.data(), f, k);
-      key[f] = {uint64_t(k[0]) << (2 * bits) | uint64_t(k[1]) << bits | k[2], f};
-    }
-    sort_by_key(key);
-    for (uint32_t i = 0; i < nf; ++i)
-      order[i] = key[i].id;
     return order;
   }
   struct Face {

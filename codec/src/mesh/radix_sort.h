@@ -1,6 +1,6 @@
 // A stable sort of (64-bit key, 32-bit id) pairs by key: the Morton order of the encoder's
-// vertices (mesh/reorder.cpp), the canonical face order of the lossless record
-// and the vertices grouped by position (lossless/lossless_record.cpp).
+// vertices (mesh/reorder.cpp) and the lossless record's vertices grouped by position
+// (lossless/lossless_record.cpp).
 #pragma once
 
 #include <cstdint>
