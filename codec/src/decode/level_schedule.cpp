@@ -1,231 +1,129 @@
-// The pipelined decoding of one clustered level; see level_schedule.h.
+// The phased decoding of one clustered level; see level_schedule.h.
 #include "decode/level_schedule.h"
 
 #include <algorithm>
-#include <exception>
+#include <atomic>
+#include <memory>
 
 namespace pomar {
 
-namespace {
-constexpr uint32_t kNoCluster = 0xFFFFFFFFu;
-// A traverser that found the window full waits for this many applies (one wake-up per
-// cluster applied would cost more than the traversals it starts).
-constexpr size_t kWakeAfter = 32;
-// The other threads take clusters from this many past the next apply (see take()).
-constexpr size_t kAhead = 128;
-/// Lock `lock` (unlocked), spinning a little first: the critical sections here last well
-/// under a microsecond and both threads take the lock every few microseconds, so a
-/// blocking lock put a thread to sleep (a system call and a wake-up, several
-/// microseconds) about once per ten clusters.
-void spin_lock(std::unique_lock<std::mutex> &lock) {
-  for (int i = 0; i < 2000; ++i) {
-    if (lock.try_lock())
-      return;
-#if defined(__x86_64__) || defined(__i386__)
-    __builtin_ia32_pause();
-#endif
+std::vector<uint8_t> cluster_owners(const ClusterGraph &graph, unsigned threads) {
+  const size_t n = graph.start.empty() ? 0 : graph.start.size() - 1;
+  std::vector<uint8_t> owner(n, 0);
+  if (threads <= 1 || n == 0)
+    return owner;
+  // Breadth-first order, each component from its smallest cluster id.
+  std::vector<uint32_t> bfs;
+  bfs.reserve(n);
+  std::vector<uint8_t> seen(n, 0);
+  for (uint32_t root = 0; root < n; ++root) {
+    if (seen[root])
+      continue;
+    seen[root] = 1;
+    bfs.push_back(root);
+    for (size_t head = bfs.size() - 1; head < bfs.size(); ++head) {
+      const uint32_t c = bfs[head];
+      for (uint32_t k = graph.start[c]; k < graph.start[c + 1]; ++k)
+        if (!seen[graph.adj[k]]) {
+          seen[graph.adj[k]] = 1;
+          bfs.push_back(graph.adj[k]);
+        }
+    }
   }
-  lock.lock();
+  for (size_t r = 0; r < n; ++r)
+    owner[bfs[r]] = static_cast<uint8_t>(r * threads / n);
+  return owner;
 }
-} // namespace
 
-void LevelSchedule::run(ThreadPool &pool, const ClusterGraph &graph, const uint32_t *order,
-                        size_t n, size_t window, const Steps &steps) {
+size_t LevelSchedule::run(ThreadPool &pool, const ClusterGraph &graph,
+                          const std::vector<uint8_t> &owner, const uint32_t *order, size_t n,
+                          size_t window, const Steps &steps) {
   graph_ = &graph;
+  owner_ = &owner;
   order_ = order;
   steps_ = &steps;
-  n_ = n;
-  window_ = std::max<size_t>(window, 1);
-  state_.assign(n, Untraversed);
-  traverse_error_.assign(n, nullptr);
+  window = std::max<size_t>(window, 1);
   const size_t clusters = graph.start.empty() ? 0 : graph.start.size() - 1;
-  traversed_now_.assign(clusters, 0);
-  applying_ = kNoCluster;
-  next_apply_ = scan_from_ = ahead_from_ = traversing_ = 0;
-  stop_ = false;
-  wake_at_ = 0;
-  waiting_ = 0;
-  main_waiting_ = false;
-  bool applier_ran = false; // (a pool whose threads did not start hands their items to us)
-  std::exception_ptr error;
-  pool.run(pool.size(), [&](size_t, unsigned thread) {
-    if (thread != 0) {
-      traverse_loop(thread);
-    } else if (!applier_ran) {
-      applier_ran = true;
-      try {
-        apply_loop();
-      } catch (...) {
-        error = std::current_exception();
-      }
+  in_window_.assign(clusters, 0);
+  for (size_t begin = 0; begin < n; begin += window) {
+    const size_t end = std::min(n, begin + window);
+    traverse_phase(pool, begin, end);
+    size_t admitted = begin;
+    while (admitted < end && steps.admit(admitted))
+      ++admitted;
+    steps.grow();
+    apply_phase(pool, begin, admitted);
+    for (size_t i = begin; i < admitted; ++i)
+      steps.applied(i);
+    if (admitted < end) { // index `admitted` failed
+      for (size_t j = admitted + 1; j < end; ++j)
+        steps.rewind(j);
+      return admitted;
+    }
+  }
+  return n;
+}
+
+/// Phase 1 for indices [begin, end): item r of the pool traverses the indices whose cluster
+/// role r owns, in increasing order, then takes the others' from the end of their lists.
+void LevelSchedule::traverse_phase(ThreadPool &pool, size_t begin, size_t end) {
+  const unsigned roles = pool.size();
+  lists_.resize(roles);
+  for (auto &l : lists_)
+    l.clear();
+  for (size_t i = begin; i < end; ++i)
+    lists_[(*owner_)[order_[i]] % roles].push_back(static_cast<uint32_t>(i));
+  const size_t count = end - begin;
+  std::unique_ptr<std::atomic<uint8_t>[]> taken(new std::atomic<uint8_t>[count]);
+  for (size_t i = 0; i < count; ++i)
+    taken[i].store(0, std::memory_order_relaxed);
+  by_.assign(count, 0);
+  pool.run(roles, [&](size_t role, unsigned thread) {
+    const auto take = [&](uint32_t i) {
+      if (taken[i - begin].exchange(1, std::memory_order_relaxed))
+        return;
+      by_[i - begin] = static_cast<uint8_t>(role);
+      steps_->traverse(i, thread);
+    };
+    for (uint32_t i : lists_[role])
+      take(i);
+    for (unsigned k = 1; k < roles; ++k) {
+      const auto &other = lists_[(role + k) % roles];
+      for (size_t j = other.size(); j-- > 0;)
+        take(other[j]);
     }
   });
-  if (error)
-    std::rethrow_exception(error);
 }
 
-/// Under mutex_: index i (order_[i]) has a neighbour in the cluster graph being applied.
-bool LevelSchedule::next_to_applying(uint32_t cluster) const {
-  if (applying_ == kNoCluster)
-    return false;
-  if (applying_ == kAll || applying_ == cluster)
-    return true;
-  for (uint32_t k = graph_->start[cluster]; k < graph_->start[cluster + 1]; ++k)
-    if (graph_->adj[k] == applying_)
-      return true;
-  return false;
-}
-
-/// Under mutex_: a neighbour of `cluster` is being traversed.
-bool LevelSchedule::neighbour_traversing(uint32_t cluster) const {
-  for (uint32_t k = graph_->start[cluster]; k < graph_->start[cluster + 1]; ++k)
-    if (traversed_now_[graph_->adj[k]])
-      return true;
-  return false;
-}
-
-/// Under mutex_: take an untraversed index of the window that may be traversed now. The
-/// applying thread (`applier`, not applying now: any index) takes the lowest; the other
-/// threads the lowest from kAhead past the next apply, else the lowest below that: their
-/// traversals then read other cache lines than the applies write, and the applying thread
-/// applies the clusters it traversed itself. Sets wake_at_ for a thread that finds none.
-bool LevelSchedule::take(size_t &i, bool applier) {
-  while (scan_from_ < n_ && state_[scan_from_] != Untraversed)
-    ++scan_from_;
-  const size_t end = std::min(n_, next_apply_ + window_);
-  bool blocked = false;
-  const auto take_in = [&](size_t from, size_t to) {
-    for (size_t j = from; j < to; ++j) {
-      if (state_[j] != Untraversed)
-        continue;
-      if (!applier && next_to_applying(order_[j])) {
-        blocked = true;
-        continue;
+/// Phase 3 for the admitted indices [begin, end): item r of the pool applies those role r
+/// traversed whose neighbours in the window role r traversed too; then this thread
+/// applies the others, in order.
+void LevelSchedule::apply_phase(ThreadPool &pool, size_t begin, size_t end) {
+  if (begin == end)
+    return;
+  for (size_t i = begin; i < end; ++i)
+    in_window_[order_[i]] = static_cast<uint32_t>(i - begin + 1);
+  apply_later_.assign(end - begin, 0);
+  for (size_t i = begin; i < end; ++i) {
+    const uint32_t c = order_[i];
+    for (uint32_t k = graph_->start[c]; k < graph_->start[c + 1]; ++k) {
+      const uint32_t j = in_window_[graph_->adj[k]];
+      if (j != 0 && by_[j - 1] != by_[i - begin]) {
+        apply_later_[i - begin] = 1;
+        break;
       }
-      state_[j] = Traversing;
-      traversed_now_[order_[j]] = 1;
-      ++traversing_;
-      i = j;
-      return true;
     }
-    return false;
-  };
-  if (applier)
-    return take_in(scan_from_, end);
-  // (ahead_from_ only moves forward, past indices taken already: the scan stays short.)
-  const size_t ahead = std::max(scan_from_, std::min(end, next_apply_ + kAhead));
-  ahead_from_ = std::max(ahead_from_, ahead);
-  while (ahead_from_ < end && state_[ahead_from_] != Untraversed)
-    ++ahead_from_;
-  if (take_in(ahead_from_, end) || take_in(scan_from_, ahead))
-    return true;
-  // Blocked by the apply: the next apply frees it; a full window: some applies later.
-  const size_t want = next_apply_ + (blocked ? 1 : kWakeAfter);
-  wake_at_ = waiting_ == 0 ? want : std::min(wake_at_, want);
-  return false;
-}
-
-/// Traverse index i on `thread` (not under mutex_); what the traversal throws is kept for
-/// index i's turn to be applied.
-void LevelSchedule::traverse(size_t i, unsigned thread) {
-  try {
-    steps_->traverse(i, thread);
-  } catch (...) {
-    traverse_error_[i] = std::current_exception();
   }
-}
-
-/// Under mutex_: index i has been traversed.
-void LevelSchedule::finish_traversal(size_t i) {
-  state_[i] = Traversed;
-  traversed_now_[order_[i]] = 0;
-  --traversing_;
-  if (main_waiting_)
-    main_wait_.notify_one();
-}
-
-void LevelSchedule::traverse_loop(unsigned thread) {
-  std::unique_lock<std::mutex> lock(mutex_, std::defer_lock);
-  spin_lock(lock);
-  for (;;) {
-    if (stop_ || next_apply_ >= n_)
-      return;
-    size_t i;
-    if (take(i, false)) {
-      lock.unlock();
-      traverse(i, thread);
-      spin_lock(lock);
-      finish_traversal(i);
-      continue;
-    }
-    ++waiting_;
-    wait_.wait(lock);
-    --waiting_;
-  }
-}
-
-void LevelSchedule::apply_loop() {
-  std::unique_lock<std::mutex> lock(mutex_, std::defer_lock);
-  spin_lock(lock);
-  for (size_t a = 0; a < n_; ++a) {
-    for (;;) {
-      if (state_[a] == Traversed) {
-        // Reserve the apply first (no new traversal next to it, or none at all), then
-        // wait for the ones running to end, traversing meanwhile if there is work.
-        if (applying_ == kNoCluster) {
-          lock.unlock(); // (only this thread changes index a's state now, and applying_)
-          const bool alone = steps_->alone(a);
-          spin_lock(lock);
-          applying_ = alone ? kAll : order_[a];
-        }
-        if (applying_ == kAll ? traversing_ == 0 : !neighbour_traversing(order_[a]))
-          break;
-      }
-      size_t i;
-      if (applying_ != kAll && take(i, true)) {
-        lock.unlock();
-        traverse(i, 0);
-        spin_lock(lock);
-        finish_traversal(i);
-        continue;
-      }
-      main_waiting_ = true;
-      main_wait_.wait(lock);
-      main_waiting_ = false;
-    }
-    const bool next_ready = a + 1 < n_ && state_[a + 1] == Traversed;
-    lock.unlock();
-    if (next_ready && steps_->prefetch)
-      steps_->prefetch(a + 1);
-    try {
-      if (traverse_error_[a])
-        std::rethrow_exception(traverse_error_[a]);
-      steps_->apply(a);
-    } catch (...) {
-      // Stop the traversers, wait for the running ones, then put back the streams of the
-      // clusters traversed past a (the state they had before this level).
-      spin_lock(lock);
-      stop_ = true;
-      applying_ = kNoCluster;
-      wait_.notify_all();
-      while (traversing_ > 0) {
-        main_waiting_ = true;
-        main_wait_.wait(lock);
-        main_waiting_ = false;
-      }
-      lock.unlock();
-      for (size_t j = a + 1; j < n_; ++j)
-        if (state_[j] == Traversed)
-          steps_->rewind(j);
-      throw;
-    }
-    spin_lock(lock);
-    state_[a] = Applied;
-    applying_ = kNoCluster;
-    next_apply_ = a + 1;
-    if (waiting_ > 0 && (next_apply_ >= wake_at_ || next_apply_ == n_))
-      wait_.notify_all();
-  }
+  pool.run(pool.size(), [&](size_t role, unsigned thread) {
+    for (size_t i = begin; i < end; ++i)
+      if (by_[i - begin] == role && !apply_later_[i - begin])
+        steps_->apply(i, thread);
+  });
+  for (size_t i = begin; i < end; ++i)
+    if (apply_later_[i - begin])
+      steps_->apply(i, 0);
+  for (size_t i = begin; i < end; ++i)
+    in_window_[order_[i]] = 0;
 }
 
 } // namespace pomar

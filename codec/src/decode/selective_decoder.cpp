@@ -72,6 +72,8 @@ struct SelectiveDecoder::State {
   std::vector<LevelStep> steps{1};
   std::vector<TraversedCluster> traversed;
   std::vector<RangeDecoder> stream_before; // each batch cluster's stream before its traversal
+  std::vector<StepCounts> first_new;       // each batch cluster's first new vertex and face
+  std::vector<uint8_t> owners;             // cluster -> thread (cluster_owners)
 
   // Attributes: descriptors and base codes (the other codes come with the positions).
   AttributeMask attribute_mask;
@@ -142,25 +144,31 @@ void SelectiveDecoder::State::decode_cluster_level(uint32_t c, int level, uint32
   k.level = level;
 }
 
-/// The data of `level` of the clusters `refine` (increasing), on the pool's threads:
-/// traversed ahead on every thread, applied in order on this one (decode/level_schedule.h).
-/// Throws what decode_cluster_level would throw for the first cluster that fails
-/// (`decoding` names it), with the clusters before it applied and the others as they were
-/// (their streams put back).
+/// The data of `level` of the clusters `refine` (increasing), on the pool's threads, a
+/// window at a time: traversed on every thread, checked and numbered in cluster order on
+/// this one, applied on every thread (decode/level_schedule.h). Throws what
+/// decode_cluster_level would throw for the first cluster that fails (`decoding` names it),
+/// with the clusters before it applied and the others as they were (their streams put
+/// back).
 void SelectiveDecoder::State::decode_level_parallel(const std::vector<uint32_t> &refine, int level,
                                                     uint32_t older_than,
                                                     const std::function<void()> &applied,
                                                     uint32_t &decoding) {
-  // The traversed clusters waiting to be applied, at most kWindow (1024 clusters of a
-  // 1M-vertex file's finest level hold about 1 MB of splits); the window does not depend
+  // The clusters traversed before the window's applies, at most kWindow (4096 clusters of
+  // a 1M-vertex file's finest level hold about 4 MB of splits); the window does not depend
   // on the thread count (neither does anything else the decoder does).
-  constexpr size_t kWindow = 1024;
+  constexpr size_t kWindow = 4096;
   const size_t window = std::min(kWindow, refine.size());
   if (traversed.size() < window) {
     traversed.resize(window);
     stream_before.resize(window);
+    first_new.resize(window);
   }
+  if (owners.empty())
+    owners = cluster_owners(graph, pool->size());
   const uint32_t l = static_cast<uint32_t>(level);
+  std::exception_ptr failure; // why the index that failed to be admitted failed
+  uint64_t vertices = mesh.vertex_count(), faces = mesh.ct.face_count(); // once admitted
   LevelSchedule::Steps work;
   work.traverse = [&](size_t i, unsigned thread) {
     const uint32_t c = refine[i];
@@ -173,28 +181,45 @@ void SelectiveDecoder::State::decode_level_parallel(const std::vector<uint32_t> 
     } catch (...) { // (the stream did not start)
       out.splits.clear();
       out.claims.clear();
+      out.adds = {};
       out.error = std::current_exception();
     }
   };
-  work.alone = [&](size_t i) { // (applying it would move the arrays)
-    const StepCounts &adds = traversed[i % window].adds;
-    return !mesh.has_room(mesh.vertex_count() + adds.vertices, mesh.ct.face_count() + adds.faces);
-  };
-  work.apply = [&](size_t i) {
+  work.admit = [&](size_t i) {
     const uint32_t c = refine[i];
-    Cluster &k = clusters[c];
-    decoding = c;
+    TraversedCluster &in = traversed[i % window];
     DecoderCodec codec(layout.header.grid.bits); // (names the cluster in errors)
     codec.set(nullptr, nullptr, nullptr, l, c);
-    steps[0].apply_cluster_level(mesh, codec, {c, l, older_than}, k.next_local,
-                                 traversed[i % window]);
-    k.level = level;
-    decoding = kNone;
+    try {
+      LevelStep::admit_cluster_level(mesh, codec, {c, l, older_than}, in);
+    } catch (...) {
+      failure = std::current_exception();
+      return false;
+    }
+    first_new[i % window] = {vertices, faces};
+    vertices += in.adds.vertices;
+    faces += in.adds.faces;
+    return true;
+  };
+  work.grow = [&] { mesh.grow(vertices, faces); };
+  work.apply = [&](size_t i, unsigned) {
+    const uint32_t c = refine[i];
+    const StepCounts &at = first_new[i % window];
+    LevelStep::apply_admitted(mesh, {c, l, older_than}, clusters[c].next_local,
+                              traversed[i % window], static_cast<uint32_t>(at.vertices),
+                              static_cast<uint32_t>(at.faces));
+  };
+  work.applied = [&](size_t i) {
+    clusters[refine[i]].level = level;
     applied();
   };
   work.rewind = [&](size_t j) { clusters[refine[j]].stream.decoder() = stream_before[j % window]; };
-  work.prefetch = [&](size_t i) { LevelStep::prefetch_cluster(mesh, traversed[i % window]); };
-  schedule.run(*pool, graph, refine.data(), refine.size(), window, work);
+  const size_t failed =
+      schedule.run(*pool, graph, owners, refine.data(), refine.size(), window, work);
+  if (failed < refine.size()) {
+    decoding = refine[failed];
+    std::rethrow_exception(failure);
+  }
 }
 
 /// After `e` while decoding cluster `c` (kNone: not in a cluster): with skip_damaged,

@@ -121,6 +121,16 @@ public:
   template <class Codec>
   void apply_cluster_level(LevelMesh &mesh, Codec &codec, const ClusterLevel &where,
                            uint32_t &next_local, TraversedCluster &in) {
+    admit_cluster_level(mesh, codec, where, in);
+    apply_splits(mesh, in.splits, where.level, where.cluster, &next_local);
+  }
+
+  /// Step 3 in two parts, for clusters applied out of order (decode/level_schedule.h).
+  /// First, in cluster order: the checks of apply_cluster_level and the claims; throws
+  /// with the mesh as it was.
+  template <class Codec>
+  static void admit_cluster_level(LevelMesh &mesh, Codec &codec, const ClusterLevel &where,
+                                  const TraversedCluster &in) {
     for (uint32_t f : in.claims)
       if (mesh.face_claim[f] == where.level)
         codec.corrupt(kSharedFace);
@@ -128,18 +138,15 @@ public:
       std::rethrow_exception(in.error);
     for (uint32_t f : in.claims)
       mesh.face_claim[f] = static_cast<uint16_t>(where.level);
-    apply_splits(mesh, in.splits, where.level, where.cluster, &next_local);
   }
-
-  /// Fetch what apply_cluster_level reads first of a cluster traversed by
-  /// traverse_cluster_level (another core traversed it): the claims of its patch faces and
-  /// the first faces of its first splits. Call it for the next cluster before applying one.
-  static void prefetch_cluster(const LevelMesh &mesh, const TraversedCluster &next) {
-    for (uint32_t f : next.claims)
-      __builtin_prefetch(&mesh.face_claim[f]);
-    const size_t n = std::min<size_t>(next.splits.size(), 4);
-    for (size_t i = 0; i < n; ++i)
-      mesh.ct.prefetch(next.splits.split[i].op.first_corner);
+  /// Then, in any order once the arrays hold every admitted cluster (LevelMesh::grow): the
+  /// splits of an admitted cluster, its new vertices from `first_vertex` and its new faces
+  /// from `first_face` (the counts the clusters before it reach).
+  static void apply_admitted(LevelMesh &mesh, const ClusterLevel &where, uint32_t &next_local,
+                             const TraversedCluster &in, uint32_t first_vertex,
+                             uint32_t first_face) {
+    apply_splits_at(mesh, in.splits, where.level, where.cluster, &next_local, first_vertex,
+                    first_face);
   }
 
 private:
@@ -182,12 +189,22 @@ private:
   /// arrays are sized once for the whole step, each split writes its entries in place.
   static void apply_splits(LevelMesh &mesh, const SplitList &splits, uint32_t level,
                            uint32_t cluster, uint32_t *next_local) {
-    CornerTable &ct = mesh.ct;
-    const uint32_t v0 = mesh.vertex_count(), n = static_cast<uint32_t>(splits.size());
-    uint32_t face = ct.face_count(), new_faces = 0;
+    const uint32_t v0 = mesh.vertex_count(), f0 = mesh.ct.face_count();
+    uint32_t new_faces = 0;
     for (const PendingSplit &ps : splits.split)
       new_faces += uint32_t(ps.op.has_l) + uint32_t(ps.op.has_r);
-    mesh.grow(size_t(v0) + n, size_t(face) + new_faces);
+    mesh.grow(size_t(v0) + splits.size(), size_t(f0) + new_faces);
+    apply_splits_at(mesh, splits, level, cluster, next_local, v0, f0);
+  }
+
+  /// apply_splits into arrays already sized: split i creates vertex v0 + i, the new faces
+  /// follow from face f0.
+  static void apply_splits_at(LevelMesh &mesh, const SplitList &splits, uint32_t level,
+                              uint32_t cluster, uint32_t *next_local, uint32_t v0,
+                              uint32_t f0) {
+    CornerTable &ct = mesh.ct;
+    const uint32_t n = static_cast<uint32_t>(splits.size());
+    uint32_t face = f0;
     const uint32_t codes = mesh.attr_codes;
     for (uint32_t i = 0; i < n; ++i) {
       prefetch_split(ct, splits, i, n);
