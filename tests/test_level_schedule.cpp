@@ -1,21 +1,20 @@
-// The pipelined schedule of a clustered level (decode/level_schedule.h) with stand-in
-// steps that record what ran when, on random cluster graphs with random delays: what the
+// The phased schedule of a clustered level (decode/level_schedule.h) with stand-in steps
+// that record what ran when, on random cluster graphs with random delays: what the
 // decoder's correctness rests on must hold for every interleaving the threads produce.
-//   - every cluster is traversed once, before it is applied; the applies run in order on
-//     the calling thread;
-//   - no traversal runs next to (or on) the cluster being applied, none at all during an
-//     apply that must be alone;
-//   - no traversal starts more than `window` indices past the next apply;
-//   - an apply that throws: run() rethrows it, nothing after it is applied, and exactly the
-//     clusters traversed past it are rewound; a traversal that throws: the same at its
-//     turn to be applied.
+//   - every cluster is traversed once; no apply runs while a traversal does (the phases);
+//   - admits run on the calling thread in index order, each after its window's traversals;
+//     the window's applies after its admits and the grow;
+//   - every admitted index is applied once; two neighbouring clusters are never applied at
+//     the same time; `applied` is called in index order on the calling thread after the
+//     window's applies;
+//   - no traversal starts more than `window` indices past the applied ones;
+//   - an admit that fails: run() returns its index, nothing from it on is applied, and
+//     exactly the indices past it that were traversed are rewound.
 #include <gtest/gtest.h>
 
 #include <atomic>
-#include <chrono>
 #include <mutex>
 #include <random>
-#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
@@ -25,8 +24,7 @@
 namespace pomar {
 namespace {
 
-/// A random graph of `clusters` clusters: a ring (neighbouring ids are adjacent, as in
-/// real files) plus random chords.
+/// A random graph of `clusters` clusters: a ring plus random chords.
 ClusterGraph random_graph(uint32_t clusters, std::mt19937 &rng) {
   std::vector<std::vector<uint32_t>> adj(clusters);
   const auto link = [&](uint32_t a, uint32_t b) {
@@ -66,20 +64,22 @@ struct Recorder {
   const ClusterGraph &graph;
   std::vector<uint32_t> order;
   size_t window;
-  std::vector<std::atomic<int>> traversing;     // by cluster
-  std::vector<std::atomic<int>> traversals;     // by index: times traversed
-  std::vector<std::atomic<int>> traversed_done; // by index: traversal finished
-  std::atomic<int> running{0};                  // traversals running
-  std::atomic<uint32_t> applying{kNone};        // cluster being applied
-  std::atomic<bool> applying_alone{false};
-  std::atomic<size_t> applied{0}; // applies done
+  std::vector<std::atomic<int>> applying;   // by cluster: applies running
+  std::vector<std::atomic<int>> traversals; // by index: times traversed
+  std::vector<std::atomic<int>> applies;    // by index: times applied
+  std::vector<int> admitted;                // by index (calling thread only)
+  std::atomic<int> traversing{0};           // traversals running
+  std::atomic<int> applies_running{0};
+  std::atomic<size_t> applied_upto{0}; // indices below it are applied ("applied" called)
+  size_t admit_next = 0;               // the index admitted next (calling thread)
+  bool grown = false;                  // the grow after the last admits ran
   std::atomic<int> violations{0};
   std::mutex messages_lock;
   std::vector<std::string> messages;
 
   Recorder(const ClusterGraph &g, std::vector<uint32_t> o, size_t w)
-      : graph(g), order(std::move(o)), window(w), traversing(g.start.size() - 1),
-        traversals(order.size()), traversed_done(order.size()) {}
+      : graph(g), order(std::move(o)), window(w), applying(g.start.size() - 1),
+        traversals(order.size()), applies(order.size()), admitted(order.size(), 0) {}
 
   void fail(const std::string &what) {
     ++violations;
@@ -87,94 +87,92 @@ struct Recorder {
     if (messages.size() < 5)
       messages.push_back(what);
   }
-  bool next_to(uint32_t a, uint32_t b) const {
-    if (a == b)
-      return true;
-    for (uint32_t k = graph.start[a]; k < graph.start[a + 1]; ++k)
-      if (graph.adj[k] == b)
-        return true;
-    return false;
-  }
-  void check_traversal(size_t i) {
-    const uint32_t c = order[i], now = applying.load();
-    if (applying_alone.load())
-      fail("traversal of index " + std::to_string(i) + " during an apply that must be alone");
-    if (now != kNone && next_to(c, now))
-      fail("traversal of cluster " + std::to_string(c) + " next to applied cluster " +
-           std::to_string(now));
-  }
 };
 
 struct ScheduleRun {
-  size_t applied = 0;
+  size_t failed = 0; // what run() returned
   std::vector<int> rewound;
-  bool threw = false;
 };
 
-ScheduleRun run_schedule(Recorder &r, ThreadPool &pool, uint32_t seed, size_t throw_at,
-                         const std::vector<bool> &alone, size_t traverse_throws_at = kNone) {
+/// Run the schedule; the admit of `fails_at` (kNone: none) fails.
+ScheduleRun run_schedule(Recorder &r, ThreadPool &pool, uint32_t seed, size_t fails_at) {
   LevelSchedule schedule;
   std::vector<std::mt19937> rngs;
   for (unsigned t = 0; t < pool.size(); ++t)
     rngs.emplace_back(seed * 31 + t);
+  std::mt19937 caller_rng(seed);
   const std::thread::id caller = std::this_thread::get_id();
+  const std::vector<uint32_t> rank = breadth_first_ranks(r.graph);
   ScheduleRun out;
   out.rewound.assign(r.order.size(), 0);
+  const auto on_caller = [&](const char *what) {
+    if (std::this_thread::get_id() != caller)
+      r.fail(std::string(what) + " off the calling thread");
+  };
   LevelSchedule::Steps steps;
   steps.traverse = [&](size_t i, unsigned thread) {
-    if (i >= r.applied.load() + r.window)
+    if (i >= r.applied_upto.load() + r.window)
       r.fail("index " + std::to_string(i) + " traversed outside the window");
-    const uint32_t c = r.order[i];
-    ++r.running;
-    ++r.traversing[c];
+    ++r.traversing;
     ++r.traversals[i];
-    r.check_traversal(i);
+    if (r.applies_running.load() != 0)
+      r.fail("traversal of index " + std::to_string(i) + " while an apply runs");
     spin(rngs[thread]);
-    r.check_traversal(i);
-    --r.traversing[c];
-    --r.running;
-    r.traversed_done[i] = 1;
-    if (i == traverse_throws_at)
-      throw std::runtime_error("damaged block");
+    if (r.applies_running.load() != 0)
+      r.fail("traversal of index " + std::to_string(i) + " while an apply runs");
+    --r.traversing;
   };
-  steps.alone = [&](size_t i) { return bool(alone[i]); };
-  steps.apply = [&](size_t i) {
-    if (std::this_thread::get_id() != caller)
-      r.fail("apply off the calling thread");
-    if (i != r.applied.load())
-      r.fail("apply of index " + std::to_string(i) + " out of order");
-    if (!r.traversed_done[i].load())
-      r.fail("apply of index " + std::to_string(i) + " before its traversal");
+  steps.admit = [&](size_t i) {
+    on_caller("admit");
+    if (i != r.admit_next)
+      r.fail("admit of index " + std::to_string(i) + " out of order");
+    if (r.traversing.load() != 0 || r.traversals[i].load() != 1)
+      r.fail("admit of index " + std::to_string(i) + " before the traversals ended");
+    r.admit_next = i + 1;
+    r.grown = false;
+    if (i == fails_at)
+      return false;
+    r.admitted[i] = 1;
+    return true;
+  };
+  steps.grow = [&] {
+    on_caller("grow");
+    r.grown = true;
+  };
+  steps.apply = [&](size_t i, unsigned thread) {
+    if (!r.admitted[i] || !r.grown)
+      r.fail("apply of index " + std::to_string(i) + " before its admit and the grow");
+    if (r.traversing.load() != 0)
+      r.fail("apply of index " + std::to_string(i) + " while a traversal runs");
     const uint32_t c = r.order[i];
-    r.applying = c;
-    r.applying_alone = bool(alone[i]);
-    if (alone[i] && r.running.load() != 0)
-      r.fail("apply that must be alone while traversals run");
+    ++r.applies_running;
+    ++r.applies[i];
+    ++r.applying[c];
     for (uint32_t k = r.graph.start[c]; k < r.graph.start[c + 1]; ++k)
-      if (r.traversing[r.graph.adj[k]].load())
-        r.fail("apply of cluster " + std::to_string(c) + " while a neighbour is traversed");
-    spin(rngs[0]);
-    r.applying_alone = false;
-    r.applying = kNone;
-    if (i == throw_at)
-      throw std::runtime_error("damaged");
-    r.applied = i + 1;
+      if (r.applying[r.graph.adj[k]].load())
+        r.fail("apply of cluster " + std::to_string(c) + " while a neighbour is applied");
+    spin(rngs[thread]);
+    --r.applying[c];
+    --r.applies_running;
+  };
+  steps.applied = [&](size_t i) {
+    on_caller("applied");
+    if (i != r.applied_upto.load() || r.applies[i].load() != 1 || r.applies_running.load())
+      r.fail("applied(" + std::to_string(i) + ") out of order or before its apply ended");
+    r.applied_upto = i + 1;
+    spin(caller_rng);
   };
   steps.rewind = [&](size_t j) {
-    if (j <= std::min(throw_at, traverse_throws_at))
-      r.fail("rewind of index " + std::to_string(j) + ", not past the failed apply");
+    on_caller("rewind");
+    if (j <= fails_at && fails_at != kNone)
+      r.fail("rewind of index " + std::to_string(j) + ", not past the failed admit");
     ++out.rewound[j];
   };
-  try {
-    schedule.run(pool, r.graph, r.order.data(), r.order.size(), r.window, steps);
-  } catch (const std::runtime_error &) {
-    out.threw = true;
-  }
-  out.applied = r.applied.load();
+  out.failed = schedule.run(pool, r.graph, rank, r.order.data(), r.order.size(), r.window, steps);
   return out;
 }
 
-TEST(LevelSchedule, TraversalsNeverMeetTheApplyAndAppliesStayInOrder) {
+TEST(LevelSchedule, PhasesNeverOverlapAndNeighboursAreNeverAppliedTogether) {
   for (unsigned threads : {2u, 3u, 7u}) {
     ThreadPool pool(threads);
     for (uint32_t seed = 1; seed <= 12; ++seed) {
@@ -186,17 +184,17 @@ TEST(LevelSchedule, TraversalsNeverMeetTheApplyAndAppliesStayInOrder) {
       for (uint32_t c = 0; c < clusters; ++c)
         if (rng() % 4 != 0)
           order.push_back(c);
-      std::vector<bool> alone(order.size());
-      for (size_t i = 0; i < order.size(); ++i)
-        alone[i] = rng() % 9 == 0;
       const size_t window = 1 + rng() % 64;
       Recorder r(graph, order, window);
-      const ScheduleRun run = run_schedule(r, pool, seed, kNone, alone);
+      const ScheduleRun run = run_schedule(r, pool, seed, kNone);
       const std::string where = std::to_string(threads) + " threads, seed " + std::to_string(seed);
-      EXPECT_FALSE(run.threw) << where;
-      EXPECT_EQ(run.applied, order.size()) << where;
-      for (size_t i = 0; i < order.size(); ++i)
+      EXPECT_EQ(run.failed, order.size()) << where;
+      EXPECT_EQ(r.applied_upto.load(), order.size()) << where;
+      for (size_t i = 0; i < order.size(); ++i) {
         EXPECT_EQ(r.traversals[i].load(), 1) << where << ", index " << i;
+        EXPECT_EQ(r.applies[i].load(), 1) << where << ", index " << i;
+        EXPECT_EQ(run.rewound[i], 0) << where << ", index " << i;
+      }
       EXPECT_EQ(r.violations.load(), 0)
           << where << ": " << (r.messages.empty() ? "" : r.messages[0]);
     }
@@ -210,40 +208,31 @@ std::vector<uint32_t> all_clusters(uint32_t n) {
   return order;
 }
 
-/// A level of `n` clusters whose apply (or traversal: `in_traversal`) of one index throws:
-/// run() rethrows, the indices before it are applied (each traversed once), not it nor any
-/// after it, and exactly the indices past it that were traversed are rewound.
-void expect_stops_at_the_failure(ThreadPool &pool, uint32_t seed, uint32_t n, bool in_traversal) {
+/// A level of `n` clusters whose admit of one index fails: run() returns it, the indices
+/// before it are applied (each traversed once), not it nor any after it, and exactly the
+/// indices past it that were traversed (the rest of its window) are rewound.
+void expect_stops_at_the_failure(ThreadPool &pool, uint32_t seed, uint32_t n) {
   std::mt19937 rng(seed);
   const ClusterGraph graph = random_graph(n, rng);
   const size_t fails = rng() % n, window = 1 + rng() % 80;
   Recorder r(graph, all_clusters(n), window);
-  const ScheduleRun run = run_schedule(r, pool, seed, in_traversal ? kNone : fails,
-                                       std::vector<bool>(n, false), in_traversal ? fails : kNone);
+  const ScheduleRun run = run_schedule(r, pool, seed, fails);
   const std::string where = "seed " + std::to_string(seed);
-  EXPECT_TRUE(run.threw) << where;
-  EXPECT_EQ(run.applied, fails) << where;
+  EXPECT_EQ(run.failed, fails) << where;
+  EXPECT_EQ(r.applied_upto.load(), fails) << where;
+  const size_t window_end = std::min<size_t>(n, (fails / window + 1) * window);
   for (size_t j = 0; j < n; ++j) {
-    const int traversed = r.traversals[j].load();
-    EXPECT_LE(traversed, 1) << where << ", index " << j;
-    if (j <= fails) {
-      EXPECT_EQ(traversed, 1) << where << ", index " << j;
-    }
-    EXPECT_EQ(run.rewound[j], j > fails ? traversed : 0) << where << ", index " << j;
+    EXPECT_EQ(r.traversals[j].load(), j < window_end ? 1 : 0) << where << ", index " << j;
+    EXPECT_EQ(r.applies[j].load(), j < fails ? 1 : 0) << where << ", index " << j;
+    EXPECT_EQ(run.rewound[j], j > fails && j < window_end ? 1 : 0) << where << ", index " << j;
   }
   EXPECT_EQ(r.violations.load(), 0) << where << ": " << (r.messages.empty() ? "" : r.messages[0]);
 }
 
-TEST(LevelSchedule, AFailedApplyStopsTheLevelAndRewindsWhatWasTraversedPastIt) {
+TEST(LevelSchedule, AFailedAdmitStopsTheLevelAndRewindsWhatWasTraversedPastIt) {
   ThreadPool pool(3);
   for (uint32_t seed = 101; seed <= 112; ++seed)
-    expect_stops_at_the_failure(pool, seed, 300, false);
-}
-
-TEST(LevelSchedule, AFailedTraversalFailsAtItsTurnToBeApplied) {
-  ThreadPool pool(2);
-  for (uint32_t seed = 201; seed <= 208; ++seed)
-    expect_stops_at_the_failure(pool, seed, 200, true);
+    expect_stops_at_the_failure(pool, seed, 300);
 }
 
 TEST(LevelSchedule, APoolOfOneThreadDoesEverythingOnTheCaller) {
@@ -251,11 +240,26 @@ TEST(LevelSchedule, APoolOfOneThreadDoesEverythingOnTheCaller) {
   std::mt19937 rng(7);
   const ClusterGraph graph = random_graph(50, rng);
   Recorder r(graph, all_clusters(50), 4);
-  const ScheduleRun run = run_schedule(r, pool, 7, kNone, std::vector<bool>(50, true));
-  EXPECT_EQ(run.applied, 50u);
-  for (size_t i = 0; i < 50; ++i)
+  const ScheduleRun run = run_schedule(r, pool, 7, kNone);
+  EXPECT_EQ(run.failed, 50u);
+  EXPECT_EQ(r.applied_upto.load(), 50u);
+  for (size_t i = 0; i < 50; ++i) {
     EXPECT_EQ(r.traversals[i].load(), 1);
+    EXPECT_EQ(r.applies[i].load(), 1);
+  }
   EXPECT_EQ(r.violations.load(), 0) << (r.messages.empty() ? "" : r.messages[0]);
+}
+
+TEST(LevelSchedule, BreadthFirstRanksNumberEveryClusterOnceComponentAfterComponent) {
+  // Two components: a path 0-2-4 and a triangle 1-3-5.
+  ClusterGraph g;
+  const std::vector<std::vector<uint32_t>> adj = {{2}, {3, 5}, {0, 4}, {1, 5}, {2}, {1, 3}};
+  g.start.push_back(0);
+  for (const auto &a : adj) {
+    g.adj.insert(g.adj.end(), a.begin(), a.end());
+    g.start.push_back(static_cast<uint32_t>(g.adj.size()));
+  }
+  EXPECT_EQ(breadth_first_ranks(g), (std::vector<uint32_t>{0, 3, 1, 4, 2, 5}));
 }
 
 } // namespace

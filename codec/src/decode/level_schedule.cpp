@@ -4,19 +4,16 @@
 #include <algorithm>
 #include <atomic>
 #include <memory>
+#include <thread>
 
 namespace pomar {
 
-std::vector<uint8_t> cluster_owners(const ClusterGraph &graph, unsigned threads) {
+std::vector<uint32_t> breadth_first_ranks(const ClusterGraph &graph) {
   const size_t n = graph.start.empty() ? 0 : graph.start.size() - 1;
-  std::vector<uint8_t> owner(n, 0);
-  if (threads <= 1 || n == 0)
-    return owner;
-  // Breadth-first order, each component from its smallest cluster id.
   std::vector<uint32_t> bfs;
   bfs.reserve(n);
   std::vector<uint8_t> seen(n, 0);
-  for (uint32_t root = 0; root < n; ++root) {
+  for (uint32_t root = 0; root < n; ++root) { // (each component from its smallest id)
     if (seen[root])
       continue;
     seen[root] = 1;
@@ -30,16 +27,17 @@ std::vector<uint8_t> cluster_owners(const ClusterGraph &graph, unsigned threads)
         }
     }
   }
+  std::vector<uint32_t> rank(n);
   for (size_t r = 0; r < n; ++r)
-    owner[bfs[r]] = static_cast<uint8_t>(r * threads / n);
-  return owner;
+    rank[bfs[r]] = static_cast<uint32_t>(r);
+  return rank;
 }
 
 size_t LevelSchedule::run(ThreadPool &pool, const ClusterGraph &graph,
-                          const std::vector<uint8_t> &owner, const uint32_t *order, size_t n,
+                          const std::vector<uint32_t> &rank, const uint32_t *order, size_t n,
                           size_t window, const Steps &steps) {
   graph_ = &graph;
-  owner_ = &owner;
+  rank_ = &rank;
   order_ = order;
   steps_ = &steps;
   window = std::max<size_t>(window, 1);
@@ -47,7 +45,7 @@ size_t LevelSchedule::run(ThreadPool &pool, const ClusterGraph &graph,
   in_window_.assign(clusters, 0);
   for (size_t begin = 0; begin < n; begin += window) {
     const size_t end = std::min(n, begin + window);
-    traverse_phase(pool, begin, end);
+    traverse_phase(pool, begin, end, begin == 0);
     size_t admitted = begin;
     while (admitted < end && steps.admit(admitted))
       ++admitted;
@@ -64,16 +62,25 @@ size_t LevelSchedule::run(ThreadPool &pool, const ClusterGraph &graph,
   return n;
 }
 
-/// Phase 1 for indices [begin, end): item r of the pool traverses the indices whose cluster
-/// role r owns, in increasing order, then takes the others' from the end of their lists.
-void LevelSchedule::traverse_phase(ThreadPool &pool, size_t begin, size_t end) {
+/// Phase 1 for indices [begin, end): item r of the pool traverses the indices of its part of
+/// the window (its r-th run by breadth-first rank), in increasing order, then takes the
+/// others' from the end of their lists. (`first`: the level's first window; item 0 runs
+/// Steps::early first.)
+void LevelSchedule::traverse_phase(ThreadPool &pool, size_t begin, size_t end, bool first) {
   const unsigned roles = pool.size();
   lists_.resize(roles);
   for (auto &l : lists_)
     l.clear();
+  // The window's clusters by their breadth-first rank, cut into `roles` equal runs.
+  by_rank_.clear();
   for (size_t i = begin; i < end; ++i)
-    lists_[(*owner_)[order_[i]] % roles].push_back(static_cast<uint32_t>(i));
+    by_rank_.push_back({(*rank_)[order_[i]], static_cast<uint32_t>(i)});
+  std::sort(by_rank_.begin(), by_rank_.end());
   const size_t count = end - begin;
+  for (size_t r = 0; r < count; ++r)
+    lists_[r * roles / count].push_back(by_rank_[r].second);
+  for (auto &l : lists_)
+    std::sort(l.begin(), l.end());
   std::unique_ptr<std::atomic<uint8_t>[]> taken(new std::atomic<uint8_t>[count]);
   for (size_t i = 0; i < count; ++i)
     taken[i].store(0, std::memory_order_relaxed);
@@ -85,6 +92,8 @@ void LevelSchedule::traverse_phase(ThreadPool &pool, size_t begin, size_t end) {
       by_[i - begin] = static_cast<uint8_t>(role);
       steps_->traverse(i, thread);
     };
+    if (first && role == 0 && steps_->early)
+      steps_->early();
     for (uint32_t i : lists_[role])
       take(i);
     for (unsigned k = 1; k < roles; ++k) {
@@ -95,35 +104,48 @@ void LevelSchedule::traverse_phase(ThreadPool &pool, size_t begin, size_t end) {
   });
 }
 
-/// Phase 3 for the admitted indices [begin, end): item r of the pool applies those role r
-/// traversed whose neighbours in the window role r traversed too; then this thread
-/// applies the others, in order.
+/// Phase 3 for the admitted indices [begin, end). A cluster next to one another role
+/// traversed (in the window) is a border cluster; the others are interior. Item r of the
+/// pool applies the indices role r traversed, in order: role 0 its border clusters first,
+/// then its interior ones; any other role its interior ones first, then, once the roles
+/// before it have applied theirs, its border ones. So no two border clusters are applied
+/// at once, and an interior cluster is next to no cluster another role applies.
 void LevelSchedule::apply_phase(ThreadPool &pool, size_t begin, size_t end) {
   if (begin == end)
     return;
   for (size_t i = begin; i < end; ++i)
     in_window_[order_[i]] = static_cast<uint32_t>(i - begin + 1);
-  apply_later_.assign(end - begin, 0);
+  border_.assign(end - begin, 0);
   for (size_t i = begin; i < end; ++i) {
     const uint32_t c = order_[i];
     for (uint32_t k = graph_->start[c]; k < graph_->start[c + 1]; ++k) {
       const uint32_t j = in_window_[graph_->adj[k]];
       if (j != 0 && by_[j - 1] != by_[i - begin]) {
-        apply_later_[i - begin] = 1;
+        border_[i - begin] = 1;
         break;
       }
     }
   }
-  pool.run(pool.size(), [&](size_t role, unsigned thread) {
-    for (size_t i = begin; i < end; ++i)
-      if (by_[i - begin] == role && !apply_later_[i - begin])
-        steps_->apply(i, thread);
-  });
-  for (size_t i = begin; i < end; ++i)
-    if (apply_later_[i - begin])
-      steps_->apply(i, 0);
   for (size_t i = begin; i < end; ++i)
     in_window_[order_[i]] = 0;
+  std::atomic<size_t> borders_done{0}; // roles 0..borders_done-1 applied their border clusters
+  pool.run(pool.size(), [&](size_t role, unsigned thread) {
+    const auto apply = [&](bool border) {
+      for (size_t i = begin; i < end; ++i)
+        if (by_[i - begin] == role && border_[i - begin] == border)
+          steps_->apply(i, thread);
+    };
+    if (role > 0)
+      apply(false);
+    // (Items are taken in increasing order, so the roles waited for are running.)
+    for (int spin = 0; borders_done.load(std::memory_order_acquire) != role; ++spin)
+      if (spin > 64)
+        std::this_thread::yield();
+    apply(true);
+    borders_done.store(role + 1, std::memory_order_release);
+    if (role == 0)
+      apply(false);
+  });
 }
 
 } // namespace pomar

@@ -7,12 +7,13 @@
 //   2. admit     the calling thread, in cluster order: checks each cluster (its claims
 //                against the clusters before it, its traversal's error) and numbers its
 //                new vertices and faces after the clusters before it; stops at a failure;
-//   3. apply     every thread applies the admitted clusters it traversed whose neighbours in
-//                the window it traversed too; then the calling thread applies the rest
-//                (clusters next to another thread's).
+//   3. apply     every thread applies the admitted clusters it traversed; those next to
+//                another thread's (border clusters) one thread after the other.
 //
 // Why the owners. Each thread keeps the same clusters level after level (a spatial part of
-// the cluster graph, `owner`): the faces and vertices a thread reads in its traversals
+// the window: its clusters by breadth-first rank in the cluster graph, cut into one run
+// per thread; a level's windows hold the same clusters as the level before's when the
+// whole mesh is refined): the faces and vertices a thread reads in its traversals
 // are the ones it wrote when it applied its clusters at the level before, so they stay in
 // its core's cache. (When one thread applied every cluster, the others read lines that
 // core had written: on a machine whose cores do not share a cache that doubled their cost
@@ -32,6 +33,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <utility>
 #include <vector>
 
 #include "decode/level_map.h"
@@ -39,9 +41,9 @@
 
 namespace pomar {
 
-/// Which thread owns each cluster: the clusters in breadth-first order over the cluster
-/// graph (component after component), cut into `threads` runs of equal length.
-std::vector<uint8_t> cluster_owners(const ClusterGraph &graph, unsigned threads);
+/// Each cluster's rank in a breadth-first order of the cluster graph (component after
+/// component): a window's clusters sorted by it and cut into runs are spatial parts.
+std::vector<uint32_t> breadth_first_ranks(const ClusterGraph &graph);
 
 class LevelSchedule {
 public:
@@ -52,6 +54,9 @@ public:
     /// number its splits after the indices admitted before it; false: it failed (then
     /// nothing after it is admitted).
     std::function<bool(size_t i)> admit;
+    /// Optional: run by one thread at the start of the level's first traversal phase,
+    /// alongside the others' traversals (making room ahead, within the arrays' capacity).
+    std::function<void()> early;
     /// Calling thread, after the window's admits: make room for what they add.
     std::function<void()> grow;
     /// Apply admitted index i on `thread` (parallel with non-neighbours); does not throw.
@@ -64,25 +69,26 @@ public:
   };
 
   /// Decode the clusters order[0..n) of one level (increasing ids, `graph`'s clusters) on
-  /// `pool`'s threads, `window` indices at a time; `owner`: cluster_owners for the pool's
-  /// size. Returns the first index that failed to be admitted (n: none); the indices
+  /// `pool`'s threads, `window` indices at a time; `rank`: breadth_first_ranks(graph).
+  /// Returns the first index that failed to be admitted (n: none); the indices
   /// before it are applied, the others are as they were (traversed ones rewound).
-  size_t run(ThreadPool &pool, const ClusterGraph &graph, const std::vector<uint8_t> &owner,
+  size_t run(ThreadPool &pool, const ClusterGraph &graph, const std::vector<uint32_t> &rank,
              const uint32_t *order, size_t n, size_t window, const Steps &steps);
 
 private:
-  void traverse_phase(ThreadPool &pool, size_t begin, size_t end);
+  void traverse_phase(ThreadPool &pool, size_t begin, size_t end, bool first);
   void apply_phase(ThreadPool &pool, size_t begin, size_t end);
 
   const ClusterGraph *graph_ = nullptr;
-  const std::vector<uint8_t> *owner_ = nullptr;
+  const std::vector<uint32_t> *rank_ = nullptr;
   const uint32_t *order_ = nullptr;
   const Steps *steps_ = nullptr;
+  std::vector<std::pair<uint32_t, uint32_t>> by_rank_; // the window's (rank, index)
   std::vector<std::vector<uint32_t>> lists_; // per thread: the window's indices it owns
   std::vector<uint8_t> taken_;               // by index in the window: being traversed
   std::vector<uint8_t> by_;                  // by index in the window: the thread that traversed it
   std::vector<uint32_t> in_window_;          // by cluster id: index in the window + 1 (0: not in it)
-  std::vector<uint8_t> apply_later_;         // by index in the window: next to another thread's
+  std::vector<uint8_t> border_;              // by index in the window: next to another role's
 };
 
 } // namespace pomar

@@ -2,10 +2,10 @@
 // and limited around damage (decode/level_map.cpp) -> the missing cluster levels, level by
 // level, each through the per-level step (refine/level_step.h) on the cluster's stream
 // (decode/cluster_stream.cpp); coarsening re-decodes from the base clustered mesh.
-// With several threads, the clusters of a level are traversed ahead on every thread and
-// applied in cluster order on the calling thread, the two overlapping (decode/
-// level_schedule.h, LevelStep::traverse_cluster_level / apply_cluster_level): the mesh is
-// the same for any thread count.
+// With several threads, the clusters of a level are traversed on every thread, admitted
+// in cluster order on the calling thread and applied on every thread, a window at a time
+// (decode/level_schedule.h; LevelStep::traverse_cluster_level, admit_cluster_level,
+// apply_admitted): the mesh is the same for any thread count.
 #include <algorithm>
 
 #include "attributes/attribute_section.h"
@@ -73,7 +73,7 @@ struct SelectiveDecoder::State {
   std::vector<TraversedCluster> traversed;
   std::vector<RangeDecoder> stream_before; // each batch cluster's stream before its traversal
   std::vector<StepCounts> first_new;       // each batch cluster's first new vertex and face
-  std::vector<uint8_t> owners;             // cluster -> thread (cluster_owners)
+  std::vector<uint32_t> ranks;             // breadth_first_ranks(graph), for the schedule
 
   // Attributes: descriptors and base codes (the other codes come with the positions).
   AttributeMask attribute_mask;
@@ -164,8 +164,8 @@ void SelectiveDecoder::State::decode_level_parallel(const std::vector<uint32_t> 
     stream_before.resize(window);
     first_new.resize(window);
   }
-  if (owners.empty())
-    owners = cluster_owners(graph, pool->size());
+  if (ranks.empty())
+    ranks = breadth_first_ranks(graph);
   const uint32_t l = static_cast<uint32_t>(level);
   std::exception_ptr failure; // why the index that failed to be admitted failed
   uint64_t vertices = mesh.vertex_count(), faces = mesh.ct.face_count(); // once admitted
@@ -201,7 +201,20 @@ void SelectiveDecoder::State::decode_level_parallel(const std::vector<uint32_t> 
     faces += in.adds.faces;
     return true;
   };
-  work.grow = [&] { mesh.grow(vertices, faces); };
+  // A level that refines every cluster reaches the level table's counts (unless a block is
+  // damaged): the arrays grow to them at the start, on one thread while the others
+  // traverse (the first writes to the new pages cost as much as the traversals save), when
+  // that moves no array (a traversal may be reading them). The windows' applies then
+  // only write entries; the arrays take their exact counts at the end of the level.
+  const LevelEntry &counts = layout.header.levels[size_t(level - 1)];
+  const bool whole = refine.size() == clusters.size() && counts.vertices >= vertices &&
+                     counts.faces >= faces && mesh.has_room(counts.vertices, counts.faces);
+  if (whole)
+    work.early = [&] { mesh.grow(counts.vertices, counts.faces); };
+  work.grow = [&] {
+    if (!whole || vertices > counts.vertices || faces > counts.faces)
+      mesh.grow(vertices, faces);
+  };
   work.apply = [&](size_t i, unsigned) {
     const uint32_t c = refine[i];
     const StepCounts &at = first_new[i % window];
@@ -215,7 +228,8 @@ void SelectiveDecoder::State::decode_level_parallel(const std::vector<uint32_t> 
   };
   work.rewind = [&](size_t j) { clusters[refine[j]].stream.decoder() = stream_before[j % window]; };
   const size_t failed =
-      schedule.run(*pool, graph, owners, refine.data(), refine.size(), window, work);
+      schedule.run(*pool, graph, ranks, refine.data(), refine.size(), window, work);
+  mesh.grow(vertices, faces); // (the exact counts: a damaged block adds fewer)
   if (failed < refine.size()) {
     decoding = refine[failed];
     std::rethrow_exception(failure);

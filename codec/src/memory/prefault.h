@@ -72,10 +72,13 @@ template <class T> void prefault_ahead_start(std::vector<T> &v) {
   if (to > from)
     prefault(reinterpret_cast<char *>(v.data()) + from, to - from);
 }
-template <class T> void prefault_ahead(std::vector<T> &v, size_t old_size) {
-  const size_t from = mapped_ahead_end(v, old_size), to = mapped_ahead_end(v, v.size());
+template <class T> void prefault_ahead(std::vector<T> &v, size_t old_size, size_t new_size) {
+  const size_t from = mapped_ahead_end(v, old_size), to = mapped_ahead_end(v, new_size);
   if (to > from)
     prefault(reinterpret_cast<char *>(v.data()) + from, to - from);
+}
+template <class T> void prefault_ahead(std::vector<T> &v, size_t old_size) {
+  prefault_ahead(v, old_size, v.size());
 }
 
 } // namespace pomar

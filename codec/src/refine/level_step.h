@@ -16,13 +16,15 @@
 // the step (damage never half-applies; the other clusters of the level can still claim
 // those faces).
 //
-// The clusters of one clustered level can also be refined in two phases (the selective
+// The clusters of one clustered level can also be refined in phases (the selective
 // decoder's threads): traverse_cluster_level runs step 1 and 2 of several clusters at once,
 // each on its own LevelStep, without touching the mesh (face claims included); then
-// apply_cluster_level, in cluster order, checks each cluster's claims against the clusters
-// applied before it and applies its splits. A cluster's traversal does not depend on the
-// splits of other clusters of its level (the level-(l-1) view), so this gives the mesh,
-// the vertex numbering and the errors of cluster_level called in cluster order.
+// admit_cluster_level, in cluster order, checks each cluster's claims against the clusters
+// admitted before it and makes them; apply_admitted applies a cluster's splits with the
+// vertex and face ids it gets in cluster order (decode/level_schedule.h applies clusters
+// that are not neighbours at once). A cluster's traversal does not depend on the splits of
+// other clusters of its level (the level-(l-1) view), so this gives the mesh, the vertex
+// numbering and the errors of cluster_level called in cluster order.
 #pragma once
 
 #include <algorithm>
