@@ -71,7 +71,7 @@ if [ "${POMAR_TEST_SANITIZE:-1}" != 0 ]; then
 fi
 
 # ---- ThreadSanitizer pass on the threaded steps -----------------------------------------------------
-# The decoder's threads traverse clusters while the calling thread applies others
+# The decoder's threads traverse a level's clusters, then apply them, several at once
 # (codec/src/decode/level_schedule.h): a data race there would not show in the outputs every time.
 # The tests that run the codec on several threads are built with -fsanitize=thread (build-tsan/,
 # pomar_tests only, a few minutes on 2 cores) and any report fails the test command.
