@@ -2,8 +2,8 @@
 // that record what ran when, on random cluster graphs with random delays: what the
 // decoder's correctness rests on must hold for every interleaving the threads produce.
 //   - every cluster is traversed once; no apply runs while a traversal does (the phases);
-//   - admits run on the calling thread in index order, each after its window's traversals;
-//     the window's applies after its admits and the grow;
+//   - admits run one at a time in index order, each once the indices up to it are
+//     traversed; the window's grow (calling thread) and applies after its admits;
 //   - every admitted index is applied once; two neighbouring clusters are never applied at
 //     the same time; `applied` is called in index order on the calling thread after the
 //     window's applies;
@@ -67,6 +67,8 @@ struct Recorder {
   std::vector<std::atomic<int>> applying;   // by cluster: applies running
   std::vector<std::atomic<int>> traversals; // by index: times traversed
   std::vector<std::atomic<int>> applies;    // by index: times applied
+  std::vector<std::atomic<int>> traversed;  // by index: its traversal ended
+  std::atomic<int> admitting{0};            // admits running
   std::vector<int> admitted;                // by index (calling thread only)
   std::atomic<int> traversing{0};           // traversals running
   std::atomic<int> applies_running{0};
@@ -79,7 +81,8 @@ struct Recorder {
 
   Recorder(const ClusterGraph &g, std::vector<uint32_t> o, size_t w)
       : graph(g), order(std::move(o)), window(w), applying(g.start.size() - 1),
-        traversals(order.size()), applies(order.size()), admitted(order.size(), 0) {}
+        traversals(order.size()), applies(order.size()), traversed(order.size()),
+        admitted(order.size(), 0) {}
 
   void fail(const std::string &what) {
     ++violations;
@@ -120,16 +123,22 @@ ScheduleRun run_schedule(Recorder &r, ThreadPool &pool, uint32_t seed, size_t fa
     spin(rngs[thread]);
     if (r.applies_running.load() != 0)
       r.fail("traversal of index " + std::to_string(i) + " while an apply runs");
+    r.traversed[i] = 1;
     --r.traversing;
   };
   steps.admit = [&](size_t i) {
-    on_caller("admit");
+    if (++r.admitting != 1)
+      r.fail("two admits at once");
     if (i != r.admit_next)
       r.fail("admit of index " + std::to_string(i) + " out of order");
-    if (r.traversing.load() != 0 || r.traversals[i].load() != 1)
-      r.fail("admit of index " + std::to_string(i) + " before the traversals ended");
+    for (size_t j = i - i % r.window; j <= i; ++j)
+      if (!r.traversed[j].load())
+        r.fail("admit of index " + std::to_string(i) + " before index " + std::to_string(j) +
+               " was traversed");
+    spin(caller_rng);
     r.admit_next = i + 1;
     r.grown = false;
+    --r.admitting;
     if (i == fails_at)
       return false;
     r.admitted[i] = 1;

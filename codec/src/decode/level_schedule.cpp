@@ -45,10 +45,11 @@ size_t LevelSchedule::run(ThreadPool &pool, const ClusterGraph &graph,
   in_window_.assign(clusters, 0);
   for (size_t begin = 0; begin < n; begin += window) {
     const size_t end = std::min(n, begin + window);
+    begin_ = admitted_ = begin;
+    admit_failed_ = false;
     traverse_phase(pool, begin, end, begin == 0);
-    size_t admitted = begin;
-    while (admitted < end && steps.admit(admitted))
-      ++admitted;
+    admit_traversed(end); // (the rest: every index is traversed now)
+    const size_t admitted = admitted_;
     steps.grow();
     apply_phase(pool, begin, admitted);
     for (size_t i = begin; i < admitted; ++i)
@@ -82,8 +83,14 @@ void LevelSchedule::traverse_phase(ThreadPool &pool, size_t begin, size_t end, b
   for (auto &l : lists_)
     std::sort(l.begin(), l.end());
   std::unique_ptr<std::atomic<uint8_t>[]> taken(new std::atomic<uint8_t>[count]);
-  for (size_t i = 0; i < count; ++i)
+  if (done_room_ < count) {
+    done_.reset(new std::atomic<uint8_t>[count]);
+    done_room_ = count;
+  }
+  for (size_t i = 0; i < count; ++i) {
     taken[i].store(0, std::memory_order_relaxed);
+    done_[i].store(0, std::memory_order_relaxed);
+  }
   by_.assign(count, 0);
   pool.run(roles, [&](size_t role, unsigned thread) {
     const auto take = [&](uint32_t i) {
@@ -91,6 +98,9 @@ void LevelSchedule::traverse_phase(ThreadPool &pool, size_t begin, size_t end, b
         return;
       by_[i - begin] = static_cast<uint8_t>(role);
       steps_->traverse(i, thread);
+      done_[i - begin].store(1, std::memory_order_release);
+      if (role == 0) // (the admits trail the traversals: hidden behind the others')
+        admit_traversed(end);
     };
     if (first && role == 0 && steps_->early)
       steps_->early();
@@ -102,6 +112,19 @@ void LevelSchedule::traverse_phase(ThreadPool &pool, size_t begin, size_t end, b
         take(other[j]);
     }
   });
+}
+
+/// Admit the indices from admitted_ on that are traversed, in order, up to `end` or the
+/// first one that fails. Role 0 of the traversal phase calls it between its traversals,
+/// the calling thread after the phase: one thread at a time.
+void LevelSchedule::admit_traversed(size_t end) {
+  while (!admit_failed_ && admitted_ < end &&
+         done_[admitted_ - begin_].load(std::memory_order_acquire)) {
+    if (steps_->admit(admitted_))
+      ++admitted_;
+    else
+      admit_failed_ = true;
+  }
 }
 
 /// Phase 3 for the admitted indices [begin, end). A cluster next to one another role

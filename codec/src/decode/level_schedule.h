@@ -4,9 +4,11 @@
 //
 //   1. traverse  every thread traverses the window's clusters it owns, then helps with the
 //                others' (from the end of their lists): per-cluster split lists;
-//   2. admit     the calling thread, in cluster order: checks each cluster (its claims
+//   2. admit     one thread at a time, in cluster order: checks each cluster (its claims
 //                against the clusters before it, its traversal's error) and numbers its
-//                new vertices and faces after the clusters before it; stops at a failure;
+//                new vertices and faces after the clusters before it; stops at a failure.
+//                Thread 0 admits as far as the traversals allow between its own, the
+//                calling thread the rest after them;
 //   3. apply     every thread applies the admitted clusters it traversed; those next to
 //                another thread's (border clusters) one thread after the other.
 //
@@ -30,9 +32,11 @@
 // order whichever goes first, so the apply order does not change the corner table.
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -50,9 +54,9 @@ public:
   struct Steps {
     /// Traverse index i (order[i]) on `thread`; keeps what it throws for admit.
     std::function<void(size_t i, unsigned thread)> traverse;
-    /// Calling thread, increasing i, after the window's traversals: check index i and
-    /// number its splits after the indices admitted before it; false: it failed (then
-    /// nothing after it is admitted).
+    /// One thread at a time, increasing i, once indices <= i are traversed (alongside
+    /// the traversals of higher ones): check index i and number its splits after the
+    /// indices admitted before it; false: it failed (then nothing after it is admitted).
     std::function<bool(size_t i)> admit;
     /// Optional: run by one thread at the start of the level's first traversal phase,
     /// alongside the others' traversals (making room ahead, within the arrays' capacity).
@@ -77,6 +81,7 @@ public:
 
 private:
   void traverse_phase(ThreadPool &pool, size_t begin, size_t end, bool first);
+  void admit_traversed(size_t end);
   void apply_phase(ThreadPool &pool, size_t begin, size_t end);
 
   const ClusterGraph *graph_ = nullptr;
@@ -87,6 +92,11 @@ private:
   std::vector<std::vector<uint32_t>> lists_; // per thread: the window's indices it owns
   std::vector<uint8_t> taken_;               // by index in the window: being traversed
   std::vector<uint8_t> by_;                  // by index in the window: the thread that traversed it
+  std::unique_ptr<std::atomic<uint8_t>[]> done_; // by index in the window: traversed
+  size_t done_room_ = 0;                         // done_'s length
+  size_t begin_ = 0;                             // the window's first index
+  size_t admitted_ = 0;                          // indices below it are admitted
+  bool admit_failed_ = false;                    // index admitted_ failed
   std::vector<uint32_t> in_window_;          // by cluster id: index in the window + 1 (0: not in it)
   std::vector<uint8_t> border_;              // by index in the window: next to another role's
 };

@@ -211,11 +211,14 @@ void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v,
   if (!resolve_patch(ring, j, sym, p))
     codec.corrupt("split symbols do not fit the vertex's neighbourhood");
   // Patches of one level must not share faces (that is what makes the splits
-  // independent); a stream that says otherwise is damaged.
+  // independent); a stream that says otherwise is damaged. (Deferred claims: the faces
+  // other clusters hold are checked when the cluster is admitted, LevelStep::
+  // admit_cluster_level, and LevelMesh::face_claim is not read here: it may be written
+  // meanwhile.)
   const uint32_t m = ring.size();
   for (uint32_t t = 0, i = p.first_face; t < p.faces; ++t, i = i + 1 == m ? 0 : i + 1) {
     const uint32_t f = ring.corner[i] / 3;
-    if (mesh.face_claim[f] == level || marks.claimed(f))
+    if ((!s.defer_claims && mesh.face_claim[f] == level) || marks.claimed(f))
       codec.corrupt(kSharedFace);
     if (!s.defer_claims)
       mesh.face_claim[f] = static_cast<uint16_t>(level);
@@ -352,7 +355,8 @@ void traverse_cluster(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32
     get_view_ring(mesh, v, level, s.ring);
     for (uint32_t c : s.ring.corner) { // (read by sv_context and code_vertex)
       __builtin_prefetch(&s.claimed[c / 3]);
-      __builtin_prefetch(&mesh.face_claim[c / 3]);
+      if (!s.defer_claims)
+        __builtin_prefetch(&mesh.face_claim[c / 3]);
     }
     const uint32_t split = queue_neighbours(s, v, came_from, s.ring, marks);
     code_vertex(mesh, codec, s, v, s.ring, level.level, key, marks, split, splits);
