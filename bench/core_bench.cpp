@@ -107,8 +107,7 @@ int main(int argc, char **argv) {
     {
       auto read = draco::ReadMeshFromFile(path);
       if (!read.ok()) {
-        std::fprintf(stderr, "Draco cannot read %s: %s\n", path.c_str(),
-                     read.status().error_msg());
+        std::fprintf(stderr, "Draco cannot read %s: %s\n", path.c_str(), read.status().error_msg());
         return 1;
       }
       std::unique_ptr<draco::Mesh> dm = std::move(read).value();
@@ -152,14 +151,14 @@ int main(int argc, char **argv) {
       pomar::DecodeOptions dopt;
       dopt.threads = threads;
       size_t decoded = 0;
-      const Times dec = time_runs(runs, [&] {
-        decoded = pomar::decode(file.data(), file.size(), dopt).vertex_count();
-      });
+      const Times dec = time_runs(
+          runs, [&] { decoded = pomar::decode(file.data(), file.size(), dopt).vertex_count(); });
       if (decoded != nv)
         throw std::runtime_error("pomar decoded " + std::to_string(decoded) + " vertices of " +
                                  std::to_string(nv));
-      const std::string t = threads == 1 ? "1 thread" : threads ? std::to_string(threads) + " threads"
-                                                                : std::string("all threads");
+      const std::string t = threads == 1 ? "1 thread"
+                            : threads    ? std::to_string(threads) + " threads"
+                                         : std::string("all threads");
       row(("pomar encode, " + t).c_str(), enc, nv, de);
       row(("pomar decode, " + t).c_str(), dec, nv, dd);
       std::printf("  (%zu bytes)\n", file.size());

@@ -202,8 +202,7 @@ private:
   /// apply_splits into arrays already sized: split i creates vertex v0 + i, the new faces
   /// follow from face f0.
   static void apply_splits_at(LevelMesh &mesh, const SplitList &splits, uint32_t level,
-                              uint32_t cluster, uint32_t *next_local, uint32_t v0,
-                              uint32_t f0) {
+                              uint32_t cluster, uint32_t *next_local, uint32_t v0, uint32_t f0) {
     CornerTable &ct = mesh.ct;
     const uint32_t n = static_cast<uint32_t>(splits.size());
     uint32_t face = f0;
