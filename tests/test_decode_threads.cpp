@@ -1,5 +1,6 @@
 // Decoding random-access files on several threads: the clusters of a level are traversed in
-// parallel and applied in cluster order, so 1, 2 and 7 threads must give the same mesh
+// parallel, numbered in cluster order and applied in parallel, a window of clusters at a
+// time (decode/level_schedule.h), so 1, 2 and 7 threads must give the same mesh
 // (positions, triangles, attributes, lineage), the same reads and, on damaged files, the same
 // errors and the same skipped blocks. Pure progressive files decode on one thread.
 #include <gtest/gtest.h>
@@ -123,7 +124,16 @@ std::vector<Case> cases() {
   out.push_back({"torus, many small clusters", gen::torus(120, 60), 0.05});
   out.push_back({"grid with holes (boundaries)", gen::grid_with_holes(90, 6), 0.02});
   out.push_back({"several components", gen::components(5), 0.05});
+  // More clusters than the decoder's window of 2048 (decode/selective_decoder.cpp): a level
+  // runs in three windows, numbered after one another (the test below checks the count).
+  out.push_back({"noisy sphere 30k in 5,000 clusters", gen::noisy_sphere(30000, 4), 1.0 / 6});
   return out;
+}
+
+TEST(DecodeThreads, TheManyClusterCaseSpansSeveralWindows) {
+  const Case c = cases().back();
+  const std::vector<uint8_t> file = encode_with(c.mesh, c.ratio);
+  EXPECT_GT(inspect(file.data(), file.size()).clusters, 2u * 2048);
 }
 
 TEST(DecodeThreads, FullDecodesAreTheSameForAnyThreadCount) {
@@ -192,13 +202,14 @@ Outcome damaged_decode(const std::vector<uint8_t> &file, unsigned threads, bool 
   return out;
 }
 
-TEST(DecodeThreads, DamagedFilesGiveTheSameResultForAnyThreadCount) {
-  const std::vector<uint8_t> file = encode_with(gen::noisy_sphere(12000, 9), 0.02);
+/// Damage in one to three places of the cluster blocks of `file`, `trials` times: 1, 2 and
+/// 7 threads give the same errors, skipped blocks and meshes, with and without skipping.
+void expect_same_damage_outcomes(const std::vector<uint8_t> &file, int trials, int min_each) {
   const FileInfo info = inspect(file.data(), file.size());
   std::mt19937 rng(11);
   const uint64_t clusters_from = info.global_bytes, size = file.size();
   int failed = 0, skipped = 0; // (the trials must exercise both)
-  for (int trial = 0; trial < 24; ++trial) {
+  for (int trial = 0; trial < trials; ++trial) {
     std::vector<uint8_t> bad = file;
     const int flips = 1 + trial % 3; // damage in one to three places of the cluster blocks
     for (int f = 0; f < flips; ++f)
@@ -217,8 +228,17 @@ TEST(DecodeThreads, DamagedFilesGiveTheSameResultForAnyThreadCount) {
       }
     }
   }
-  EXPECT_GT(failed, 8);
-  EXPECT_GT(skipped, 8);
+  EXPECT_GT(failed, min_each);
+  EXPECT_GT(skipped, min_each);
+}
+
+TEST(DecodeThreads, DamagedFilesGiveTheSameResultForAnyThreadCount) {
+  expect_same_damage_outcomes(encode_with(gen::noisy_sphere(12000, 9), 0.02), 24, 8);
+}
+
+TEST(DecodeThreads, DamagedFilesOfSeveralWindowsGiveTheSameResultForAnyThreadCount) {
+  // (5,000 clusters: damage in a later window comes after whole windows were applied.)
+  expect_same_damage_outcomes(encode_with(gen::noisy_sphere(30000, 4), 1.0 / 6), 9, 3);
 }
 
 } // namespace
