@@ -23,7 +23,9 @@
 //
 // Why the result does not depend on the threads. A traversal reads the level-(l-1) view,
 // the same whichever clusters of the level are applied (refine/level_step.h); during phase 1
-// nothing is applied anyway. Phase 2 gives every cluster the vertex and face ids it gets
+// nothing is applied anyway (what runs alongside the traversals writes only what they do
+// not read: the admits LevelMesh::face_claim, Steps::early the arrays past their ends,
+// within their capacity). Phase 2 gives every cluster the vertex and face ids it gets
 // when the clusters are applied one by one in cluster order, and the same first error.
 // In phase 3 two clusters applied at once are not neighbours in the cluster graph, so no
 // face holds vertices of both (a face's vertices are pairwise adjacent): their splits write
