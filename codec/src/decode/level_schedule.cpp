@@ -82,23 +82,21 @@ void LevelSchedule::traverse_phase(ThreadPool &pool, size_t begin, size_t end, b
     lists_[r * roles / count].push_back(by_rank_[r].second);
   for (auto &l : lists_)
     std::sort(l.begin(), l.end());
-  std::unique_ptr<std::atomic<uint8_t>[]> taken(new std::atomic<uint8_t>[count]);
-  if (done_room_ < count) {
-    done_.reset(new std::atomic<uint8_t>[count]);
-    done_room_ = count;
+  if (state_room_ < count) {
+    state_.reset(new std::atomic<uint8_t>[count]);
+    state_room_ = count;
   }
-  for (size_t i = 0; i < count; ++i) {
-    taken[i].store(0, std::memory_order_relaxed);
-    done_[i].store(0, std::memory_order_relaxed);
-  }
+  for (size_t i = 0; i < count; ++i)
+    state_[i].store(kUntaken, std::memory_order_relaxed);
   by_.assign(count, 0);
   pool.run(roles, [&](size_t role, unsigned thread) {
     const auto take = [&](uint32_t i) {
-      if (taken[i - begin].exchange(1, std::memory_order_relaxed))
+      uint8_t untaken = kUntaken;
+      if (!state_[i - begin].compare_exchange_strong(untaken, kTaken, std::memory_order_relaxed))
         return;
       by_[i - begin] = static_cast<uint8_t>(role);
       steps_->traverse(i, thread);
-      done_[i - begin].store(1, std::memory_order_release);
+      state_[i - begin].store(kTraversed, std::memory_order_release);
       if (role == 0) // (the admits trail the traversals: hidden behind the others')
         admit_traversed(end);
     };
@@ -119,7 +117,7 @@ void LevelSchedule::traverse_phase(ThreadPool &pool, size_t begin, size_t end, b
 /// the calling thread after the phase: one thread at a time.
 void LevelSchedule::admit_traversed(size_t end) {
   while (!admit_failed_ && admitted_ < end &&
-         done_[admitted_ - begin_].load(std::memory_order_acquire)) {
+         state_[admitted_ - begin_].load(std::memory_order_acquire) == kTraversed) {
     if (steps_->admit(admitted_))
       ++admitted_;
     else

@@ -93,11 +93,13 @@ private:
   std::vector<std::pair<uint32_t, uint32_t>> by_rank_; // the window's (rank, index)
   std::vector<std::vector<uint32_t>> lists_;           // per thread: the window's indices it owns
   std::vector<uint8_t> by_; // by index in the window: the thread that traversed it
-  std::unique_ptr<std::atomic<uint8_t>[]> done_; // by index in the window: traversed
-  size_t done_room_ = 0;                         // done_'s length
-  size_t begin_ = 0;                             // the window's first index
-  size_t admitted_ = 0;                          // indices below it are admitted
-  bool admit_failed_ = false;                    // index admitted_ failed
+  // By index in the window: untaken, taken by a thread, traversed.
+  enum : uint8_t { kUntaken, kTaken, kTraversed };
+  std::unique_ptr<std::atomic<uint8_t>[]> state_;
+  size_t state_room_ = 0;           // state_'s length
+  size_t begin_ = 0;                // the window's first index
+  size_t admitted_ = 0;             // indices below it are admitted
+  bool admit_failed_ = false;       // index admitted_ failed
   std::vector<uint32_t> in_window_; // by cluster id: index in the window + 1 (0: not in it)
   std::vector<uint8_t> border_;     // by index in the window: next to another role's
 };

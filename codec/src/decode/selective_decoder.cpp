@@ -3,7 +3,7 @@
 // level, each through the per-level step (refine/level_step.h) on the cluster's stream
 // (decode/cluster_stream.cpp); coarsening re-decodes from the base clustered mesh.
 // With several threads, the clusters of a level are traversed on every thread, admitted
-// in cluster order on the calling thread and applied on every thread, a window at a time
+// in cluster order one thread at a time and applied on every thread, a window at a time
 // (decode/level_schedule.h; LevelStep::traverse_cluster_level, admit_cluster_level,
 // apply_admitted): the mesh is the same for any thread count.
 #include <algorithm>
@@ -145,8 +145,8 @@ void SelectiveDecoder::State::decode_cluster_level(uint32_t c, int level, uint32
 }
 
 /// The data of `level` of the clusters `refine` (increasing), on the pool's threads, a
-/// window at a time: traversed on every thread, checked and numbered in cluster order on
-/// this one, applied on every thread (decode/level_schedule.h). Throws what
+/// window at a time: traversed on every thread, checked and numbered in cluster order
+/// one thread at a time, applied on every thread (decode/level_schedule.h). Throws what
 /// decode_cluster_level would throw for the first cluster that fails (`decoding` names it),
 /// with the clusters before it applied and the others as they were (their streams put
 /// back).
@@ -205,16 +205,17 @@ void SelectiveDecoder::State::decode_level_parallel(const std::vector<uint32_t> 
   // A level that refines every cluster reaches the level table's counts (unless a block is
   // damaged): the arrays grow to them at the start, on one thread while the others
   // traverse (the first writes to the new pages cost as much as the traversals save), when
-  // that moves no array (a traversal may be reading them). The windows' applies then
-  // only write entries; the arrays take their exact counts at the end of the level.
+  // that moves no array (a traversal may be reading them). The windows then grow them only
+  // past what they hold; the arrays take their exact counts at the end of the level.
   const LevelEntry &counts = layout.header.levels[size_t(level - 1)];
-  const bool whole = refine.size() == clusters.size() && counts.vertices >= vertices &&
-                     counts.faces >= faces && mesh.has_room(counts.vertices, counts.faces);
-  if (whole)
-    work.early = [&] { mesh.grow(counts.vertices, counts.faces); };
+  if (refine.size() == clusters.size() && mesh.has_room(counts.vertices, counts.faces))
+    work.early = [&] {
+      mesh.grow(std::max<uint64_t>(counts.vertices, vertices),
+                std::max<uint64_t>(counts.faces, faces));
+    };
   work.grow = [&] {
-    if (!whole || vertices > counts.vertices || faces > counts.faces)
-      mesh.grow(vertices, faces);
+    mesh.grow(std::max<uint64_t>(mesh.vertex_count(), vertices),
+              std::max<uint64_t>(mesh.ct.face_count(), faces));
   };
   work.apply = [&](size_t i, unsigned) {
     const uint32_t c = refine[i];
