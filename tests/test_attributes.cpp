@@ -308,6 +308,38 @@ TEST(AttributeRoundTrip, EveryCombinationProgressiveAndClustered) {
     }
 }
 
+// Whatever the encoder writes, the readers take: every mix of attributes (texture file names
+// with no coded attribute among them, the form a textured OBJ whose UVs are not kept has), in
+// both layouts, through inspect, check_blocks, a full decode and every level.
+TEST(AttributeRoundTrip, EveryEncodedMixReadsBack) {
+  const Mesh sphere = gen::noisy_sphere(900, 4, 0.1);
+  std::vector<Mesh> mixes;
+  for (int has = 0; has <= kAll; ++has)
+    if (!(has & kAlpha) || (has & kColour))
+      mixes.push_back(with_attributes(sphere, has));
+  Mesh names_only = sphere;
+  names_only.texture_files = {"atlas_0.jpg", "atlas 1.png"};
+  mixes.push_back(names_only);
+  for (const Mesh &m : mixes)
+    for (bool clustered : {false, true}) {
+      SCOPED_TRACE(std::to_string(m.attributes.size()) + " attributes, " +
+                   std::to_string(m.texture_files.size()) + " texture files" +
+                   (clustered ? ", clustered" : ""));
+      Coded c;
+      ASSERT_NO_THROW(c = encode_with(m, clustered));
+      FileInfo info;
+      ASSERT_NO_THROW(info = inspect(c.file.data(), c.file.size()));
+      EXPECT_EQ(info.attributes.size(), m.attributes.size());
+      EXPECT_EQ(info.texture_files, m.texture_files);
+      EXPECT_NO_THROW(check_blocks(c.file.data(), c.file.size()));
+      const Mesh out = decode(c.file.data(), c.file.size());
+      EXPECT_EQ(out.vertex_count(), m.vertex_count());
+      expect_round_trip(c, out, false);
+      for (int level = 0; level < int(info.levels.size()); level += 3)
+        EXPECT_EQ(decode(c.file.data(), c.file.size(), level).texture_files, m.texture_files);
+    }
+}
+
 TEST(AttributeRoundTrip, SeveralBitDepths) {
   const Mesh m = with_attributes(gen::noisy_sphere(800, 2, 0.1), kAll);
   for (int bits : {4, 8, 12, 16}) {

@@ -119,7 +119,7 @@ void init_attributes(const AttributeTable &table, LevelMesh &lm, const Attribute
   }
 }
 
-std::vector<uint8_t> write_attributes(const AttributeTable &t) {
+std::vector<uint8_t> write_attributes(const AttributeTable &t, uint32_t base_vertices) {
   std::vector<uint8_t> out;
   ByteWriter w(out);
   w.u8(kAttributeSectionVersion);
@@ -147,7 +147,13 @@ std::vector<uint8_t> write_attributes(const AttributeTable &t) {
     w.u16(static_cast<uint16_t>(f.size()));
     w.bytes(reinterpret_cast<const uint8_t *>(f.data()), f.size());
   }
-  const uint32_t n = t.codes, count = n ? static_cast<uint32_t>(t.base.size() / n) : 0;
+  // The base mesh's vertex count, also when no attribute has codes (texture file names only):
+  // the reader checks it against the header.
+  const uint32_t n = t.codes, count = base_vertices;
+  if (size_t(count) * n != t.base.size())
+    throw Error(
+        Error::Kind::Internal,
+        "internal encoder error: the base mesh's attribute codes do not match its vertices");
   w.u32(count);
   std::vector<uint8_t> stream;
   RangeEncoder rc(&stream);

@@ -55,8 +55,9 @@ bool keeps_any(const AttributeTable &table, const AttributeMask &mask);
 void init_attributes(const AttributeTable &table, LevelMesh &lm,
                      const AttributeMask &mask = AttributeMask());
 
-/// The ATTR section body of `table` (table.base holds the base vertices' codes).
-std::vector<uint8_t> write_attributes(const AttributeTable &table);
+/// The ATTR section body of `table` for a base mesh of `base_vertices` vertices (table.base
+/// holds their codes: base_vertices * table.codes values).
+std::vector<uint8_t> write_attributes(const AttributeTable &table, uint32_t base_vertices);
 /// Parse a section body (bounds-checked; "damaged .pomar file: ATTR section ..." errors).
 AttributeTable read_attributes(const uint8_t *data, size_t size, uint32_t base_vertices);
 /// The table of the file's ATTR section (checksum checked), or nullptr if it has none.

@@ -272,7 +272,8 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
         attr_bits += rb.attr_bits[k];
       attributes.estimated_bytes[i] = static_cast<uint64_t>(attr_bits / 8.0 + 0.5);
     }
-    sections.push_back({kAttributeSectionTag, 0, write_attributes(attributes)}); // optional
+    sections.push_back(
+        {kAttributeSectionTag, 0, write_attributes(attributes, header.base_vertices)}); // optional
   }
   if (hook) { // the lossless stage's record, in the decoder's numbering
     std::vector<uint32_t> decoded_to_cut(nv);
@@ -284,10 +285,18 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
   std::vector<uint8_t> file = write_file(header, pack_base_mesh(base, in.grid.bits), blocks,
                                          clustered.tables, clustered.blocks, sections);
   if (report) {
-    const FileLayout layout = read_layout(file.data(), file.size());
-    report->info = file_info(layout, file.size());
-    if (const auto table = load_attribute_table(file.data(), layout))
-      describe_attributes(*table, report->info);
+    // The report is read from the file just written: a failure here is the encoder's own
+    // inconsistency, never a damaged file.
+    try {
+      const FileLayout layout = read_layout(file.data(), file.size());
+      report->info = file_info(layout, file.size());
+      if (const auto table = load_attribute_table(file.data(), layout))
+        describe_attributes(*table, report->info);
+    } catch (const Error &e) {
+      throw Error(Error::Kind::Internal,
+                  std::string("internal encoder error: the file it wrote does not read back (") +
+                      e.what() + ")");
+    }
     report->input_vertices = input_vertices;
     report->unreferenced_vertices = input_vertices - nv;
     report->quantize_seconds = t_quantize;
