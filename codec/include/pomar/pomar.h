@@ -90,14 +90,34 @@ private:
   int64_t cluster_ = kNoBlock;
 };
 
+/// A material of a textured mesh: an OBJ `newmtl` block, a PLY/MeshLab texture.
+struct Material {
+  std::string name;       ///< OBJ: the `newmtl` name; PLY/MeshLab: "texture_<i>"
+  int32_t texture = -1;   ///< index into Mesh::texture_files (its map_Kd), or -1: none
+  std::string properties; ///< the block's other lines (Kd, Ks, Ns, illum, ...), as read
+};
+
 /// A triangle mesh as flat arrays: x,y,z per vertex and three vertex indices per
 /// triangle, counter-clockwise seen from outside; optionally per-vertex attributes
-/// (pomar/attributes.h) and the texture files the texture coordinates refer to.
+/// (pomar/attributes.h), per-corner texture coordinates with a material per face, and the
+/// texture files the texture coordinates refer to.
 struct Mesh {
   std::vector<float> positions;    // 3 * vertex_count()
   std::vector<uint32_t> triangles; // 3 * triangle_count()
   std::vector<VertexAttribute> attributes;
   std::vector<std::string> texture_files; ///< metadata, kept as given
+  /// Per-corner texture coordinates (MeshLab's wedge texcoords, OBJ `f v/vt`, PLY face
+  /// `texcoord`): u, v of corner k of triangle f at [6 f + 2 k], or empty. A vertex whose
+  /// corners differ is on a seam; the codec keeps every corner's value (on a grid over
+  /// their range, or bit for bit) and never opens a seam at a coarser level.
+  std::vector<float> corner_texcoords;
+  /// Per-triangle material: an index into `materials`, or empty (no materials).
+  std::vector<uint32_t> face_materials;
+  std::vector<Material> materials;
+  /// Set on decoded per-corner texture coordinates: 0 = exact, else the quantization bits;
+  /// `corner_texcoord_bound` the largest error of a component against the input.
+  int corner_texcoord_bits = 0;
+  double corner_texcoord_bound = 0;
   size_t vertex_count() const { return positions.size() / 3; }
   size_t triangle_count() const { return triangles.size() / 3; }
   /// The first attribute of this kind (and this name, if given), or nullptr.
