@@ -9,8 +9,9 @@
 #     (multipart/byteranges answers) and checks the meshes against the local file's
 #     (web/test/real_servers.sh);
 #  4. runs the viewer in headless Chromium (web/test/browser_test.py), screenshots compared
-#     with docs/images/web_test/, then on an emulated phone with touch input
-#     (web/test/mobile_test.py).
+#     with docs/images/web_test/, a coloured Z-up model (web/test/coloured_mesh.py, encoded
+#     here) drawn with its colours and stood up on Z; then on an emulated phone with touch
+#     input (web/test/mobile_test.py).
 # (Plus web/test/unit_test.mjs: request coalescing and the choice of levels for a view;
 # web/test/detail_test.mjs: the detail measured per cluster on a flat + bumpy grid.)
 # Each step is skipped with a message when emscripten, Node.js or Chromium is missing.
@@ -29,6 +30,8 @@ mkdir -p "$samples"
 "$TOOL" encode "$REPO/samples/bunny.ply" "$samples/bunny.pomar" -q
 "$TOOL" encode "$REPO/samples/bunny.ply" "$samples/bunny_c5.pomar" --cluster-ratio 0.05 -q
 "$TOOL" encode "$REPO/samples/bunny.ply" "$samples/bunny_progressive.pomar" --progressive -q
+python3 "$REPO/web/test/coloured_mesh.py" "$samples/coloured_zup.ply"
+"$TOOL" encode "$samples/coloured_zup.ply" "$samples/coloured_zup.pomar" -q
 node "$REPO/web/test/unit_test.mjs"
 echo "web tests: the measured detail of each cluster (node web/test/detail_test.mjs)"
 node "$REPO/web/test/detail_test.mjs" "$TOOL"
@@ -44,13 +47,13 @@ fi
 in_browser() {
   echo "web tests: $1 (web/test/$2)"
   local status=0
-  python3 "$REPO/web/test/$2" "$samples/bunny_c5.pomar" || status=$?
+  python3 "$REPO/web/test/$2" "$samples/bunny_c5.pomar" "${@:3}" || status=$?
   if [ "$status" = 77 ]; then
     echo "web tests: $2 SKIPPED"
   elif [ "$status" != 0 ]; then
     exit "$status"
   fi
 }
-in_browser "the viewer in headless Chromium" browser_test.py
+in_browser "the viewer in headless Chromium" browser_test.py --coloured "$samples/coloured_zup.pomar"
 in_browser "the viewer on an emulated phone, touch input" mobile_test.py
 echo "web tests: passed"
