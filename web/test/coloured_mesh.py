@@ -5,7 +5,7 @@
     python3 web/test/coloured_mesh.py OUT.ply
 
 An ellipsoid standing along Z (semi-axes 0.5, 0.6, 1.5: Z is the longest extent and 2.5 x
-the Y extent, so the viewer's `up: auto` takes Z), a UV sphere of 48 x 32 quads split into
+the Y extent, so the viewer's `up: auto` takes Z), a UV sphere of 128 x 96 quads split into
 triangles, written as binary PLY with per-vertex red, green, blue: three bands along Z,
 pure red at the bottom (z < -0.5), pure green in the middle, pure blue at the top (z >
 0.5). Seen Z-up, red is at the bottom of the picture and blue at its top.
@@ -14,7 +14,7 @@ import math
 import struct
 import sys
 
-SEGMENTS, RINGS = 48, 32
+SEGMENTS, RINGS = 128, 96
 AXES = (0.5, 0.6, 1.5)
 BANDS = ((255, 0, 0), (0, 255, 0), (0, 0, 255))  # bottom, middle, top
 

@@ -2,9 +2,10 @@
 # The web tests (called by scripts/test.sh):  bash web/test/run.sh BUILD_DIR POMAR_TOOL
 #  1. builds the WebAssembly decoder (web/build.sh, in BUILD_DIR; it also vendors three.js
 #     from npm into web/dist/ for the page);
-#  2. encodes samples/bunny.ply three ways with the native tool and checks that the WASM
-#     decoder decodes them bit for bit like the native one, and that damaged/truncated
-#     copies give messages (web/test/wasm_decode_test.mjs, Node.js);
+#  2. encodes samples/bunny.ply three ways and a coloured mesh (web/test/coloured_mesh.py)
+#     with the native tool and checks that the WASM decoder decodes them bit for bit like
+#     the native one (colours too), and that damaged/truncated copies give messages
+#     (web/test/wasm_decode_test.mjs, Node.js);
 #  3. streams one of them from Debian's nginx and Apache through the client's own transport
 #     (multipart/byteranges answers) and checks the meshes against the local file's
 #     (web/test/real_servers.sh);
@@ -37,7 +38,7 @@ echo "web tests: the measured detail of each cluster (node web/test/detail_test.
 node "$REPO/web/test/detail_test.mjs" "$TOOL"
 echo "web tests: WASM decode = native decode (node web/test/wasm_decode_test.mjs)"
 node "$REPO/web/test/wasm_decode_test.mjs" "$TOOL" "$samples/bunny.pomar" "$samples/bunny_c5.pomar" \
-  "$samples/bunny_progressive.pomar"
+  "$samples/bunny_progressive.pomar" "$samples/coloured_zup.pomar"
 bash "$REPO/web/test/real_servers.sh" "$samples/bunny_c5.pomar"
 if ! command -v chromium >/dev/null 2>&1; then
   echo "web tests: browser test SKIPPED: chromium not installed"
