@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <map>
+#include <random>
 #include <set>
 
 #include "pomar/mesh_io.h"
@@ -172,21 +173,39 @@ TEST(TextureSeams, EveryLevelIsClosedAndInItsCharts) {
 TEST(TextureSeams, SelectionsAreClosedAndInTheirCharts) {
   const Mesh m = cube_mapped(gen::noisy_sphere(4000, 7, 0.05));
   const Coded c = encode_textured(m, true);
-  SelectiveDecoder d(std::make_unique<MemorySource>(c.file.data(), c.file.size()));
-  const int finest = d.finest_level(), base = d.base_clustered_level();
-  // Half the clusters at the finest level, the others at levels between (smooth
-  // transitions raise their neighbours as needed): the whole surface, at mixed levels.
-  for (uint32_t k = 0; k < d.cluster_count(); ++k)
-    d.want_cluster(k, k % 2 ? finest : base + int(k % 5) * (finest - base) / 5);
-  d.update();
-  const Mesh mixed = d.mesh();
-  EXPECT_EQ(welded_boundary_edges(mixed), 0u) << "mixed levels: a seam opened";
-  expect_faces_in_one_chart(mixed, "mixed levels");
-  const float centre[3] = {1, 0, 0};
-  d.clear_wanted();
-  d.want_sphere(centre, 0.5f, finest);
-  d.update();
-  expect_faces_in_one_chart(d.mesh(), "a region");
+  for (unsigned threads : {1u, 2u}) {
+    SelectiveOptions so;
+    so.threads = threads;
+    SelectiveDecoder d(std::make_unique<MemorySource>(c.file.data(), c.file.size()), so);
+    const int finest = d.finest_level(), base = d.base_clustered_level();
+    ASSERT_GT(finest, base + 2);
+    std::vector<uint32_t> link_start, link;
+    d.cluster_links(link_start, link);
+    EXPECT_GT(link.size(), 0u) << "the copies of seam vertices are linked";
+    // Random levels per cluster (smooth transitions raise their neighbours as needed): the
+    // whole surface at mixed levels, welded, has no boundary edge.
+    std::mt19937 rng(threads);
+    for (int round = 0; round < 4; ++round) {
+      d.clear_wanted();
+      for (uint32_t k = 0; k < d.cluster_count(); ++k)
+        d.want_cluster(k, base + int(rng() % uint32_t(finest - base + 1)));
+      d.update();
+      const Mesh mixed = d.mesh();
+      const std::string what =
+          "round " + std::to_string(round) + ", " + std::to_string(threads) + " threads";
+      EXPECT_EQ(welded_boundary_edges(mixed), 0u) << what << ": a seam opened";
+      expect_faces_in_one_chart(mixed, what);
+      for (uint32_t k = 0; k < d.cluster_count(); ++k)
+        for (uint32_t i = link_start[k]; i < link_start[k + 1]; ++i)
+          ASSERT_EQ(d.levels()[k], d.levels()[link[i]]) << what << ": linked clusters apart";
+    }
+    const float centre[3] = {1, 0, 0};
+    d.clear_wanted();
+    d.want_sphere(centre, 0.5f, finest);
+    d.update();
+    EXPECT_EQ(welded_boundary_edges(d.mesh()), 0u) << "a region: a seam opened";
+    expect_faces_in_one_chart(d.mesh(), "a region");
+  }
 }
 
 TEST(TextureSeams, DroppingTextureCoordinatesDropsCornersAndMaterials) {
