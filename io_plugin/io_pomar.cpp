@@ -283,8 +283,10 @@ bool PomarIOPlugin::open(const QString &format, const QString &fileName, MeshMod
 
     if (mesh.find(pomar::AttributeKind::TexCoord))
       m.updateDataMask(MeshModel::MM_VERTTEXCOORD); // optional in CMeshO: enable first
+    if (!mesh.corner_texcoords.empty())
+      m.updateDataMask(MeshModel::MM_WEDGTEXCOORD); // per-corner UVs: the wedges'
     // Also clears m's attributes; the mask tells MeshLab what to show (colours, ...).
-    mask = pomar::to_vcg(mesh, m.cm) & kKeptMask;
+    mask = pomar::to_vcg(mesh, m.cm) & (kKeptMask | vcg::tri::io::Mask::IOM_WEDGTEXCOORD);
     if (!info.clustered())
       cluster.clear(); // a progressive file's vertices have no cluster
     pomar::meshlab::setLayerAttributes(m.cm, cluster, vertexLevel, native, skipDamaged);

@@ -4,6 +4,10 @@
 // files of ../shared/data/textured/.
 #include <pomar/mesh_io.h>
 #include <pomar/pomar.h>
+#include <pomar/vcg_adapter.h>
+
+#include <vcg/complex/complex.h>
+#include <wrap/io_trimesh/import_ply.h>
 
 #include <gtest/gtest.h>
 
@@ -359,6 +363,80 @@ TEST_F(TexturedIo, RealPlyTextureDouble) {
   EXPECT_EQ(m.corner_texcoords, (std::vector<float>{0, 0, 1, 0, 1, 1, 0, 0, 1, 1, 0, 1,
                                                     0, 0, 1, 0, 1, 1, 0, 0, 1, 1, 0, 1}));
   expect_round_trips(m, "double", [&](const std::string &n) { return path(n); });
+}
+
+// ---- vcglib meshes (MeshLab): wedge texture coordinates ----
+
+namespace wedge {
+class V;
+class F;
+struct Types : vcg::UsedTypes<vcg::Use<V>::AsVertexType, vcg::Use<F>::AsFaceType> {};
+class V
+    : public vcg::Vertex<Types, vcg::vertex::Coord3f, vcg::vertex::Normal3f, vcg::vertex::Color4b,
+                         vcg::vertex::Qualityf, vcg::vertex::TexCoord2f, vcg::vertex::BitFlags> {};
+class F : public vcg::Face<Types, vcg::face::VertexRef, vcg::face::WedgeTexCoord2f,
+                           vcg::face::BitFlags> {};
+class M : public vcg::tri::TriMesh<std::vector<V>, std::vector<F>> {};
+} // namespace wedge
+
+namespace optional { // as MeshLab's CMeshO: wedge texture coordinates to enable
+class V;
+class F;
+struct Types : vcg::UsedTypes<vcg::Use<V>::AsVertexType, vcg::Use<F>::AsFaceType> {};
+class V
+    : public vcg::Vertex<Types, vcg::vertex::Coord3f, vcg::vertex::Normal3f, vcg::vertex::Color4b,
+                         vcg::vertex::Qualityf, vcg::vertex::TexCoord2f, vcg::vertex::BitFlags> {};
+class F : public vcg::Face<Types, vcg::face::InfoOcf, vcg::face::VertexRef,
+                           vcg::face::WedgeTexCoordfOcf, vcg::face::BitFlags> {};
+class M : public vcg::tri::TriMesh<std::vector<V>, vcg::face::vector_ocf<F>> {};
+} // namespace optional
+
+constexpr int kWedge = vcg::tri::io::Mask::IOM_WEDGTEXCOORD;
+
+TEST_F(TexturedIo, VcgWedgeTexcoordsBothWays) {
+  const Mesh m = textured_strip(10);
+  wedge::M vm;
+  EXPECT_EQ(to_vcg(m, vm) & kWedge, kWedge);
+  EXPECT_EQ(vm.textures, m.texture_files);
+  EXPECT_EQ(vm.face[3].WT(1).N(), 1); // quad 1: material "right", texture 1
+  EXPECT_FLOAT_EQ(vm.face[3].WT(1).U(), m.corner_texcoords[6 * 3 + 2]);
+  const Mesh back = from_vcg(vm, nullptr, kVcgAllAttributes, true);
+  expect_same_textured(m, back, false); // materials as "texture_<i>"
+  EXPECT_EQ(back.materials[1].name, "texture_1");
+  EXPECT_TRUE(from_vcg(vm, nullptr, 0).corner_texcoords.empty()); // not asked for
+  // A face type with optional wedge texture coordinates: written only once enabled.
+  optional::M om;
+  EXPECT_EQ(to_vcg(m, om) & kWedge, 0);
+  EXPECT_TRUE(from_vcg(om, nullptr, kVcgAllAttributes).corner_texcoords.empty());
+  om.face.EnableWedgeTexCoord();
+  EXPECT_EQ(to_vcg(m, om) & kWedge, kWedge);
+  expect_same_textured(m, from_vcg(om, nullptr, kVcgAllAttributes, true), false);
+  // Corner data that does not fit is refused, the vcg mesh left as it is.
+  Mesh bad = m;
+  bad.face_materials.pop_back();
+  EXPECT_THROW(to_vcg(bad, vm), Error);
+  EXPECT_EQ(vm.face.size(), m.triangle_count());
+}
+
+TEST_F(TexturedIo, VcgImporterAgreesWithLoadMesh) {
+  for (const char *name :
+       {"/textured/meshlab/TextureDouble.ply", "/textured/meshlab/laurana500.ply"}) {
+    const std::string file = kData + name;
+    if (!exists(file))
+      continue;
+    SCOPED_TRACE(file);
+    const Mesh ours = load_mesh(file);
+    wedge::M vm;
+    int mask = 0;
+    ASSERT_EQ(vcg::tri::io::ImporterPLY<wedge::M>::Open(vm, file.c_str(), mask), 0);
+    ASSERT_TRUE(mask & kWedge);
+    const Mesh theirs = from_vcg(vm, nullptr, kVcgAllAttributes, true);
+    EXPECT_EQ(ours.triangles, theirs.triangles);
+    EXPECT_EQ(ours.corner_texcoords, theirs.corner_texcoords);
+    if (!ours.face_materials.empty()) { // (without texnumber vcglib sets n() = 0)
+      EXPECT_EQ(ours.face_materials, theirs.face_materials);
+    }
+  }
 }
 
 } // namespace
