@@ -1,4 +1,4 @@
-// pomar_rd: rate-distortion of every level of detail of a .pomar file (issue 7).
+// pomar_rd: rate-distortion of every level of detail of a .pomar file (docs/rate_distortion.md).
 //
 //   pomar_rd IN.mesh [IN.pomar] [--csv OUT.csv] [--svg OUT.svg] [--bits N] [--samples N]
 //            [--seed N] [--no-draco] [--save-pomar OUT.pomar]

@@ -285,8 +285,10 @@ bool PomarIOPlugin::open(const QString &format, const QString &fileName, MeshMod
       m.updateDataMask(MeshModel::MM_VERTTEXCOORD); // optional in CMeshO: enable first
     if (!mesh.corner_texcoords.empty())
       m.updateDataMask(MeshModel::MM_WEDGTEXCOORD); // per-corner UVs: the wedges'
-    // Also clears m's attributes; the mask tells MeshLab what to show (colours, ...).
+    // Also clears m's attributes. What was read goes into the layer's data mask too: the GUI
+    // picks the rendering (vertex colour, ...) from that mask, not from the returned one.
     mask = pomar::to_vcg(mesh, m.cm) & (kKeptMask | vcg::tri::io::Mask::IOM_WEDGTEXCOORD);
+    m.Enable(mask);
     if (!info.clustered())
       cluster.clear(); // a progressive file's vertices have no cluster
     pomar::meshlab::setLayerAttributes(m.cm, cluster, vertexLevel, native, skipDamaged);

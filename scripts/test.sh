@@ -6,8 +6,8 @@
 # vcglib are checked while the tests run; then the web tests (web/test/run.sh: the WebAssembly decoder
 # against the native one, the viewer in headless Chromium); then the same suite again under ASan + UBSan (build-asan/),
 # the threaded tests under ThreadSanitizer (build-tsan/), then a timed libFuzzer run of each fuzz target
-# (build-fuzz/; POMAR_TEST_FUZZ_SECONDS, default 20, 0 skips). Takes about 16-20 minutes from scratch
-# on 2 cores (a fresh clone on 2026-12-02: 16.3 minutes, the ThreadSanitizer pass included).
+# (build-fuzz/; POMAR_TEST_FUZZ_SECONDS, default 20, 0 skips). Takes about 16-20 minutes from a
+# fresh clone on 2 cores, the ThreadSanitizer pass included.
 set -euo pipefail
 
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"

@@ -74,10 +74,9 @@ TEST(MemorySize, FormatsWithBinaryUnits) {
 
 TEST(MemoryEstimate, IsAboveTheMeasuredPeaks) {
   // Peak RSS (KiB) of `pomar encode` / `pomar decode` measured with /usr/bin/time
-  // (bench/README.md, "Memory", 2026-12-02; the last one in the fifth session): vertices,
-  // faces, encode (two threads), decode random access on one thread, on two and on eight
-  // (sixth session: the larger of 2-3 runs), decode progressive. The estimates must stay
-  // above them with some margin.
+  // (bench/README.md, "Memory"): vertices, faces, encode (two threads), decode random
+  // access on one thread, on two and on eight (the larger of 2-3 runs), decode progressive.
+  // The estimates must stay at least 10% above them.
   struct Peak {
     uint64_t v, f, enc, dec_ra, dec_ra2, dec_ra8, dec_prog;
   } peaks[] = {{34834, 69451, 19072, 8824, 9592, 11464, 8776},             // bunny
@@ -107,19 +106,18 @@ TEST(MemoryEstimate, IsAboveTheMeasuredPeaks) {
 }
 
 TEST(MemoryEstimate, LosslessStageIsAboveTheMeasuredPeaks) {
-  // Peak RSS (KiB, /usr/bin/time, two threads; bench/README.md "Memory of the lossless
-  // stage", seventh session; the --keep-order rows measured again in the ninth, after the
-  // record stopped copying the mesh): noisy spheres encoded with --keep-order, and the same spheres
-  // with 10% of their faces duplicated and 5% more vertices no face uses (the encoder's
-  // check sees the cut mesh: the coded counts; the file's header holds them too), then
-  // decoded. Before the lossless terms the estimates were 0.64-0.79 of these peaks.
+  // Peak RSS (KiB, /usr/bin/time, two threads; bench/README.md, "Memory"): noisy spheres
+  // encoded with --keep-order, and the same spheres with 10% of their faces duplicated and
+  // 5% more vertices no face uses (the encoder's check sees the cut mesh: the coded counts;
+  // the file's header holds them too), then decoded. Without the lossless terms the
+  // estimates would be 0.64-0.79 of the messy and first-measured --keep-order peaks.
   struct Peak {
     uint64_t v, f;
     bool keep_order;
     uint64_t enc, dec;
-  } peaks[] = {{299292, 598580, true, 109536, 58212},     // 300k, --keep-order (ninth session)
+  } peaks[] = {{299292, 598580, true, 109536, 58212},     // 300k, --keep-order
                {299292, 598580, false, 132380, 47144},    // 300k, messy
-               {998562, 1997120, true, 344272, 175920},   // 1M, --keep-order (ninth session)
+               {998562, 1997120, true, 344272, 175920},   // 1M, --keep-order
                {998562, 1997120, false, 365860, 139588}}; // 1M, messy
   for (const Peak &p : peaks) {
     const uint64_t thread = decode_thread_memory(p.v, p.f);
@@ -148,8 +146,7 @@ TEST(MemoryEstimate, LosslessStageIsAboveTheMeasuredPeaks) {
 
 TEST(MemoryEstimate, EachInputFormatIsTenToTwentyFivePercentAboveItsPeaks) {
   // Peak RSS (KiB) of `pomar encode` (two threads) by input format, measured with
-  // /usr/bin/time (bench/README.md, "Memory", per input format, fifth session of
-  // 2026-12-02): noisy spheres (F = 2V), 2-row strips (F = V) and, for OBJ with normals
+  // /usr/bin/time (bench/README.md, "Memory"): noisy spheres (F = 2V), 2-row strips (F = V) and, for OBJ with normals
   // and texture coordinates ("f a/a/a"), a torus (F = 2V) and strips.
   using In = EncodeInput;
   struct Peak {
@@ -273,8 +270,8 @@ TEST(MemoryEstimate, InputFormatFromTheLoadReport) {
 }
 
 TEST(MemoryEstimate, AttributesAreAboveTheMeasuredPeaks) {
-  // bench/README.md, "Memory", per-vertex attributes; peak RSS in KiB. Encoding (fifth
-  // session, two threads): tori of 300k, 1M and 3M vertices (F = 2V, binary PLY) with RGB colour,
+  // bench/README.md, "Memory", per-vertex attributes; peak RSS in KiB. Encoding (two
+  // threads): tori of 300k, 1M and 3M vertices (F = 2V, binary PLY) with RGB colour,
   // normal, quality and UV (8 codes), colour only (3) or quality only (1). Decoding (binary
   // PLY out, one thread): a 1M-vertex torus and a 490k one with the 8 codes, the 1M one
   // with quality only.

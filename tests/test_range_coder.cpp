@@ -145,10 +145,10 @@ TEST(RangeCoder, TruncatedStreamIsDetected) {
 }
 
 TEST(RangeCoder, DominantSymbolNeverReachesFrequencyZero) {
-  // A symbol coded over and over climbs towards the 2^16 total; its count used to wrap in
-  // 16 bits (to 0 at 65,512 + 24), after which coding it never terminated.
+  // A symbol coded over and over climbs towards the 2^16 total; a count kept in 16 bits
+  // would wrap (to 0 at 65,512 + 24), after which coding it would never terminate.
   // Where the dominant count lands when the total passes 2^16 depends on the history:
-  // warm-ups of 0..59 updates of another symbol cover cases that used to reach 0 (e.g. 6).
+  // warm-ups of 0..59 updates of another symbol cover cases that reach 0 in 16 bits (e.g. 6).
   for (int symbols : {2, 3, 17, 40, 64}) {
     for (int warmup = 0; warmup < 60; ++warmup) {
       FrequencyModel model(symbols);

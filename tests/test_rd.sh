@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Tests of bench/pomar_rd (issue 7) on samples/bunny.ply; no ../shared data needed.
+# Tests of bench/pomar_rd (docs/rate_distortion.md) on samples/bunny.ply; no ../shared data needed.
 #   test_rd.sh POMAR_RD POMAR_CLI POMAR_GEN_MESH SAMPLES_DIR
 # 1. the full decode's error is the quantization error: Hausdorff <= sqrt(3)/2 * cell / diag
 #    (a vertex moves at most half a cell per axis; surface points are convex combinations);

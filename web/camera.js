@@ -28,9 +28,43 @@ export function multiply(a, b) {
   return out;
 }
 
-/** A camera orbiting `target` at `distance`, framing a model of size `extent`. */
+/** A camera orbiting `target` at `distance`, framing a model of size `extent`, around the
+ *  up axis `up` ('y' or 'z'): yaw turns around it, pitch lifts the eye towards it. */
 export function orbitCamera() {
-  return { target: [0, 0, 0], distance: 1, yaw: 0.6, pitch: 0.3, fovY: Math.PI / 4, extent: 1 };
+  return { target: [0, 0, 0], distance: 1, yaw: 0.6, pitch: 0.3, fovY: Math.PI / 4, extent: 1, up: 'y' };
+}
+
+/** The orbit is computed in a Y-up frame; with up 'z' that frame is turned by 90 degrees
+ *  around X (its Y becomes the model's +Z, its front +Z the model's -Y: a Z-up model is
+ *  seen from its -Y side, as Z-up tools call the front). */
+export function toModel(c, v) {
+  return c.up === 'z' ? [v[0], -v[2], v[1]] : v;
+}
+
+/** The camera's up vector in model coordinates. */
+export function upVector(c) {
+  return toModel(c, [0, 1, 0]);
+}
+
+/** The up axis `auto` picks for a box of extents [dx, dy, dz]: 'z' when Z is the longest
+ *  extent and at least UP_Z_RATIO x the Y extent (a standing scan stored Z-up: its height
+ *  is along Z), else 'y' (the default of most mesh files). A box cannot tell more: a flat
+ *  or wide Z-up model (a relief, a car) stays Y-up and needs the menu. */
+export const UP_Z_RATIO = 1.2;
+export function autoUp(extents) {
+  const [dx, dy, dz] = extents;
+  return dz >= dx && dz >= UP_Z_RATIO * dy ? 'z' : 'y';
+}
+
+/** Extents [dx, dy, dz] of the box of `positions` (xyz). */
+export function extentsOf(positions) {
+  const lo = [Infinity, Infinity, Infinity];
+  const hi = [-Infinity, -Infinity, -Infinity];
+  for (let i = 0; i < positions.length; ++i) {
+    lo[i % 3] = Math.min(lo[i % 3], positions[i]);
+    hi[i % 3] = Math.max(hi[i % 3], positions[i]);
+  }
+  return [0, 1, 2].map((k) => (hi[k] > lo[k] ? hi[k] - lo[k] : 0));
 }
 
 /** Frame the mesh (positions, xyz): target its box centre, from 1.6 x its size (divided by
@@ -48,15 +82,14 @@ export function frameMesh(camera, positions, aspect = 1) {
 }
 
 export function eyeOf(c) {
-  return [c.target[0] + c.distance * Math.cos(c.pitch) * Math.sin(c.yaw),
-    c.target[1] + c.distance * Math.sin(c.pitch),
-    c.target[2] + c.distance * Math.cos(c.pitch) * Math.cos(c.yaw)];
+  const offset = toModel(c, [Math.cos(c.pitch) * Math.sin(c.yaw), Math.sin(c.pitch), Math.cos(c.pitch) * Math.cos(c.yaw)]);
+  return c.target.map((t, k) => t + c.distance * offset[k]);
 }
 
 /** Move the target by (dx, dy) in the camera's screen plane (right, up), in model units. */
 export function pan(c, dx, dy) {
-  const right = [Math.cos(c.yaw), 0, -Math.sin(c.yaw)];
-  const up = [-Math.sin(c.pitch) * Math.sin(c.yaw), Math.cos(c.pitch), -Math.sin(c.pitch) * Math.cos(c.yaw)];
+  const right = toModel(c, [Math.cos(c.yaw), 0, -Math.sin(c.yaw)]);
+  const up = toModel(c, [-Math.sin(c.pitch) * Math.sin(c.yaw), Math.cos(c.pitch), -Math.sin(c.pitch) * Math.cos(c.yaw)]);
   c.target = c.target.map((t, k) => t + dx * right[k] + dy * up[k]);
 }
 
@@ -65,7 +98,7 @@ export function viewOf(c, width, height) {
   const eye = eyeOf(c);
   const near = Math.max(c.distance * 0.01, c.extent * 1e-4);
   const far = c.distance + 4 * c.extent;
-  const viewProj = multiply(perspective(c.fovY, width / height, near, far), lookAt(eye, c.target, [0, 1, 0]));
+  const viewProj = multiply(perspective(c.fovY, width / height, near, far), lookAt(eye, c.target, upVector(c)));
   return { eye, viewProj, fovY: c.fovY, height, width, near, far };
 }
 

@@ -11,7 +11,8 @@
 // (adjacent blocks in one range, up to `maxRanges` ranges in one request, at most
 // `maxInFlight` requests at once) and decode them
 // on top of the current mesh. Meshes arrive as typed arrays: positions (Float32Array, xyz),
-// triangles (Uint32Array), vertexCluster, vertexLevel (Uint32Array), clusterBounds.
+// triangles (Uint32Array), vertexCluster, vertexLevel (Uint32Array), clusterBounds, and
+// colour ({components: 3 or 4, values: Uint8Array}, or null: the file has no colour).
 // Errors (HTTP errors, servers without Range support, damaged or truncated files) reject
 // the promises with an Error whose message says what happened; damaged cluster blocks are
 // skipped (as `pomar decode --skip-damaged` does) and reported through `onWarning`.

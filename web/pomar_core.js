@@ -13,6 +13,10 @@ export function loadModule(options = {}) {
 
 export class PomarError extends Error {}
 
+/** Attribute kinds of pw_attribute_components (pomar::AttributeKind). */
+export const ATTRIBUTE_COLOUR = 1;
+export const ATTRIBUTE_TEXCOORD = 4;
+
 function lastError(M) {
   return M.UTF8ToString(M._pw_last_error());
 }
@@ -117,6 +121,18 @@ export class Decoder {
     return new Int32Array(M.HEAP32.buffer, M._pw_levels(this.h), this.info.clusters).slice();
   }
 
+  /** The extracted mesh's attribute of `kind` (ATTRIBUTE_*) for its `nv` vertices:
+   *  {components, values} (a copy: Uint8Array for colour, Float32Array otherwise), or null. */
+  attribute(kind, nv) {
+    const M = this.M;
+    const components = M._pw_attribute_components(this.h, kind);
+    if (!components) return null;
+    const ptr = M._pw_attribute_values(this.h, kind);
+    const values = kind === ATTRIBUTE_COLOUR ? new Uint8Array(M.HEAPU8.buffer, ptr, components * nv).slice()
+      : new Float32Array(M.HEAPF32.buffer, ptr, components * nv).slice();
+    return { components, values };
+  }
+
   /** Damaged blocks skipped so far: { count, text } (text: one line per block). */
   damaged() {
     const M = this.M;
@@ -125,7 +141,9 @@ export class Decoder {
 
   /** The current mesh as typed arrays (copies, transferable), plus per-cluster bounds:
    *  BOUNDS_STRIDE floats per cluster (bbox min, max, longest edge, face count, normal cone,
-   *  detail of its newest vertices and their count: see view_refine.js). */
+   *  detail of its newest vertices and their count: see view_refine.js), and `colour`:
+   *  the per-vertex colour, {components: 3 (RGB) or 4 (RGBA), values: Uint8Array of
+   *  vertices x components}, or null when the file has none. */
   mesh() {
     const M = this.M;
     if (M._pw_extract(this.h) < 0) throw new PomarError(lastError(M));
@@ -134,6 +152,7 @@ export class Decoder {
     const f32 = (ptr, n) => new Float32Array(M.HEAPF32.buffer, ptr, n).slice();
     const u32 = (ptr, n) => new Uint32Array(M.HEAPU32.buffer, ptr, n).slice();
     return {
+      colour: this.attribute(ATTRIBUTE_COLOUR, nv),
       positions: f32(M._pw_positions(this.h), 3 * nv),
       triangles: u32(M._pw_triangles(this.h), 3 * nt),
       vertexCluster: u32(M._pw_vertex_cluster(this.h), nv),

@@ -18,6 +18,7 @@ function post(type, id, extra) {
   const mesh = stream.decoder.mesh();
   const transfer = [mesh.positions.buffer, mesh.triangles.buffer, mesh.vertexCluster.buffer,
     mesh.vertexLevel.buffer, mesh.clusterBounds.buffer];
+  if (mesh.colour) transfer.push(mesh.colour.values.buffer);
   const stats = { ...stream.stats(), vertices: mesh.positions.length / 3, triangles: mesh.triangles.length / 3, ...extra };
   self.postMessage({ type, id, info: stream.info, mesh, levels: stream.levels, stats }, transfer);
 }

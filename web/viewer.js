@@ -6,7 +6,7 @@
 // (web/test/browser_test.py) and reports to the test server; &test=fidelity the pixel
 // comparison of bench/web_fidelity_bench.py (web/test/fidelity_page.js).
 import { open } from './pomar.js';
-import { frameMesh, orbitCamera, pan, viewOf } from './camera.js';
+import { autoUp, extentsOf, frameMesh, orbitCamera, pan, upVector, viewOf } from './camera.js';
 import * as THREE from './dist/three.module.js';
 
 const $ = (id) => document.getElementById(id);
@@ -15,14 +15,16 @@ const params = new URLSearchParams(location.search);
 
 // ------------------------------------------------------------------ renderer
 // One three.js mesh drawn with a small shader: flat shading from screen-space derivatives
-// (the decoded mesh has no normals), colour by cluster or by level. &shading=smooth shades
-// with vertex normals instead (area-weighted face normals, computed at each upload), e.g.
-// to compare refinement policies (bench/web_fidelity_bench.py --shading smooth).
+// (the decoded mesh has no normals), a headlight, and the colour of the material chosen in
+// the colour menu (MATERIALS below). &shading=smooth shades with vertex normals instead
+// (area-weighted face normals, computed at each upload), e.g. to compare refinement
+// policies (bench/web_fidelity_bench.py --shading smooth).
 const VS = `precision highp float;
 in vec3 position;
 in float cluster;
 in float level;
 in vec3 normal;
+in vec3 rgb;
 uniform mat4 projectionMatrix;
 uniform mat4 modelViewMatrix;
 uniform int colourMode;
@@ -30,11 +32,13 @@ uniform float finest;
 uniform float base;
 out vec3 vPosition;
 out vec3 vNormal;
+out vec3 vRgb;
 flat out vec3 vColour;
 vec3 hue(float h) { return clamp(abs(mod(h * 6.0 + vec3(0, 4, 2), 6.0) - 3.0) - 1.0, 0.0, 1.0); }
 void main() {
   vPosition = position;
   vNormal = normal;
+  vRgb = rgb;
   if (colourMode == 1) vColour = 0.35 + 0.65 * hue(fract(cluster * 0.61803));
   else if (colourMode == 2) vColour = 0.3 + 0.7 * hue(0.66 * (1.0 - (level - base) / max(1.0, finest - base)));
   else vColour = vec3(0.82, 0.80, 0.76);
@@ -43,8 +47,10 @@ void main() {
 const FS = `precision highp float;
 in vec3 vPosition;
 in vec3 vNormal;
+in vec3 vRgb;
 flat in vec3 vColour;
 uniform vec3 eye;
+uniform highp int colourMode; // highp: the vertex shader's int precision (shared uniform)
 uniform int smoothShading;
 out vec4 colour;
 void main() {
@@ -52,7 +58,8 @@ void main() {
                                                              : normalize(cross(dFdx(vPosition), dFdy(vPosition)));
   vec3 l = normalize(eye - vPosition);
   float d = abs(dot(n, l));
-  colour = vec4(vColour * (0.25 + 0.75 * d), 1.0);
+  // Own colours (mode 3) are interpolated across the face and lit like the others.
+  colour = vec4((colourMode == 3 ? vRgb : vColour) * (0.25 + 0.75 * d), 1.0);
 }`;
 
 const smoothShading = params.get('shading') === 'smooth';
@@ -77,6 +84,47 @@ function vertexNormals(p, t) {
   return n;
 }
 
+// ------------------------------------------------------------------ materials
+// The colour menu. Each material is a colour mode of the shader (`mode`), the test of
+// whether it applies to a mesh (`available`, default: always) and the vertex attributes it
+// needs beside the positions (`attributes(mesh, model)`: name -> THREE.BufferAttribute,
+// built from the same decoded mesh at every upload, so they always match the geometry).
+// The first available one is chosen when a file opens: the file's own colours when it has
+// them. A texture is one more entry of this list: available when the mesh has a
+// "texcoord" attribute and texture files, its attributes the UVs, plus a sampler uniform
+// and a mode of the shader.
+const MATERIALS = [
+  { id: 'own', label: 'own colours', mode: 3, available: (mesh) => !!mesh.colour,
+    attributes: (mesh) => ({ rgb: new THREE.BufferAttribute(mesh.colour.values, mesh.colour.components, true) }) },
+  { id: 'plain', label: 'plain', mode: 0 },
+  { id: 'clusters', label: 'clusters', mode: 1,
+    attributes: (mesh) => ({ cluster: new THREE.BufferAttribute(Float32Array.from(mesh.vertexCluster), 1) }) },
+  { id: 'levels', label: 'levels', mode: 2, attributes: (mesh, model) => {
+    // Colour by level: the level of the vertex's cluster (the level map), not the level
+    // that created the vertex (which mixes all levels up to it in every region).
+    const levels = model ? model.levels : null;
+    const level = new Float32Array(mesh.vertexCluster.length);
+    for (let v = 0; v < level.length; ++v) level[v] = levels && levels.length ? levels[mesh.vertexCluster[v]] : mesh.vertexLevel[v];
+    return { level: new THREE.BufferAttribute(level, 1) };
+  } },
+];
+const usable = (material, mesh) => !material.available || material.available(mesh);
+let drawnMesh = { positions: new Float32Array(0), vertexCluster: new Uint32Array(0), colour: null };
+/** The material of the colour menu, or the plain one if it does not apply to the mesh. */
+function material() {
+  const chosen = MATERIALS.find((m) => m.id === $('colour').value);
+  return chosen && usable(chosen, drawnMesh) ? chosen : MATERIALS.find((m) => m.id === 'plain');
+}
+function initMaterials() {
+  $('colour').replaceChildren(...MATERIALS.map((m) => new Option(m.label, m.id)));
+  $('colour').value = 'plain';
+}
+/** Enable the materials that apply to `mesh`; with `chooseDefault`, select the first. */
+function offerMaterials(mesh, chooseDefault) {
+  for (const option of $('colour').options) option.disabled = !usable(MATERIALS.find((m) => m.id === option.value), mesh);
+  if (chooseDefault) $('colour').value = MATERIALS.find((m) => usable(m, mesh)).id;
+}
+
 let renderer = null;
 let scene = null;
 let shown = null; // the THREE.Mesh
@@ -96,24 +144,35 @@ function initGL() {
   scene.add(shown);
 }
 function upload(mesh, model) {
+  // Every decoded state (open, refinement of a region or of everything, coarsening, a
+  // rebuilt decoder) arrives here: the attributes of all the materials that apply are
+  // built from this one mesh, so switching materials needs no upload and no buffer lags
+  // behind the geometry.
   const g = new THREE.BufferGeometry();
   g.setAttribute('position', new THREE.BufferAttribute(mesh.positions, 3));
-  g.setAttribute('cluster', new THREE.BufferAttribute(Float32Array.from(mesh.vertexCluster), 1));
-  // Colour by level: the level of the vertex's cluster (the level map), not the level
-  // that created the vertex (which mixes all levels up to it in every region).
-  const levels = model ? model.levels : null;
-  const level = new Float32Array(mesh.vertexCluster.length);
-  for (let v = 0; v < level.length; ++v) level[v] = levels && levels.length ? levels[mesh.vertexCluster[v]] : mesh.vertexLevel[v];
-  g.setAttribute('level', new THREE.BufferAttribute(level, 1));
+  for (const m of MATERIALS) {
+    if (!m.attributes || !usable(m, mesh)) continue;
+    for (const [name, attribute] of Object.entries(m.attributes(mesh, model))) g.setAttribute(name, attribute);
+  }
   if (smoothShading) g.setAttribute('normal', new THREE.BufferAttribute(vertexNormals(mesh.positions, mesh.triangles), 3));
   g.setIndex(new THREE.BufferAttribute(mesh.triangles, 1));
   shown.geometry.dispose();
   shown.geometry = g;
+  drawnMesh = mesh;
+  offerMaterials(mesh, false);
 }
 
 // ------------------------------------------------------------------ camera
 const camera = orbitCamera();
 let cameraVersion = 0;
+// The up axis: the menu's Y or Z, or `auto`: camera.js autoUp on the box of the base mesh
+// (Z when Z is the longest extent and 1.2 x the Y extent or more). The orbit turns around it.
+let modelExtents = null;
+function applyUp() {
+  const auto = modelExtents ? autoUp(modelExtents) : 'y';
+  camera.up = $('up').value === 'auto' ? auto : $('up').value;
+  $('up').options[0].textContent = modelExtents ? `auto (${auto.toUpperCase()})` : 'auto';
+}
 // Pixels drawn per CSS pixel: the device's, at most 2 (a phone at 3 would draw 2.25x the
 // pixels for little to see, and the target error is in drawn pixels).
 const MAX_PIXEL_RATIO = 2;
@@ -137,12 +196,12 @@ function frame(model) {
   c.near = v.near;
   c.far = v.far;
   c.position.set(...v.eye);
-  c.up.set(0, 1, 0);
+  c.up.set(...upVector(camera));
   c.lookAt(...camera.target);
   c.updateProjectionMatrix();
   const u = shown.material.uniforms;
   u.eye.value.set(...v.eye);
-  u.colourMode.value = Number($('colour').value);
+  u.colourMode.value = material().mode;
   u.finest.value = model ? model.info.finestLevel : 1;
   u.base.value = model ? model.info.baseLevel : 0;
   renderer.render(scene, c);
@@ -200,7 +259,7 @@ async function openSource(source, extraOptions = {}) {
   $('warning').textContent = '';
   if (model) model.close();
   model = null;
-  upload({ positions: new Float32Array(0), triangles: new Uint32Array(0), vertexCluster: new Uint32Array(0), vertexLevel: new Uint32Array(0) });
+  upload({ positions: new Float32Array(0), triangles: new Uint32Array(0), vertexCluster: new Uint32Array(0), vertexLevel: new Uint32Array(0), colour: null });
   frame(null);
   const m = await open(source, {
     ...extraOptions,
@@ -210,6 +269,9 @@ async function openSource(source, extraOptions = {}) {
   model = m;
   // The header's box is the quantization cube; frame the base mesh's own box instead.
   frameMesh(camera, m.mesh.positions, canvas.clientWidth / Math.max(1, canvas.clientHeight));
+  modelExtents = extentsOf(m.mesh.positions);
+  applyUp();
+  offerMaterials(m.mesh, true);
   ++cameraVersion;
   onMesh(m.mesh, m);
   if (m.info.clusters === 0) await m.want({ all: m.info.finestLevel }); // progressive: no regions
@@ -254,6 +316,7 @@ canvas.addEventListener('wheel', (e) => {
 }, { passive: false });
 window.addEventListener('resize', moved);
 $('colour').addEventListener('change', () => frame(model));
+$('up').addEventListener('change', () => { applyUp(); moved(); });
 $('target').addEventListener('change', moved);
 $('refine').addEventListener('change', moved);
 $('open').addEventListener('submit', (e) => {
@@ -272,8 +335,12 @@ window.addEventListener('drop', (e) => {
 
 // ------------------------------------------------------------------ start
 // For the console and the browser tests (web/test/mobile_test.py): the viewer's state.
-window.pomarViewer = { model: () => model, camera, refining: () => refining };
+// drawn(): what the drawn geometry holds (vertices, colours uploaded, the material).
+window.pomarViewer = { model: () => model, camera, refining: () => refining, upVector: () => upVector(camera),
+  drawn: () => ({ vertices: shown.geometry.attributes.position.count, colours: shown.geometry.attributes.rgb ? shown.geometry.attributes.rgb.count : 0,
+    material: material().id }) };
 try {
+  initMaterials();
   initGL();
   frame(null);
   if (params.get('test')) {

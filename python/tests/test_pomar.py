@@ -418,7 +418,7 @@ def test_progress_callback_and_interruption(bunny):
     assert len(pomar.decode(data).faces) == len(bunny.faces)  # nothing left behind
 
 
-# Per-vertex attributes (issue 16, issue 12).
+# Per-vertex attributes.
 
 def torus_attributes(vertices, alpha=False):
     """Colours, unit normals, two scalars and texture coordinates for torus() vertices."""

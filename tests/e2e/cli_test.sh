@@ -634,7 +634,7 @@ for count in 2147483648 2147483647; do
   done
 done
 
-# ---- per-vertex attributes (issue 12) ------------------------------------------------------------------
+# ---- per-vertex attributes ---------------------------------------------------------------------------
 
 section "attributes: a coloured, scalar-carrying PLY (generated: the bunny with colour, normals, quality)"
 mkdir -p "$WORK/attr"

@@ -63,8 +63,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     std::remove(path.c_str());
     // A leaked FILE*/fd is a finding too: after `ulimit -n` inputs fopen fails (EMFILE).
     const std::vector<int> fds_after = open_fds();
-    // (regressions/readers-crash-4401b907...: vcglib's ASCII STL reader leaked its FILE on a
-    // malformed vertex; pomar now reads ASCII STL itself.)
+    // (regressions/readers-crash-4401b907...: vcglib's ASCII STL reader leaks its FILE on a
+    // malformed vertex; pomar reads ASCII STL itself.)
     if (fds_after != fds_before) {
       std::fprintf(stderr, "file descriptor leak: load_mesh(\"%s\") left %zu more open\n",
                    path.c_str(), fds_after.size() - fds_before.size());

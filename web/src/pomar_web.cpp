@@ -331,7 +331,8 @@ EMSCRIPTEN_KEEPALIVE const char *pw_damaged(Handle *h) {
 EMSCRIPTEN_KEEPALIVE int pw_damaged_count(Handle *h) { return int(h->decoder->damaged().size()); }
 
 /// Extract the current mesh; then pw_positions (3 floats per vertex), pw_triangles (3
-/// indices per face), pw_vertex_cluster, pw_vertex_level point at it until the next call.
+/// indices per face), pw_vertex_cluster, pw_vertex_level and pw_attribute_values point at
+/// it until the next call.
 EMSCRIPTEN_KEEPALIVE int pw_extract(Handle *h) {
   return guarded([&] {
     // Every cluster at the finest level: exactly the encoded input (a lossless record
@@ -360,6 +361,23 @@ EMSCRIPTEN_KEEPALIVE const uint32_t *pw_vertex_cluster(Handle *h) {
   return h->vertex_cluster.data();
 }
 EMSCRIPTEN_KEEPALIVE const uint32_t *pw_vertex_level(Handle *h) { return h->vertex_level.data(); }
+
+/// The extracted mesh's first attribute of `kind` (pomar::AttributeKind: 1 colour, 2
+/// normal, 3 scalar, 4 texcoord): its components per vertex (colour 3 = RGB or 4 = RGBA;
+/// 0: the mesh has no such attribute) and its values, pw_vertex_count() x components of
+/// them (colour: bytes, 0..255 a channel; the other kinds: floats), valid until the next
+/// pw_extract. The web viewer draws the colour (web/viewer.js).
+EMSCRIPTEN_KEEPALIVE int pw_attribute_components(Handle *h, int kind) {
+  const pomar::VertexAttribute *a = h->mesh.find(static_cast<pomar::AttributeKind>(kind));
+  return a && a->vertex_count() == h->mesh.vertex_count() ? int(a->components) : 0;
+}
+EMSCRIPTEN_KEEPALIVE const void *pw_attribute_values(Handle *h, int kind) {
+  const pomar::VertexAttribute *a = h->mesh.find(static_cast<pomar::AttributeKind>(kind));
+  if (!a)
+    return nullptr;
+  return a->kind == pomar::AttributeKind::Colour ? static_cast<const void *>(a->colour.data())
+                                                 : static_cast<const void *>(a->values.data());
+}
 
 /// Per cluster of the extracted mesh, kBoundsStride floats (web/view_refine.js reads them):
 ///  0-5  bounding box min xyz, max xyz;

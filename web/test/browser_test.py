@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The web viewer in a real headless browser.
 
-    python3 web/test/browser_test.py FILE.pomar [--images DIR] [--chromium PATH]
+    python3 web/test/browser_test.py FILE.pomar [--coloured COLOURED.pomar] [--images DIR] [--chromium PATH]
 
 Serves the repository's web/ folder and copies of FILE (intact, truncated in the global
 part, truncated in the cluster blocks, one cluster block damaged, and through a path that
@@ -18,6 +18,11 @@ web/test/run.sh does): at most --max-differing of their pixels may differ by mor
 small colour threshold (see page_test.js). --update-references writes the new screenshots
 there instead (after a deliberate change to the encoder, the camera or the rendering; look
 at them). --no-compare skips the comparison (another file than the sample).
+--coloured: a Z-up model with per-vertex colour, web/test/coloured_mesh.py encoded (run.sh
+makes it): the viewer picks Z as the up axis by itself and draws the model's own colours
+(red at the bottom of the picture, blue at its top), its colour buffer matches the
+geometry after region refinement, coarsening and full resolution, the plain material is
+grey and the Y-up choice turns the model on its side (screenshots coloured_*).
 Exit status 0 = pass, 1 = a check failed, 77 = Chromium or the WebAssembly build missing.
 """
 import argparse
@@ -38,6 +43,39 @@ import serve  # noqa: E402
 from browser_support import CHROMIUM_FLAGS, Checks, parse, stop  # noqa: E402
 
 
+def coloured_checks(check, c):
+    """What the page saw of the coloured Z-up model (page_test.js colouredSession)."""
+    if 'exception' in c:
+        check(False, 'the coloured model: ' + c['exception'])
+        return
+    check(c['material'] == 'own', f"a file with colours opens with its own colours (colour menu: {c['material']})")
+    check(c['up'] == 'z' and c['upVector'] == [0, 0, 1], f"up: auto picks Z for a Z-up model (up {c['up']}, camera up {c['upVector']})")
+    for name in ('base', 'region', 'coarsened', 'full'):
+        s = c[name]
+        d = s['drawn'] or {}
+        check(d.get('colours') == d.get('vertices') == s['vertices'] == s['meshColours'] and s['vertices'] > 0,
+              f"{name} (levels {s['minLevel']}..{s['maxLevel']}): {s['vertices']} vertices, "
+              f"{d.get('vertices')} drawn with {d.get('colours')} colours")
+    check(c['full']['minLevel'] == c['full']['maxLevel'] and c['region']['minLevel'] < c['region']['maxLevel'],
+          'the coloured model went through a region, the base and full resolution')
+    for name in ('base', 'full'):
+        p = c[name]['pixels']
+        hues = ', '.join(f"{h} {100 * p[h]['fraction']:.1f}%" for h in ('red', 'green', 'blue'))
+        check(p['covered'] > 0.02 and all(p[h]['fraction'] > 0.05 for h in ('red', 'green', 'blue')),
+              f"{name}: the model's own colours are drawn ({hues} of its {100 * p['covered']:.1f}% of the pixels)")
+    p = c['full']['pixels']
+    check(p['red']['height'] > p['green']['height'] > p['blue']['height'],
+          f"Z up: red (bottom band) under green under blue (mean heights from the top "
+          f"{p['red']['height']:.2f}, {p['green']['height']:.2f}, {p['blue']['height']:.2f})")
+    check(p['aspect'] > 1.5, f"Z up: the model stands (its pixels' box is {p['aspect']:.2f} times as high as wide)")
+    g = c['plain']
+    saturated = sum(g[h]['fraction'] for h in ('red', 'green', 'blue'))
+    check(g['covered'] > 0.02 and saturated < 0.001, f"the plain material is grey ({100 * saturated:.2f}% saturated pixels)")
+    y = c['forcedY']
+    check(y['up'] == 'y' and y['pixels']['aspect'] < p['aspect'] / 2,
+          f"up: Y lays it on its side (up {y['up']}, box height / width {y['pixels']['aspect']:.2f})")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     ap.add_argument('pomar', help='a clustered .pomar file')
@@ -50,6 +88,7 @@ def main():
     ap.add_argument('--update-references', action='store_true', help='write docs/images/web_test/*.png')
     ap.add_argument('--no-compare', action='store_true', help='do not compare screenshots')
     ap.add_argument('--max-gap', type=int, help="pomar.js maxGap for the session (bytes; default: pomar.js's)")
+    ap.add_argument('--coloured', help='a Z-up .pomar with per-vertex colour (web/test/coloured_mesh.py)')
     args = parse(ap, 'browser_test')
     if args is None:
         return 77
@@ -79,6 +118,8 @@ def main():
         damaged[len(blob) - 40] ^= 0x5A  # inside the last cluster blocks
         with open(os.path.join(data, 'damaged_blocks.pomar'), 'wb') as f:
             f.write(bytes(damaged))
+        if args.coloured:
+            shutil.copy(args.coloured, os.path.join(data, 'coloured.pomar'))
         reports = os.path.join(work, 'reports')
         os.makedirs(reports)
         server = serve.make_server(root, 0, test=True, report_dir=reports)
@@ -87,6 +128,8 @@ def main():
         gap = '' if args.max_gap is None else f'&maxGap={args.max_gap}'
         if not (args.no_compare or args.update_references):
             gap += '&ref=/ref/'
+        if args.coloured:
+            gap += '&coloured=/data/coloured.pomar'
         url = (f'{base}/web/index.html?test=1&file=/data/model.pomar{gap}'
                f'&target={args.target}&closeup={args.closeup}&missing=/data/missing.pomar'
                '&noRange=/no-range/data/model.pomar&singleRange=/single-range/data/model.pomar&truncatedGlobal=/data/truncated_global.pomar'
@@ -172,6 +215,10 @@ def main():
               if e['truncatedBlocks']['warning'] else 'a file cut in its cluster blocks: no warning')
         check(not e['damagedBlocks']['error'] and 'damaged' in e['damagedBlocks']['warning'],
               'a damaged cluster block is skipped with a warning')
+        check(r.get('up') == 'y' and r.get('material') == 'plain',
+              f"the bunny (Y-up, no colour): up {r.get('up')}, material {r.get('material')}")
+        if args.coloured:
+            coloured_checks(check, r.get('coloured') or {'exception': 'the page ran no coloured session'})
         compared = r.get('comparisons', {})
         for name, c in sorted(compared.items()):
             if 'missing' in c:
@@ -190,7 +237,10 @@ def main():
             print(f'expected images written: {REFERENCES}/ ({", ".join(sorted(names))})')
         if args.images:
             os.makedirs(args.images, exist_ok=True)
-            for name in ('base', 'closeup', 'closeup_levels', 'overview', 'overview_levels', 'zoomout', 'full'):
+            names = ['base', 'closeup', 'closeup_levels', 'overview', 'overview_levels', 'zoomout', 'full']
+            if args.coloured:
+                names += ['coloured_base', 'coloured_full', 'coloured_plain', 'coloured_y']
+            for name in names:
                 shutil.copy(os.path.join(reports, name + '.png'), os.path.join(args.images, f'web_{name}.png'))
             print(f'screenshots: {args.images}/web_*.png')
     finally:

@@ -1,7 +1,8 @@
 // The scripted browser test, run by viewer.js with ?test=1 (web/test/browser_test.py starts
 // the server and headless Chromium, then checks what this posts to /report/).
 // ?file=URL of an intact file; &missing=, &truncatedGlobal=, &truncatedBlocks=,
-// &damagedBlocks=, &noRange= URLs of the error cases.
+// &damagedBlocks=, &noRange= URLs of the error cases; &coloured= URL of a Z-up model with
+// per-vertex colour (web/test/coloured_mesh.py: red, green, blue bands from bottom to top).
 import { closeUp } from '../camera.js';
 
 const params = new URLSearchParams(location.search);
@@ -106,6 +107,92 @@ async function settle(v, what) {
   return steps;
 }
 
+/** What the frame shows: the fraction of pixels drawn (not the background), the box of
+ *  those pixels (its height / width: `aspect`), and for each pure hue (red, green, blue)
+ *  the fraction of the drawn pixels of that saturated hue (its channel at least 60 and
+ *  twice the other two plus 10: lighting darkens a colour but keeps its hue; grey and the
+ *  background are not counted) and their mean height in the view (0 top, 1 bottom). */
+function pixelStats(v) {
+  v.frame();
+  const gl = $('view').getContext('webgl2');
+  const w = gl.drawingBufferWidth;
+  const h = gl.drawingBufferHeight;
+  const px = new Uint8Array(4 * w * h);
+  gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, px);
+  let covered = 0;
+  const box = [w, h, -1, -1];
+  const hues = [0, 1, 2].map(() => ({ count: 0, height: 0 }));
+  for (let y = 0; y < h; ++y) {
+    for (let x = 0; x < w; ++x) {
+      const i = 4 * (y * w + x);
+      const c = [px[i], px[i + 1], px[i + 2]];
+      if (Math.abs(c[0] - 32) + Math.abs(c[1] - 36) + Math.abs(c[2] - 42) <= 12) continue;
+      ++covered;
+      const top = h - 1 - y; // readPixels rows start at the bottom
+      box[0] = Math.min(box[0], x);
+      box[1] = Math.min(box[1], top);
+      box[2] = Math.max(box[2], x);
+      box[3] = Math.max(box[3], top);
+      for (let k = 0; k < 3; ++k) {
+        const others = c.filter((_, j) => j !== k);
+        if (c[k] >= 60 && c[k] >= 2 * Math.max(...others) + 10) {
+          ++hues[k].count;
+          hues[k].height += top / h;
+        }
+      }
+    }
+  }
+  const named = {};
+  ['red', 'green', 'blue'].forEach((name, k) => {
+    named[name] = { fraction: hues[k].count / Math.max(1, covered), height: hues[k].count ? hues[k].height / hues[k].count : -1 };
+  });
+  return { covered: covered / (w * h), aspect: covered ? (box[3] - box[1] + 1) / (box[2] - box[0] + 1) : 0, ...named };
+}
+
+/** The coloured Z-up model: drawn with its own colours by default, the colour buffer in
+ *  step with the geometry through region refinement, coarsening and full resolution, grey
+ *  in the plain material, the camera Z-up by itself and Y-up when asked. */
+async function colouredSession(v) {
+  const out = {};
+  const viewer = window.pomarViewer;
+  const drawn = () => (viewer.drawn ? viewer.drawn() : null);
+  try {
+    const m = await within(20000, v.openSource(params.get('coloured')), 'coloured model');
+    const state = () => ({ drawn: drawn(), vertices: m.mesh.positions.length / 3, meshColours: m.mesh.colour ? m.mesh.colour.values.length / m.mesh.colour.components : 0,
+      minLevel: Math.min(...m.levels), maxLevel: Math.max(...m.levels) });
+    out.material = $('colour').value;
+    out.up = v.camera.up || null;
+    out.upVector = viewer.upVector ? viewer.upVector() : null;
+    out.base = { ...state(), pixels: pixelStats(v) };
+    await screenshot('coloured_base', v);
+    await within(20000, m.want({ cluster: 0, level: m.info.finestLevel }), 'coloured: one cluster');
+    out.region = state();
+    await within(20000, m.want({ all: m.info.baseLevel }), 'coloured: coarsened');
+    out.coarsened = state();
+    await within(20000, m.want({ all: m.info.finestLevel }), 'coloured: full resolution');
+    out.full = { ...state(), pixels: pixelStats(v) };
+    await screenshot('coloured_full', v);
+    $('colour').value = 'plain';
+    out.plain = pixelStats(v);
+    await screenshot('coloured_plain', v);
+    $('colour').value = 'own';
+    if ($('up')) {
+      $('up').value = 'y';
+      $('up').dispatchEvent(new Event('change'));
+    }
+    out.forcedY = { up: v.camera.up || null, pixels: pixelStats(v) };
+    await screenshot('coloured_y', v);
+    if ($('up')) {
+      $('up').value = 'auto';
+      $('up').dispatchEvent(new Event('change'));
+    }
+  } catch (e) {
+    out.exception = String(e && e.stack ? e.stack : e);
+  }
+  note('coloured model', JSON.stringify(out));
+  return out;
+}
+
 export async function run(v) {
   const result = { ok: false, log };
   try {
@@ -118,6 +205,8 @@ export async function run(v) {
     const fetchOptions = params.has('maxGap') ? { maxGap: Number(params.get('maxGap')) } : {};
     const model = await within(30000, v.openSource(params.get('file'), fetchOptions), 'open');
     result.firstFrameMs = performance.now() - t0;
+    result.up = v.camera.up;
+    result.material = $('colour').value;
     result.info = { clusters: model.info.clusters, baseLevel: model.info.baseLevel, finestLevel: model.info.finestLevel,
       fileBytes: model.info.fileBytes, globalBytes: model.info.globalBytes };
     result.base = snapshot(model, await screenshot('base', v));
@@ -129,9 +218,9 @@ export async function run(v) {
     const before = model.stats.bytesFetched;
     result.closeupSteps = await settle(v, 'close-up');
     result.closeup = snapshot(model, await screenshot('closeup', v), { bytesForCloseup: model.stats.bytesFetched - before });
-    $('colour').value = '2'; // the same view coloured by level
+    $('colour').value = 'levels'; // the same view coloured by level
     await screenshot('closeup_levels', v);
-    $('colour').value = '0';
+    $('colour').value = 'plain';
     note('close-up', JSON.stringify(result.closeup));
 
     // The whole model on screen: refine until the projected error is under the target.
@@ -139,9 +228,9 @@ export async function run(v) {
     v.camera.distance = 1.6 * v.camera.extent;
     result.overviewSteps = await settle(v, 'overview');
     result.overview = snapshot(model, await screenshot('overview', v));
-    $('colour').value = '2';
+    $('colour').value = 'levels';
     await screenshot('overview_levels', v);
-    $('colour').value = '0';
+    $('colour').value = 'plain';
     note('overview', JSON.stringify(result.overview));
 
     // Zoom out: what shrinks to a few pixels coarsens.
@@ -193,6 +282,7 @@ export async function run(v) {
       result.errors[key] = { error: $('error').textContent, warning: $('warning').textContent };
       note(key, JSON.stringify(result.errors[key]));
     }
+    if (params.get('coloured')) result.coloured = await colouredSession(v);
     result.ok = true;
   } catch (e) {
     result.exception = String(e && e.stack ? e.stack : e);

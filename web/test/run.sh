@@ -2,15 +2,17 @@
 # The web tests (called by scripts/test.sh):  bash web/test/run.sh BUILD_DIR POMAR_TOOL
 #  1. builds the WebAssembly decoder (web/build.sh, in BUILD_DIR; it also vendors three.js
 #     from npm into web/dist/ for the page);
-#  2. encodes samples/bunny.ply three ways with the native tool and checks that the WASM
-#     decoder decodes them bit for bit like the native one, and that damaged/truncated
-#     copies give messages (web/test/wasm_decode_test.mjs, Node.js);
+#  2. encodes samples/bunny.ply three ways and a coloured mesh (web/test/coloured_mesh.py)
+#     with the native tool and checks that the WASM decoder decodes them bit for bit like
+#     the native one (colours too), and that damaged/truncated copies give messages
+#     (web/test/wasm_decode_test.mjs, Node.js);
 #  3. streams one of them from Debian's nginx and Apache through the client's own transport
 #     (multipart/byteranges answers) and checks the meshes against the local file's
 #     (web/test/real_servers.sh);
 #  4. runs the viewer in headless Chromium (web/test/browser_test.py), screenshots compared
-#     with docs/images/web_test/, then on an emulated phone with touch input
-#     (web/test/mobile_test.py).
+#     with docs/images/web_test/, a coloured Z-up model (web/test/coloured_mesh.py, encoded
+#     here) drawn with its colours and stood up on Z; then on an emulated phone with touch
+#     input (web/test/mobile_test.py).
 # (Plus web/test/unit_test.mjs: request coalescing and the choice of levels for a view;
 # web/test/detail_test.mjs: the detail measured per cluster on a flat + bumpy grid.)
 # Each step is skipped with a message when emscripten, Node.js or Chromium is missing.
@@ -29,12 +31,14 @@ mkdir -p "$samples"
 "$TOOL" encode "$REPO/samples/bunny.ply" "$samples/bunny.pomar" -q
 "$TOOL" encode "$REPO/samples/bunny.ply" "$samples/bunny_c5.pomar" --cluster-ratio 0.05 -q
 "$TOOL" encode "$REPO/samples/bunny.ply" "$samples/bunny_progressive.pomar" --progressive -q
+python3 "$REPO/web/test/coloured_mesh.py" "$samples/coloured_zup.ply"
+"$TOOL" encode "$samples/coloured_zup.ply" "$samples/coloured_zup.pomar" -q
 node "$REPO/web/test/unit_test.mjs"
 echo "web tests: the measured detail of each cluster (node web/test/detail_test.mjs)"
 node "$REPO/web/test/detail_test.mjs" "$TOOL"
 echo "web tests: WASM decode = native decode (node web/test/wasm_decode_test.mjs)"
 node "$REPO/web/test/wasm_decode_test.mjs" "$TOOL" "$samples/bunny.pomar" "$samples/bunny_c5.pomar" \
-  "$samples/bunny_progressive.pomar"
+  "$samples/bunny_progressive.pomar" "$samples/coloured_zup.pomar"
 bash "$REPO/web/test/real_servers.sh" "$samples/bunny_c5.pomar"
 if ! command -v chromium >/dev/null 2>&1; then
   echo "web tests: browser test SKIPPED: chromium not installed"
@@ -44,13 +48,13 @@ fi
 in_browser() {
   echo "web tests: $1 (web/test/$2)"
   local status=0
-  python3 "$REPO/web/test/$2" "$samples/bunny_c5.pomar" || status=$?
+  python3 "$REPO/web/test/$2" "$samples/bunny_c5.pomar" "${@:3}" || status=$?
   if [ "$status" = 77 ]; then
     echo "web tests: $2 SKIPPED"
   elif [ "$status" != 0 ]; then
     exit "$status"
   fi
 }
-in_browser "the viewer in headless Chromium" browser_test.py
+in_browser "the viewer in headless Chromium" browser_test.py --coloured "$samples/coloured_zup.pomar"
 in_browser "the viewer on an emulated phone, touch input" mobile_test.py
 echo "web tests: passed"

@@ -6,7 +6,8 @@
 // mesh, a selective decode (two clusters refined, their neighbours by the level map rule)
 // and the full resolution; the WebAssembly decoder (web/pomar_core.js, the worker's own
 // code) decodes the same requests, in an order that exercises refinement on top of a
-// decoded state and coarsening, and every position (as bits) and index must match. Then
+// decoded state and coarsening, and every position (as bits), index and colour byte (a
+// file with per-vertex colour: the mesh's `colour`, drawn by the viewer) must match. Then
 // truncated copies and copies with flipped bytes must open and decode or fail with a
 // pomar message, never trap.
 import { execFileSync } from 'node:child_process';
@@ -28,7 +29,8 @@ const work = mkdtempSync(join(tmpdir(), 'pomar-wasm-'));
 const result = checker();
 const check = result.check;
 
-/** Vertices (as float bits) and faces of a binary little-endian PLY written by the tool. */
+/** Vertices (as float bits), their colour bytes (red, green, blue, alpha if present) and
+ *  faces of a binary little-endian PLY written by the tool. */
 function readPly(path) {
   const buf = readFileSync(path);
   const end = buf.indexOf('end_header\n') + 'end_header\n'.length;
@@ -53,7 +55,7 @@ function readPly(path) {
     }
   };
   let at = end;
-  const out = { positionBits: [], triangles: [] };
+  const out = { positionBits: [], triangles: [], colour: [] };
   for (const el of elements) {
     for (let i = 0; i < el.count; ++i) {
       for (const p of el.props) {
@@ -64,12 +66,14 @@ function readPly(path) {
           for (let k = 0; k < n; ++k, at += size[p[2]]) out.triangles.push(get(p[2], at));
         } else {
           if (el.name === 'vertex' && 'xyz'.includes(p[1])) out.positionBits.push(get(p[0], at));
+          if (el.name === 'vertex' && ['red', 'green', 'blue', 'alpha'].includes(p[1])) out.colour.push(get(p[0], at));
           at += size[p[0]];
         }
       }
     }
   }
-  return { positionBits: Uint32Array.from(out.positionBits), triangles: Uint32Array.from(out.triangles) };
+  return { positionBits: Uint32Array.from(out.positionBits), triangles: Uint32Array.from(out.triangles),
+    colour: Uint8Array.from(out.colour) };
 }
 
 function native(file, args) {
@@ -90,10 +94,16 @@ function compare(wasmMesh, nativeMesh, what) {
     `${what}: ${bits.length / 3} vertices in WASM, ${nativeMesh.positionBits.length / 3} native`);
   check(sameArrays(bits, nativeMesh.positionBits), `${what}: positions differ`);
   check(sameArrays(wasmMesh.triangles, nativeMesh.triangles), `${what}: triangles differ`);
-  if (result.failures === 0) console.log(`  ${what}: ${bits.length / 3} vertices, ${wasmMesh.triangles.length / 3} faces identical`);
+  const colour = wasmMesh.colour ? wasmMesh.colour.values : new Uint8Array(0);
+  check(sameArrays(colour, nativeMesh.colour), `${what}: colours differ (${colour.length} bytes in WASM, ${nativeMesh.colour.length} native)`);
+  if (result.failures === 0) {
+    console.log(`  ${what}: ${bits.length / 3} vertices, ${wasmMesh.triangles.length / 3} faces` +
+      `${colour.length ? `, ${colour.length} colour bytes` : ''} identical`);
+  }
 }
 
-/** The mesh with vertices sorted by position bits and faces rotated and sorted. */
+/** The mesh with vertices (and their colours) sorted by position bits and faces rotated
+ *  and sorted. */
 function canonical(m) {
   const bits = m.positionBits || new Uint32Array(m.positions.buffer, m.positions.byteOffset, m.positions.length);
   const n = bits.length / 3;
@@ -101,9 +111,13 @@ function canonical(m) {
   order.sort((i, j) => bits[3 * i] - bits[3 * j] || bits[3 * i + 1] - bits[3 * j + 1] || bits[3 * i + 2] - bits[3 * j + 2]);
   const rank = new Uint32Array(n);
   const positionBits = new Uint32Array(3 * n);
+  const colourIn = m.positionBits ? m.colour : m.colour ? m.colour.values : new Uint8Array(0);
+  const per = n ? colourIn.length / n : 0; // colour bytes per vertex
+  const colour = new Uint8Array(colourIn.length);
   order.forEach((v, r) => {
     rank[v] = r;
     positionBits.set(bits.subarray(3 * v, 3 * v + 3), 3 * r);
+    colour.set(colourIn.subarray(per * v, per * v + per), per * r);
   });
   const faces = [];
   for (let f = 0; f < m.triangles.length; f += 3) {
@@ -112,7 +126,9 @@ function canonical(m) {
     faces.push([t[k], t[(k + 1) % 3], t[(k + 2) % 3]]);
   }
   faces.sort((x, y) => x[0] - y[0] || x[1] - y[1] || x[2] - y[2]);
-  return { positions: new Float32Array(positionBits.buffer), positionBits, triangles: Uint32Array.from(faces.flat()) };
+  return { positions: new Float32Array(positionBits.buffer), positionBits, triangles: Uint32Array.from(faces.flat()),
+    // The colour as it came: bytes (a native PLY) or pomar_core.js's {components, values}.
+    colour: m.positionBits ? colour : per ? { components: per, values: colour } : null };
 }
 
 /** Open `bytes` as the page does (pomar_stream.js over a RangeFile), from a Blob. */

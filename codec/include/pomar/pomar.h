@@ -179,6 +179,8 @@ struct LosslessReport {
   size_t degenerate_faces = 0;      ///< faces repeating a vertex kept in the record
   size_t unreferenced_vertices = 0; ///< vertices no coded face uses, kept in the record
   bool keep_order = false;          ///< the input vertex numbering is stored
+  size_t seam_edges = 0;            ///< texture seam edges (per-corner values differ across)
+  size_t wedge_copies = 0;          ///< of vertex_copies, those made at texture seams
   uint64_t bytes = 0;               ///< size of the record (the LSLS section body)
   /// "non-manifold: 421 vertices and 12 edges stored as cuts; 3 duplicate faces kept; ...",
   /// "" if nothing was stored.

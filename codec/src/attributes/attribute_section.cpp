@@ -6,6 +6,7 @@
 #include <string>
 
 #include "format/bit_io.h"
+#include "lossless/seam_cut.h"
 #include "refine/level_traversal.h"
 
 namespace pomar {
@@ -40,8 +41,18 @@ template <class Out> Out described(const StoredAttribute &s) {
 AttributeTable plan_attributes(const Mesh &mesh, const AttributeOptions &options) {
   AttributeTable t;
   for (const VertexAttribute &a : mesh.attributes)
-    if (options.keep.keeps(a.kind)) {
-      t.stored.push_back(describe(a, options));
+    if (keeps_attribute(a.name, a.kind, options.keep)) {
+      if (a.name == kWedgeMaterial) { // integers: a grid of at most one unit a step
+        AttributeOptions exact_integers = options;
+        const float hi =
+            a.values.empty() ? 0.0f : *std::max_element(a.values.begin(), a.values.end());
+        exact_integers.scalar_bits = 1;
+        while (exact_integers.scalar_bits < 24 && double(1u << exact_integers.scalar_bits) <= hi)
+          ++exact_integers.scalar_bits;
+        t.stored.push_back(describe(a, exact_integers));
+      } else {
+        t.stored.push_back(describe(a, options));
+      }
       t.codes += t.stored.back().codes();
     }
   if (t.stored.size() > 255)
@@ -63,7 +74,7 @@ std::vector<int64_t> attribute_codes(const Mesh &mesh, const AttributeTable &tab
                                      const std::vector<uint32_t> &to_input) {
   std::vector<const VertexAttribute *> kept;
   for (const VertexAttribute &a : mesh.attributes)
-    if (options.keep.keeps(a.kind))
+    if (keeps_attribute(a.name, a.kind, options.keep))
       kept.push_back(&a);
   std::vector<int64_t> codes(to_input.size() * table.codes);
   for (size_t v = 0; v < to_input.size(); ++v) {
@@ -88,7 +99,7 @@ std::vector<AttributeCodeModels> attribute_models(const AttributeTable &table) {
 
 bool keeps_any(const AttributeTable &table, const AttributeMask &mask) {
   for (const StoredAttribute &s : table.stored)
-    if (mask.keeps(s.kind))
+    if (keeps_attribute(s.name, s.kind, mask))
       return true;
   return false;
 }
@@ -273,7 +284,7 @@ void attach_attributes(const AttributeTable &t, const LevelMesh &lm, const Attri
     throw Error("internal error: the decoded mesh lacks attribute codes");
   for (size_t i = 0, first = 0; i < t.stored.size(); first += t.stored[i].codes(), ++i) {
     const StoredAttribute &s = t.stored[i];
-    if (!mask.keeps(s.kind))
+    if (!keeps_attribute(s.name, s.kind, mask))
       continue;
     VertexAttribute a = described<VertexAttribute>(s);
     if (s.kind == AttributeKind::Colour)

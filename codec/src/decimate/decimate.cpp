@@ -495,8 +495,8 @@ Decimation decimate(CornerTable ct, const std::vector<int32_t> &q, const Decimat
   Decimation result;
   std::vector<uint32_t> alive;
   for (uint32_t v = 0; v < ct.vertex_count(); ++v)
-    if (ct.VC[v] != kNone)
-      alive.push_back(v);
+    if (ct.VC[v] != kNone && !(options.locked && (*options.locked)[v]))
+      alive.push_back(v); // (the candidates v_from: a locked vertex is never one)
   const double initial = static_cast<double>(alive.size());
   Decimator d(ct, q, options);
   while (result.levels.size() < options.max_levels) {

@@ -23,10 +23,13 @@ struct Collapse {
 };
 
 struct DecimationOptions {
-  double normal_cosine = 0.7;  ///< reject collapses turning a patch face normal more
+  double normal_cosine = 0.7;        ///< reject collapses turning a patch face normal more
   double min_level_fraction = 0.002; ///< stop when a level removes fewer vertices than this
   uint32_t max_levels = 250;
   unsigned threads = 1; ///< threads evaluating the candidates (the result does not depend on it)
+  /// Per vertex, optional: 1 = never v_from (the vertex stays to the base mesh; it may be
+  /// v_to). Texture seams lock their vertices (lossless/seam_cut.h).
+  const std::vector<uint8_t> *locked = nullptr;
 };
 
 struct Decimation {
@@ -37,7 +40,7 @@ struct Decimation {
 };
 
 /// Decimate the mesh described by `ct` (consumed) with quantized positions `q` (xyz).
-Decimation decimate(CornerTable ct, const std::vector<int32_t> &q,
-                    const DecimationOptions &options, const Progress &progress);
+Decimation decimate(CornerTable ct, const std::vector<int32_t> &q, const DecimationOptions &options,
+                    const Progress &progress);
 
 } // namespace pomar

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "attributes/attribute_section.h"
+#include "attributes/material_section.h"
 #include "decode/damage.h"
 #include "decode/decoder_codec.h"
 #include "decode/global_levels.h"
@@ -131,6 +132,8 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
     check_level_exists(options.level, static_cast<int>(levels));
   // The ATTR section (descriptors, base mesh codes) first: the attributes count in the check.
   const std::unique_ptr<AttributeTable> attributes = load_attribute_table(data, layout);
+  const std::unique_ptr<MaterialTable> materials =
+      load_material_table(data, layout, attributes ? attributes->texture_files.size() : 0);
   FileInfo info = file_info(layout, size);
   if (attributes)
     describe_attributes(*attributes, info);
@@ -187,6 +190,8 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
   Mesh mesh = to_mesh(std::move(lm), h.grid);
   if (attributes)
     attach_attributes(*attributes, lm, options.attributes, mesh);
+  if (materials)
+    attach_materials(*materials, options.attributes, mesh);
   if (r.level == static_cast<int>(levels))
     undo_cut_or_report(data, layout, options, r, mesh); // the full mesh: as it was input
   return mesh;

@@ -9,6 +9,7 @@
 #include <algorithm>
 
 #include "attributes/attribute_section.h"
+#include "attributes/material_section.h"
 #include "decode/cluster_stream.h"
 #include "decode/damage.h"
 #include "decode/decoder_codec.h"
@@ -78,6 +79,7 @@ struct SelectiveDecoder::State {
   // Attributes: descriptors and base codes (the other codes come with the positions).
   AttributeMask attribute_mask;
   std::unique_ptr<AttributeTable> attributes;
+  std::unique_ptr<MaterialTable> materials; // per-corner values (MATL section)
 
   bool clustered() const { return layout.header.clustered(); }
   void reset_to_snapshot();
@@ -315,6 +317,8 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   s.finest = static_cast<int>(h.levels.size());
   s.mesh = base_level_mesh(s.global.data(), s.layout);
   s.attributes = load_attribute_table(s.global.data(), s.layout);
+  s.materials = load_material_table(s.global.data(), s.layout,
+                                    s.attributes ? s.attributes->texture_files.size() : 0);
   if (s.attributes) { // attribute codes come with the positions, whatever the mask says
     describe_attributes(*s.attributes, s.info);
     // Checked again with the attributes, which only the global part describes.
@@ -626,6 +630,8 @@ Mesh SelectiveDecoder::mesh() const {
   Mesh out = to_mesh(s.mesh, s.layout.header.grid);
   if (s.attributes)
     attach_attributes(*s.attributes, s.mesh, s.attribute_mask, out);
+  if (s.materials)
+    attach_materials(*s.materials, s.attribute_mask, out);
   return out;
 }
 
@@ -658,6 +664,8 @@ Mesh SelectiveDecoder::take_mesh() {
   Mesh out = to_mesh(std::move(s.mesh), s.layout.header.grid);
   if (s.attributes)
     attach_attributes(*s.attributes, s.mesh, s.attribute_mask, out);
+  if (s.materials)
+    attach_materials(*s.materials, s.attribute_mask, out);
   s.back_to_base();
   return out;
 }

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "attributes/attribute_section.h"
+#include "attributes/material_section.h"
 #include "decimate/decimate.h"
 #include "encode/clusters.h"
 #include "encode/encoder_codec.h"
@@ -229,6 +230,13 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
   auto t1 = std::chrono::steady_clock::now();
   DecimationOptions decimation;
   decimation.threads = resolve_threads(options.threads);
+  std::vector<uint8_t> locked; // (prepared numbering)
+  if (hook && !hook->locked.empty()) {
+    locked.resize(nv);
+    for (uint32_t v = 0; v < nv; ++v)
+      locked[v] = hook->locked[in.to_input[v]];
+    decimation.locked = &locked;
+  }
   const Decimation dec = decimate(std::move(in.ct), in.q, decimation, options.progress);
   const double t_decimate = seconds_since(t1);
 
@@ -275,6 +283,8 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
     sections.push_back(
         {kAttributeSectionTag, 0, write_attributes(attributes, header.base_vertices)}); // optional
   }
+  if (hook && !hook->materials.empty()) // per-corner values: a reader must turn them back
+    sections.push_back({kMaterialSectionTag, kSectionRequired, hook->materials});
   if (hook) { // the lossless stage's record, in the decoder's numbering
     std::vector<uint32_t> decoded_to_cut(nv);
     for (uint32_t i = 0; i < nv; ++i)

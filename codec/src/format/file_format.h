@@ -43,7 +43,7 @@ constexpr uint32_t section_tag(const char (&name)[5]) {
          uint32_t(uint8_t(name[2])) << 16 | uint32_t(uint8_t(name[3])) << 24;
 }
 std::string section_name(uint32_t tag); // "LSLS", or the bytes in hex if not printable
-/// The lossless record (issue 13, codec/src/lossless/): required.
+/// The lossless record (codec/src/lossless/): required.
 constexpr uint32_t kLosslessTag = section_tag("LSLS");
 
 /// A section of the global part as a writer hands it over.

@@ -27,48 +27,37 @@ namespace {
 // /usr/bin/time on closed meshes (F = 2V) and open strips (F = V, F = 4V/3) of 30k to 2M
 // vertices (bench/README.md, "Memory").
 //
-// Decode (refitted 2026-12-02, after the one-shot decode stopped copying its mesh and a
-// pending split shrank from 160 to 28 bytes; binary PLY output, one thread; since the text
-// and STL writers write in 1 MiB chunks every output format peaks within 1% of binary
-// PLY, measured at 100k, 300k and 1M vertices): least-squares
-// 5.0 MiB + 45 B/vertex + 31 B/face (random access), 5.4 MiB + 56 B/vertex + 29 B/face
-// (progressive), rounded up so that every peak of 300k vertices and more is 17-21% below
-// the estimate. Each further decoding thread: 13.6-28 B/vertex measured then (small meshes:
-// the thread's allocator arena), estimated at 2 MiB + 16 B/vertex + 4 B/face (refitted in
-// the sixth session to 6 MiB + 5 B/face: kThreadFixed below). Checked
-// again in the fifth session (2026-12-02, two threads, every output format: binary and
-// ASCII PLY, OBJ, OFF, binary and ASCII STL, at 300k and 1M vertices): spheres and tori
-// with attributes 0.76-0.85 of the estimates, but an open strip (F = V, 1M vertices, 24,614
-// clusters) 0.91 on one thread and 0.94 on two (its second thread: 24 B/vertex): random
-// access raised from 52 to 56 B/vertex (0.87 and 0.91; the thread's part was kept, since
-// the encoder's check adds it too and the encode rows already cover a second thread). Sixth
-// session, with the per-thread part refitted: 1M strips (F = V) 0.71-0.73 of the estimate
-// on one thread and on two, the 1M sphere 0.76 and 0.76.
+// Decode (binary PLY output; every output format peaks within 1% of it, the text and STL
+// writers writing in 1 MiB chunks; measured at 100k, 300k and 1M vertices, one and two
+// threads): least squares 5.0 MiB + 45 B/vertex + 31 B/face (random access), 5.4 MiB + 56
+// B/vertex + 29 B/face (progressive), rounded up above every peak of 300k vertices and
+// more. The random-access per-vertex term is 56 B so
+// that an open strip (F = V, 1M vertices, 24,614 clusters: its second thread takes 24
+// B/vertex) stays 0.91 of the estimate on two threads; 1M strips are 0.71-0.73 of it with
+// the per-thread part below, the 1M sphere 0.76, spheres and tori with attributes 0.76-0.85.
 //
-// Encode, per input format (EncodeInput; measured 2026-12-02 in the fourth session, again
-// in the fifth after the faster readers, two encoding threads): peaks of `pomar encode` on
+// Encode, per input format (EncodeInput; two encoding threads): peaks of `pomar encode` on
 // noisy spheres (F = 2V) of 100k, 300k, 1M and 3M vertices and 2-row strips (F = V) of
 // 100k, 300k and 1M, each as binary and ASCII PLY, OBJ, OFF, binary and ASCII STL, and tori
-// (F = 2V) with attributes (bench/README.md, "Memory", per input format and "After the
-// faster readers"). Lines through the 300k and 1M peaks, raised and rounded so that every
-// peak of 300k vertices and more is 10-25% below its estimate.
+// (F = 2V) with attributes (bench/README.md, "Memory"). Lines through the 300k and 1M
+// peaks, raised and rounded so that every peak of 300k vertices and more is 10-25% below
+// its estimate.
 //   - Binary and ASCII PLY, OFF, binary and ASCII STL (read in 4 MiB chunks) and plain OBJ
 //     (pomar's own reader: the text and the flat arrays) peak within 3% of each other at
 //     300k and 1M (STL 9-11% more at 3M: the weld's table): the encoder's own peak is the
 //     maximum. One row, which is also the estimate for a mesh already in memory
-//     (EncodeInput::Mesh, the library's check): 12 MiB + 200 B/vertex + 36 B/face (fourth
-//     session's least squares: 6.3 MiB + 170 + 29; fifth session: 0.75-0.83 of it). ASCII
-//     STL was 6 MiB + 370 B/face (its whole text held: 3.4 times its peak now), plain OBJ
-//     the tinyobjloader row below (2.4 times its peak now).
+//     (EncodeInput::Mesh, the library's check): 12 MiB + 200 B/vertex + 36 B/face (least
+//     squares: 6.3 MiB + 170 + 29; the peaks 0.75-0.83 of it). Neither ASCII STL nor plain
+//     OBJ holds its whole text beside the arrays, so they need no row of their own.
 //   - OBJ through tinyobjloader, positions and faces only (relative or slashed indices,
 //     materials, ...): its arrays (an index triple of 12 bytes per corner, ...) and the text
 //     peak above the encoder: 16 MiB + 24 B/vertex + 244 B/face (least squares: 16 MiB - 3
-//     + 217; fifth session: 0.81-0.89 of it).
+//     + 217; the peaks 0.81-0.89 of it).
 //   - OBJ through tinyobjloader with normals, texture coordinates or colours: their lines
 //     and per-corner indices ("f 1/1/1 ...") held too. Normals and texture coordinates per
 //     vertex, tori and strips: least squares about 13 MiB + 23 B/vertex + 285 B/face; 16 MiB
-//     + 32 B/vertex + 330 B/face, 0.84-0.88 of it (the row above was 1.02-1.18 times too
-//     low for them). Normals only ("f a//a"), colours only, one normal per face (flat
+//     + 32 B/vertex + 330 B/face, 0.84-0.88 of it (they peak 1.02-1.18 times the
+//     row above). Normals only ("f a//a"), colours only, one normal per face (flat
 //     shading: twice as many normals as vertices): 0.67-0.85 of it. Files with still more
 //     values (one per corner) hold more than this: encode_input_extra (kObjValueLine).
 // STL's size check sees half a vertex per facet (a closed mesh once welded). For an open
@@ -79,7 +68,7 @@ namespace {
 // OBJ with more normals and texture coordinates than one of each per vertex (one of each
 // per corner: 3 'vn' and 3 'vt' lines per face, "f a/ta/na ..."; all of them left out of the
 // .pomar, which keeps per-vertex values) holds them beyond the ObjAttributes row: tori of
-// 100k, 300k and 1M vertices (F = 2V) peaked 93.5, 281.6 and 893.1 MiB against the row's
+// 100k, 300k and 1M vertices (F = 2V) peak at 93.5, 281.6 and 893.1 MiB against the row's
 // 81.9, 214.2 and 675.9 (1.14-1.32 times); 12-24 bytes per line past 2 per vertex. With 32
 // bytes per such line (encode_input_extra) the peaks are 0.83-0.92 of the estimate.
 constexpr uint64_t kObjValueLine = 32;
@@ -109,43 +98,36 @@ constexpr uint64_t kClusteredDecodePerFace = 36;
 constexpr uint64_t kProgressiveDecodePerVertex = 64;
 constexpr uint64_t kProgressiveDecodePerFace = 34;
 // Each thread past the first that walks the clustered levels: its claim stamps (4 bytes per
-// face), the pipeline's traversed clusters and its allocator arena. Measured in the sixth
-// session (decode --threads 1, 2 and 8, GNU time %M, the larger of 2-3 runs): the average
+// face), the pipeline's traversed clusters and its allocator arena. Measured with decode
+// --threads 1, 2 and 8 (GNU time %M, the larger of 2-3 runs): the average
 // of the 7 extra threads of an 8-thread decode is 4.3-5.2 bytes per face (bunny 0.37 MiB,
 // noisy spheres 300k 2.76, 1M 8.14, 2M 15.86, dragon 3.98, 1M strips 4.28-5.03 MiB), the
 // first extra thread 2-4 MiB more (bunny 0.75, 300k 5.13, 1M 10.95, 2M 18.89, 10M 78.7,
 // dragon 7.20, strips 6.66-8.46 MiB; the encoder's at 1M 11.4). 6 MiB + 5 bytes per face:
-// the first extra thread 0.71-0.88 of it from 300k faces up. There is no per-vertex term
-// any more: the marks by vertex id are the global levels', on the calling thread only,
-// since a cluster keeps its marks by rank (fifth session); the 16 bytes per vertex it had
-// made the 1M sphere's extra thread 3 times its measure.
+// the first extra thread 0.71-0.88 of it from 300k faces up. There is no per-vertex term:
+// a cluster keeps its marks by rank in the cluster, and the marks by vertex id are the
+// global levels', on the calling thread only.
 constexpr uint64_t kThreadFixed = 6ull << 20;
 constexpr uint64_t kThreadPerFace = 5;
 
 // Per-vertex attributes (bench/README.md, "Memory", attributes): encoding, what tori (F =
 // 2V, binary PLY) with colour, normal, quality and UV (8 codes), colour (3) or quality (1)
-// peak above the same torus without attributes, refitted in the fifth session (2026-12-02;
-// until then 32 + 84 B per code, fitted before the encoder freed its input once quantized:
-// about three times these peaks): 226-243 B/vertex (8 codes), 74-93 (3), 31-41 (1) at 300k
-// and 1M vertices (100k: 262, 94, 40). 16 + 34 B per code: each part 0.62-0.85 of its
+// peak above the same torus without attributes (the encoder frees its input once
+// quantized): 226-243 B/vertex (8 codes), 74-93 (3), 31-41 (1) at 300k and 1M vertices (100k: 262, 94, 40). 16 + 34 B per code: each part 0.62-0.85 of its
 // estimate at 300k and 1M, each whole peak 0.71-0.80 of the PLY row plus the part.
 // Decoding: 81 B/vertex (8 codes, 27 bytes of values) and 12 B/vertex (1 code, 4 bytes): the
 // codes (8 B each) plus the values, plus slack.
-// The lossless stage (seventh session, bench/README.md "Memory of the lossless stage"):
-// noisy spheres of 300k and 1M vertices encoded with --keep-order (F = 2V) peaked 143 and
-// 414 MiB where the PLY row said 89.6 and 271.0; the same spheres with 10% of their faces
-// duplicated, shuffled, and 5% more vertices no face uses (cut and recorded) 131 and 361
-// MiB where it said 94.5 and 287.4 (the load check, input counts). 128 and 88 bytes per
-// face on top (the encoder's check: the cut mesh's faces; the load check with --keep-order:
-// the file's), two threads' part included: the peaks 0.81-0.86 and 0.77-0.87 of the sums
-// (MemoryEstimate.LosslessStageIsAboveTheMeasuredPeaks). Their decodes (two threads)
-// peaked 64 and 198 MiB (keep-order) and 46 and 136 (messy) where the clustered row said
-// 53.4 and 145.4: 32 bytes per vertex and 28 per face on top, 0.81-0.86 (keep-order).
-// Ninth session: the record no longer copies the mesh it codes the order on, nor the input
-// when nothing is cut; --keep-order encodes of the spheres then peaked 107 and 336 MiB
-// (decodes 57 and 172), 0.65 of the sums. The terms are left as they were: a messy mesh
-// encoded with --keep-order pays the cut's copy and the order's work together, which no
-// measurement here separates.
+// The lossless stage (bench/README.md, "Memory"): noisy spheres of 300k and 1M vertices
+// with 10% of their faces duplicated, shuffled, and 5% more vertices no face uses (cut and
+// recorded) peak at 131 and 361 MiB to encode where the load check's PLY row (input
+// counts) says 94.5 and 287.4, and at 46 and 136 MiB to decode where the clustered row says
+// 53.4 and 145.4. The terms: 88 bytes per face on top to encode (the encoder's check: the
+// cut mesh's faces), 128 with --keep-order (checked at load: the file's faces), two
+// threads' part included, and 32 bytes per vertex and 28 per face to undo the record at
+// full resolution. A --keep-order encode of a messy mesh pays the cut's copy and the
+// order's work together; of a clean one (no copy of the mesh or the input), 107 and 336
+// MiB on the spheres (decodes 57 and 172), 0.65 of the sums
+// (MemoryEstimate.LosslessStageIsAboveTheMeasuredPeaks).
 constexpr uint64_t kLosslessEncodePerFace = 88;
 constexpr uint64_t kLosslessKeepOrderEncodePerFace = 128;
 constexpr uint64_t kLosslessDecodePerVertex = 32;
@@ -479,7 +461,7 @@ void check_encode_memory(uint64_t vertices, uint64_t faces, uint64_t limit, uint
   check_memory("encode", vertices, faces, needed, held, limit);
 }
 
-uint64_t decode_thread_memory(uint64_t /*vertices: no per-vertex part since the sixth session*/,
+uint64_t decode_thread_memory(uint64_t /*vertices: no per-vertex part*/,
                               uint64_t faces) {
   return add_mul(kThreadFixed, faces, kThreadPerFace);
 }

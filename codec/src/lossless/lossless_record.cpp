@@ -735,18 +735,40 @@ Mesh apply_lossless_record(Mesh &&decoded, const LosslessRecord &r, const Quanti
   for (const auto &d : r.duplicates)
     faces += d.second;
   const auto map = [&](uint32_t v) { return out_of.empty() ? v : out_of[v]; };
+  // Per-corner values follow their faces (D's corner k is the output face's corner k, but
+  // for a flip); a face the record adds back repeating a vertex gets zeros and material 0.
+  const bool uv = !decoded.corner_texcoords.empty(), mat = !decoded.face_materials.empty();
+  if ((uv && decoded.corner_texcoords.size() != 6 * size_t(nf)) ||
+      (mat && decoded.face_materials.size() != nf))
+    throw Error(Error::Kind::Internal, "internal error: the per-corner values do not fit the mesh");
+  if (uv)
+    out.corner_texcoords.assign(6 * faces, 0.0f);
+  if (mat)
+    out.face_materials.assign(faces, 0);
   size_t flip = 0, dup = 0, at = 0;
-  const auto put = [&](uint32_t i, uint32_t a, uint32_t b, uint32_t c) {
+  const auto put = [&](uint32_t i, uint32_t g, uint32_t a, uint32_t b, uint32_t c) {
     uint32_t f[3] = {map(a), map(b), map(c)};
+    int order[3] = {0, 1, 2};
     if (flip < r.flipped.size() && r.flipped[flip] == i) {
       std::swap(f[1], f[2]);
+      std::swap(order[1], order[2]);
       ++flip;
     }
     uint32_t n = 1;
     if (dup < r.duplicates.size() && r.duplicates[dup].first == i)
       n += r.duplicates[dup++].second;
-    for (uint32_t k = 0; k < n; ++k, at += 3)
+    for (uint32_t k = 0; k < n; ++k, at += 3) {
       std::copy(f, f + 3, &out.triangles[at]);
+      if (uv)
+        for (int j = 0; j < 3; ++j) {
+          out.corner_texcoords[2 * (at + j)] =
+              decoded.corner_texcoords[6 * size_t(g) + 2 * order[j]];
+          out.corner_texcoords[2 * (at + j) + 1] =
+              decoded.corner_texcoords[6 * size_t(g) + 2 * order[j] + 1];
+        }
+      if (mat)
+        out.face_materials[at / 3] = decoded.face_materials[g];
+    }
   };
   const uint32_t top = decoded.triangles.empty()
                            ? 0
@@ -761,20 +783,20 @@ Mesh apply_lossless_record(Mesh &&decoded, const LosslessRecord &r, const Quanti
       while (end[k0] == i)
         ++k0;
       const uint32_t k1 = uint32_t(by[i].key >> 32), k2 = uint32_t(by[i].key);
-      const uint32_t s = by[i].id & 3; // the face as D has it: (k0, k1, k2) rotated back
+      const uint32_t s = by[i].id & 3, g = by[i].id >> 2; // D's face g: (k0, k1, k2) rotated back
       if (s == 0)
-        put(i, k0, k1, k2);
+        put(i, g, k0, k1, k2);
       else if (s == 1)
-        put(i, k2, k0, k1);
+        put(i, g, k2, k0, k1);
       else
-        put(i, k1, k2, k0);
+        put(i, g, k1, k2, k0);
     }
   } else {
     const std::vector<uint32_t> order = canonical_face_order(decoded.triangles);
     out.triangles.resize(3 * faces);
     for (uint32_t i = 0; i < nf; ++i) {
       const uint32_t *t = &decoded.triangles[3 * size_t(order[i])];
-      put(i, t[0], t[1], t[2]);
+      put(i, order[i], t[0], t[1], t[2]);
     }
   }
   for (const auto &d : r.degenerate) {
@@ -787,6 +809,9 @@ Mesh apply_lossless_record(Mesh &&decoded, const LosslessRecord &r, const Quanti
   // carry the same values: the cut copies attributes); the extra vertices, those the record
   // stores (bit for bit).
   out.texture_files = std::move(decoded.texture_files);
+  out.materials = std::move(decoded.materials);
+  out.corner_texcoord_bits = decoded.corner_texcoord_bits;
+  out.corner_texcoord_bound = decoded.corner_texcoord_bound;
   for (size_t i = 0; i < decoded.attributes.size(); ++i) {
     const VertexAttribute *x = extra_of[i];
     VertexAttribute b = std::move(decoded.attributes[i]);

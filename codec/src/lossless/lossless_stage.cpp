@@ -8,8 +8,10 @@
 #include <numeric>
 #include <string>
 
+#include "attributes/material_section.h"
 #include "format/file_format.h"
 #include "geometry/quantize.h"
+#include "lossless/seam_cut.h"
 #include "mesh/corner_table.h"
 #include "repair/cut.h"
 
@@ -112,6 +114,9 @@ std::string LosslessReport::summary() const {
     s += (i == 0 ? (s.empty() ? "" : "; ") : i + 1 == kept.size() ? " and " : ", ") + kept[i];
   if (!kept.empty())
     s += " kept";
+  if (seam_edges || wedge_copies)
+    s += (s.empty() ? "" : "; ") + plural(seam_edges, "texture seam edge", "texture seam edges") +
+         " (" + plural(wedge_copies, "vertex copy", "vertex copies") + " welded on decoding)";
   return s + " (" + plural(bytes, "byte", "bytes") + ")";
 }
 
@@ -256,12 +261,22 @@ std::vector<uint8_t> encode_any(const Mesh &mesh, const EncodeOptions &options,
       *owned = Mesh();
       released = true;
     };
+  // Per-corner values are coded as the seam cut (lossless/seam_cut.h), whose copies the
+  // record welds back: such a mesh always has a record.
+  const bool corners = has_corner_values(mesh) && options.attributes.keep.texcoords;
+  if (corners)
+    validate_corner_values(mesh, options.attributes.exact);
+  if (options.strict && corners)
+    throw Error(Error::Kind::Usage,
+                "per-corner texture coordinates and face materials are kept with a lossless "
+                "record, which strict mode does not write: encode without strict (--strict), "
+                "or drop the texture coordinates");
   if (options.strict)
     return encode_manifold(mesh, options, report, nullptr, release);
 
   // False once the topology is known to be one the manifold encoder does not take as it is.
   bool valid = true;
-  if (!options.keep_order && all_vertices_used(mesh)) {
+  if (!options.keep_order && !corners && all_vertices_used(mesh)) {
     // Most meshes are clean: code them as they are (the file is then byte for byte what
     // strict gives). The manifold encoder checks the topology early (its corner table),
     // before it releases the mesh: if the table refuses the mesh (TopologyError), the mesh
@@ -287,6 +302,7 @@ std::vector<uint8_t> encode_any(const Mesh &mesh, const EncodeOptions &options,
                             // no cut and no attribute to neutralise: no copy)
   RepairMap map;
   RepairReport repair;
+  SeamCut seams;
   LosslessHook hook;
   hook.grid = make_quantizer(mesh.positions.data(), nv, options.bits);
   LosslessRecord record;
@@ -318,6 +334,22 @@ std::vector<uint8_t> encode_any(const Mesh &mesh, const EncodeOptions &options,
         coded = &mesh;
       else
         cut = mesh;
+    }
+    hook.locked.clear();
+    hook.materials.clear();
+    if (corners) { // the cut's faces get their corners' values, then it is cut at its seams
+      if (coded != &cut) {
+        cut = mesh;
+        coded = &cut;
+      }
+      corner_values_of_cut(mesh, map, cut);
+      seams = cut_at_seams(cut, map, static_cast<uint32_t>(nv));
+      hook.locked = std::move(seams.locked);
+      MaterialTable materials;
+      materials.corner_texcoords = !mesh.corner_texcoords.empty();
+      materials.face_materials = !mesh.face_materials.empty();
+      materials.materials = mesh.materials;
+      hook.materials = write_materials(materials);
     }
     if (coded == &cut)
       usable_attributes_for_unused_vertices(cut);
@@ -360,6 +392,8 @@ std::vector<uint8_t> encode_any(const Mesh &mesh, const EncodeOptions &options,
     l.degenerate_faces = record.degenerate.size();
     l.unreferenced_vertices = record.extra_q.size() / 3;
     l.keep_order = options.keep_order;
+    l.seam_edges = seams.seam_edges;
+    l.wedge_copies = seams.wedge_copies;
     l.bytes = report->info.lossless_bytes;
     report->info.input_vertices = nv;
     report->info.input_faces = mesh.triangle_count();

@@ -23,6 +23,11 @@ struct LosslessHook {
   /// Called once the decoder's numbering is known (decoded vertex i is vertex
   /// decoded_to_cut[i] of the mesh given to encode_manifold); returns the LSLS body.
   std::function<std::vector<uint8_t>(const std::vector<uint32_t> &decoded_to_cut)> record;
+  /// Per vertex of the mesh given to encode_manifold, optional: 1 = decimation keeps it (a
+  /// texture seam's vertex, lossless/seam_cut.h).
+  std::vector<uint8_t> locked;
+  /// The body of the required MATL section (materials of per-corner values), or empty.
+  std::vector<uint8_t> materials;
 };
 
 /// The codec proper (codec/src/encode/encoder.cpp): a manifold, oriented mesh; unreferenced

@@ -6,8 +6,8 @@
 // arrays of its input preparation (quantized positions, Morton keys, renumbered faces,
 // corner tables) and the PLY reader's. Each first write to a page is a page fault. Where
 // faults are dear (virtual machines: about 7 us each on the 2-core VM of bench/README.md,
-// "Page faults", against under 1 us a page in one madvise call) they were a seventh of
-// the CPU time of a 134k-vertex decode. Prefaulting changes no byte and no result: the
+// "Page faults", against under 1 us a page in one madvise call) they are a seventh of
+// the CPU time of a 134k-vertex decode that does not prefault. Prefaulting changes no byte and no result: the
 // pages would be mapped a moment later anyway.
 #pragma once
 

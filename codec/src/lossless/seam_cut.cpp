@@ -1,0 +1,261 @@
+// Texture seams: the seam cut (encoder) and the wedge values back into corners (decoder).
+#include "lossless/seam_cut.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <numeric>
+
+#include "mesh/corner_table.h"
+#include "mesh/radix_sort.h"
+
+namespace pomar {
+
+const char *const kWedgeTexcoord = "pomar:corner texcoord";
+const char *const kWedgeMaterial = "pomar:face material";
+
+bool internal_attribute_name(const std::string &name) { return name.rfind("pomar:", 0) == 0; }
+
+bool keeps_attribute(const std::string &name, AttributeKind kind, const AttributeMask &mask) {
+  if (kind == AttributeKind::Scalar && name == kWedgeMaterial)
+    return mask.texcoords;
+  return mask.keeps(kind);
+}
+
+bool has_corner_values(const Mesh &mesh) {
+  return !mesh.corner_texcoords.empty() || !mesh.face_materials.empty();
+}
+
+void validate_corner_values(const Mesh &mesh, bool exact) {
+  const size_t nf = mesh.triangle_count();
+  auto invalid = [](const std::string &what) { throw Error(Error::Kind::InvalidMesh, what); };
+  if (!mesh.corner_texcoords.empty() && mesh.corner_texcoords.size() != 6 * nf)
+    invalid("per-corner texture coordinates: " + std::to_string(mesh.corner_texcoords.size()) +
+            " values for " + std::to_string(nf) + " triangles (6 a triangle)");
+  if (!mesh.face_materials.empty() && mesh.face_materials.size() != nf)
+    invalid("face materials: " + std::to_string(mesh.face_materials.size()) + " for " +
+            std::to_string(nf) + " triangles");
+  for (size_t f = 0; f < mesh.face_materials.size(); ++f)
+    if (mesh.face_materials[f] >= mesh.materials.size())
+      invalid("face " + std::to_string(f) + " has material " +
+              std::to_string(mesh.face_materials[f]) + "; the mesh has " +
+              std::to_string(mesh.materials.size()) + " materials");
+  for (const Material &m : mesh.materials)
+    if (m.texture >= 0 && size_t(m.texture) >= mesh.texture_files.size())
+      invalid("material '" + m.name + "' names texture " + std::to_string(m.texture) +
+              "; the mesh has " + std::to_string(mesh.texture_files.size()) + " texture files");
+  for (const VertexAttribute &a : mesh.attributes)
+    if (internal_attribute_name(a.name))
+      invalid("attribute '" + a.name + "': names starting with 'pomar:' are the codec's own");
+  if (!exact)
+    for (size_t i = 0; i < mesh.corner_texcoords.size(); ++i)
+      if (!std::isfinite(mesh.corner_texcoords[i]))
+        invalid("texture coordinate of corner " + std::to_string(i / 2 % 3) + " of face " +
+                std::to_string(i / 6) + " is " +
+                (std::isnan(mesh.corner_texcoords[i]) ? "NaN" : "infinite") +
+                " (--exact-attributes keeps such values bit for bit)");
+}
+
+namespace {
+
+/// Union-find over the corners (path halving).
+uint32_t find(std::vector<uint32_t> &parent, uint32_t c) {
+  while (parent[c] != c)
+    c = parent[c] = parent[parent[c]];
+  return c;
+}
+
+} // namespace
+
+void corner_values_of_cut(const Mesh &input, const RepairMap &map, Mesh &cut) {
+  const size_t nf = cut.triangle_count();
+  if (map.face_origin.size() != nf || map.flipped.size() != nf)
+    throw Error(Error::Kind::Internal, "internal lossless error: the cut's face map does not fit");
+  cut.corner_texcoords.clear();
+  cut.face_materials.clear();
+  if (!input.corner_texcoords.empty()) {
+    cut.corner_texcoords.resize(6 * nf);
+    for (size_t f = 0; f < nf; ++f) {
+      const float *from = &input.corner_texcoords[6 * size_t(map.face_origin[f])];
+      float *to = &cut.corner_texcoords[6 * f];
+      static constexpr int kKept[3] = {0, 1, 2}, kFlipped[3] = {0, 2, 1};
+      const int *order = map.flipped[f] ? kFlipped : kKept;
+      for (int k = 0; k < 3; ++k) {
+        to[2 * k] = from[2 * order[k]];
+        to[2 * k + 1] = from[2 * order[k] + 1];
+      }
+    }
+  }
+  if (!input.face_materials.empty()) {
+    cut.face_materials.resize(nf);
+    for (size_t f = 0; f < nf; ++f)
+      cut.face_materials[f] = input.face_materials[map.face_origin[f]];
+  }
+}
+
+SeamCut cut_at_seams(Mesh &mesh, RepairMap &map, uint32_t input_vertices) {
+  const uint32_t nv = static_cast<uint32_t>(mesh.vertex_count());
+  const uint32_t nf = static_cast<uint32_t>(mesh.triangle_count());
+  const uint32_t nc = 3 * nf;
+  const std::vector<uint32_t> &V = mesh.triangles;
+  const bool has_uv = !mesh.corner_texcoords.empty(), has_mat = !mesh.face_materials.empty();
+  // Whether corners a and b (at the same vertex) have the same value, bit for bit.
+  auto same = [&](uint32_t a, uint32_t b) {
+    if (has_uv && std::memcmp(&mesh.corner_texcoords[2 * size_t(a)],
+                              &mesh.corner_texcoords[2 * size_t(b)], 2 * sizeof(float)) != 0)
+      return false;
+    return !has_mat || mesh.face_materials[a / 3] == mesh.face_materials[b / 3];
+  };
+
+  // The edges, each as (smaller, larger vertex) with the corner that starts it in its face:
+  // sorted, the two faces of an interior edge are neighbours (the mesh is manifold).
+  std::vector<Keyed> edges(nc);
+  for (uint32_t c = 0; c < nc; ++c) {
+    const uint32_t a = V[c], b = V[c - c % 3 + (c + 1) % 3];
+    edges[c] = {uint64_t(std::min(a, b)) << 32 | std::max(a, b), c};
+  }
+  std::sort(edges.begin(), edges.end(), [](const Keyed &x, const Keyed &y) {
+    return x.key != y.key ? x.key < y.key : x.id < y.id;
+  });
+  std::vector<uint32_t> parent(nc);
+  std::iota(parent.begin(), parent.end(), 0u);
+  SeamCut cut;
+  cut.locked.assign(nv, 0);
+  auto next = [](uint32_t c) { return c - c % 3 + (c + 1) % 3; };
+  for (uint32_t i = 0; i + 1 < nc; ++i) {
+    if (edges[i].key != edges[i + 1].key)
+      continue;
+    // Face f has a -> b starting at corner cf, face g has b -> a starting at cg.
+    const uint32_t cf = edges[i].id, cg = edges[i + 1].id;
+    const uint32_t f_a = cf, f_b = next(cf), g_b = cg, g_a = next(cg);
+    bool seam = false;
+    for (const auto &[x, y] : {std::pair<uint32_t, uint32_t>{f_a, g_a}, {f_b, g_b}}) {
+      if (same(x, y))
+        parent[find(parent, x)] = find(parent, y);
+      else
+        seam = true;
+    }
+    if (seam) {
+      ++cut.seam_edges;
+      cut.locked[V[cf]] = cut.locked[V[next(cf)]] = 1;
+    }
+    ++i;
+  }
+  // Mesh boundary edges are not seams: the wedges they separate are already apart.
+
+  // One vertex per wedge: the wedge of the vertex's first corner keeps it, the others get
+  // copies, numbered in corner order.
+  std::vector<uint32_t> vertex_of_root(nc, kNone), first_root(nv, kNone);
+  std::vector<uint32_t> copy_source; // cut vertex nv + i copies vertex copy_source[i]
+  std::vector<uint32_t> triangles(nc);
+  for (uint32_t c = 0; c < nc; ++c) {
+    const uint32_t r = find(parent, c), v = V[c];
+    if (vertex_of_root[r] == kNone) {
+      if (first_root[v] == kNone) {
+        first_root[v] = r;
+        vertex_of_root[r] = v;
+      } else {
+        vertex_of_root[r] = nv + static_cast<uint32_t>(copy_source.size());
+        copy_source.push_back(v);
+      }
+    }
+    triangles[c] = vertex_of_root[r];
+  }
+  cut.wedge_copies = copy_source.size();
+  const uint32_t total = nv + static_cast<uint32_t>(copy_source.size());
+
+  // The wedge values of every vertex (a vertex no face uses: zeros).
+  VertexAttribute uv, material;
+  uv.kind = AttributeKind::TexCoord;
+  uv.name = kWedgeTexcoord;
+  uv.components = 2;
+  uv.values.assign(2 * size_t(total), 0.0f);
+  material.kind = AttributeKind::Scalar;
+  material.name = kWedgeMaterial;
+  material.components = 1;
+  material.values.assign(total, 0.0f);
+  for (uint32_t c = 0; c < nc; ++c) {
+    const uint32_t w = triangles[c];
+    if (has_uv)
+      std::memcpy(&uv.values[2 * size_t(w)], &mesh.corner_texcoords[2 * size_t(c)],
+                  2 * sizeof(float));
+    if (has_mat)
+      material.values[w] = static_cast<float>(mesh.face_materials[c / 3]);
+  }
+
+  // The copies: positions and attributes of the vertex they copy.
+  mesh.positions.reserve(3 * size_t(total));
+  for (uint32_t s : copy_source)
+    for (int k = 0; k < 3; ++k)
+      mesh.positions.push_back(mesh.positions[3 * size_t(s) + k]);
+  for (VertexAttribute &a : mesh.attributes) {
+    const size_t n = a.components;
+    for (uint32_t s : copy_source) {
+      if (a.kind == AttributeKind::Colour)
+        for (size_t k = 0; k < n; ++k)
+          a.colour.push_back(a.colour[s * n + k]);
+      else
+        for (size_t k = 0; k < n; ++k)
+          a.values.push_back(a.values[s * n + k]);
+    }
+  }
+  cut.locked.resize(total, 0);
+  for (uint32_t i = 0; i < copy_source.size(); ++i)
+    cut.locked[nv + i] = cut.locked[copy_source[i]];
+  // Cut vertex v (v < nv) stands for input vertex v (< input_vertices) or for the copy
+  // map.copy_of[v - input_vertices]; so does each of its wedge copies.
+  if (map.copy_of.size() + input_vertices != nv)
+    throw Error(Error::Kind::Internal, "internal lossless error: the seam cut's map does not fit");
+  for (uint32_t s : copy_source)
+    map.copy_of.push_back(s < input_vertices ? s : map.copy_of[s - input_vertices]);
+
+  mesh.triangles.swap(triangles);
+  if (has_uv)
+    mesh.attributes.push_back(std::move(uv));
+  if (has_mat)
+    mesh.attributes.push_back(std::move(material));
+  mesh.corner_texcoords.clear();
+  mesh.corner_texcoords.shrink_to_fit();
+  mesh.face_materials.clear();
+  mesh.face_materials.shrink_to_fit();
+  return cut;
+}
+
+void corners_from_wedges(Mesh &mesh) {
+  const size_t nv = mesh.vertex_count(), nc = mesh.triangles.size();
+  for (size_t i = 0; i < mesh.attributes.size();) {
+    VertexAttribute &a = mesh.attributes[i];
+    const bool uv = a.kind == AttributeKind::TexCoord && a.name == kWedgeTexcoord;
+    const bool mat = a.kind == AttributeKind::Scalar && a.name == kWedgeMaterial;
+    if (!uv && !mat) {
+      ++i;
+      continue;
+    }
+    if (a.vertex_count() != nv)
+      throw Error(Error::Kind::Internal, "internal error: the wedge values do not fit the mesh");
+    if (uv) {
+      mesh.corner_texcoords.resize(2 * nc);
+      for (size_t c = 0; c < nc; ++c)
+        std::memcpy(&mesh.corner_texcoords[2 * c], &a.values[2 * size_t(mesh.triangles[c])],
+                    2 * sizeof(float));
+      mesh.corner_texcoord_bits = a.bits;
+      mesh.corner_texcoord_bound = a.bound;
+    } else {
+      mesh.face_materials.resize(nc / 3);
+      for (size_t f = 0; f < nc / 3; ++f) {
+        const float m = a.values[mesh.triangles[3 * f]];
+        const float r = std::nearbyint(m);
+        // (The grid of the material codes is at most one unit a step: within half of it.)
+        if (!(r >= 0) || r >= float(mesh.materials.size()) || std::fabs(m - r) >= 0.5f)
+          throw Error(Error::Kind::DamagedFile,
+                      "damaged .pomar file: face " + std::to_string(f) + " has material " +
+                          std::to_string(m) + "; the file has " +
+                          std::to_string(mesh.materials.size()) + " materials");
+        mesh.face_materials[f] = static_cast<uint32_t>(r);
+      }
+    }
+    mesh.attributes.erase(mesh.attributes.begin() + long(i));
+  }
+}
+
+} // namespace pomar

@@ -1,0 +1,274 @@
+// Per-corner texture coordinates and face materials: kept on a full decode, and at every
+// level and in every selection the seams stay closed and every face's corners lie in one
+// chart of its material.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <set>
+
+#include "pomar/mesh_io.h"
+#include "pomar/pomar.h"
+#include "pomar/random_access.h"
+#include "support/mesh_attributes.h"
+#include "support/mesh_gen.h"
+
+namespace pomar {
+namespace {
+
+constexpr int kCellsU = 3, kCellsV = 2; // the atlas: 6 charts, one per cube face
+
+/// `m` with a cube-map atlas: each face goes to the chart of its normal's dominant axis and
+/// sign, its corners projected onto that chart's plane in its cell of the atlas (seams
+/// between the charts); charts 0-2 are material 0, charts 3-5 material 1 (two textures).
+Mesh cube_mapped(Mesh m) {
+  const size_t nf = m.triangle_count();
+  m.corner_texcoords.resize(6 * nf);
+  m.face_materials.resize(nf);
+  m.texture_files = {"atlas_a.png", "atlas b.jpg"};
+  m.materials = {{"front", 0, "Kd 1 1 1\nNs 10"}, {"back", 1, "Kd 0.8 0.8 0.8"}};
+  auto p = [&](uint32_t v) {
+    return gen::detail::Vec3{m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]};
+  };
+  for (size_t f = 0; f < nf; ++f) {
+    const uint32_t *t = &m.triangles[3 * f];
+    const gen::detail::Vec3 n =
+        gen::detail::cross(gen::detail::sub(p(t[1]), p(t[0])), gen::detail::sub(p(t[2]), p(t[0])));
+    int axis = 0;
+    for (int k = 1; k < 3; ++k)
+      if (std::fabs(n[k]) > std::fabs(n[axis]))
+        axis = k;
+    const int chart = axis + (n[axis] < 0 ? 3 : 0);
+    m.face_materials[f] = chart < 3 ? 0 : 1;
+    for (int c = 0; c < 3; ++c) {
+      const gen::detail::Vec3 q = p(t[c]);
+      const double a = q[(axis + 1) % 3], b = q[(axis + 2) % 3]; // about -1.3..1.3
+      const double s = 0.5 + 0.35 * std::max(-1.4, std::min(1.4, a)) / 1.4;
+      const double r = 0.5 + 0.35 * std::max(-1.4, std::min(1.4, b)) / 1.4;
+      m.corner_texcoords[6 * f + 2 * c] = float((chart % kCellsU + s) / kCellsU);
+      m.corner_texcoords[6 * f + 2 * c + 1] = float((chart / kCellsU + r) / kCellsV);
+    }
+  }
+  return m;
+}
+
+/// The chart (atlas cell) a texture coordinate falls in.
+int chart_of(const float *uv) {
+  const int i = std::min(kCellsU - 1, std::max(0, int(std::floor(uv[0] * kCellsU))));
+  const int j = std::min(kCellsV - 1, std::max(0, int(std::floor(uv[1] * kCellsV))));
+  return j * kCellsU + i;
+}
+
+using Position = std::array<float, 3>;
+using Edge = std::pair<uint32_t, uint32_t>;
+
+/// The mesh's edges used by one face only, its vertices welded by position.
+size_t welded_boundary_edges(const Mesh &m) {
+  std::map<Position, uint32_t> id;
+  std::vector<uint32_t> weld(m.vertex_count());
+  for (size_t v = 0; v < m.vertex_count(); ++v)
+    weld[v] =
+        id.emplace(Position{m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]},
+                   uint32_t(id.size()))
+            .first->second;
+  std::map<Edge, int> uses;
+  for (size_t c = 0; c < m.triangles.size(); ++c) {
+    const uint32_t a = weld[m.triangles[c]], b = weld[m.triangles[c - c % 3 + (c + 1) % 3]];
+    ++uses[{std::min(a, b), std::max(a, b)}];
+  }
+  size_t boundary = 0;
+  for (const auto &e : uses)
+    boundary += e.second == 1;
+  return boundary;
+}
+
+/// Every face's corners in one chart, and that chart of the face's material.
+void expect_faces_in_one_chart(const Mesh &m, const std::string &what) {
+  ASSERT_EQ(m.corner_texcoords.size(), 6 * m.triangle_count()) << what;
+  ASSERT_EQ(m.face_materials.size(), m.triangle_count()) << what;
+  size_t wrong = 0;
+  for (size_t f = 0; f < m.triangle_count(); ++f) {
+    const int c0 = chart_of(&m.corner_texcoords[6 * f]);
+    const bool same = c0 == chart_of(&m.corner_texcoords[6 * f + 2]) &&
+                      c0 == chart_of(&m.corner_texcoords[6 * f + 4]);
+    wrong += !same || m.face_materials[f] != (c0 < 3 ? 0u : 1u);
+  }
+  EXPECT_EQ(wrong, 0u) << what << ": faces whose corners leave their chart";
+}
+
+struct Coded {
+  Mesh input;
+  std::vector<uint8_t> file;
+  EncodeReport report;
+};
+
+Coded encode_textured(const Mesh &m, bool clustered, bool exact = false) {
+  Coded c;
+  c.input = m;
+  EncodeOptions o;
+  o.bits = 16; // positions (nearly) unique: the checks weld by position
+  o.progressive = !clustered;
+  o.cluster_ratio = 0.02;
+  o.attributes.exact = exact;
+  c.file = encode(c.input, o, &c.report);
+  return c;
+}
+
+/// A full decode against the input: the same faces (through the report's vertex map), each
+/// corner's texture coordinate within the bound (or exact), the same material.
+void expect_corners_kept(const Coded &c, const Mesh &out, bool exact) {
+  ASSERT_EQ(out.triangle_count(), c.input.triangle_count());
+  ASSERT_EQ(out.vertex_count(), c.input.vertex_count()); // the seam copies welded back
+  EXPECT_EQ(out.materials.size(), c.input.materials.size());
+  for (size_t i = 0; i < out.materials.size(); ++i) {
+    EXPECT_EQ(out.materials[i].name, c.input.materials[i].name);
+    EXPECT_EQ(out.materials[i].texture, c.input.materials[i].texture);
+    EXPECT_EQ(out.materials[i].properties, c.input.materials[i].properties);
+  }
+  EXPECT_EQ(out.texture_files, c.input.texture_files);
+  if (exact) {
+    EXPECT_EQ(out.corner_texcoord_bits, 0);
+  } else {
+    EXPECT_EQ(out.corner_texcoord_bits, 12);
+    EXPECT_GT(out.corner_texcoord_bound, 0.0);
+    EXPECT_LE(out.corner_texcoord_bound, 1.0 / 4095); // half a step over a range of at most 2
+  }
+  // Input faces by their rotation starting at the smallest vertex: (face, rotation).
+  std::map<std::array<uint32_t, 3>, std::pair<size_t, int>> input_faces;
+  auto rotation = [](const uint32_t *t) {
+    int s = 0;
+    for (int k = 1; k < 3; ++k)
+      if (t[k] < t[s])
+        s = k;
+    return s;
+  };
+  for (size_t f = 0; f < c.input.triangle_count(); ++f) {
+    const uint32_t *t = &c.input.triangles[3 * f];
+    const int s = rotation(t);
+    input_faces[{t[s], t[(s + 1) % 3], t[(s + 2) % 3]}] = {f, s};
+  }
+  const std::vector<uint32_t> &to_input = c.report.decoded_to_input;
+  ASSERT_EQ(to_input.size(), out.vertex_count());
+  size_t corners_off = 0, materials_off = 0;
+  for (size_t f = 0; f < out.triangle_count(); ++f) {
+    const uint32_t t[3] = {to_input[out.triangles[3 * f]], to_input[out.triangles[3 * f + 1]],
+                           to_input[out.triangles[3 * f + 2]]};
+    const int s = rotation(t);
+    const auto it = input_faces.find({t[s], t[(s + 1) % 3], t[(s + 2) % 3]});
+    ASSERT_NE(it, input_faces.end()) << "decoded face " << f << " is not an input face";
+    const auto [g, gs] = it->second;
+    materials_off += out.face_materials[f] != c.input.face_materials[g];
+    for (int k = 0; k < 3; ++k) { // decoded corner (s + k) is input corner (gs + k)
+      const float *a = &out.corner_texcoords[6 * f + 2 * ((s + k) % 3)];
+      const float *b = &c.input.corner_texcoords[6 * g + 2 * ((gs + k) % 3)];
+      for (int j = 0; j < 2; ++j)
+        corners_off += exact ? std::memcmp(a + j, b + j, 4) != 0
+                             : std::fabs(double(a[j]) - b[j]) > out.corner_texcoord_bound;
+    }
+  }
+  EXPECT_EQ(corners_off, 0u) << "corner texture coordinates off their input's";
+  EXPECT_EQ(materials_off, 0u) << "faces with another material";
+}
+
+TEST(TextureSeams, CornersAndMaterialsAreKept) {
+  const Mesh m = cube_mapped(gen::noisy_sphere(3000, 3, 0.05));
+  for (bool clustered : {false, true})
+    for (bool exact : {false, true}) {
+      SCOPED_TRACE(std::string(clustered ? "clustered" : "progressive") + (exact ? ", exact" : ""));
+      const Coded c = encode_textured(m, clustered, exact);
+      EXPECT_GT(c.report.lossless.seam_edges, 50u);
+      EXPECT_GT(c.report.lossless.wedge_copies, 50u);
+      expect_corners_kept(c, decode(c.file.data(), c.file.size()), exact);
+    }
+}
+
+TEST(TextureSeams, EveryLevelIsClosedAndInItsCharts) {
+  const Mesh m = cube_mapped(gen::noisy_sphere(4000, 5, 0.05));
+  ASSERT_EQ(welded_boundary_edges(m), 0u);
+  for (bool clustered : {false, true}) {
+    SCOPED_TRACE(clustered ? "clustered" : "progressive");
+    const Coded c = encode_textured(m, clustered);
+    const FileInfo info = inspect(c.file.data(), c.file.size());
+    ASSERT_GT(info.levels.size(), 3u);
+    for (int level = 0; level <= int(info.levels.size()); ++level) {
+      const Mesh d = decode(c.file.data(), c.file.size(), level);
+      const std::string what = "level " + std::to_string(level);
+      EXPECT_EQ(welded_boundary_edges(d), 0u) << what << ": a seam opened";
+      expect_faces_in_one_chart(d, what);
+    }
+  }
+}
+
+TEST(TextureSeams, SelectionsAreClosedAndInTheirCharts) {
+  const Mesh m = cube_mapped(gen::noisy_sphere(4000, 7, 0.05));
+  const Coded c = encode_textured(m, true);
+  SelectiveDecoder d(std::make_unique<MemorySource>(c.file.data(), c.file.size()));
+  const int finest = d.finest_level(), base = d.base_clustered_level();
+  // Half the clusters at the finest level, the others at levels between (smooth
+  // transitions raise their neighbours as needed): the whole surface, at mixed levels.
+  for (uint32_t k = 0; k < d.cluster_count(); ++k)
+    d.want_cluster(k, k % 2 ? finest : base + int(k % 5) * (finest - base) / 5);
+  d.update();
+  const Mesh mixed = d.mesh();
+  EXPECT_EQ(welded_boundary_edges(mixed), 0u) << "mixed levels: a seam opened";
+  expect_faces_in_one_chart(mixed, "mixed levels");
+  const float centre[3] = {1, 0, 0};
+  d.clear_wanted();
+  d.want_sphere(centre, 0.5f, finest);
+  d.update();
+  expect_faces_in_one_chart(d.mesh(), "a region");
+}
+
+TEST(TextureSeams, DroppingTextureCoordinatesDropsCornersAndMaterials) {
+  const Mesh m = cube_mapped(gen::noisy_sphere(1500, 3, 0.05));
+  EncodeOptions o;
+  o.attributes.keep.texcoords = false;
+  const std::vector<uint8_t> file = encode(m, o);
+  const Mesh out = decode(file.data(), file.size());
+  EXPECT_TRUE(out.corner_texcoords.empty());
+  EXPECT_TRUE(out.face_materials.empty());
+  EXPECT_EQ(out.vertex_count(), m.vertex_count());
+  // Kept in the file, left out by the decoder.
+  const std::vector<uint8_t> kept = encode(m, EncodeOptions());
+  DecodeOptions dropping;
+  dropping.attributes.texcoords = false;
+  const Mesh without = decode(kept.data(), kept.size(), dropping);
+  EXPECT_TRUE(without.corner_texcoords.empty());
+  EXPECT_TRUE(without.attributes.empty());
+  EXPECT_EQ(without.vertex_count(), m.vertex_count());
+}
+
+TEST(TextureSeams, BadCornerValuesAreNamed) {
+  Mesh m = cube_mapped(gen::noisy_sphere(500, 3, 0.05));
+  auto expect_refused = [](const Mesh &bad, const std::string &words) {
+    try {
+      encode(bad, EncodeOptions());
+      ADD_FAILURE() << "not refused: " << words;
+    } catch (const Error &e) {
+      EXPECT_EQ(e.kind(), Error::Kind::InvalidMesh) << e.what();
+      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+    }
+  };
+  Mesh nan = m;
+  nan.corner_texcoords[6 * 7 + 3] = std::nanf("");
+  expect_refused(nan, "corner 1 of face 7 is NaN");
+  Mesh material = m;
+  material.face_materials[4] = 2;
+  expect_refused(material, "face 4 has material 2");
+  Mesh sizes = m;
+  sizes.corner_texcoords.pop_back();
+  expect_refused(sizes, "per-corner texture coordinates");
+  EncodeOptions exact;
+  exact.attributes.exact = true; // NaN kept bit for bit
+  const std::vector<uint8_t> file = encode(nan, exact);
+  const Mesh out = decode(file.data(), file.size());
+  size_t nans = 0;
+  for (float x : out.corner_texcoords)
+    nans += std::isnan(x);
+  EXPECT_EQ(nans, 1u);
+}
+
+} // namespace
+} // namespace pomar
