@@ -84,10 +84,10 @@ TEST_F(AttributeFiles, ObjTextureNamesAndUvsRoundTripThroughPomar) {
   save_mesh(out, decoded);
   EXPECT_TRUE(attributes_not_saved(out, decoded).empty());
   const std::string mtl = read_text(path("out dir.mtl"));
-  EXPECT_NE(mtl.find("map_Kd my skin.png\n"), std::string::npos) << mtl;
+  EXPECT_NE(mtl.find("newmtl skin\nKd 1 1 1\nmap_Kd my skin.png\n"), std::string::npos) << mtl;
   const std::string obj = read_text(out);
   EXPECT_NE(obj.find("mtllib out\\ dir.mtl\n"), std::string::npos);
-  EXPECT_NE(obj.find("\nusemtl texture_0\n"), std::string::npos);
+  EXPECT_NE(obj.find("\nusemtl skin\n"), std::string::npos); // the material, kept by the file
   EXPECT_NE(obj.find("\nvt "), std::string::npos);
 
   LoadReport back_report;

@@ -150,6 +150,15 @@ void warn_dropped(const std::string &file, const std::vector<std::string> &what,
   std::fprintf(stderr, "pomar: warning: %s %s %s%s\n", file.c_str(), verb, list.c_str(), why);
 }
 
+/// What follows the list of what a mesh file cannot hold: where it would be kept.
+const char *not_written_hint(const std::string &path) {
+  std::string ext = path.size() >= 4 ? path.substr(path.size() - 4) : "";
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  return ext == ".ply" ? ": not written (.obj keeps them)"
+                       : ": not written (.ply keeps every attribute)";
+}
+
 int run_encode(const EncodeArgs &a) {
   const auto t0 = Clock::now();
   const uint64_t memory_limit = pomar::parse_memory_size(a.max_memory);
@@ -412,7 +421,7 @@ int run_selective_decode(const DecodeArgs &a) {
   pomar::save_mesh(a.out, mesh, !a.ascii);
   if (!a.quiet)
     warn_dropped(a.out, pomar::attributes_not_saved(a.out, mesh), "cannot hold",
-                 ": not written (.ply keeps every attribute)");
+                 not_written_hint(a.out));
   if (a.stats || !a.quiet) {
     const uint64_t file_size = d.info().total_bytes;
     std::printf("%s: %zu vertices, %zu faces; %u of %u clusters refined (levels %d..%d), %u "
@@ -450,7 +459,7 @@ int run_decode(const DecodeArgs &a) {
   pomar::save_mesh(a.out, mesh, !a.ascii);
   if (!a.quiet)
     warn_dropped(a.out, pomar::attributes_not_saved(a.out, mesh), "cannot hold",
-                 ": not written (.ply keeps every attribute)");
+                 not_written_hint(a.out));
   if (!a.quiet || a.stats)
     std::printf("%s: %zu vertices, %zu faces (decoded in %.3f s, %zu bytes read)\n", a.out.c_str(),
                 mesh.vertex_count(), mesh.triangle_count(), t_decode, data.size());

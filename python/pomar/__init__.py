@@ -182,8 +182,10 @@ def write(path, mesh, *, binary=True, **encode_options):
         raise TypeError(f"options {sorted(encode_options)} apply to .pomar files only")
     lost = _pomar.write_mesh(path, mesh.vertices, mesh.faces, binary, Mesh._attributes(mesh))
     if lost:
-        warnings.warn(f"{path} cannot hold {', '.join(lost)}: not written (.ply keeps every "
-                      "attribute)", stacklevel=2)
+        where = (".obj keeps them" if path.lower().endswith(".ply")
+                 else ".ply keeps every attribute")
+        warnings.warn(f"{path} cannot hold {', '.join(lost)}: not written ({where})",
+                      stacklevel=2)
 
 
 class SelectiveDecoder(_pomar.SelectiveDecoder):

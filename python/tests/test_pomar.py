@@ -756,7 +756,8 @@ def test_textured_sample_and_bad_corner_data(tmp_path):
 def test_tool_verify_compares_corners_and_materials(tmp_path):
     """`pomar verify ORIGINAL FILE DECODED`: the decoded mesh file's per-corner texture
     coordinates and materials against the original's, faces matched by their corners."""
-    sample = os.path.join(SAMPLES, "textured_sphere.obj")
+    sample = str(tmp_path / "torus.obj")
+    pomar.write(sample, textured_torus())
     m = pomar.read(sample)
     data = pomar.encode(m, keep_order=True)  # decoded vertices in the input order
     (tmp_path / "s.pomar").write_bytes(data)
@@ -775,7 +776,8 @@ def test_tool_verify_compares_corners_and_materials(tmp_path):
     for name in ("same.obj", "same.ply"):
         run = verify(name, m.corner_texcoords, m.face_materials)
         assert run.returncode == 0, run.stderr
-        assert "per-corner texture coordinates: exact, max error 0" in run.stdout
+        assert "per-corner texture coordinates: 12 bits, within" in run.stdout
+        assert "max error 0\n" in run.stdout
         assert "face materials: 2 materials, the same" in run.stdout
     moved = m.corner_texcoords.copy()
     moved[7, 1, 0] += 0.01
@@ -785,3 +787,42 @@ def test_tool_verify_compares_corners_and_materials(tmp_path):
     other[0] = 1
     run = verify("other.obj", m.corner_texcoords, other)
     assert run.returncode == 3 and "1 faces differ" in run.stderr
+
+
+def test_textured_mesh_through_the_codec(tmp_path):
+    mesh = textured_torus()
+    for exact in (True, False):
+        back = pomar.decode(pomar.encode(mesh, exact_attributes=exact, keep_order=True))
+        assert back.corner_texcoords.shape == mesh.corner_texcoords.shape
+        assert back.materials == mesh.materials and back.texture_files == ["skin.png"]
+        info = [a for a in back.attribute_info if a["kind"] == "corner texcoord"]
+        assert len(info) == 1 and info[0]["exact"] == exact
+        # Faces by their corner vertices (the numbering is kept), corners in that order.
+        def faces(m):
+            out = {}
+            for f, t in enumerate(m.faces.tolist()):
+                r = t.index(min(t))
+                key = tuple(t[r:] + t[:r])
+                out[key] = (np.roll(m.corner_texcoords[f], -r, axis=0), int(m.face_materials[f]))
+            return out
+        a, b = faces(mesh), faces(back)
+        assert a.keys() == b.keys()
+        bound = info[0]["bound"]
+        for key, (uv, material) in a.items():
+            assert material == b[key][1]
+            if exact:
+                assert np.array_equal(uv, b[key][0])
+            else:
+                assert np.abs(uv - b[key][0]).max() <= bound
+
+
+@pytest.mark.skipif("POMAR_TOOL" not in os.environ, reason="needs the pomar tool")
+def test_tool_encodes_and_verifies_a_textured_obj(tmp_path):
+    obj, file = str(tmp_path / "t.obj"), str(tmp_path / "t.pomar")
+    pomar.write(obj, textured_torus())
+    tool = os.environ["POMAR_TOOL"]
+    subprocess.run([tool, "encode", obj, file], check=True, capture_output=True)
+    run = subprocess.run([tool, "verify", obj, file], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    assert "per-corner texture coordinates: 12 bits" in run.stdout
+    assert "face materials: 2 materials, the same per face" in run.stdout
