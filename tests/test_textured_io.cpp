@@ -324,6 +324,33 @@ TEST_F(TexturedIo, ObjPerVertexWhenCornersAgreePerCornerWhenTheyDiffer) {
             std::vector<std::string>{"texture coordinates (not given for every corner)"});
 }
 
+TEST_F(TexturedIo, ObjCornersWithPerVertexNormalsAndColours) {
+  Mesh m = textured_strip(6);
+  VertexAttribute n;
+  n.kind = AttributeKind::Normal;
+  n.name = "normal";
+  n.components = 3;
+  VertexAttribute c;
+  c.kind = AttributeKind::Colour;
+  c.name = "colour";
+  c.components = 3;
+  for (size_t v = 0; v < m.vertex_count(); ++v) {
+    n.values.insert(n.values.end(), {0.0f, 0.6f, 0.8f});
+    c.colour.insert(c.colour.end(), {uint8_t(v * 10), 128, 255});
+  }
+  m.attributes = {c, n};
+  save_mesh(path("n.obj"), m);
+  EXPECT_NE(read_text(path("n.obj")).find("\nf 1/1/1 "), std::string::npos);
+  LoadReport r;
+  const Mesh back = load_mesh(path("n.obj"), &r);
+  EXPECT_TRUE(r.ignored_attributes.empty()) << joined(r.ignored_attributes);
+  expect_same_textured(m, back);
+  ASSERT_NE(back.find(AttributeKind::Normal), nullptr);
+  EXPECT_EQ(back.find(AttributeKind::Normal)->values, n.values);
+  ASSERT_NE(back.find(AttributeKind::Colour), nullptr);
+  EXPECT_EQ(back.find(AttributeKind::Colour)->colour, c.colour);
+}
+
 TEST_F(TexturedIo, ObjFacesBeforeAnyUsemtlAndUndefinedNames) {
   write("m.mtl", "# a comment\nnewmtl red\nKd 1 0 0\n\nnewmtl tex\nmap_Kd -s 1 1 1 t.png\n");
   const std::string text = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 2 0 0\n"
