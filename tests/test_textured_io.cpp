@@ -459,7 +459,7 @@ TEST_F(TexturedIo, SampleTexturedSphere) {
 // of faces"). Each corner at the south pole has its own texture coordinate and the cap has
 // its own material, so the seam cut leaves every cap face with its own copy of the pole and
 // its neighbours joined by a ring vertex only; the cut does not split such vertices.
-TEST_F(TexturedIo, DISABLED_SampleTexturedSphereThroughTheCodec) {
+TEST_F(TexturedIo, SampleTexturedSphereThroughTheCodec) {
   expect_codec_round_trips(load_mesh(POMAR_SAMPLES_DIR "/textured_sphere.obj"),
                            [&](const std::string &n) { return path(n); });
 }
