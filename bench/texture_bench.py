@@ -4,8 +4,8 @@
     python3 bench/texture_bench.py [--data DIR] [--build DIR] [--generated N]
 
 For every textured OBJ (the data folder's `textured/usb/usb.obj`,
-`meshlab_bunny10k_textured.obj`, and a generated cube-mapped noisy sphere of N vertices:
-6 charts, ragged seams), the texture coordinates' cost is a file size difference: the file
+`meshlab_bunny10k_textured.obj`, and a generated cube-mapped sphere of about N vertices:
+6 charts, seams along the cube's edges), the texture coordinates' cost is a file size difference: the file
 with them minus the file without them. pomar: `pomar encode` against `pomar encode --drop
 texcoords` (default options: random access, 12-bit positions, 12-bit texture coordinates).
 Draco 1.5.5: `draco_encoder -qp 12 -qt 12 -cl 10` on the OBJ against the same OBJ without
@@ -51,53 +51,48 @@ def strip_texture(src, dst):
 
 
 def cube_mapped_sphere(path, n, seed=3):
-    """A noisy sphere (a subdivided octahedron pushed out, positions jittered) whose faces
-    go to the chart of their normal's dominant axis: 6 charts in a 3 x 2 atlas."""
+    """A noisy sphere (a latitude-longitude grid of about n vertices, radii jittered by 1%)
+    whose faces go to the chart of their centroid's dominant axis: 6 charts in a 3 x 2
+    atlas, the seams along the cube's edges."""
     rng = random.Random(seed)
-    k = max(2, int(math.sqrt(n / 4.0)))
-    verts, index, faces = [], {}, []
+    rows = max(4, int(math.sqrt(n / 2.0)))
+    cols = 2 * rows
+    pos = [(0.0, 0.0, 1.0)]
+    for i in range(1, rows):
+        th = math.pi * i / rows
+        for j in range(cols):
+            ph = 2 * math.pi * j / cols
+            r = 1 + 0.01 * (rng.random() - 0.5)
+            pos.append((r * math.sin(th) * math.cos(ph), r * math.sin(th) * math.sin(ph),
+                        r * math.cos(th)))
+    pos.append((0.0, 0.0, -1.0))
+    south = len(pos) - 1
 
-    def vid(p):
-        key = tuple(round(x * 1e6) for x in p)
-        if key not in index:
-            index[key] = len(verts)
-            verts.append(p)
-        return index[key]
+    def ring(i, j):
+        return 1 + (i - 1) * cols + j % cols
 
-    octa = [(1, 0, 0), (0, 1, 0), (-1, 0, 0), (0, -1, 0)]
-    for top in (1, -1):
-        for i in range(4):
-            a, b, c = octa[i], octa[(i + 1) % 4], (0, 0, top)
-            if top < 0:
-                a, b = b, a
-            for r in range(k):
-                for s in range(k - r):
-                    def at(r_, s_):
-                        t = k - r_ - s_
-                        return tuple((a[j] * t + b[j] * s_ + c[j] * r_) / k for j in range(3))
-                    faces.append((vid(at(r, s)), vid(at(r, s + 1)), vid(at(r + 1, s))))
-                    if s + r + 1 < k:
-                        faces.append((vid(at(r, s + 1)), vid(at(r + 1, s + 1)), vid(at(r + 1, s))))
-    pos = []
-    for p in verts:
-        l = math.sqrt(sum(x * x for x in p))
-        f = (1 + 0.05 * (rng.random() - 0.5)) / l
-        pos.append(tuple(x * f for x in p))
+    faces = []
+    for j in range(cols):
+        faces.append((0, ring(1, j), ring(1, j + 1)))
+        faces.append((south, ring(rows - 1, j + 1), ring(rows - 1, j)))
+    for i in range(1, rows - 1):
+        for j in range(cols):
+            a, b, c, d = ring(i, j), ring(i, j + 1), ring(i + 1, j), ring(i + 1, j + 1)
+            faces.append((a, c, d))
+            faces.append((a, d, b))
     with open(path, 'w') as out:
         for p in pos:
             out.write('v %.7f %.7f %.7f\n' % p)
         vt, corners = {}, []
         for fa in faces:
-            p = [pos[v] for v in fa]
-            u = [p[1][j] - p[0][j] for j in range(3)]
-            w = [p[2][j] - p[0][j] for j in range(3)]
-            nrm = [u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]]
-            axis = max(range(3), key=lambda j: abs(nrm[j]))
-            chart = axis + (3 if nrm[axis] < 0 else 0)
+            cen = [sum(pos[v][j] for v in fa) / 3 for j in range(3)]
+            axis = max(range(3), key=lambda j: abs(cen[j]))
+            chart = axis + (3 if cen[axis] < 0 else 0)
             cs = []
-            for q in p:
-                s = 0.5 + 0.35 * max(-1.4, min(1.4, q[(axis + 1) % 3])) / 1.4
-                t = 0.5 + 0.35 * max(-1.4, min(1.4, q[(axis + 2) % 3])) / 1.4
+            for v in fa:
+                q = pos[v]
+                s = 0.5 + 0.45 * max(-1.0, min(1.0, q[(axis + 1) % 3]))
+                t = 0.5 + 0.45 * max(-1.0, min(1.0, q[(axis + 2) % 3]))
                 key = ('%.6f' % ((chart % 3 + s) / 3), '%.6f' % ((chart // 3 + t) / 2))
                 if key not in vt:
                     vt[key] = len(vt) + 1
