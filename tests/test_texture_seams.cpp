@@ -227,6 +227,31 @@ TEST(TextureSeams, DroppingTextureCoordinatesDropsCornersAndMaterials) {
   EXPECT_EQ(without.vertex_count(), m.vertex_count());
 }
 
+TEST(TextureSeams, EmbeddedImagesComeBackBitForBit) {
+  Mesh m = cube_mapped(gen::noisy_sphere(800, 3, 0.05));
+  m.texture_images = {std::vector<uint8_t>{0x89, 'P', 'N', 'G', 0, 1, 2, 255}, {}};
+  for (bool clustered : {false, true}) {
+    const Coded c = encode_textured(m, clustered);
+    const FileInfo info = inspect(c.file.data(), c.file.size());
+    EXPECT_EQ(info.embedded_texture_bytes, (std::vector<uint64_t>{8, 0}));
+    EXPECT_EQ(decode(c.file.data(), c.file.size()).texture_images, m.texture_images);
+    EXPECT_EQ(decode(c.file.data(), c.file.size(), 1).texture_images, m.texture_images);
+    DecodeOptions no_uv;
+    no_uv.attributes.texcoords = false;
+    EXPECT_TRUE(decode(c.file.data(), c.file.size(), no_uv).texture_images.empty());
+  }
+  Mesh plain = m; // per-vertex data only (no corners): the images still go in
+  plain.corner_texcoords.clear();
+  plain.face_materials.clear();
+  plain.materials.clear();
+  const std::vector<uint8_t> file = encode(plain, EncodeOptions());
+  EXPECT_EQ(decode(file.data(), file.size()).texture_images, m.texture_images);
+  Mesh too_many = m;
+  too_many.texture_images.resize(3);
+  too_many.texture_images[2] = {1};
+  EXPECT_THROW(encode(too_many, EncodeOptions()), Error);
+}
+
 TEST(TextureSeams, BadCornerValuesAreNamed) {
   Mesh m = cube_mapped(gen::noisy_sphere(500, 3, 0.05));
   auto expect_refused = [](const Mesh &bad, const std::string &words) {

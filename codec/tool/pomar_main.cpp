@@ -17,6 +17,7 @@
 #include <cstring>
 #include <map>
 #include <memory>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "pomar/limits.h"
@@ -83,6 +84,7 @@ struct EncodeArgs {
   uint32_t clusters = 0;
   double cluster_ratio = 0.01;
   bool progressive = false, quiet = false, repair = false, strict = false, keep_order = false;
+  bool embed_textures = false;
   std::string max_memory = "auto";
   unsigned threads = 0;
   pomar::AttributeOptions attributes;
@@ -131,12 +133,104 @@ std::string describe_precision(pomar::AttributeKind kind, uint32_t components, i
 }
 
 void print_attributes(const pomar::FileInfo &i) {
-  for (const pomar::AttributeInfo &a : i.attributes)
-    std::printf("  attribute %-10s %-8s %.2f bits/vertex (%s)\n", a.name.c_str(),
-                pomar::kind_name(a.kind), bpv(a.bytes, i.vertices),
-                describe_precision(a.kind, a.components, a.bits, a.bound).c_str());
-  for (const std::string &t : i.texture_files)
-    std::printf("  texture file %s\n", t.c_str());
+  for (const pomar::AttributeInfo &a : i.attributes) {
+    // (the seam cut's wedge values: per-corner texture coordinates and face materials)
+    if (a.name == "pomar:corner texcoord")
+      std::printf("  per-corner texture coordinates %.2f bits/vertex (%s)\n",
+                  bpv(a.bytes, i.vertices),
+                  describe_precision(a.kind, a.components, a.bits, a.bound).c_str());
+    else if (a.name == "pomar:face material")
+      std::printf("  face materials %.2f bits/vertex (exact)\n", bpv(a.bytes, i.vertices));
+    else
+      std::printf("  attribute %-10s %-8s %.2f bits/vertex (%s)\n", a.name.c_str(),
+                  pomar::kind_name(a.kind), bpv(a.bytes, i.vertices),
+                  describe_precision(a.kind, a.components, a.bits, a.bound).c_str());
+  }
+  for (size_t t = 0; t < i.texture_files.size(); ++t) {
+    const uint64_t embedded = t < i.embedded_texture_bytes.size() ? i.embedded_texture_bytes[t] : 0;
+    if (embedded)
+      std::printf("  texture file %s (embedded, %llu bytes)\n", i.texture_files[t].c_str(),
+                  static_cast<unsigned long long>(embedded));
+    else
+      std::printf("  texture file %s\n", i.texture_files[t].c_str());
+  }
+}
+
+/// The folder of `path` ("" for the current one), with a trailing '/'.
+std::string folder_of(const std::string &path) {
+  const size_t slash = path.rfind('/');
+  return slash == std::string::npos ? std::string() : path.substr(0, slash + 1);
+}
+
+/// A texture file name a decode may write beside its output: relative, no "..", no control
+/// characters (the names come from the file).
+bool safe_texture_name(const std::string &name) {
+  if (name.empty() || name[0] == '/' || name.find('\\') != std::string::npos)
+    return false;
+  for (unsigned char c : name)
+    if (c < 0x20 || c == 0x7F)
+      return false;
+  for (size_t start = 0; start <= name.size();) {
+    const size_t end = std::min(name.find('/', start), name.size());
+    const std::string part = name.substr(start, end - start);
+    if (part == ".." || part.empty())
+      return false;
+    start = end + 1;
+  }
+  return true;
+}
+
+/// --embed-textures: each texture file's bytes, read beside the input mesh.
+void embed_textures(const std::string &in, pomar::Mesh &mesh) {
+  mesh.texture_images.assign(mesh.texture_files.size(), {});
+  for (size_t t = 0; t < mesh.texture_files.size(); ++t) {
+    const std::string &name = mesh.texture_files[t];
+    const std::string path = name.size() && name[0] == '/' ? name : folder_of(in) + name;
+    try {
+      mesh.texture_images[t] = pomar::read_file(path);
+    } catch (const pomar::Error &e) {
+      throw pomar::Error(pomar::Error::Kind::Io, "--embed-textures: texture file '" + name +
+                                                     "' of " + in + " cannot be read: " + e.what());
+    }
+  }
+}
+
+/// The decoded mesh's embedded images, written beside `out` under their texture file
+/// names; an existing file is never replaced (the same bytes: nothing to do; other bytes:
+/// a warning). Returns how many images were written.
+size_t write_embedded_textures(const std::string &out, const pomar::Mesh &mesh, bool quiet) {
+  size_t written = 0;
+  for (size_t t = 0; t < mesh.texture_images.size() && t < mesh.texture_files.size(); ++t) {
+    const std::vector<uint8_t> &image = mesh.texture_images[t];
+    const std::string &name = mesh.texture_files[t];
+    if (image.empty())
+      continue;
+    if (!safe_texture_name(name)) {
+      std::fprintf(stderr,
+                   "pomar: warning: embedded texture %zu not written: its name is not a "
+                   "relative path inside the output's folder\n",
+                   t);
+      continue;
+    }
+    const std::string path = folder_of(out) + name;
+    if (std::FILE *f = std::fopen(path.c_str(), "rb")) {
+      std::fclose(f);
+      if (pomar::read_file(path) != image && !quiet)
+        std::fprintf(stderr,
+                     "pomar: warning: %s exists and differs from the embedded texture '%s': "
+                     "kept as it is\n",
+                     path.c_str(), name.c_str());
+      continue;
+    }
+    const size_t slash = name.rfind('/');
+    if (slash != std::string::npos) // its folders inside the output's
+      for (size_t at = name.find('/'); at != std::string::npos && at <= slash;
+           at = name.find('/', at + 1))
+        ::mkdir((folder_of(out) + name.substr(0, at)).c_str(), 0777);
+    pomar::write_file_atomic(path, image.data(), image.size());
+    ++written;
+  }
+  return written;
 }
 
 /// One stderr warning naming what is lost: `what` is the list, `why` ends the line.
@@ -174,10 +268,13 @@ int run_encode(const EncodeArgs &a) {
   });
   if (!a.quiet)
     warn_dropped(a.in, load.ignored_attributes, "has",
-                 ", not kept (.pomar keeps positions, triangles and per-vertex colour, normals, "
-                 "scalars and texture coordinates)");
+                 ", not kept (.pomar keeps positions, triangles, per-vertex colour, normals, "
+                 "scalars and texture coordinates, per-corner texture coordinates and "
+                 "materials)");
   const double t_load = since(t0);
   const double t_repair = a.repair ? repair_and_report(mesh, a.quiet) : 0.0;
+  if (a.embed_textures)
+    embed_textures(a.in, mesh);
   pomar::EncodeOptions opt;
   opt.bits = a.bits;
   opt.clusters = a.clusters;
@@ -419,6 +516,7 @@ int run_selective_decode(const DecodeArgs &a) {
   const pomar::Mesh mesh = d.exact_mesh(); // every region at its finest: the input exactly
   const double t_decode = since(t0);
   pomar::save_mesh(a.out, mesh, !a.ascii);
+  write_embedded_textures(a.out, mesh, a.quiet);
   if (!a.quiet)
     warn_dropped(a.out, pomar::attributes_not_saved(a.out, mesh), "cannot hold",
                  not_written_hint(a.out));
@@ -457,6 +555,7 @@ int run_decode(const DecodeArgs &a) {
   }
   const double t_decode = since(t0);
   pomar::save_mesh(a.out, mesh, !a.ascii);
+  write_embedded_textures(a.out, mesh, a.quiet);
   if (!a.quiet)
     warn_dropped(a.out, pomar::attributes_not_saved(a.out, mesh), "cannot hold",
                  not_written_hint(a.out));
@@ -533,6 +632,7 @@ nlohmann::json info_json(const pomar::FileInfo &i) {
   j["attributes"] = attributes;
   j["attribute_bytes"] = i.attribute_bytes;
   j["texture_files"] = i.texture_files;
+  j["embedded_texture_bytes"] = i.embedded_texture_bytes;
   return j;
 }
 
@@ -992,6 +1092,11 @@ int main(int argc, char **argv) {
                 "Also store the input's vertex numbering (a full decode gives the vertices back "
                 "in the input order, e.g. for per-vertex data kept elsewhere); costs a few bits "
                 "per vertex (pomar info shows it as the lossless record)");
+  enc->add_flag("--embed-textures", ea.embed_textures,
+                "Store the texture image files (found beside the input, by the names its "
+                "materials or header give) in the .pomar, so that one file is the whole asset; "
+                "decode writes them beside its output (never over an existing file). Without "
+                "it, the names are kept and resolved relative to the file");
   enc->add_flag("-q,--quiet", ea.quiet,
                 "Print nothing on success (what --repair changed is still printed)");
   enc->add_option("--drop", ea.drop,

@@ -830,6 +830,39 @@ run --help
 expect_rc 0
 for sub in encode decode info verify; do expect_contains "$OUT" "$sub" "pomar --help"; done
 
+section "a textured OBJ with --embed-textures: one self-contained file; decode writes the image beside its output"
+TEX="$WORK/tex"
+mkdir -p "$TEX/in" "$TEX/out" "$TEX/again"
+cp "$SAMPLES/textured_sphere.obj" "$SAMPLES/textured_sphere.mtl" "$SAMPLES/textured_sphere.png" "$TEX/in/"
+run encode --embed-textures "$TEX/in/textured_sphere.obj" "$TEX/sphere.pomar"
+expect_rc 0
+expect_contains "$ERR" "texture seam edges" "encode's stderr"
+run info "$TEX/sphere.pomar"
+expect_rc 0
+expect_contains "$OUT" "texture file textured_sphere.png (embedded, " "pomar info"
+expect_contains "$OUT" "per-corner texture coordinates" "pomar info"
+run verify "$TEX/in/textured_sphere.obj" "$TEX/sphere.pomar"
+expect_rc 0
+run decode -q "$TEX/sphere.pomar" "$TEX/out/back.obj"
+expect_rc 0
+cmp -s "$TEX/out/textured_sphere.png" "$SAMPLES/textured_sphere.png" || fail "the embedded image did not come back bit for bit"
+pass
+run verify "$TEX/in/textured_sphere.obj" "$TEX/sphere.pomar" "$TEX/out/back.obj"
+expect_rc 0
+# An existing file of that name is never replaced.
+printf 'not an image' >"$TEX/again/textured_sphere.png"
+run decode "$TEX/sphere.pomar" "$TEX/again/back.obj"
+expect_rc 0
+expect_contains "$ERR" "exists and differs from the embedded texture" "decode's stderr"
+[ "$(cat "$TEX/again/textured_sphere.png")" = "not an image" ] || fail "decode replaced an existing file"
+pass
+# A texture file that is not there is named.
+rm "$TEX/in/textured_sphere.png"
+run encode --embed-textures "$TEX/in/textured_sphere.obj" "$TEX/missing.pomar"
+expect_nonzero
+expect_contains "$ERR" "texture file 'textured_sphere.png'" "encode's error"
+expect_no_file "$TEX/missing.pomar"
+
 help_mentions() { # help_mentions SUBCOMMAND OPTION...
   local sub="$1"; shift
   section "$sub --help"
@@ -839,7 +872,7 @@ help_mentions() { # help_mentions SUBCOMMAND OPTION...
   for opt in "$@"; do expect_contains "$OUT" "$opt" "pomar $sub --help"; done
 }
 help_mentions encode --bits --progressive --clusters --cluster-ratio --repair --strict --keep-order --quiet --max-memory 512M input output \
-  --drop --normal-bits --scalar-bits --texcoord-bits --exact-attributes
+  --drop --normal-bits --scalar-bits --texcoord-bits --exact-attributes --embed-textures
 help_mentions decode --level --cluster --sphere --box --stats --ascii --quiet --skip-damaged --max-memory input output \
   --no-attributes
 help_mentions info --json --check input

@@ -106,6 +106,10 @@ struct Mesh {
   std::vector<uint32_t> triangles; // 3 * triangle_count()
   std::vector<VertexAttribute> attributes;
   std::vector<std::string> texture_files; ///< metadata, kept as given
+  /// Embedded texture images: texture_images[i] holds the bytes of texture_files[i] (empty:
+  /// not embedded), or the vector is empty. encode() stores them in the file (one .pomar is
+  /// then a self-contained asset); decode() gives them back bit for bit.
+  std::vector<std::vector<uint8_t>> texture_images;
   /// Per-corner texture coordinates (MeshLab's wedge texcoords, OBJ `f v/vt`, PLY face
   /// `texcoord`): u, v of corner k of triangle f at [6 f + 2 k], or empty. A vertex whose
   /// corners differ is on a seam; the codec keeps every corner's value (on a grid over
@@ -243,6 +247,8 @@ struct FileInfo {
   /// Per-vertex attributes (filled by inspect(); empty if the file has none).
   std::vector<AttributeInfo> attributes;
   std::vector<std::string> texture_files;
+  /// Per texture file: the bytes of its embedded image (0: not embedded; filled by inspect()).
+  std::vector<uint64_t> embedded_texture_bytes;
   uint64_t attribute_bytes = 0; ///< the whole ATTR section
   /// Version 4: bytes of the lossless record (0 = none): undone by a full decode.
   uint64_t lossless_bytes = 0;

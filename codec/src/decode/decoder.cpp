@@ -7,6 +7,7 @@
 
 #include "attributes/attribute_section.h"
 #include "attributes/material_section.h"
+#include "attributes/texture_images.h"
 #include "decode/damage.h"
 #include "decode/decoder_codec.h"
 #include "decode/global_levels.h"
@@ -30,8 +31,10 @@ FileInfo inspect(const uint8_t *data, size_t size) {
     const ClusterIndex index = read_cluster_index(data + layout.index_offset, layout);
     info.cluster_block_bytes = index.size;
   }
-  if (const auto table = load_attribute_table(data, layout))
+  if (const auto table = load_attribute_table(data, layout)) {
     describe_attributes(*table, info);
+    info.embedded_texture_bytes = texture_image_sizes(data, layout, table->texture_files.size());
+  }
   return info;
 }
 
@@ -172,6 +175,8 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
     Mesh mesh = d.take_mesh(); // (no second copy of the mesh)
     if (complete)
       undo_cut_or_report(data, layout, options, r, mesh); // the full mesh: as it was input
+    if (attributes && options.attributes.texcoords)
+      mesh.texture_images = load_texture_images(data, layout, attributes->texture_files.size());
     return mesh;
   }
   LevelMesh lm = base_level_mesh(data, layout);
@@ -192,6 +197,8 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
     attach_attributes(*attributes, lm, options.attributes, mesh);
   if (materials)
     attach_materials(*materials, options.attributes, mesh);
+  if (attributes && options.attributes.texcoords)
+    mesh.texture_images = load_texture_images(data, layout, attributes->texture_files.size());
   if (r.level == static_cast<int>(levels))
     undo_cut_or_report(data, layout, options, r, mesh); // the full mesh: as it was input
   return mesh;

@@ -10,6 +10,7 @@
 
 #include "attributes/attribute_section.h"
 #include "attributes/material_section.h"
+#include "attributes/texture_images.h"
 #include "decode/cluster_stream.h"
 #include "decode/damage.h"
 #include "decode/decoder_codec.h"
@@ -655,6 +656,9 @@ bool SelectiveDecoder::complete() const {
 
 Mesh SelectiveDecoder::exact_mesh(std::vector<uint32_t> *source) const {
   Mesh m = mesh();
+  if (s_->attributes && s_->attribute_mask.texcoords) // embedded images (TEXI), if any
+    m.texture_images =
+        load_texture_images(s_->global.data(), s_->layout, s_->attributes->texture_files.size());
   if (complete()) {
     undo_cut(s_->global.data(), s_->layout, m, source); // the record lies in the global part
   } else if (source) {

@@ -10,6 +10,7 @@
 
 #include "attributes/attribute_section.h"
 #include "attributes/material_section.h"
+#include "attributes/texture_images.h"
 #include "decimate/decimate.h"
 #include "encode/clusters.h"
 #include "encode/encoder_codec.h"
@@ -224,6 +225,9 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
       attributes.codes ? attribute_codes(mesh, attributes, options.attributes, in.to_input)
                        : std::vector<int64_t>();
   const size_t input_vertices = mesh.vertex_count();
+  std::vector<uint8_t> images; // (optional section: embedded texture images)
+  if (options.attributes.keep.texcoords && has_texture_images(mesh))
+    images = write_texture_images(mesh);
   if (release_input)
     release_input(); // `mesh` is not read past this point
 
@@ -296,6 +300,8 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
     sections.push_back(
         {kAttributeSectionTag, 0, write_attributes(attributes, header.base_vertices)}); // optional
   }
+  if (!images.empty())
+    sections.push_back({kTextureImagesTag, 0, std::move(images)});
   if (hook && !hook->materials.empty()) // per-corner values: a reader must turn them back
     sections.push_back({kMaterialSectionTag, kSectionRequired, hook->materials});
   if (hook) { // the lossless stage's record, in the decoder's numbering

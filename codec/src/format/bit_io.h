@@ -49,6 +49,11 @@ public:
     return f;
   }
   size_t position() const { return pos_; }
+  void skip(size_t n) {
+    if (pos_ > size_ || size_ - pos_ < n)
+      throw Error(Error::Kind::DamagedFile, std::string(what_) + " is truncated");
+    pos_ += n;
+  }
 
 private:
   uint32_t get(int n) {

@@ -553,7 +553,7 @@ const uint8_t *section_body(const uint8_t *data, const FileLayout &L, size_t i) 
 const std::vector<uint32_t> &known_sections() {
   // The sections this build's decoders honour.
   static const std::vector<uint32_t> known = {section_tag("ATTR"), kLosslessTag,
-                                              section_tag("MATL")};
+                                              section_tag("MATL"), section_tag("TEXI")};
   return known;
 }
 

@@ -810,6 +810,7 @@ Mesh apply_lossless_record(Mesh &&decoded, const LosslessRecord &r, const Quanti
   // stores (bit for bit).
   out.texture_files = std::move(decoded.texture_files);
   out.materials = std::move(decoded.materials);
+  out.texture_images = std::move(decoded.texture_images);
   out.corner_texcoord_bits = decoded.corner_texcoord_bits;
   out.corner_texcoord_bound = decoded.corner_texcoord_bound;
   for (size_t i = 0; i < decoded.attributes.size(); ++i) {
