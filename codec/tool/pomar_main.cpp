@@ -162,6 +162,18 @@ std::string folder_of(const std::string &path) {
   return slash == std::string::npos ? std::string() : path.substr(0, slash + 1);
 }
 
+/// A texture file name as a path beside `mesh_path`: MeshLab's "<this>" stands for the mesh
+/// file's name without its extension.
+std::string texture_path(const std::string &mesh_path, const std::string &name) {
+  std::string base = mesh_path.substr(folder_of(mesh_path).size());
+  if (const size_t dot = base.rfind('.'); dot != std::string::npos && dot > 0)
+    base.resize(dot);
+  std::string out = name;
+  for (size_t at = out.find("<this>"); at != std::string::npos; at = out.find("<this>", at))
+    out.replace(at, 6, base);
+  return out;
+}
+
 /// A texture file name a decode may write beside its output: relative, no "..", no control
 /// characters (the names come from the file).
 bool safe_texture_name(const std::string &name) {
@@ -185,7 +197,8 @@ void embed_textures(const std::string &in, pomar::Mesh &mesh) {
   mesh.texture_images.assign(mesh.texture_files.size(), {});
   for (size_t t = 0; t < mesh.texture_files.size(); ++t) {
     const std::string &name = mesh.texture_files[t];
-    const std::string path = name.size() && name[0] == '/' ? name : folder_of(in) + name;
+    const std::string file = texture_path(in, name);
+    const std::string path = file.size() && file[0] == '/' ? file : folder_of(in) + file;
     try {
       mesh.texture_images[t] = pomar::read_file(path);
     } catch (const pomar::Error &e) {
@@ -202,7 +215,7 @@ size_t write_embedded_textures(const std::string &out, const pomar::Mesh &mesh, 
   size_t written = 0;
   for (size_t t = 0; t < mesh.texture_images.size() && t < mesh.texture_files.size(); ++t) {
     const std::vector<uint8_t> &image = mesh.texture_images[t];
-    const std::string &name = mesh.texture_files[t];
+    const std::string name = texture_path(out, mesh.texture_files[t]);
     if (image.empty())
       continue;
     if (!safe_texture_name(name)) {
