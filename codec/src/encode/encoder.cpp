@@ -1,5 +1,6 @@
-// pomar::encode, as a list of steps: prepare the input (validate, quantize, renumber) ->
-// decimate (section 4) -> base mesh -> global levels (section 5.1) -> clustered levels
+// The manifold encoder (encode_manifold, called by pomar::encode in
+// lossless/lossless_stage.cpp), as a list of steps: prepare the input (validate, quantize,
+// renumber) -> decimate (section 4) -> base mesh -> global levels (section 5.1) -> clustered levels
 // (section 5.2, encode/clusters.cpp) -> file (format/file_format.cpp) -> report.
 // The levels are coded by the traversal the decoder runs (encode/encoder_codec.h).
 #include <algorithm>
