@@ -164,6 +164,7 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
     d.want_all(static_cast<int>(target));
     d.update(options.progress);
     r.damaged = d.damaged();
+    r.decode_rounds = d.decode_rounds();
     for (int l : d.levels()) {
       r.level = std::max(r.level, l);
       r.clusters_below_request += l < static_cast<int>(target);
