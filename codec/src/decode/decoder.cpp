@@ -21,7 +21,7 @@ namespace pomar {
 
 FileInfo inspect(const uint8_t *data, size_t size) {
   const FileLayout layout = read_layout(data, size);
-  read_base_mesh(data, layout); // checks the base block too
+  read_base_mesh(data, layout, false); // checks the base block too (nothing kept)
   FileInfo info = file_info(layout, size);
   lossless_info(data, layout, info);
   if (layout.header.clustered()) {
@@ -54,7 +54,7 @@ std::string describe_damage(const std::vector<DamagedBlock> &blocks, size_t firs
 std::vector<DamagedBlock> check_blocks(const uint8_t *data, size_t size) {
   const FileLayout layout = read_layout(data, size, size, true);
   const FileHeader &h = layout.header;
-  read_base_mesh(data, layout);
+  read_base_mesh(data, layout, false);
   std::vector<DamagedBlock> damaged;
   const size_t global = h.clustered() ? h.global_levels : h.levels.size();
   for (size_t i = 0; i < global; ++i) {
