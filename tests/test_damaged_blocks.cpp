@@ -187,10 +187,63 @@ TEST(DamagedBlocks, SeveralDamagedClusters) {
   d->want_all(d->finest_level());
   d->update();
   expect_decoded_around(e, *d, bad);
+  // Every damaged block fails its 8-bit check: all are found before the decode, in one round.
+  EXPECT_EQ(d->decode_rounds(), 1u);
   const std::vector<DamagedBlock> listed = check_blocks(file.data(), file.size());
   ASSERT_EQ(listed.size(), 3u);
   for (const DamagedBlock &b : listed)
     EXPECT_NE(b.problem.find("checksum mismatch"), std::string::npos);
+}
+
+// A truncated file with thousands of missing blocks costs what the blocks that are there
+// cost: the missing ones are found before the level map is decoded, so the map is decoded
+// once (one round), each block is read at most once, and the window of a parallel level
+// meets no missing block.
+TEST(DamagedBlocks, TruncatedManyClusterFileDecodesInOneRound) {
+  EncodeOptions eo;
+  eo.clusters = 5000;
+  Encoded e;
+  e.file = encode(gen::icosphere(6), eo);
+  e.info = inspect(e.file.data(), e.file.size());
+  ASSERT_GT(e.info.clusters, 4000u);
+  for (const double kept : {0.4, 0.6}) {
+    const size_t keep = size_t(double(e.file.size()) * kept);
+    ASSERT_GT(keep, e.info.global_bytes);
+    const std::vector<uint8_t> file(e.file.begin(), e.file.begin() + long(keep));
+    std::vector<uint32_t> missing;
+    for (uint32_t c = 0; c < e.info.clusters; ++c)
+      if (block_offset(e, c) + e.info.cluster_block_bytes[c] > keep)
+        missing.push_back(c);
+    ASSERT_GT(missing.size(), 1000u);
+    for (const unsigned threads : {1u, 2u}) {
+      SCOPED_TRACE("kept " + std::to_string(kept) + ", threads " + std::to_string(threads));
+      SelectiveOptions so;
+      so.skip_damaged = true;
+      so.threads = threads;
+      so.min_parallel_vertices = 0; // every level on the threads
+      SelectiveDecoder d(std::make_unique<MemorySource>(file.data(), file.size()), so);
+      d.want_all(d.finest_level());
+      d.update();
+      EXPECT_EQ(d.decode_rounds(), 1u);
+      EXPECT_EQ(d.blocks_read(), e.info.clusters - missing.size());
+      EXPECT_LE(d.bytes_read(), keep);
+      expect_decoded_around(e, d, missing);
+      // A finer request afterwards: the caps stand, nothing is decoded again.
+      d.want_all(d.finest_level());
+      d.update();
+      EXPECT_EQ(d.decode_rounds(), 2u);
+      EXPECT_EQ(d.damaged().size(), missing.size());
+      DecodeOptions o;
+      o.skip_damaged = true;
+      o.threads = threads;
+      o.min_parallel_vertices = 0;
+      DecodeReport r;
+      const Mesh m = decode(file.data(), file.size(), o, &r);
+      EXPECT_EQ(r.decode_rounds, 1u);
+      EXPECT_EQ(r.damaged.size(), missing.size());
+      EXPECT_EQ(canonical(m), canonical(d.mesh()));
+    }
+  }
 }
 
 TEST(DamagedBlocks, DamageFoundByARegionRequestStaysReportedOnce) {

@@ -11,6 +11,10 @@
 #include <functional>
 #include <iterator>
 
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <pomar/limits.h>
 
 #include "support/hostile_files.h"
@@ -20,6 +24,7 @@ namespace pomar {
 namespace {
 
 namespace fs = std::filesystem;
+using namespace hostile;
 const fs::path kRegressions = fs::path(POMAR_SOURCE_DIR) / "tests" / "fuzz" / "regressions";
 
 std::vector<uint8_t> read_bytes(const fs::path &p) {
@@ -51,6 +56,98 @@ std::string error_of(const std::function<void()> &f) {
     return e.what();
   }
   return "";
+}
+
+// A progressive image of a larger mesh whose header claims `base_vertices` and `base_faces`
+// (every level grown by one vertex and one face over them, so the level table stays
+// consistent), its base block zeroed (zero bytes decode as endless zero steps) and every
+// checksum recomputed (the header's at least: the base block's too if the layout accepts the
+// header, which `*parsed` says).
+std::vector<uint8_t> claiming_base(uint64_t base_vertices, uint64_t base_faces, bool *parsed) {
+  EncodeOptions o;
+  o.progressive = true;
+  o.memory_limit = kNoMemoryLimit;
+  std::vector<uint8_t> b = encode(gen::icosphere(5), o);
+  const uint32_t levels = uint32_t(get_le(b, 48, 4));
+  put_le(b, 40, base_vertices, 4);
+  put_le(b, 44, base_faces, 4);
+  for (uint32_t i = 0; i < levels; ++i) {
+    const size_t e = kFixedHeaderBytes + kLevelEntryBytes * i;
+    put_le(b, e, base_vertices + i + 1, 4);
+    put_le(b, e + 4, base_faces + i + 1, 4);
+  }
+  put_le(b, 32, base_vertices + levels, 4);
+  put_le(b, 36, base_faces + levels, 4);
+  const size_t base_at = header_size(b.data(), b.size()); // (the base block follows the header)
+  std::fill(b.begin() + long(base_at), b.begin() + long(base_at + get_le(b, 52, 4)), 0);
+  *parsed = repair_checksums(b);
+  return b;
+}
+
+/// Runs `f` in a child whose address space may grow by at most `extra` bytes; returns
+/// true if it finished (every call refused the file with pomar::Error or decoded it).
+bool within_address_space(uint64_t extra, const std::function<void()> &f) {
+  long pages = 0, page = sysconf(_SC_PAGESIZE);
+  {
+    std::ifstream statm("/proc/self/statm");
+    statm >> pages;
+  }
+  const pid_t child = fork();
+  if (child == 0) {
+    const rlim_t limit = rlim_t(pages) * rlim_t(page) + extra;
+    const rlimit r{limit, limit};
+    setrlimit(RLIMIT_AS, &r);
+    try {
+      f();
+    } catch (const Error &) {
+    } catch (...) {
+      _exit(2);
+    }
+    _exit(0);
+  }
+  int status = 0;
+  waitpid(child, &status, 0);
+  return WIFEXITED(status) && WEXITSTATUS(status) == 0;
+}
+
+// Inspection needs memory and time in proportion to the file: the base counts are bounded
+// by the base block before anything is sized from them (two sign bits a face, three
+// vertices a face at most), and the base mesh is checked without being stored.
+TEST(HostileFiles, BaseCountsAreBoundedByTheBaseBlock) {
+  bool parsed = true;
+  const std::vector<uint8_t> sizes = claiming_base(1000, 1000, &parsed); // (for its sizes)
+  const uint64_t base_bytes = get_le(sizes, 52, 4), file = sizes.size();
+  // Far more than the block can hold, within the 512 x file size rule: refused by the
+  // layout, before a count is used (no loop runs: the message says so).
+  const uint64_t huge = 400 * file;
+  const std::vector<uint8_t> claims = claiming_base(3 * huge / 2, huge, &parsed);
+  EXPECT_FALSE(parsed);
+  for (const std::function<void()> &f :
+       std::vector<std::function<void()>>{[&] { inspect(claims.data(), claims.size()); },
+                                          [&] { check_blocks(claims.data(), claims.size()); },
+                                          [&] { decode(claims.data(), claims.size()); }})
+    EXPECT_NE(error_of(f).find("cannot be coded in a base mesh block"), std::string::npos)
+        << error_of(f);
+  // As much as the bounds let through, zero bytes: the positions decode (all zero), the
+  // first face repeats a vertex and stops the stream; nothing of the claimed mesh is stored.
+  const uint64_t faces = 4 * base_bytes + 64;
+  const std::vector<uint8_t> zeros = claiming_base(3 * faces, faces, &parsed);
+  EXPECT_TRUE(parsed);
+  for (const std::function<void()> &f :
+       std::vector<std::function<void()>>{[&] { inspect(zeros.data(), zeros.size()); },
+                                          [&] { check_blocks(zeros.data(), zeros.size()); }})
+    EXPECT_NE(error_of(f).find("base mesh face repeats a vertex"), std::string::npos)
+        << error_of(f);
+    // Memory: every entry point within 64 MiB more address space (a child with RLIMIT_AS).
+#if !defined(__SANITIZE_ADDRESS__)
+  for (const std::vector<uint8_t> *b : {&claims, &zeros})
+    EXPECT_TRUE(within_address_space(uint64_t(64) << 20, [&] {
+      for (const std::function<void()> &f : std::vector<std::function<void()>>{
+               [&] { inspect(b->data(), b->size()); }, [&] { check_blocks(b->data(), b->size()); },
+               [&] { decode(b->data(), b->size()); }})
+        error_of(f);
+    }));
+#endif
 }
 
 // The file of ../shared/regressions (found by a 20-minute fuzz_decoder run): tables placed

@@ -371,6 +371,9 @@ struct DecodeReport {
   int level = 0;                     ///< the finest level decoded anywhere
   /// Clustered files with damage: clusters decoded below the requested level.
   uint32_t clusters_below_request = 0;
+  /// Clustered files: the level map's decode rounds (SelectiveDecoder::decode_rounds): 1,
+  /// plus one per damaged block that passed its checks and failed while it was decoded.
+  uint32_t decode_rounds = 0;
 };
 
 /// One line per block of blocks[first..], "  cluster 17 (kept at level 16): problem" (no

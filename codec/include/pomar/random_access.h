@@ -181,6 +181,10 @@ public:
   uint64_t bytes_read() const;       ///< everything read from the source so far
   uint32_t blocks_read() const;      ///< cluster blocks read so far
   uint32_t clusters_decoded() const; ///< clusters above the base clustered level
+  /// Level maps decoded by update() so far: one per update() (clustered files), plus
+  /// one for each block that fails while it is decoded (a block missing from a truncated
+  /// file or failing its check is found before, and costs no round).
+  uint32_t decode_rounds() const;
 
 private:
   struct State;

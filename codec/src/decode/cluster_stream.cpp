@@ -18,20 +18,22 @@ void ClusterStream::init(ByteSource *source, uint32_t id, uint64_t offset, uint3
   stats_ = stats;
 }
 
-void ClusterStream::fail_check() const {
-  throw Error(Error::Kind::DamagedFile,
-              "damaged .pomar file: checksum mismatch in the block of cluster " +
-                  std::to_string(id_))
-      .in_block(Error::kNoBlock, id_);
+std::string ClusterStream::check_message() const {
+  return "damaged .pomar file: checksum mismatch in the block of cluster " + std::to_string(id_);
 }
 
-size_t ClusterStream::more(size_t needed) {
-  if (failed_)
-    fail_check();
-  const size_t size = block_.size();
-  if (loaded_ >= size)
-    return loaded_; // past the end: the decoder reads zeros (and notices overruns)
-  const size_t upto = std::min(size, std::max(needed, loaded_ + kChunk));
+bool ClusterStream::missing() const { return offset_ + size_ > source_->size(); }
+
+std::string ClusterStream::missing_message() const {
+  return "truncated .pomar file: the block of cluster " + std::to_string(id_) + " ends at byte " +
+         std::to_string(offset_ + size_) + ", the file has " + std::to_string(source_->size());
+}
+
+void ClusterStream::fail_check() const {
+  throw Error(Error::Kind::DamagedFile, check_message()).in_block(Error::kNoBlock, id_);
+}
+
+bool ClusterStream::load(size_t upto) {
   {
     const std::lock_guard<std::mutex> guard(stats_->lock);
     source_->read(offset_ + loaded_, upto - loaded_, block_.data() + loaded_);
@@ -40,24 +42,29 @@ size_t ClusterStream::more(size_t needed) {
       ++stats_->blocks;
   }
   loaded_ = upto;
-  if (loaded_ == size && !checked_) {
-    failed_ = !passes_block_check(block_.data(), size, check_);
-    if (failed_)
-      fail_check();
-    checked_ = true;
+  if (loaded_ == block_.size() && !checked_) {
+    failed_ = !passes_block_check(block_.data(), loaded_, check_);
+    checked_ = !failed_;
   }
+  return !failed_;
+}
+
+size_t ClusterStream::more(size_t needed) {
+  if (failed_)
+    fail_check();
+  const size_t size = block_.size();
+  if (loaded_ >= size)
+    return loaded_; // past the end: the decoder reads zeros (and notices overruns)
+  if (!load(std::min(size, std::max(needed, loaded_ + kChunk))))
+    fail_check();
   return loaded_;
 }
 
 void ClusterStream::start(bool whole) {
   // A truncated file (accepted with skip_damaged): nothing is allocated for a block that
   // is not there.
-  if (offset_ + size_ > source_->size())
-    throw Error(Error::Kind::TruncatedFile, "truncated .pomar file: the block of cluster " +
-                                                std::to_string(id_) + " ends at byte " +
-                                                std::to_string(offset_ + size_) +
-                                                ", the file has " + std::to_string(source_->size()))
-        .in_block(Error::kNoBlock, id_);
+  if (missing())
+    throw Error(Error::Kind::TruncatedFile, missing_message()).in_block(Error::kNoBlock, id_);
   if (failed_)
     fail_check();
   if (block_.empty() && size_ > 0)
@@ -67,6 +74,18 @@ void ClusterStream::start(bool whole) {
   else if (loaded_ < std::min<size_t>(block_.size(), kChunk))
     more(std::min<size_t>(block_.size(), kChunk));
   rc_.reset(block_.data(), loaded_, this);
+}
+
+std::string ClusterStream::problem() {
+  if (missing())
+    return missing_message();
+  if (failed_)
+    return check_message();
+  if (checked_ || size_ == 0)
+    return {};
+  if (block_.empty())
+    block_.resize(size_);
+  return load(block_.size()) ? std::string() : check_message();
 }
 
 } // namespace pomar

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <mutex>
+#include <string>
 #include <vector>
 
 #include "entropy/range_coder.h"
@@ -33,6 +34,9 @@ public:
   /// decoded to the end, or its check must pass first), otherwise bytes are read as the
   /// decoder needs them. Throws if the file ends before the block (truncated file).
   void start(bool whole);
+  /// The checks start(true) makes, without the throw: the block is read whole if the file
+  /// holds it. Returns why start(true) would fail (empty: it would not).
+  std::string problem();
   RangeDecoder &decoder() { return rc_; }
   /// The block passed its 8-bit check (it has been read whole).
   bool checked() const { return checked_; }
@@ -42,6 +46,10 @@ public:
 
 private:
   [[noreturn]] void fail_check() const;
+  bool load(size_t upto); // reads up to byte `upto`; false if the whole block fails its check
+  bool missing() const;   // the file ends before the block (truncated file)
+  std::string missing_message() const;
+  std::string check_message() const;
   ByteSource *source_ = nullptr;
   ReadStats *stats_ = nullptr;
   uint32_t id_ = 0, size_ = 0;

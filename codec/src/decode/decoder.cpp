@@ -22,7 +22,7 @@ namespace pomar {
 
 FileInfo inspect(const uint8_t *data, size_t size) {
   const FileLayout layout = read_layout(data, size);
-  read_base_mesh(data, layout); // checks the base block too
+  read_base_mesh(data, layout, false); // checks the base block too (nothing kept)
   FileInfo info = file_info(layout, size);
   lossless_info(data, layout, info);
   if (layout.header.clustered()) {
@@ -57,7 +57,7 @@ std::string describe_damage(const std::vector<DamagedBlock> &blocks, size_t firs
 std::vector<DamagedBlock> check_blocks(const uint8_t *data, size_t size) {
   const FileLayout layout = read_layout(data, size, size, true);
   const FileHeader &h = layout.header;
-  read_base_mesh(data, layout);
+  read_base_mesh(data, layout, false);
   std::vector<DamagedBlock> damaged;
   const size_t global = h.clustered() ? h.global_levels : h.levels.size();
   for (size_t i = 0; i < global; ++i) {
@@ -167,6 +167,7 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
     d.want_all(static_cast<int>(target));
     d.update(options.progress);
     r.damaged = d.damaged();
+    r.decode_rounds = d.decode_rounds();
     for (int l : d.levels()) {
       r.level = std::max(r.level, l);
       r.clusters_below_request += l < static_cast<int>(target);

@@ -94,6 +94,8 @@ struct SelectiveDecoder::State {
   void check_target_memory() const;
   void check_cluster_data();
   bool skip_cluster(uint32_t c, const Error &e);
+  void cap_failing_blocks();
+  uint32_t rounds = 0;     // decode_target calls (SelectiveDecoder::decode_rounds)
   std::vector<int> target; // the level map being decoded
   int target_of(uint32_t c) const { return target.empty() ? finest : target[c]; }
 };
@@ -241,6 +243,23 @@ void SelectiveDecoder::State::decode_level_parallel(const std::vector<uint32_t> 
   }
 }
 
+/// With skip_damaged, before a level map is decoded: the blocks it needs that are missing
+/// (truncated file) or fail their 8-bit check, all found at once without a throw (each is
+/// read whole, as its decode would read it) and capped as skip_cluster caps them. A level
+/// map limited by the caps needs no other block, so the decode that follows meets only
+/// damage no check can see (a block that passes its checks and still fails).
+void SelectiveDecoder::State::cap_failing_blocks() {
+  for (uint32_t c = 0; c < target.size(); ++c) {
+    if (target[c] <= clusters[c].level || cap[c] == global_levels)
+      continue;
+    const std::string problem = clusters[c].stream.problem();
+    if (problem.empty())
+      continue;
+    damaged.push_back(damaged_cluster(c, problem, global_levels));
+    cap[c] = global_levels;
+  }
+}
+
 /// After `e` while decoding cluster `c` (kNone: not in a cluster): with skip_damaged,
 /// record the damage, cap the cluster at the base clustered level and return true (the
 /// caller decodes again); otherwise false (the caller rethrows).
@@ -379,6 +398,7 @@ const std::vector<int> &SelectiveDecoder::levels() const { return s_->levels; }
 const std::vector<DamagedBlock> &SelectiveDecoder::damaged() const { return s_->damaged; }
 uint64_t SelectiveDecoder::bytes_read() const { return s_->reads.bytes; }
 uint32_t SelectiveDecoder::blocks_read() const { return s_->reads.blocks; }
+uint32_t SelectiveDecoder::decode_rounds() const { return s_->rounds; }
 
 uint32_t SelectiveDecoder::clusters_decoded() const {
   uint32_t n = 0;
@@ -518,8 +538,10 @@ void SelectiveDecoder::update(const Progress &progress) {
       s.uniform_cap = int(reached);
     return;
   }
-  // Decode the completed level map; a damaged block caps its cluster and the map is
-  // completed and decoded again (each round skips one more block, so this ends).
+  // Decode the completed level map. Blocks that are missing or fail their check are capped
+  // before it is decoded (cap_failing_blocks); a block that fails while it is decoded caps
+  // its cluster and the map is completed and decoded again (each such round skips one more
+  // block, so this ends).
   for (;;) {
     uint32_t decoding = kNone; // the cluster being decoded when an error is thrown
     try {
@@ -535,8 +557,11 @@ void SelectiveDecoder::update(const Progress &progress) {
 /// Bring the mesh to the level map completed from `wanted` and limited by the caps;
 /// `decoding` names the cluster being decoded (kNone between clusters).
 void SelectiveDecoder::State::decode_target(const Progress &progress, uint32_t &decoding) {
+  ++rounds;
   target = complete_level_map(wanted, graph.start, graph.adj, global_levels, graph.link_start,
                               graph.link);
+  if (skip_damaged)
+    cap_failing_blocks();
   if (!damaged.empty()) {
     // Each damaged cluster limits the others to its cap + their distance to it, the
     // largest map below both the request and the caps that keeps the level map rule.

@@ -131,7 +131,8 @@ constexpr uint64_t kMaxFileBytes = uint64_t(1) << 48;
 /// offset wrap around and land back inside the buffer).
 void advance(uint64_t &offset, uint64_t bytes, const char *what) {
   if (bytes > kMaxFileBytes || offset > kMaxFileBytes - bytes)
-    bad(std::string(what) + " size " + std::to_string(bytes) + " is impossible (more than 2^48 bytes)");
+    bad(std::string(what) + " size " + std::to_string(bytes) +
+        " is impossible (more than 2^48 bytes)");
   offset += bytes;
 }
 
@@ -193,8 +194,9 @@ std::vector<uint8_t> write_file(FileHeader header, const std::vector<uint8_t> &b
                                 const std::vector<std::vector<uint8_t>> &cluster_blocks,
                                 const std::vector<Section> &sections) {
   if (sections.size() > kMaxSections)
-    throw Error(Error::Kind::Internal, "internal error: more than " + std::to_string(kMaxSections) + " sections");
-  header.version = !sections.empty() ? kSectionsFormatVersion
+    throw Error(Error::Kind::Internal,
+                "internal error: more than " + std::to_string(kMaxSections) + " sections");
+  header.version = !sections.empty()    ? kSectionsFormatVersion
                    : header.clustered() ? kClusteredFormatVersion
                                         : kFormatVersion;
   header.flags = static_cast<uint16_t>((header.flags & kFlagClustered) |
@@ -249,8 +251,8 @@ size_t header_size(const uint8_t *data, size_t size) {
   const uint16_t flags = r.u16();
   ByteReader c(data + 48, 4, "the .pomar header");
   const uint64_t levels = std::min<uint32_t>(c.u32(), kMaxLevels);
-  size_t bytes =
-      kFixedHeaderBytes + kLevelEntryBytes * levels + ((flags & kFlagClustered) ? kClusterHeaderBytes : 0);
+  size_t bytes = kFixedHeaderBytes + kLevelEntryBytes * levels +
+                 ((flags & kFlagClustered) ? kClusterHeaderBytes : 0);
   if (flags & kFlagSections) { // version 4: the section count, then the table
     if (size < bytes + 4)
       return bytes + 4;
@@ -277,8 +279,9 @@ FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size, boo
                                               " (this build reads versions 1 to 4)");
   h.flags = r.u16();
   const bool v4 = h.version == kSectionsFormatVersion;
-  const bool flags_ok = v4 ? (h.flags & ~(kFlagClustered | kFlagSections)) == 0 && (h.flags & kFlagSections)
-                           : (h.flags & ~kFlagClustered) == 0 && (h.version != kFormatVersion) == h.clustered();
+  const bool flags_ok =
+      v4 ? (h.flags & ~(kFlagClustered | kFlagSections)) == 0 && (h.flags & kFlagSections)
+         : (h.flags & ~kFlagClustered) == 0 && (h.version != kFormatVersion) == h.clustered();
   if (!flags_ok)
     bad("unknown flags " + std::to_string(h.flags) + " for version " + std::to_string(h.version));
   h.grid.bits = r.u8();
@@ -388,6 +391,18 @@ FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size, boo
     bad("level table does not end at the announced vertex/face counts");
   if (h.base_bytes == 0)
     bad("empty base mesh block");
+  // The base block bounds the base counts: a face's two other corners differ from its first
+  // (build_corner_table refuses repeats), so each costs at least a sign bit, two bits a face,
+  // and a stream of n bytes holds at most 8 (n + 9) + 32 bits (the decoder reads up to 8
+  // zero bytes past its end); every base vertex is used by a face (the encoder codes no
+  // unreferenced vertex), so there are at most three per face. A header claiming more is
+  // refused before anything is sized from it.
+  if (h.base_faces > 4 * uint64_t(h.base_bytes) + 64)
+    bad(std::to_string(h.base_faces) + " base faces cannot be coded in a base mesh block of " +
+        std::to_string(h.base_bytes) + " bytes");
+  if (h.base_vertices > 3 * uint64_t(h.base_faces))
+    bad(std::to_string(h.base_vertices) + " base vertices for " + std::to_string(h.base_faces) +
+        " base faces: more than three per face");
   // Offsets: every addition is checked (advance), and nothing below subtracts sizes.
   uint64_t offset = L.header_bytes;
   L.base_offset = offset;
@@ -419,8 +434,8 @@ FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size, boo
   L.file_size = file_size;
   // With allow_truncated, only what every decode needs must be present; a strict reader
   // needs every byte the header announces.
-  const uint64_t needed = !allow_truncated ? offset
-                          : h.clustered()  ? L.global_bytes
+  const uint64_t needed = !allow_truncated         ? offset
+                          : h.clustered()          ? L.global_bytes
                           : L.level_offset.empty() ? L.global_bytes
                                                    : L.level_offset[0]; // base + sections
   if (needed > file_size)
@@ -432,7 +447,7 @@ FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size, boo
   return L;
 }
 
-BaseMesh read_base_mesh(const uint8_t *data, const FileLayout &L) {
+BaseMesh read_base_mesh(const uint8_t *data, const FileLayout &L, bool keep) {
   const FileHeader &h = L.header;
   const uint8_t *p = data + L.base_offset;
   if (checksum(p, h.base_bytes) != h.base_checksum)
@@ -444,31 +459,43 @@ BaseMesh read_base_mesh(const uint8_t *data, const FileLayout &L) {
   RangeDecoder rc(p, h.base_bytes);
   BaseModels m;
   const int64_t top = (int64_t(1) << h.grid.bits) - 1;
-  b.q.resize(size_t(h.base_vertices) * 3);
+  // (The counts are bounded by the block's size, read_layout; a stream that runs past its
+  // block stops at once.)
+  const size_t nq = size_t(h.base_vertices) * 3, nt = size_t(h.base_faces) * 3;
+  if (keep)
+    b.q.resize(nq);
   int64_t prev[3] = {0, 0, 0};
-  for (size_t i = 0; i < b.q.size(); ++i) {
+  for (size_t i = 0; i < nq; ++i) {
     const int64_t v = prev[i % 3] + get_signed(rc, m.coord[i % 3], nullptr);
     if (v < 0 || v > top)
       bad("position outside the quantization grid");
-    b.q[i] = static_cast<int32_t>(v);
+    if (rc.overrun())
+      bad("data ends too early");
+    if (keep)
+      b.q[i] = static_cast<int32_t>(v);
     prev[i % 3] = v;
   }
-  b.triangles.resize(size_t(h.base_faces) * 3);
+  if (keep)
+    b.triangles.resize(nt);
   int64_t prev_first = 0;
-  for (size_t f = 0; f < b.triangles.size(); f += 3) {
+  for (size_t f = 0; f < nt; f += 3) {
     const int64_t a = prev_first + get_signed(rc, m.first, nullptr);
     const int64_t x = a + get_signed(rc, m.other, nullptr),
                   y = a + get_signed(rc, m.other, nullptr);
     for (int64_t i : {a, x, y})
       if (i < 0 || i >= int64_t(h.base_vertices))
         bad("face refers to a missing vertex");
-    b.triangles[f] = uint32_t(a);
-    b.triangles[f + 1] = uint32_t(x);
-    b.triangles[f + 2] = uint32_t(y);
+    if (x == a || y == a || x == y)
+      bad("face repeats a vertex");
+    if (rc.overrun())
+      bad("data ends too early");
+    if (keep) {
+      b.triangles[f] = uint32_t(a);
+      b.triangles[f + 1] = uint32_t(x);
+      b.triangles[f + 2] = uint32_t(y);
+    }
     prev_first = a;
   }
-  if (rc.overrun())
-    bad("data ends too early");
   return b;
 }
 
@@ -491,6 +518,12 @@ ClusterIndex read_cluster_index(const uint8_t *data, const FileLayout &L) {
   const FileHeader &h = L.header;
   check_block(data, h.index_bytes, h.index_checksum, "cluster index");
   ClusterIndex index;
+  // Each entry ends with its 8-bit check (8 bits the stream must hold): the index block
+  // bounds the count (read_base_mesh: at most 8 (n + 9) + 32 bits in n bytes).
+  if (h.clusters > uint64_t(h.index_bytes) + 16)
+    throw Error(Error::Kind::DamagedFile, "damaged .pomar file: " + std::to_string(h.clusters) +
+                                              " clusters cannot be indexed in " +
+                                              std::to_string(h.index_bytes) + " bytes");
   RangeDecoder rc(data, h.index_bytes);
   SizeModels m;
   uint64_t offset = L.clusters_offset, total = 0;
@@ -541,12 +574,14 @@ int find_section(const FileLayout &L, uint32_t tag) {
 const uint8_t *section_body(const uint8_t *data, const FileLayout &L, size_t i) {
   const SectionEntry &e = L.header.sections.at(i);
   if (L.section_offset[i] + e.bytes > L.file_size)
-    throw Error(Error::Kind::TruncatedFile, "truncated .pomar file: section " + section_name(e.tag) + " ends at byte " +
-                std::to_string(L.section_offset[i] + e.bytes) + ", the file has " +
-                std::to_string(L.file_size));
+    throw Error(Error::Kind::TruncatedFile, "truncated .pomar file: section " +
+                                                section_name(e.tag) + " ends at byte " +
+                                                std::to_string(L.section_offset[i] + e.bytes) +
+                                                ", the file has " + std::to_string(L.file_size));
   const uint8_t *p = data + L.section_offset[i];
   if (checksum(p, e.bytes) != e.checksum)
-    throw Error(Error::Kind::DamagedFile, "damaged .pomar file: checksum mismatch in section " + section_name(e.tag));
+    throw Error(Error::Kind::DamagedFile,
+                "damaged .pomar file: checksum mismatch in section " + section_name(e.tag));
   return p;
 }
 
@@ -560,8 +595,9 @@ const std::vector<uint32_t> &known_sections() {
 void require_known_sections(const FileLayout &L, const std::vector<uint32_t> &known) {
   for (const SectionEntry &e : L.header.sections)
     if ((e.flags & kSectionRequired) && std::find(known.begin(), known.end(), e.tag) == known.end())
-      throw Error(Error::Kind::Unsupported, "this build of pomar cannot read the file's section " + section_name(e.tag) +
-                  ", which it needs (written by a newer pomar?)");
+      throw Error(Error::Kind::Unsupported, "this build of pomar cannot read the file's section " +
+                                                section_name(e.tag) +
+                                                ", which it needs (written by a newer pomar?)");
 }
 
 std::vector<uint8_t> with_sections(const uint8_t *file, size_t size,

@@ -106,7 +106,7 @@ struct FileLayout {
   size_t header_bytes = 0;
   size_t base_offset = 0;
   std::vector<size_t> section_offset; // start of each section's body
-  std::vector<size_t> level_offset; // start of each global level's connectivity bytes
+  std::vector<size_t> level_offset;   // start of each global level's connectivity bytes
   size_t tables_offset = 0, index_offset = 0, clusters_offset = 0;
   size_t global_bytes = 0; // everything before the first cluster block
   uint64_t file_size = 0;  // bytes actually present (less than announced if truncated)
@@ -151,8 +151,9 @@ FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size = 0,
                        bool allow_truncated = false);
 /// Decode the cluster index block (`data` = the whole index block).
 ClusterIndex read_cluster_index(const uint8_t *data, const FileLayout &layout);
-/// Check the base block's checksum and unpack it.
-BaseMesh read_base_mesh(const uint8_t *data, const FileLayout &layout);
+/// Check the base block's checksum and unpack it; `keep` false checks it without storing
+/// anything (inspection: memory independent of the counts).
+BaseMesh read_base_mesh(const uint8_t *data, const FileLayout &layout, bool keep = true);
 /// Throw if level `i` is missing (truncated file) or its checksum does not match.
 void check_level(const uint8_t *data, const FileLayout &layout, size_t i);
 /// The index of the section with `tag`, or -1.
