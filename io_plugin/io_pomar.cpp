@@ -74,12 +74,13 @@ bool hasOwnVertexNormals(const CMeshO &m) {
   return count > 0 && differ * 100 > count;
 }
 
-/// The per-vertex data a .pomar file keeps (vcg::tri::io::Mask bits).
+/// The per-vertex and per-wedge data a .pomar file keeps (vcg::tri::io::Mask bits).
 constexpr int kKeptMask = vcg::tri::io::Mask::IOM_VERTCOLOR | vcg::tri::io::Mask::IOM_VERTNORMAL |
                           vcg::tri::io::Mask::IOM_VERTQUALITY |
-                          vcg::tri::io::Mask::IOM_VERTTEXCOORD;
+                          vcg::tri::io::Mask::IOM_VERTTEXCOORD |
+                          vcg::tri::io::Mask::IOM_WEDGTEXCOORD;
 
-/// What the layer has of the kept per-vertex data (MeshModel's data mask), as from_vcg's mask.
+/// What the layer has of the kept data (MeshModel's data mask), as from_vcg's mask.
 int layerAttributes(MeshModel &mm) {
   using M = vcg::tri::io::Mask;
   int mask = pomar::kVcgCustomScalars;
@@ -91,11 +92,14 @@ int layerAttributes(MeshModel &mm) {
     mask |= M::IOM_VERTQUALITY;
   if (mm.hasDataMask(MeshModel::MM_VERTTEXCOORD))
     mask |= M::IOM_VERTTEXCOORD;
+  if (mm.hasDataMask(MeshModel::MM_WEDGTEXCOORD))
+    mask |= M::IOM_WEDGTEXCOORD;
   return mask;
 }
 
 /// What the mesh carries that the saved .pomar file does not keep: everything but positions,
-/// triangles, named per-vertex float attributes and the per-vertex data in `saveMask`.
+/// triangles, named per-vertex float attributes and the per-vertex and per-wedge data in
+/// `saveMask` (texture names with either texture coordinates).
 QStringList notKept(MeshModel &mm, int saveMask) {
   using M = vcg::tri::io::Mask;
   const CMeshO &m = mm.cm;
@@ -131,16 +135,15 @@ QStringList notKept(MeshModel &mm, int saveMask) {
   if (mm.hasDataMask(MeshModel::MM_FACEQUALITY) &&
       anyFace([](const CFaceO &f) { return f.cQ() != 0; }))
     out << "per-face quality";
-  if (mm.hasDataMask(MeshModel::MM_WEDGTEXCOORD))
-    out << "per-wedge texture coordinates";
+  if (mm.hasDataMask(MeshModel::MM_WEDGTEXCOORD) && !(saveMask & M::IOM_WEDGTEXCOORD))
+    out << "per-wedge texture coordinates (tick TexCoord under Wedge / -m wt)";
   if (mm.hasDataMask(MeshModel::MM_WEDGNORMAL))
     out << "per-wedge normals";
   if (mm.hasDataMask(MeshModel::MM_WEDGCOLOR))
     out << "per-wedge colors";
   if (mm.hasDataMask(MeshModel::MM_POLYGONAL))
     out << "polygons (faux edges; saved as triangles)";
-  if (!m.textures.empty() &&
-      !(mm.hasDataMask(MeshModel::MM_VERTTEXCOORD) && (saveMask & M::IOM_VERTTEXCOORD)))
+  if (!m.textures.empty() && !(saveMask & (M::IOM_VERTTEXCOORD | M::IOM_WEDGTEXCOORD)))
     out << QString("%1 texture(s)").arg(m.textures.size());
   if (m.en > 0)
     out << QString("%1 edge(s)").arg(m.en);
@@ -177,9 +180,10 @@ QList<MeshIOInterface::Format> PomarIOPlugin::exportFormats() const {
 
 void PomarIOPlugin::GetExportMaskCapability(QString & /*format*/, int &capability,
                                             int &defaultBits) const {
-  // Per-vertex colour, normals, quality and texture coordinates (named per-vertex float
-  // attributes are always kept). Normals are off by default: MeshLab recomputes them from
-  // the geometry; a layer with its own normals gets a warning if they are not ticked.
+  // Per-vertex colour, normals, quality and texture coordinates, per-wedge texture coordinates
+  // with each face's texture (named per-vertex float attributes are always kept). Normals are
+  // off by default: MeshLab recomputes them from the geometry; a layer with its own normals
+  // gets a warning if they are not ticked.
   capability = kKeptMask;
   defaultBits = kKeptMask & ~vcg::tri::io::Mask::IOM_VERTNORMAL;
 }
@@ -281,13 +285,12 @@ bool PomarIOPlugin::open(const QString &format, const QString &fileName, MeshMod
       pomar::meshlab::warn(*this, "", warning);
     }
 
-    if (mesh.find(pomar::AttributeKind::TexCoord))
-      m.updateDataMask(MeshModel::MM_VERTTEXCOORD); // optional in CMeshO: enable first
-    if (!mesh.corner_texcoords.empty())
-      m.updateDataMask(MeshModel::MM_WEDGTEXCOORD); // per-corner UVs: the wedges'
+    pomar::meshlab::enableRoomFor(mesh, m);
     // Also clears m's attributes. What was read goes into the layer's data mask too: the GUI
-    // picks the rendering (vertex colour, ...) from that mask, not from the returned one.
-    mask = pomar::to_vcg(mesh, m.cm) & (kKeptMask | vcg::tri::io::Mask::IOM_WEDGTEXCOORD);
+    // picks the rendering (vertex colour, wedge texture, ...) from that mask, not from the
+    // returned one. m.textures are names relative to the file: the GUI loads them after open()
+    // with the file's folder as the current directory, as for the stock OBJ and PLY readers.
+    mask = pomar::to_vcg(mesh, m.cm) & kKeptMask;
     m.Enable(mask);
     if (!info.clustered())
       cluster.clear(); // a progressive file's vertices have no cluster
@@ -411,8 +414,9 @@ bool PomarIOPlugin::save(const QString &format, const QString &fileName, MeshMod
   if (!dropped.isEmpty())
     pomar::meshlab::warn(
         *this, "",
-        QString("%1: not saved (a .pomar file keeps positions, triangles and per-vertex "
-                "colour, normals, quality, texture coordinates and float attributes): %2")
+        QString("%1: not saved (a .pomar file keeps positions, triangles, per-vertex colour, "
+                "normals, quality, texture coordinates and float attributes, per-wedge texture "
+                "coordinates and texture names): %2")
             .arg(QFileInfo(path).fileName(), dropped.join("; ")));
   Log("pomar: saved %s: %zu bytes", qUtf8Printable(path), bytes.size());
   return true;

@@ -7,8 +7,11 @@
 //            file) and "pomar_level" (-1 when unknown), and the per-mesh std::string
 //            attribute "pomar_source": the absolute path of the file, for filter plugins
 //            that refine the mesh later from the same file.
-//   save():  positions and triangles only (anything else is named in a warning); the file
-//            is encoded in memory and then replaces the destination atomically.
+//   save():  positions, triangles, named per-vertex floats and what the save mask ticks of
+//            per-vertex colour, normals, quality and texture coordinates and per-wedge
+//            texture coordinates (with each face's texture and the texture names); anything
+//            else is named in a warning. The file is encoded in memory and then replaces the
+//            destination atomically.
 #pragma once
 
 #include <QObject>

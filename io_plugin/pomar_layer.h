@@ -62,6 +62,15 @@ void setLayerAttributes(MeshType &m, const std::vector<uint32_t> &cluster,
   Alloc::template GetPerMeshAttribute<int>(m, kSkipDamagedAttribute)() = skipDamaged ? 1 : 0;
 }
 
+/// Enables the optional CMeshO data that pomar::to_vcg fills from `mesh` (per-vertex and
+/// per-wedge texture coordinates): to_vcg writes only where the mesh has room.
+inline void enableRoomFor(const pomar::Mesh &mesh, MeshModel &mm) {
+  if (mesh.find(pomar::AttributeKind::TexCoord))
+    mm.updateDataMask(MeshModel::MM_VERTTEXCOORD);
+  if (!mesh.corner_texcoords.empty())
+    mm.updateDataMask(MeshModel::MM_WEDGTEXCOORD);
+}
+
 /// A warning in MeshLab's log (with `logPrefix`) and on stderr ("pomar: "): Log() is a
 /// no-op in meshlabserver.
 inline void warn(MeshLabInterface &plugin, const char *logPrefix, const QString &text) {

@@ -364,9 +364,9 @@ void replaceMesh(PomarFilterPlugin::Session &s, MeshModel &mm, const std::vector
     }
   CMeshO &m = mm.cm;
   // The decoded attributes of these vertices go with them (colour, normals, quality,
-  // texture coordinates, named floats); texture coordinates are optional in CMeshO.
-  if (mesh.find(pomar::AttributeKind::TexCoord))
-    mm.updateDataMask(MeshModel::MM_VERTTEXCOORD);
+  // texture coordinates, named floats), and each corner's texture coordinates with the face's
+  // texture go into its wedge; texture coordinates are optional in CMeshO.
+  pomar::meshlab::enableRoomFor(mesh, mm);
   // Clear() + ClearAttributes() (saved colours of Show Clusters included), then the new
   // vertices and faces with their attributes.
   const int written = pomar::to_vcg(mesh, m);
@@ -374,7 +374,7 @@ void replaceMesh(PomarFilterPlugin::Session &s, MeshModel &mm, const std::vector
   const bool ownQuality = written & vcg::tri::io::Mask::IOM_VERTQUALITY;
   const bool ownNormals = written & vcg::tri::io::Mask::IOM_VERTNORMAL;
   // The decoded colour, quality and texture coordinates enter the layer's data mask, which the
-  // GUI renders from (vertex colour shown as soon as the layer is refreshed).
+  // GUI renders from (vertex colour and wedge texture shown as soon as the layer is refreshed).
   mm.Enable(written);
   pomar::meshlab::setLayerAttributes(m, s.clustered ? clusterOf : std::vector<uint32_t>(), levelOf,
                                      s.path, s.skipDamaged);
@@ -680,6 +680,16 @@ bool PomarFilterPlugin::refineOrCoarsen(bool refine, MeshModel &mm, Session &s, 
         ++vertices;
         chosen[size_t(cluster[v])] = 1;
       }
+  // The clusters linked to a chosen one (rooted at copies of one texture seam vertex, of which
+  // a layer at full resolution shows one) go with it: the level map gives linked clusters one
+  // level, so coarsening one without its twin would leave both where they are.
+  std::vector<uint32_t> linkStart, link;
+  s.decoder->cluster_links(linkStart, link);
+  const std::vector<char> selected = chosen;
+  for (uint32_t c = 0; c < s.clusters; ++c)
+    if (selected[c])
+      for (uint32_t i = linkStart[c]; i < linkStart[c + 1]; ++i)
+        chosen[link[i]] = 1;
   const size_t count = size_t(std::count(chosen.begin(), chosen.end(), 1));
   if (count == 0)
     return fail(QString("nothing selected: select the faces of the region to %1 first").arg(verb));

@@ -1,13 +1,15 @@
 # shellcheck shell=bash
 # Sourced function library (bash) of the scripted MeshLab 2020.09 GUI sessions under Xvfb:
-# scripts/gui_screenshot.sh, scripts/gui_refine_screenshots.sh and the ctest test
-# tests/io_plugin/gui_colour_test.sh. It builds the private MeshLab tree with
-# tests/support/meshlab_tree.sh (recipe /work/shared/docs/meshlab-plugins.md section 5b).
+# scripts/gui_screenshot.sh, scripts/gui_refine_screenshots.sh and the ctest tests
+# tests/io_plugin/gui_colour_test.sh and tests/io_plugin/gui_texture_test.sh. It builds the
+# private MeshLab tree with tests/support/meshlab_tree.sh (recipe
+# /work/shared/docs/meshlab-plugins.md section 5b).
 #
 # A script sources it, calls mlgui_init NAME (before any cd: it cd's to the repository) and
 # mlgui_parse_args, then the steps in this order: mlgui_require_tools, mlgui_build,
 # mlgui_make_workdir, mlgui_pick_meshlab, mlgui_encode_bunny, mlgui_start_xvfb; then per session
 # mlgui_start_meshlab, mlgui_answer_preopen, mlgui_check_opened, mlgui_capture, mlgui_stop_meshlab.
+# The screenshot tests use mlgui_open_full, mlgui_viewer and mlgui_check_quadrants in between.
 # Globals set here: REPO BUILD POMAR SYS_MLLIB TIMEOUT RENDER_WAIT (mlgui_init), USE_INSTALLED
 # OUTDIR (mlgui_parse_args), WORK XVFB_PID ML_PID (mlgui_make_workdir), MESHLAB
 # (mlgui_pick_meshlab), DATA (mlgui_encode_bunny), DISPLAY (mlgui_start_xvfb), ERRLOG ML_PID
@@ -200,4 +202,103 @@ mlgui_capture() {
   mkdir -p "$(dirname "$2")"
   import -window "$1" "$2"
   log "$3wrote ${2#"$REPO"/} ($(identify -format '%wx%h' "$2" 2>/dev/null || echo '?'))"
+}
+
+# mlgui_open_full FILE LOG: starts MESHLAB on FILE (HOME=WORK/home, its log in LOG), answers the
+# "Pre-Open Options" dialog with its defaults (full resolution), waits for the load and checks
+# the plugin's "pomar: opened" line (mlgui_check_opened full).
+mlgui_open_full() {
+  local id=""
+  mlgui_start_meshlab "$WORK/home" "$2" "$1"
+  for _ in $(seq $((TIMEOUT * 5))); do
+    id="$(xdotool search --name '^Pre-Open Options$' 2>/dev/null | head -n1 || true)"
+    [ -n "$id" ] && break
+    kill -0 "$ML_PID" 2>/dev/null || fail_log "meshlab exited before the Pre-Open Options dialog"
+    sleep 0.2
+  done
+  [ -n "$id" ] || fail_log "no Pre-Open Options dialog within ${TIMEOUT}s (is the plugin loaded?)"
+  mlgui_answer_preopen "$id" full
+  for _ in $(seq $((TIMEOUT * 5))); do
+    grep -q 'All files opened' "$ERRLOG" && break
+    kill -0 "$ML_PID" 2>/dev/null || fail_log "meshlab exited while opening"
+    sleep 0.2
+  done
+  grep -q 'All files opened' "$ERRLOG" || fail_log "the mesh did not load within ${TIMEOUT}s"
+  mlgui_check_opened full ""
+}
+
+# mlgui_viewer WINDOW: prints the viewer of MeshLab's main window WINDOW as "W H X Y" (relative to
+# WINDOW): the most deeply nested X window inside it that covers at least a quarter of it (the
+# OpenGL widget); nothing if there is none.
+mlgui_viewer() {
+  xwininfo -tree -id "$1" | awk -v main="$(xwininfo -id "$1" | awk '
+      /Absolute upper-left X:/ { x = $NF } /Absolute upper-left Y:/ { y = $NF }
+      /Width:/ { w = $NF } /Height:/ { h = $NF } END { print w, h, x, y }')" '
+    BEGIN { split(main, m, " ") }
+    match($0, /[0-9]+x[0-9]+\+-?[0-9]+\+-?[0-9]+ +\+-?[0-9]+\+-?[0-9]+$/) {
+      split(substr($0, RSTART), g, /[x+ ]+/) # W H x y X Y
+      depth = match($0, /[^ ]/)
+      if (g[1] * g[2] * 4 >= m[1] * m[2] && depth > best) {
+        best = depth; out = g[1] " " g[2] " " (g[5] - m[3]) " " (g[6] - m[4])
+      }
+    }
+    END { print out }'
+}
+
+# mlgui_check_quadrants SHOT "W H X Y" MIN_SHARE_PERCENT: checks the viewer region of the
+# screenshot SHOT for a mesh drawn as four quadrants of pure colour: red top left, green top right,
+# blue bottom left, yellow bottom right. Every pixel is classified as red, green, blue or yellow
+# when strongly saturated (its bright channels at least 128, each dark one at most a quarter of
+# the darkest bright one; for yellow red and green within a quarter of each other), anything else
+# (MeshLab's grey mesh, the blue background gradient with red = green = blue / 2) as none. Each
+# colour must cover at least MIN_SHARE_PERCENT of the viewer, and their mean positions must be
+# where the quadrants are (red and blue left of green and yellow, red and green above blue and
+# yellow). Prints the count and centre per colour; returns 1 after printing FAIL lines otherwise.
+mlgui_check_quadrants() {
+  local w h x y
+  read -r w h x y <<<"$2"
+  convert "$1" -crop "${w}x${h}+${x}+${y}" +repage -depth 8 txt:- | awk -v min="$3" '
+    function classify(r, g, b,   lo) {
+      if (r >= 128 && g >= 128) {
+        lo = r < g ? r : g
+        return (b * 4 <= lo && (r > g ? r - g : g - r) * 4 <= lo) ? "yellow" : ""
+      }
+      if (r >= 128) return (g * 4 <= r && b * 4 <= r) ? "red" : ""
+      if (g >= 128) return (r * 4 <= g && b * 4 <= g) ? "green" : ""
+      if (b >= 128) return (r * 4 <= b && g * 4 <= b) ? "blue" : ""
+      return ""
+    }
+    /^#/ { next }
+    match($0, /^[0-9]+,[0-9]+: *\([^)]*\)/) {
+      pixel = substr($0, 1, RLENGTH)
+      gsub(/[ ()]/, "", pixel); split(pixel, c, /[,:]/) # x y r g b
+      ++total
+      k = classify(c[3] + 0, c[4] + 0, c[5] + 0)
+      if (k == "") next
+      ++n[k]; sx[k] += c[1]; sy[k] += c[2]
+    }
+    END {
+      if (total == 0) { print "FAIL: no pixels read from the screenshot"; exit 1 }
+      bad = 0
+      split("red green blue yellow", names, " ")
+      for (i = 1; i <= 4; ++i) {
+        k = names[i]
+        if (n[k] > 0) { cx[k] = sx[k] / n[k]; cy[k] = sy[k] / n[k] }
+        printf "%-6s %6d pixels (%5.2f%% of %d)", k, n[k], 100 * n[k] / total, total
+        if (n[k] > 0) printf ", centre %.0f,%.0f", cx[k], cy[k]
+        printf "\n"
+        if (100 * n[k] < min * total) {
+          printf "FAIL: %s covers less than %d%% of the viewer\n", k, min; bad = 1
+        }
+      }
+      if (!bad) { # the quadrants where the mesh has them (y grows downwards in the image)
+        if (!(cx["red"] < cx["green"] && cx["blue"] < cx["yellow"])) {
+          print "FAIL: red/blue are not left of green/yellow"; bad = 1
+        }
+        if (!(cy["red"] < cy["blue"] && cy["green"] < cy["yellow"])) {
+          print "FAIL: red/green are not above blue/yellow"; bad = 1
+        }
+      }
+      exit bad
+    }'
 }

@@ -182,9 +182,10 @@ TEST_F(PomarPluginTest, FormatsAndCapabilities) {
   int capability = -1, defaultBits = -1;
   plugin()->GetExportMaskCapability(format, capability, defaultBits);
   using M = vcg::tri::io::Mask;
-  EXPECT_EQ(capability,
-            M::IOM_VERTCOLOR | M::IOM_VERTNORMAL | M::IOM_VERTQUALITY | M::IOM_VERTTEXCOORD);
-  EXPECT_EQ(defaultBits, M::IOM_VERTCOLOR | M::IOM_VERTQUALITY | M::IOM_VERTTEXCOORD);
+  EXPECT_EQ(capability, M::IOM_VERTCOLOR | M::IOM_VERTNORMAL | M::IOM_VERTQUALITY |
+                            M::IOM_VERTTEXCOORD | M::IOM_WEDGTEXCOORD);
+  EXPECT_EQ(defaultBits,
+            M::IOM_VERTCOLOR | M::IOM_VERTQUALITY | M::IOM_VERTTEXCOORD | M::IOM_WEDGTEXCOORD);
 }
 
 TEST_F(PomarPluginTest, ParameterDefaults) {
@@ -504,15 +505,14 @@ TEST_F(PomarPluginTest, OpenEnablesWhatItReadsOnTheLayer) {
   QFile::remove(path("attrs.pomar"));
 }
 
-// A textured file (per-corner texture coordinates, two materials): open enables the wedge
-// texture coordinates on the layer, fills them with the corners' values and the face's
-// texture, and returns IOM_WEDGTEXCOORD.
-TEST_F(PomarPluginTest, OpenTexturedFileFillsTheWedges) {
+/// A sphere with per-corner texture coordinates and two textures, a chart per half: a seam
+/// around the equator.
+pomar::Mesh texturedSphere() {
   pomar::Mesh mesh = pomar::gen::noisy_sphere(400, 3);
   const size_t nf = mesh.triangle_count();
   mesh.texture_files = {"a.png", "b.png"};
   mesh.materials = {{"a", 0, "Kd 1 1 1\n"}, {"b", 1, ""}};
-  for (size_t f = 0; f < nf; ++f) { // a chart per half: a seam around the equator
+  for (size_t f = 0; f < nf; ++f) {
     const float *p0 = &mesh.positions[3 * mesh.triangles[3 * f]];
     const bool top = p0[2] >= 0;
     mesh.face_materials.push_back(top ? 0 : 1);
@@ -522,6 +522,37 @@ TEST_F(PomarPluginTest, OpenTexturedFileFillsTheWedges) {
       mesh.corner_texcoords.push_back(0.25f * p[1] + 0.5f);
     }
   }
+  return mesh;
+}
+
+/// The faces of a layer as their wedge texture coordinates, starting at the smallest, and
+/// texture index, as a multiset (a full decode gives the faces back as a multiset; positions
+/// are quantized).
+std::multiset<std::array<float, 7>> wedgeFaces(const CMeshO &m) {
+  std::multiset<std::array<float, 7>> out;
+  for (const CFaceO &f : m.face) {
+    if (f.IsD())
+      continue;
+    std::array<std::pair<float, float>, 3> c;
+    for (int k = 0; k < 3; ++k)
+      c[size_t(k)] = {f.cWT(k).U(), f.cWT(k).V()};
+    const size_t first = size_t(std::min_element(c.begin(), c.end()) - c.begin());
+    std::array<float, 7> row{};
+    for (size_t k = 0; k < 3; ++k) {
+      row[2 * k] = c[(first + k) % 3].first;
+      row[2 * k + 1] = c[(first + k) % 3].second;
+    }
+    row[6] = f.cWT(0).N();
+    out.insert(row);
+  }
+  return out;
+}
+
+// A textured file (per-corner texture coordinates, two materials): open enables the wedge
+// texture coordinates on the layer, fills them with the corners' values and the face's
+// texture, and returns IOM_WEDGTEXCOORD.
+TEST_F(PomarPluginTest, OpenTexturedFileFillsTheWedges) {
+  const pomar::Mesh mesh = texturedSphere();
   pomar::EncodeOptions exact;
   exact.attributes.exact = true;
   exact.keep_order = true;
@@ -552,6 +583,54 @@ TEST_F(PomarPluginTest, OpenTexturedFileFillsTheWedges) {
   mm->cm.ClearAttributes();
   doc_.delMesh(mm);
   QFile::remove(path("tex.pomar"));
+}
+
+// A layer with wedge texture coordinates (an OBJ in MeshLab) saved with TexCoord ticked under
+// Wedge (meshlabserver -m wt): the file keeps them, each face's texture and the texture names,
+// and opening it gives the layer back. Without the tick the warning names them.
+TEST_F(PomarPluginTest, SaveKeepsWedgeTexcoordsAndTextures) {
+  using M = vcg::tri::io::Mask;
+  const pomar::Mesh mesh = texturedSphere();
+  MeshModel *mm = doc_.addNewMesh("", "tex", true);
+  mm->updateDataMask(MeshModel::MM_WEDGTEXCOORD);
+  ASSERT_EQ(pomar::to_vcg(mesh, mm->cm) & M::IOM_WEDGTEXCOORD, M::IOM_WEDGTEXCOORD);
+  mm->UpdateBoxAndNormals();
+  g_warnings.clear();
+  ASSERT_TRUE(save(
+      *mm, path("w.pomar"),
+      [](RichParameterList &par) { par.setValue("ExactAttributes", BoolValue(true)); },
+      M::IOM_WEDGTEXCOORD))
+      << plugin()->errorMsg().toStdString();
+  EXPECT_TRUE(g_warnings.isEmpty()) << g_warnings.join("\n").toStdString();
+  const std::vector<uint8_t> bytes = readBytes(path("w.pomar"));
+  const pomar::Mesh decoded = pomar::decode(bytes.data(), bytes.size());
+  EXPECT_EQ(decoded.corner_texcoords.size(), 6 * mesh.triangle_count());
+  EXPECT_EQ(decoded.face_materials.size(), mesh.triangle_count());
+  EXPECT_EQ(decoded.texture_files, mesh.texture_files);
+  ASSERT_EQ(decoded.materials.size(), 2u);
+  EXPECT_EQ(decoded.materials[0].texture, 0);
+  EXPECT_EQ(decoded.materials[1].texture, 1);
+
+  MeshModel *back = doc_.addNewMesh(path("w.pomar"), "back", true);
+  RichParameterList pre;
+  plugin()->initPreOpenParameter("pomar", path("w.pomar"), pre);
+  int mask = 0;
+  ASSERT_TRUE(plugin()->open("pomar", path("w.pomar"), *back, mask, pre));
+  EXPECT_EQ(mask, M::IOM_WEDGTEXCOORD);
+  EXPECT_EQ(back->cm.textures, mesh.texture_files);
+  EXPECT_TRUE(wedgeFaces(back->cm) == wedgeFaces(mm->cm));
+
+  // Not ticked: not in the file, and the warning says how to keep them.
+  g_warnings.clear();
+  ASSERT_TRUE(save(
+      *mm, path("w.pomar"), [](RichParameterList &) {}, 0));
+  const QString all = g_warnings.join("\n");
+  EXPECT_TRUE(all.contains("per-wedge texture coordinates (tick TexCoord under Wedge / -m wt)"))
+      << all.toStdString();
+  EXPECT_TRUE(all.contains("2 texture(s)")) << all.toStdString();
+  const std::vector<uint8_t> plain = readBytes(path("w.pomar"));
+  EXPECT_TRUE(pomar::decode(plain.data(), plain.size()).corner_texcoords.empty());
+  QFile::remove(path("w.pomar"));
 }
 
 TEST_F(PomarPluginTest, FailedSaveWritesNothing) {

@@ -143,6 +143,53 @@ expect_rc 0
 expect_output "colour 'colour': RGBA, 8 bits exact, max error 0"
 rm -f "$OUTDIR"/octa*
 
+# ---- 1b. wedge texture coordinates (-m wt) ----------------------------------------------------------
+# The input is samples/textured_sphere.obj as a PLY with per-face texcoord lists and texnumber
+# (written by `pomar decode`): MeshLab 2020.09's OBJ importer aborts on an OBJ with vt lines
+# (an assertion in vcglib's import_obj.h), so the textured input goes in as PLY.
+
+section "-m wt: a PLY with wedge texture coordinates saves them, the face textures and the texture name"
+pomar encode -q "$SAMPLES/textured_sphere.obj" "$OUTDIR/tex_src.pomar"
+expect_rc 0
+pomar decode -q "$OUTDIR/tex_src.pomar" "$OUTDIR/tex.ply"
+expect_rc 0
+rm -f "$OUTDIR/tex_src.pomar"
+ml -i tex.ply -o tex.pomar -m wt
+expect_rc 0
+expect_file "$OUTDIR/tex.pomar"
+expect_no_output "per-wedge texture coordinates"
+expect_no_output "texture(s)"
+pomar info "$OUTDIR/tex.pomar"
+expect_output "attribute pomar:corner texcoord"
+expect_output "attribute pomar:face material"
+expect_output "texture file textured_sphere.png"
+pomar verify "$OUTDIR/tex.ply" "$OUTDIR/tex.pomar"
+expect_rc 0
+expect_output "face materials: 2 materials, the same per face"
+
+section "-m wt: the .pomar opens with its wedge texture coordinates and texture name"
+ml -i tex.pomar -o tex_back.ply -m wt
+expect_rc 0
+expect_output "tex.pomar loaded has 222 vn 440 fn"
+expect_file "$OUTDIR/tex_back.ply"
+run grep -a -c -e "comment TextureFile textured_sphere.png" -e "property list uchar float texcoord" \
+  "$OUTDIR/tex_back.ply"
+expect_output "2"
+# MeshLab's PLY writer leaves out texnumber (which faces have no texture): all but the face
+# materials match.
+pomar verify "$OUTDIR/tex.ply" "$OUTDIR/tex.pomar" "$OUTDIR/tex_back.ply"
+expect_output "the face materials of the original are missing from the decoded mesh"
+expect_no_output "texture coordinates of the original are missing"
+
+section "without -m wt the warning names the wedge texture coordinates and the texture"
+ml -i tex.ply -o tex_plain.pomar
+expect_rc 0
+expect_output "per-wedge texture coordinates (tick TexCoord under Wedge / -m wt)"
+expect_output "1 texture(s)"
+pomar info "$OUTDIR/tex_plain.pomar"
+expect_no_output "pomar:corner texcoord"
+rm -f "$OUTDIR"/tex*
+
 # ---- 2. a non-manifold mesh is saved exactly (the cut is stored), and opens as it was ------------
 
 section "saving a non-manifold mesh works and keeps it exactly"

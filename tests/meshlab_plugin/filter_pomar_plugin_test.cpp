@@ -541,6 +541,65 @@ TEST_F(FilterPomarTest, AttributesSurviveRefineAndShowFilters) {
   EXPECT_EQ(mm->cm.vn, int(full.vertex_count()));
 }
 
+/// Set Level, Refine and Coarsen replace the layer with a decode: each corner's texture
+/// coordinates go into its wedge with the face's texture, and the wedges are enabled on the
+/// layer (the GUI draws the texture from its data mask), at every level; the texture names
+/// stay.
+TEST_F(FilterPomarTest, WedgeTexcoordsSurviveLevelChanges) {
+  pomar::Mesh textured = *input_;
+  textured.texture_files = {"top.png", "bottom.png"};
+  textured.materials = {{"top", 0, ""}, {"bottom", 1, ""}};
+  for (size_t f = 0; f < textured.triangle_count(); ++f) { // a chart per half
+    const bool top = textured.positions[3 * textured.triangles[3 * f] + 2] >= 0;
+    textured.face_materials.push_back(top ? 0 : 1);
+    for (size_t k = 0; k < 3; ++k) {
+      const float *p = &textured.positions[3 * textured.triangles[3 * f + k]];
+      textured.corner_texcoords.push_back(0.25f * p[0] + (top ? 0.25f : 0.75f));
+      textured.corner_texcoords.push_back(0.25f * p[1] + 0.5f);
+    }
+  }
+  const std::vector<uint8_t> bytes = pomar::encode(textured);
+  writeBytes(path("textured.pomar"), bytes);
+  auto d = decoderOf(bytes);
+  const int base = d->base_clustered_level(), finest = d->finest_level();
+  ASSERT_LT(base, finest);
+  // The layer holds the decoder's mesh at `level` everywhere, with its corners in the wedges.
+  auto expectWedgesAt = [&](MeshModel &mm, int level) {
+    SCOPED_TRACE(level);
+    d->clear_wanted();
+    d->want_all(level);
+    d->update();
+    const pomar::Mesh want = d->exact_mesh();
+    ASSERT_TRUE(mm.hasDataMask(MeshModel::MM_WEDGTEXCOORD));
+    ASSERT_EQ(size_t(mm.cm.fn), want.triangle_count());
+    ASSERT_EQ(want.corner_texcoords.size(), 6 * want.triangle_count());
+    for (size_t f = 0; f < want.triangle_count(); ++f)
+      for (int k = 0; k < 3; ++k) {
+        const CFaceO &face = mm.cm.face[f];
+        ASSERT_EQ(face.cWT(k).U(), want.corner_texcoords[6 * f + 2 * size_t(k)]);
+        ASSERT_EQ(face.cWT(k).V(), want.corner_texcoords[6 * f + 2 * size_t(k) + 1]);
+        ASSERT_EQ(face.cWT(k).N(), want.materials[want.face_materials[f]].texture);
+      }
+    EXPECT_EQ(mm.cm.textures, textured.texture_files);
+  };
+  MeshModel *mm = open("textured.pomar", 1); // base clustered mesh
+  expectWedgesAt(*mm, base);
+  mm->clearDataMask(MeshModel::MM_WEDGTEXCOORD); // the filters enable them themselves
+  ASSERT_TRUE(setLevel((base + finest) / 2)) << filter()->errorMsg().toStdString();
+  expectWedgesAt(*mm, (base + finest) / 2);
+  mm->clearDataMask(MeshModel::MM_WEDGTEXCOORD);
+  vcg::tri::UpdateSelection<CMeshO>::FaceAll(mm->cm);
+  ASSERT_TRUE(refine(finest)) << filter()->errorMsg().toStdString();
+  expectWedgesAt(*mm, finest); // the file's corners exactly
+  // Coarsening everything gives the base clustered mesh: each seam vertex shows as one vertex
+  // at full resolution, the cluster of its copy comes along.
+  mm->clearDataMask(MeshModel::MM_WEDGTEXCOORD);
+  vcg::tri::UpdateSelection<CMeshO>::FaceAll(mm->cm);
+  ASSERT_TRUE(coarsen(base)) << filter()->errorMsg().toStdString();
+  expectWedgesAt(*mm, base);
+  QFile::remove(path("textured.pomar"));
+}
+
 TEST_F(FilterPomarTest, ShowClustersAndLevels) {
   MeshModel *mm = open("clustered.pomar");
   ASSERT_TRUE(apply(kShowClusters)) << filter()->errorMsg().toStdString();
