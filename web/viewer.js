@@ -141,6 +141,13 @@ function offerMaterials(mesh, chooseDefault) {
 // which is three.js's default upload (flipY). A texture that does not load is named in
 // the page (#textures) and the texture entry is taken away: the model is drawn with its
 // own colours, or plain.
+/** A mesh whose vertices' corners disagree (a welded one) cannot be drawn with its texture. */
+function reportConflicts(mesh) {
+  if (!mesh.texcoords && mesh.texcoordConflicts) {
+    $('textures').textContent = `texture: ${mesh.texcoordConflicts} vertices have corners with different texture coordinates ` +
+      '(a welded mesh): the texture is not drawn';
+  }
+}
 const textures = {
   base: null,     // the URL the names are relative to (null: a dropped file, no URL)
   files: [],      // the file's texture names
@@ -155,16 +162,13 @@ const textures = {
     this.loaded = this.files.map(() => null);
     this.failed = this.files.map(() => '');
     $('textures').textContent = '';
-    if (!mesh.texcoords && mesh.texcoordConflicts) {
-      $('textures').textContent = `texture: ${mesh.texcoordConflicts} vertices have corners with different texture coordinates ` +
-        '(a welded mesh): the texture is not drawn';
-    }
+    reportConflicts(mesh);
     if (!mesh.texcoords || !this.files.length) return (this.ready = Promise.resolve());
     const generation = ++this.generation;
     this.ready = Promise.all(this.files.map((name, i) => this.load(name, i, generation))).then(() => {
       if (generation !== this.generation) return;
       const failed = this.failed.filter((f) => f);
-      $('textures').textContent = failed.length ? `${failed.join('\n')}\n(drawn with ${material().id === 'own' ? 'own colours' : 'no texture'} instead)` : '';
+      $('textures').textContent = failed.length ? `${failed.join('\n')}\n(drawn ${material().id === 'own' ? 'with its own colours' : 'plain'} instead)` : '';
     });
     return this.ready;
   },
@@ -288,6 +292,7 @@ function upload(mesh, model) {
   shown.geometry.dispose();
   shown.geometry = g;
   drawnMesh = mesh;
+  reportConflicts(mesh);
   offerMaterials(mesh, false);
 }
 
