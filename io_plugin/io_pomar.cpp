@@ -283,8 +283,10 @@ bool PomarIOPlugin::open(const QString &format, const QString &fileName, MeshMod
 
     if (mesh.find(pomar::AttributeKind::TexCoord))
       m.updateDataMask(MeshModel::MM_VERTTEXCOORD); // optional in CMeshO: enable first
-    // Also clears m's attributes; the mask tells MeshLab what to show (colours, ...).
+    // Also clears m's attributes. What was read goes into the layer's data mask too: the GUI
+    // picks the rendering (vertex colour, ...) from that mask, not from the returned one.
     mask = pomar::to_vcg(mesh, m.cm) & kKeptMask;
+    m.Enable(mask);
     if (!info.clustered())
       cluster.clear(); // a progressive file's vertices have no cluster
     pomar::meshlab::setLayerAttributes(m.cm, cluster, vertexLevel, native, skipDamaged);

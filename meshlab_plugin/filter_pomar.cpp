@@ -373,8 +373,9 @@ void replaceMesh(PomarFilterPlugin::Session &s, MeshModel &mm, const std::vector
   const bool ownColour = written & vcg::tri::io::Mask::IOM_VERTCOLOR;
   const bool ownQuality = written & vcg::tri::io::Mask::IOM_VERTQUALITY;
   const bool ownNormals = written & vcg::tri::io::Mask::IOM_VERTNORMAL;
-  if (ownColour)
-    mm.updateDataMask(MeshModel::MM_VERTCOLOR);
+  // The decoded colour, quality and texture coordinates enter the layer's data mask, which the
+  // GUI renders from (vertex colour shown as soon as the layer is refreshed).
+  mm.Enable(written);
   pomar::meshlab::setLayerAttributes(m, s.clustered ? clusterOf : std::vector<uint32_t>(), levelOf,
                                      s.path, s.skipDamaged);
   for (size_t v = 0; v < mesh.vertex_count(); ++v) {

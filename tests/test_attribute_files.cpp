@@ -209,6 +209,115 @@ TEST_F(AttributeFiles, WritersNameWhatTheyCannotHold) {
     EXPECT_TRUE(attributes_not_saved(std::string("x") + ext, plain).empty());
 }
 
+/// `sphere` as an ASCII PLY with colours red green blue alpha, every alpha 255; with `quad`,
+/// plus a separate quad (a polygon: the reader takes the vcglib path, not the capture).
+std::string opaque_rgba_ply(const Mesh &sphere, bool quad) {
+  const size_t nv = sphere.vertex_count(), nf = sphere.triangle_count();
+  std::string s = "ply\nformat ascii 1.0\nelement vertex " + std::to_string(nv + (quad ? 4 : 0)) +
+                  "\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\n"
+                  "property uchar green\nproperty uchar blue\nproperty uchar alpha\n"
+                  "element face " +
+                  std::to_string(nf + (quad ? 1 : 0)) +
+                  "\nproperty list uchar int vertex_indices\nend_header\n";
+  for (size_t v = 0; v < nv + (quad ? 4 : 0); ++v) {
+    const float x = v < nv ? sphere.positions[3 * v] : 3.0f + float((v - nv) % 2);
+    const float y = v < nv ? sphere.positions[3 * v + 1] : float((v - nv) / 2);
+    const float z = v < nv ? sphere.positions[3 * v + 2] : 0.0f;
+    s += std::to_string(x) + " " + std::to_string(y) + " " + std::to_string(z) + " " +
+         std::to_string(v * 7 % 256) + " " + std::to_string(v * 13 % 256) + " " +
+         std::to_string(v * 31 % 256) + " 255\n";
+  }
+  for (size_t t = 0; t < nf; ++t)
+    s += "3 " + std::to_string(sphere.triangles[3 * t]) + " " +
+         std::to_string(sphere.triangles[3 * t + 1]) + " " +
+         std::to_string(sphere.triangles[3 * t + 2]) + "\n";
+  if (quad)
+    s += "4 " + std::to_string(nv) + " " + std::to_string(nv + 1) + " " + std::to_string(nv + 3) +
+         " " + std::to_string(nv + 2) + "\n";
+  return s;
+}
+
+/// Every colour of `m` is RGBA with alpha 255.
+void expect_opaque_rgba(const Mesh &m, const char *what) {
+  const VertexAttribute *c = m.find(AttributeKind::Colour);
+  ASSERT_NE(c, nullptr) << what;
+  ASSERT_EQ(c->components, 4u) << what;
+  ASSERT_EQ(c->colour.size(), 4 * m.vertex_count()) << what;
+  for (size_t v = 0; v < m.vertex_count(); ++v)
+    ASSERT_EQ(c->colour[4 * v + 3], 255) << what << ": vertex " << v;
+}
+
+// A PLY with an alpha property gives RGBA colours also when every alpha is 255: on both
+// read paths, through the PLY (binary and ASCII) and OFF writers, and through .pomar in
+// both layouts at every level. OBJ, which has no alpha, names it.
+TEST_F(AttributeFiles, PlyAlphaIsKeptWhenEveryAlphaIs255) {
+  const Mesh sphere = gen::noisy_sphere(600, 3, 0.1);
+  for (bool quad : {false, true}) {
+    SCOPED_TRACE(quad ? "with a quad" : "triangles");
+    LoadReport r;
+    const Mesh m = load_mesh(write("in.ply", opaque_rgba_ply(sphere, quad)), &r);
+    EXPECT_TRUE(r.ignored_attributes.empty()) << joined(r.ignored_attributes);
+    EXPECT_EQ(r.polygons_triangulated, quad ? 1u : 0u);
+    expect_opaque_rgba(m, "read");
+    EXPECT_EQ(m.find(AttributeKind::Colour)->colour[4 * 5], 5 * 7 % 256);
+    for (const bool binary : {true, false}) {
+      save_mesh(path("out.ply"), m, binary);
+      EXPECT_NE(read_text(path("out.ply")).find("property uchar alpha\n"), std::string::npos);
+      const Mesh back = load_mesh(path("out.ply"));
+      expect_opaque_rgba(back, "PLY written back");
+      EXPECT_EQ(back.find(AttributeKind::Colour)->colour, m.find(AttributeKind::Colour)->colour);
+    }
+    save_mesh(path("out.off"), m);
+    EXPECT_TRUE(attributes_not_saved(path("out.off"), m).empty());
+    const Mesh off = load_mesh(path("out.off"));
+    expect_opaque_rgba(off, "OFF written back");
+    EXPECT_EQ(off.find(AttributeKind::Colour)->colour, m.find(AttributeKind::Colour)->colour);
+    EXPECT_EQ(joined(attributes_not_saved(path("out.obj"), m)), "the alpha of the colours");
+    for (const bool progressive : {true, false}) {
+      SCOPED_TRACE(progressive ? "progressive" : "clustered");
+      EncodeOptions o;
+      o.progressive = progressive;
+      o.keep_order = true; // colours compare vertex by vertex
+      const std::vector<uint8_t> file = encode(m, o);
+      const Mesh full = decode(file.data(), file.size());
+      expect_opaque_rgba(full, "full decode");
+      EXPECT_EQ(full.find(AttributeKind::Colour)->colour, m.find(AttributeKind::Colour)->colour);
+      const FileInfo info = inspect(file.data(), file.size());
+      ASSERT_EQ(info.attributes.size(), 1u);
+      EXPECT_EQ(info.attributes[0].components, 4u);
+      for (int level = 0; level < int(info.levels.size()); ++level)
+        expect_opaque_rgba(decode(file.data(), file.size(), level),
+                           ("level " + std::to_string(level)).c_str());
+    }
+  }
+}
+
+// Every property of the vertex and face elements that is not kept is named in the warning;
+// an unknown vertex scalar is kept by its name.
+TEST_F(AttributeFiles, PlyPropertiesNotKeptAreNamed) {
+  const std::string file = write(
+      "p.ply", "ply\nformat ascii 1.0\nelement vertex 4\n"
+               "property float x\nproperty float y\nproperty float z\n"
+               "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+               "property int flags\nproperty list uchar int neighbours\nproperty float wetness\n"
+               "element face 2\nproperty list uchar int vertex_indices\nproperty int material\n"
+               "property list uchar float corner_weights\nproperty float quality\nend_header\n"
+               "0 0 0 1 2 3 0 1 1 0.5\n1 0 0 1 2 3 0 1 2 0.25\n0 1 0 1 2 3 0 1 3 0.125\n"
+               "1 1 0 1 2 3 0 1 0 2\n"
+               "3 0 1 2 7 3 1 1 1 0.5\n3 1 3 2 8 3 1 1 1 0.5\n");
+  LoadReport r;
+  const Mesh m = load_mesh(file, &r);
+  EXPECT_EQ(r.ignored_attributes,
+            (std::vector<std::string>{"flags", "vertex list property 'neighbours'", "quality",
+                                      "face property 'material'",
+                                      "face list property 'corner_weights'"}));
+  ASSERT_NE(m.find(AttributeKind::Scalar, "wetness"), nullptr);
+  EXPECT_EQ(m.find(AttributeKind::Scalar, "wetness")->values,
+            (std::vector<float>{0.5f, 0.25f, 0.125f, 2.0f}));
+  ASSERT_NE(m.find(AttributeKind::Colour), nullptr);
+  EXPECT_EQ(m.find(AttributeKind::Colour)->components, 3u);
+}
+
 /// `m` written to `name` in each text format (and binary PLY with attributes): files of
 /// several MiB, which the writers hand to the file in 1 MiB chunks.
 TEST_F(AttributeFiles, FilesOfManyChunksReadBackExactly) {

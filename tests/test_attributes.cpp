@@ -11,6 +11,7 @@
 #include <random>
 
 #include "attributes/attribute_quantize.h"
+#include "format/file_format.h"
 #include "pomar/limits.h"
 #include "pomar/pomar.h"
 #include "pomar/random_access.h"
@@ -199,8 +200,69 @@ TEST(AttributeQuantize, ValidationNamesTheProblem) {
   n.name = "normal";
   n.components = 3;
   n.values = {0, 0, 1, 0, 0, 0, 1, 0, 0};
-  expect_error(triangle_with(n), true, "of vertex 1 has length 0");
+  EXPECT_NO_THROW(validate_attributes(triangle_with(n), true)); // zero-length: kept as (0, 0, 0)
   EXPECT_NO_THROW(validate_attributes(triangle_with(n), false));
+  n.values[4] = std::numeric_limits<float>::quiet_NaN();
+  expect_error(triangle_with(n), true, "normal attribute 'normal' of vertex 1 is NaN");
+  n.values[4] = 0;
+  n.values[8] = -std::numeric_limits<float>::infinity();
+  expect_error(triangle_with(n), true, "normal attribute 'normal' of vertex 2 is infinite");
+  EXPECT_NO_THROW(validate_attributes(triangle_with(n), false));
+}
+
+// A zero-length normal has the code one past the grid on both axes, only in an attribute
+// whose descriptor says it holds some; it decodes to exactly (0, 0, 0).
+TEST(AttributeQuantize, ZeroNormalsHaveTheirOwnCode) {
+  VertexAttribute n;
+  n.kind = AttributeKind::Normal;
+  n.name = "normal";
+  n.components = 3;
+  n.values = {0, 0, 1, 0.3f, -0.2f, 0.9f};
+  AttributeOptions o;
+  for (int bits : {4, 9, 16}) {
+    SCOPED_TRACE(bits);
+    o.normal_bits = bits;
+    StoredAttribute plain = describe(n, o);
+    EXPECT_FALSE(plain.zero_normals); // no zero normal: codes and ranges as without the code
+    int64_t lo, hi;
+    code_range(plain, 1, lo, hi);
+    EXPECT_EQ(hi, (int64_t(1) << bits) - 2);
+
+    VertexAttribute z = n;
+    z.values.insert(z.values.end(), {0.0f, -0.0f, 0.0f});
+    const StoredAttribute s = describe(z, o);
+    EXPECT_TRUE(s.zero_normals);
+    for (uint32_t k = 0; k < 2; ++k) {
+      code_range(s, k, lo, hi);
+      EXPECT_EQ(lo, 0);
+      EXPECT_EQ(hi, int64_t(octahedral_zero_code(bits)));
+    }
+    VertexAttribute out = z;
+    std::fill(out.values.begin(), out.values.end(), 7.0f);
+    for (size_t v = 0; v < 3; ++v) {
+      int64_t c[2];
+      to_codes(s, z, v, c);
+      EXPECT_EQ(is_zero_normal(c[0], c[1], bits), v == 2);
+      EXPECT_LE(c[0], int64_t(octahedral_zero_code(bits)) - (v == 2 ? 0 : 1));
+      from_codes(s, c, out, v);
+    }
+    const float zero[3] = {0, 0, 0};
+    EXPECT_EQ(0, std::memcmp(&out.values[6], zero, sizeof zero)); // +0, exactly
+    EXPECT_LE(angle_degrees(&out.values[3], &z.values[3]), normal_error_bound(bits));
+    const int64_t half[2] = {int64_t(octahedral_zero_code(bits)), 0};
+    try {
+      from_codes(s, half, out, 1);
+      ADD_FAILURE() << "half of the zero code decoded";
+    } catch (const Error &e) {
+      EXPECT_EQ(e.kind(), Error::Kind::DamagedFile);
+      EXPECT_NE(std::string(e.what()).find("vertex 1 has half of the zero-normal code"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  o.exact = true; // exact normals keep the floats' bits: no code of their own
+  n.values.insert(n.values.end(), {0.0f, 0.0f, 0.0f});
+  EXPECT_FALSE(describe(n, o).zero_normals);
 }
 
 // ---------------------------------------------------------------- round trips
@@ -371,6 +433,84 @@ TEST(AttributeRoundTrip, ExactModeIsBitExactWithSpecialValues) {
   for (bool clustered : {false, true}) {
     const Coded c = encode_with(m, clustered, o);
     expect_round_trip(c, decode(c.file.data(), c.file.size()), true);
+  }
+}
+
+/// The first byte of the file's ATTR section body: its section version.
+uint8_t attribute_section_version(const std::vector<uint8_t> &file) {
+  const FileLayout layout = read_layout(file.data(), file.size());
+  const int i = find_section(layout, section_tag("ATTR"));
+  EXPECT_GE(i, 0);
+  return i < 0 ? 0 : section_body(file.data(), layout, size_t(i))[0];
+}
+
+/// Whether normal v of `a` is exactly (+0, +0, +0).
+bool is_plus_zero(const VertexAttribute &a, size_t v) {
+  const float zero[3] = {0, 0, 0};
+  return std::memcmp(&a.values[3 * v], zero, sizeof zero) == 0;
+}
+
+// Zero-length normals (scattered, and a whole patch of neighbours) are kept without
+// --exact-attributes: exactly (0, 0, 0) in the full decode and in every level, the others
+// within their bound, in both layouts; a mesh without them gets the descriptor of before.
+TEST(AttributeRoundTrip, ZeroLengthNormalsComeBackAsZero) {
+  const Mesh sphere = with_attributes(gen::noisy_sphere(1500, 4, 0.1), kAll);
+  Mesh m = sphere;
+  VertexAttribute &n = *m.find(AttributeKind::Normal);
+  size_t zeros = 0;
+  for (size_t v = 0; v < m.vertex_count(); ++v)
+    if (v % 37 == 0 || m.positions[3 * v + 2] > 0.9f) { // (the cap: zero neighbours of zeros)
+      n.values[3 * v] = v % 2 ? -0.0f : 0.0f;
+      n.values[3 * v + 1] = n.values[3 * v + 2] = 0;
+      ++zeros;
+    }
+  ASSERT_GT(zeros, 60u);
+  for (bool clustered : {false, true}) {
+    SCOPED_TRACE(clustered ? "clustered" : "progressive");
+    const Coded plain = encode_with(sphere, clustered);
+    EXPECT_EQ(attribute_section_version(plain.file), 1);
+    const Coded c = encode_with(m, clustered);
+    EXPECT_EQ(attribute_section_version(c.file), 2);
+    const FileInfo info = inspect(c.file.data(), c.file.size());
+    std::printf("%zu zero normals of %zu, %s: %zu bytes (without them: %zu)\n", zeros,
+                m.vertex_count(), clustered ? "clustered" : "progressive", c.file.size(),
+                plain.file.size());
+    const Mesh full = decode(c.file.data(), c.file.size());
+    expect_round_trip(c, full, false);
+    const VertexAttribute &got = *full.find(AttributeKind::Normal);
+    EXPECT_EQ(got.bits, 9);
+    size_t decoded_zeros = 0;
+    for (size_t v = 0; v < full.vertex_count(); ++v) {
+      const size_t i = c.report.decoded_to_input[v];
+      const bool zero =
+          n.values[3 * i] == 0 && n.values[3 * i + 1] == 0 && n.values[3 * i + 2] == 0;
+      ASSERT_EQ(is_plus_zero(got, v), zero) << "vertex " << v;
+      decoded_zeros += zero;
+    }
+    EXPECT_EQ(decoded_zeros, zeros);
+    for (int level = 0; level <= int(info.levels.size()); ++level) {
+      SCOPED_TRACE("level " + std::to_string(level));
+      expect_same_as_full(decode(c.file.data(), c.file.size(), level), full);
+    }
+    DecodeOptions without; // the normals left out, and all attributes left out
+    without.attributes.normals = false;
+    const Mesh no_normals = decode(c.file.data(), c.file.size(), without);
+    EXPECT_EQ(no_normals.positions, full.positions);
+    EXPECT_EQ(no_normals.find(AttributeKind::Normal), nullptr);
+    EXPECT_EQ(no_normals.find(AttributeKind::Colour)->colour,
+              full.find(AttributeKind::Colour)->colour);
+    without.attributes = AttributeMask::none();
+    EXPECT_EQ(decode(c.file.data(), c.file.size(), without).positions, full.positions);
+  }
+  // NaN and infinite normals stay an error naming the vertex.
+  n.values[3 * 5 + 1] = std::numeric_limits<float>::quiet_NaN();
+  try {
+    encode_with(m, true);
+    ADD_FAILURE() << "a NaN normal was encoded";
+  } catch (const Error &e) {
+    EXPECT_NE(std::string(e.what()).find("normal attribute 'normal' of vertex 5 is NaN"),
+              std::string::npos)
+        << e.what();
   }
 }
 

@@ -489,7 +489,8 @@ TEST_F(MeshIoTest, PlyBinaryAttributesReadWithoutVcglibAsVcglibReadsThem) {
     EXPECT_EQ(x.colour, y.colour) << x.name;
     EXPECT_TRUE(same_bits(x.values, y.values)) << x.name;
   }
-  EXPECT_EQ(b.find(AttributeKind::Colour)->components, 3u);
+  EXPECT_EQ(b.find(AttributeKind::Colour)->components, 4u); // the file's alpha, all 255
+  EXPECT_EQ(b.find(AttributeKind::Colour)->colour[3], 255);
   EXPECT_EQ(rb.ignored_attributes, ra.ignored_attributes);
   EXPECT_EQ(rb.unreferenced_vertices, ra.unreferenced_vertices);
   EXPECT_GE(rb.unreferenced_vertices, 1u);

@@ -222,6 +222,14 @@ TEST(RandomAccess, LevelMapCompletion) {
             (std::vector<int>{10, 9, 8, 7, 6}));
   EXPECT_EQ(complete_level_map({0, 0, 9, 0, 0}, start, adj, 6), (std::vector<int>{7, 8, 9, 8, 7}));
   EXPECT_EQ(complete_level_map({0, 0, 0, 0, 0}, start, adj, 6), (std::vector<int>(5, 6)));
+  // Clusters 0 and 4 linked (the copies of a seam vertex): one level, the higher one.
+  const std::vector<uint32_t> link_start = {0, 1, 1, 1, 1, 2}, link = {4, 0};
+  EXPECT_EQ(complete_level_map({10, 0, 0, 0, 0}, start, adj, 6, link_start, link),
+            (std::vector<int>{10, 9, 8, 9, 10}));
+  EXPECT_EQ(complete_level_map({0, 0, 0, 7, 0}, start, adj, 6, link_start, link),
+            (std::vector<int>{6, 6, 6, 7, 6}));
+  EXPECT_EQ(complete_level_map({0, 0, 0, 8, 0}, start, adj, 6, link_start, link),
+            (std::vector<int>{7, 6, 7, 8, 7}));
 }
 
 /// A colour per vertex from its position, so that take_mesh() has attributes to hand over.

@@ -85,7 +85,7 @@ TEST(Samples, ColouredScanKeepsItsColoursExactly) {
   ASSERT_EQ(input.attributes.size(), 2u);
   const VertexAttribute &colour = input.attributes[0], &quality = input.attributes[1];
   ASSERT_EQ(colour.kind, AttributeKind::Colour);
-  ASSERT_EQ(colour.components, 3u);
+  ASSERT_EQ(colour.components, 4u); // the file has red green blue alpha (every alpha 255)
   ASSERT_EQ(quality.kind, AttributeKind::Scalar);
   EncodeReport r;
   const std::vector<uint8_t> file = encode(input, EncodeOptions(), &r);
@@ -98,8 +98,8 @@ TEST(Samples, ColouredScanKeepsItsColoursExactly) {
   size_t changed_colours = 0;
   for (size_t i = 0; i < out.vertex_count(); ++i) {
     const uint32_t v = r.decoded_to_input[i];
-    for (uint32_t k = 0; k < 3; ++k)
-      changed_colours += out.attributes[0].colour[3 * i + k] != colour.colour[3 * v + k];
+    for (uint32_t k = 0; k < 4; ++k)
+      changed_colours += out.attributes[0].colour[4 * i + k] != colour.colour[4 * v + k];
     ASSERT_LE(std::abs(double(out.attributes[1].values[i]) - double(quality.values[v])), bound)
         << "vertex " << v;
   }

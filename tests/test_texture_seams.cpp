@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <map>
+#include <random>
 #include <set>
 
 #include "pomar/mesh_io.h"
@@ -18,41 +19,9 @@
 namespace pomar {
 namespace {
 
-constexpr int kCellsU = 3, kCellsV = 2; // the atlas: 6 charts, one per cube face
-
-/// `m` with a cube-map atlas: each face goes to the chart of its normal's dominant axis and
-/// sign, its corners projected onto that chart's plane in its cell of the atlas (seams
-/// between the charts); charts 0-2 are material 0, charts 3-5 material 1 (two textures).
-Mesh cube_mapped(Mesh m) {
-  const size_t nf = m.triangle_count();
-  m.corner_texcoords.resize(6 * nf);
-  m.face_materials.resize(nf);
-  m.texture_files = {"atlas_a.png", "atlas b.jpg"};
-  m.materials = {{"front", 0, "Kd 1 1 1\nNs 10"}, {"back", 1, "Kd 0.8 0.8 0.8"}};
-  auto p = [&](uint32_t v) {
-    return gen::detail::Vec3{m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]};
-  };
-  for (size_t f = 0; f < nf; ++f) {
-    const uint32_t *t = &m.triangles[3 * f];
-    const gen::detail::Vec3 n =
-        gen::detail::cross(gen::detail::sub(p(t[1]), p(t[0])), gen::detail::sub(p(t[2]), p(t[0])));
-    int axis = 0;
-    for (int k = 1; k < 3; ++k)
-      if (std::fabs(n[k]) > std::fabs(n[axis]))
-        axis = k;
-    const int chart = axis + (n[axis] < 0 ? 3 : 0);
-    m.face_materials[f] = chart < 3 ? 0 : 1;
-    for (int c = 0; c < 3; ++c) {
-      const gen::detail::Vec3 q = p(t[c]);
-      const double a = q[(axis + 1) % 3], b = q[(axis + 2) % 3]; // about -1.3..1.3
-      const double s = 0.5 + 0.35 * std::max(-1.4, std::min(1.4, a)) / 1.4;
-      const double r = 0.5 + 0.35 * std::max(-1.4, std::min(1.4, b)) / 1.4;
-      m.corner_texcoords[6 * f + 2 * c] = float((chart % kCellsU + s) / kCellsU);
-      m.corner_texcoords[6 * f + 2 * c + 1] = float((chart / kCellsU + r) / kCellsV);
-    }
-  }
-  return m;
-}
+constexpr int kCellsU = kCubeMapCellsU,
+              kCellsV = kCubeMapCellsV; // the atlas: a chart per cube face
+Mesh cube_mapped(Mesh m) { return with_cube_map_texture(std::move(m)); }
 
 /// The chart (atlas cell) a texture coordinate falls in.
 int chart_of(const float *uv) {
@@ -204,21 +173,39 @@ TEST(TextureSeams, EveryLevelIsClosedAndInItsCharts) {
 TEST(TextureSeams, SelectionsAreClosedAndInTheirCharts) {
   const Mesh m = cube_mapped(gen::noisy_sphere(4000, 7, 0.05));
   const Coded c = encode_textured(m, true);
-  SelectiveDecoder d(std::make_unique<MemorySource>(c.file.data(), c.file.size()));
-  const int finest = d.finest_level(), base = d.base_clustered_level();
-  // Half the clusters at the finest level, the others at levels between (smooth
-  // transitions raise their neighbours as needed): the whole surface, at mixed levels.
-  for (uint32_t k = 0; k < d.cluster_count(); ++k)
-    d.want_cluster(k, k % 2 ? finest : base + int(k % 5) * (finest - base) / 5);
-  d.update();
-  const Mesh mixed = d.mesh();
-  EXPECT_EQ(welded_boundary_edges(mixed), 0u) << "mixed levels: a seam opened";
-  expect_faces_in_one_chart(mixed, "mixed levels");
-  const float centre[3] = {1, 0, 0};
-  d.clear_wanted();
-  d.want_sphere(centre, 0.5f, finest);
-  d.update();
-  expect_faces_in_one_chart(d.mesh(), "a region");
+  for (unsigned threads : {1u, 2u}) {
+    SelectiveOptions so;
+    so.threads = threads;
+    SelectiveDecoder d(std::make_unique<MemorySource>(c.file.data(), c.file.size()), so);
+    const int finest = d.finest_level(), base = d.base_clustered_level();
+    ASSERT_GT(finest, base + 2);
+    std::vector<uint32_t> link_start, link;
+    d.cluster_links(link_start, link);
+    EXPECT_GT(link.size(), 0u) << "the copies of seam vertices are linked";
+    // Random levels per cluster (smooth transitions raise their neighbours as needed): the
+    // whole surface at mixed levels, welded, has no boundary edge.
+    std::mt19937 rng(threads);
+    for (int round = 0; round < 4; ++round) {
+      d.clear_wanted();
+      for (uint32_t k = 0; k < d.cluster_count(); ++k)
+        d.want_cluster(k, base + int(rng() % uint32_t(finest - base + 1)));
+      d.update();
+      const Mesh mixed = d.mesh();
+      const std::string what =
+          "round " + std::to_string(round) + ", " + std::to_string(threads) + " threads";
+      EXPECT_EQ(welded_boundary_edges(mixed), 0u) << what << ": a seam opened";
+      expect_faces_in_one_chart(mixed, what);
+      for (uint32_t k = 0; k < d.cluster_count(); ++k)
+        for (uint32_t i = link_start[k]; i < link_start[k + 1]; ++i)
+          ASSERT_EQ(d.levels()[k], d.levels()[link[i]]) << what << ": linked clusters apart";
+    }
+    const float centre[3] = {1, 0, 0};
+    d.clear_wanted();
+    d.want_sphere(centre, 0.5f, finest);
+    d.update();
+    EXPECT_EQ(welded_boundary_edges(d.mesh()), 0u) << "a region: a seam opened";
+    expect_faces_in_one_chart(d.mesh(), "a region");
+  }
 }
 
 TEST(TextureSeams, DroppingTextureCoordinatesDropsCornersAndMaterials) {

@@ -649,6 +649,10 @@ double attribute_error(const pomar::VertexAttribute &a, size_t i, const pomar::V
   if (exact && std::memcmp(x, y, 4 * n) == 0)
     return 0;
   if (a.kind == pomar::AttributeKind::Normal && !exact) {
+    const bool zero_x = x[0] == 0 && x[1] == 0 && x[2] == 0;
+    const bool zero_y = y[0] == 0 && y[1] == 0 && y[2] == 0;
+    if (zero_x || zero_y) // a zero-length normal comes back as exactly zero
+      return zero_x && zero_y ? 0 : HUGE_VAL;
     const double cx = double(x[1]) * y[2] - double(x[2]) * y[1];
     const double cy = double(x[2]) * y[0] - double(x[0]) * y[2];
     const double cz = double(x[0]) * y[1] - double(x[1]) * y[0];
@@ -874,8 +878,8 @@ int main(int argc, char **argv) {
       ->capture_default_str();
   enc->add_flag("--exact-attributes", ea.attributes.exact,
                 "Store normals, scalars and texture coordinates bit for bit (NaN, infinities, "
-                "denormals, zero normals included); colour is always exact. Without it a NaN "
-                "or infinite value or a zero-length normal is an error");
+                "denormals, -0 included); colour is always exact. Without it a NaN or "
+                "infinite value is an error (a zero-length normal comes back as (0, 0, 0))");
   enc->add_option("--max-memory", ea.max_memory,
                   "Refuse (exit 7, no output file) a mesh whose loading and encoding would need "
                   "more than SIZE of memory, checked from the file's header before reading it: "

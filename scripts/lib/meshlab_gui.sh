@@ -1,7 +1,8 @@
 # shellcheck shell=bash
 # Sourced function library (bash) of the scripted MeshLab 2020.09 GUI sessions under Xvfb:
-# scripts/gui_screenshot.sh and scripts/gui_refine_screenshots.sh. It builds the private MeshLab
-# tree with tests/support/meshlab_tree.sh (recipe /work/shared/docs/meshlab-plugins.md section 5b).
+# scripts/gui_screenshot.sh, scripts/gui_refine_screenshots.sh and the ctest test
+# tests/io_plugin/gui_colour_test.sh. It builds the private MeshLab tree with
+# tests/support/meshlab_tree.sh (recipe /work/shared/docs/meshlab-plugins.md section 5b).
 #
 # A script sources it, calls mlgui_init NAME (before any cd: it cd's to the repository) and
 # mlgui_parse_args, then the steps in this order: mlgui_require_tools, mlgui_build,
@@ -94,11 +95,14 @@ mlgui_make_workdir() {
 
 # mlgui_pick_meshlab PLUGIN...: sets MESHLAB. With --installed /usr/bin/meshlab, after checking that
 # the plugins (by file name) are installed in /usr; otherwise meshlab in a private tree WORK/tree
-# with the system plugins and the built PLUGIN... (paths relative to the repository) instead of
-# any installed plugin of the same name.
+# with the system plugins and the built PLUGIN... (absolute, or relative to the repository)
+# instead of any installed plugin of the same name.
 mlgui_pick_meshlab() {
-  local so names=() tree="$WORK/tree"
-  for so in "$@"; do names+=("$(basename "$so")"); done
+  local so names=() paths=() tree="$WORK/tree"
+  for so in "$@"; do
+    names+=("$(basename "$so")")
+    case "$so" in /*) paths+=("$so") ;; *) paths+=("$REPO/$so") ;; esac
+  done
   if [ "$USE_INSTALLED" -eq 1 ]; then
     MESHLAB=/usr/bin/meshlab
     for so in "${names[@]}"; do
@@ -106,10 +110,10 @@ mlgui_pick_meshlab() {
         die "--installed: $SYS_MLLIB/plugins/$so not found (cmake --install $BUILD --prefix /usr)"
     done
   else
-    for so in "$@"; do [ -f "$so" ] || die "$so was not built"; done
+    for so in "${paths[@]}"; do [ -f "$so" ] || die "$so was not built"; done
     mltree_create "$tree" "$SYS_MLLIB" /usr/bin/meshlab meshlab
     mltree_link_stock_except "$tree" "$SYS_MLLIB" "${names[@]}"
-    for so in "$@"; do mltree_link "$tree" "$REPO/$so"; done
+    mltree_link "$tree" "${paths[@]}"
     MESHLAB="$tree/bin/meshlab"
   fi
   log "meshlab: $MESHLAB"
@@ -141,16 +145,17 @@ mlgui_start_xvfb() {
   log "Xvfb on $DISPLAY"
 }
 
-# mlgui_start_meshlab HOME LOG: starts MESHLAB on DATA/bunny.pomar in the background (ML_PID) with
-# a fresh HOME, its stdout and stderr in LOG (ERRLOG).
+# mlgui_start_meshlab HOME LOG [FILE]: starts MESHLAB on FILE (absolute; default DATA/bunny.pomar)
+# in the background (ML_PID) with a fresh HOME, its stdout and stderr in LOG (ERRLOG), in FILE's
+# folder.
 mlgui_start_meshlab() {
-  local home="$1"
+  local home="$1" file="${3:-$DATA/bunny.pomar}"
   ERRLOG="$2"
   rm -rf "$home"
   mkdir -p "$home" "$WORK/run"
   chmod 700 "$WORK/run"
   # Fresh HOME: first start, no saved settings (MeshLab writes ~/.config/VCG/*.conf).
-  (cd "$DATA" && HOME="$home" XDG_RUNTIME_DIR="$WORK/run" exec "$MESHLAB" "$DATA/bunny.pomar") \
+  (cd "$(dirname "$file")" && HOME="$home" XDG_RUNTIME_DIR="$WORK/run" exec "$MESHLAB" "$file") \
     >"$ERRLOG" 2>&1 &
   ML_PID=$!
 }

@@ -737,6 +737,92 @@ run verify "$WORK/attr/c.ply" "$WORK/attr/b.pomar"
 expect_rc 0
 expect_contains "$OUT" "12-bit octahedral" "--normal-bits"
 
+section "attributes: RGBA with every alpha 255 and zero-length normals, both layouts, every level"
+python3 - "$BUNNY" "$WORK/attr/rgba.ply" "$WORK/attr/zero.obj" "$WORK/attr/nann.ply" <<'PY'
+import math, struct, sys
+data = open(sys.argv[1], 'rb').read()
+end = data.index(b'end_header\n') + len(b'end_header\n')
+head = data[:end].decode()
+nv = int(head.split('element vertex ')[1].split()[0])
+nf = int(head.split('element face ')[1].split()[0])
+pos = struct.unpack_from('<%df' % (3 * nv), data, end)
+faces = data[end + 12 * nv:]
+out = ['ply', 'format binary_little_endian 1.0', 'element vertex %d' % nv] + \
+      ['property float %s' % a for a in 'xyz'] + \
+      ['property uchar %s' % c for c in ('red', 'green', 'blue', 'alpha')] + \
+      ['element face %d' % nf, 'property list uchar int vertex_indices', 'end_header']
+body = bytearray()
+for v in range(nv):
+    body += struct.pack('<3f4B', *pos[3 * v:3 * v + 3], v % 256, (7 * v) % 256, 40, 255)
+open(sys.argv[2], 'wb').write(('\n'.join(out) + '\n').encode() + bytes(body) + faces)
+out = out[:3] + ['property float %s' % a for a in 'xyz'] + \
+      ['property float %s' % a for a in ('nx', 'ny', 'nz')] + out[-3:]
+body = bytearray()
+for v in range(nv):  # normals of length 0 are fine, a NaN (vertex 5) is not
+    body += struct.pack('<6f', *pos[3 * v:3 * v + 3], 0, float('nan') if v == 5 else 0, 0)
+open(sys.argv[4], 'wb').write(('\n'.join(out) + '\n').encode() + bytes(body) + faces)
+tris = [struct.unpack_from('<3i', faces, 13 * f + 1) for f in range(nf)]
+used = sorted(set(v for t in tris for v in t)) # (OBJ: a vertex no face uses has no normal)
+index = {v: i + 1 for i, v in enumerate(used)}
+def obj(path):
+    lines = []
+    for v in used:
+        x, y, z = pos[3 * v:3 * v + 3]
+        lines.append('v %r %r %r' % (x, y, z))
+    for v in used:
+        x, y, z = pos[3 * v:3 * v + 3]
+        r = math.sqrt(x * x + y * y + z * z) or 1.0
+        if v % 50 == 3:
+            lines.append('vn 0 0 0')
+        else:
+            lines.append('vn %r %r %r' % (x / r, y / r, z / r))
+    for t in tris:
+        a, b, c = (index[v] for v in t)
+        lines.append('f %d//%d %d//%d %d//%d' % (a, a, b, b, c, c))
+    open(path, 'w').write('\n'.join(lines) + '\n')
+obj(sys.argv[3])
+PY
+for layout in --progressive --cluster-ratio=0.02; do
+  run encode "$layout" "$WORK/attr/rgba.ply" "$WORK/attr/rgba.pomar"
+  expect_rc 0
+  expect_contains "$OUT" "(RGBA, 8 bits exact)" "encode output of an RGBA PLY ($layout)"
+  run verify "$WORK/attr/rgba.ply" "$WORK/attr/rgba.pomar"
+  expect_rc 0
+  expect_contains "$OUT" "colour 'colour': RGBA, 8 bits exact, max error 0" "verify ($layout)"
+  for level in 0 2 -1; do
+    if [ "$level" = -1 ]; then run decode "$WORK/attr/rgba.pomar" "$WORK/attr/rgba_back.ply"
+    else run decode --level "$level" "$WORK/attr/rgba.pomar" "$WORK/attr/rgba_back.ply"; fi
+    expect_rc 0
+    grep -aq "^property uchar alpha$" "$WORK/attr/rgba_back.ply" || fail "level $level ($layout) lost the alpha"; pass
+  done
+  run encode "$layout" "$WORK/attr/zero.obj" "$WORK/attr/zero.pomar"
+  expect_rc 0
+  expect_contains "$OUT" "attribute normal" "encode output of an OBJ with zero normals ($layout)"
+  run verify "$WORK/attr/zero.obj" "$WORK/attr/zero.pomar"
+  expect_rc 0
+  expect_contains "$OUT" "normal 'normal': 9-bit octahedral" "verify of zero normals ($layout)"
+  for level in 1 -1; do
+    if [ "$level" = -1 ]; then run decode --ascii "$WORK/attr/zero.pomar" "$WORK/attr/zero_back.ply"
+    else run decode --ascii --level "$level" "$WORK/attr/zero.pomar" "$WORK/attr/zero_back.ply"; fi
+    expect_rc 0
+    grep -q "^property float nx$" "$WORK/attr/zero_back.ply" || fail "level $level ($layout) lost the normals"; pass
+  done
+  # The full decode has as many normals of exactly 0 0 0 as the input.
+  python3 - "$WORK/attr/zero.obj" "$WORK/attr/zero_back.ply" <<'PY' || fail "zero normals not kept exactly ($layout)"
+import sys
+want = sum(1 for l in open(sys.argv[1]) if l.strip() == 'vn 0 0 0')
+text = open(sys.argv[2]).read().split('end_header\n')[1].splitlines()
+nv = int(open(sys.argv[2]).read().split('element vertex ')[1].split()[0])
+got = sum(1 for l in text[:nv] if l.split()[3:6] == ['0', '0', '0'])
+sys.exit(0 if want > 0 and got == want else 1)
+PY
+  pass
+done
+run encode "$WORK/attr/nann.ply" "$WORK/attr/nann.pomar"
+expect_rc 1
+expect_contains "$ERR" "normal attribute 'normal' of vertex 5 is NaN" "a NaN normal is an error naming the vertex"
+expect_no_file "$WORK/attr/nann.pomar"
+
 # ---- --help ------------------------------------------------------------------------------------------
 
 section "--help"

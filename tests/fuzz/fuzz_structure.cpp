@@ -14,6 +14,7 @@
 #include <pomar/limits.h>
 
 #include "support/hostile_files.h"
+#include "support/mesh_attributes.h"
 #include "support/mesh_gen.h"
 
 namespace {
@@ -82,6 +83,9 @@ extern "C" int LLVMFuzzerInitialize(int *, char ***) {
   g_images.push_back(encode_image(icosphere(2), false, 6));
   g_images.push_back(encode_image(torus(12, 8), false, 10));
   g_images.push_back(encode_image(grid_with_holes(8, 2), false, 4));
+  // Per-corner texture coordinates and two materials (MATL section, wedge attributes).
+  g_images.push_back(encode_image(pomar::with_cube_map_texture(icosphere(2)), false, 4));
+  g_images.push_back(encode_image(pomar::with_cube_map_texture(icosphere(2)), true, 0));
   return 0;
 }
 

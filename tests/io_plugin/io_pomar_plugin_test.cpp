@@ -25,6 +25,7 @@
 
 #include <vcg/complex/algorithms/update/normal.h>
 
+#include "support/mesh_attributes.h"
 #include "support/mesh_gen.h"
 
 #include "support/mesh_compare.h"
@@ -456,6 +457,51 @@ TEST_F(PomarPluginTest, SaveAndOpenKeepAttributes) {
   EXPECT_TRUE(g_warnings.join("\n").contains("per-vertex colors (tick Color"));
   EXPECT_EQ(infoOf(readBytes(path("a.pomar"))).attributes.size(), 2u);
   QFile::remove(path("a.pomar"));
+}
+
+// MeshLab's GUI renders a layer from its data mask (MeshModel::hasDataMask), not from the
+// mask open() returns: each attribute read (and only those) is enabled on the layer, as
+// MeshModel::Enable does for the stock readers.
+TEST_F(PomarPluginTest, OpenEnablesWhatItReadsOnTheLayer) {
+  using M = vcg::tri::io::Mask;
+  const int kKept = M::IOM_VERTCOLOR | M::IOM_VERTNORMAL | M::IOM_VERTQUALITY | M::IOM_VERTTEXCOORD;
+  struct Case {
+    int has;      ///< pomar::with_attributes's
+    int mask;     ///< the mask open() returns
+    int dataMask; ///< the optional data enabled on the layer (MeshModel::MM_*)
+  };
+  using MM = MeshModel;
+  for (const Case &c :
+       {Case{pomar::kColour, M::IOM_VERTCOLOR, MM::MM_VERTCOLOR},
+        Case{pomar::kColour | pomar::kAlpha | pomar::kNormals, M::IOM_VERTCOLOR | M::IOM_VERTNORMAL,
+             MM::MM_VERTCOLOR},
+        Case{pomar::kScalars, M::IOM_VERTQUALITY, MM::MM_VERTQUALITY},
+        Case{pomar::kTexcoords, M::IOM_VERTTEXCOORD, MM::MM_VERTTEXCOORD},
+        Case{pomar::kAll, kKept, MM::MM_VERTCOLOR | MM::MM_VERTQUALITY | MM::MM_VERTTEXCOORD},
+        Case{0, 0, 0}}) {
+    SCOPED_TRACE(c.has);
+    const pomar::Mesh mesh = pomar::with_attributes(pomar::gen::noisy_sphere(400, 3), c.has);
+    const std::vector<uint8_t> bytes = pomar::encode(mesh);
+    {
+      std::ofstream out(QFile::encodeName(path("attrs.pomar")).toStdString(), std::ios::binary);
+      out.write(reinterpret_cast<const char *>(bytes.data()), std::streamsize(bytes.size()));
+    }
+    MeshModel *mm = doc_.addNewMesh(path("attrs.pomar"), "attrs", true);
+    ASSERT_FALSE(mm->hasDataMask(MM::MM_VERTCOLOR)); // a new layer: only what is always on
+    RichParameterList par;
+    plugin()->initPreOpenParameter("pomar", path("attrs.pomar"), par);
+    int mask = 0;
+    ASSERT_TRUE(plugin()->open("pomar", path("attrs.pomar"), *mm, mask, par))
+        << plugin()->errorMsg().toStdString();
+    EXPECT_EQ(mask, c.mask);
+    for (int bit : {MM::MM_VERTCOLOR, MM::MM_VERTQUALITY, MM::MM_VERTTEXCOORD})
+      EXPECT_EQ(mm->hasDataMask(bit), bool(c.dataMask & bit)) << "MeshModel data bit " << bit;
+    EXPECT_TRUE(mm->hasDataMask(MM::MM_VERTNORMAL)); // always on in MeshLab
+    EXPECT_EQ(bool(c.dataMask & MM::MM_VERTTEXCOORD), vcg::tri::HasPerVertexTexCoord(mm->cm));
+    mm->cm.ClearAttributes();
+    doc_.delMesh(mm);
+  }
+  QFile::remove(path("attrs.pomar"));
 }
 
 TEST_F(PomarPluginTest, FailedSaveWritesNothing) {

@@ -140,7 +140,7 @@ ml -i octa.pomar -o octa_back.ply -m vc vn
 expect_rc 0
 pomar verify "$OUTDIR/octa.ply" "$OUTDIR/octa.pomar" "$OUTDIR/octa_back.ply"
 expect_rc 0
-expect_output "colour 'colour': RGB, 8 bits exact, max error 0"
+expect_output "colour 'colour': RGBA, 8 bits exact, max error 0"
 rm -f "$OUTDIR"/octa*
 
 # ---- 2. a non-manifold mesh is saved exactly (the cut is stored), and opens as it was ------------

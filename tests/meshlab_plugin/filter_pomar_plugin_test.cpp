@@ -523,9 +523,14 @@ TEST_F(FilterPomarTest, AttributesSurviveRefineAndShowFilters) {
   };
   MeshModel *mm = open("coloured.pomar", 1); // base clustered mesh
   expectFileColours(*mm);
+  // The GUI draws vertex colours only when they are in the layer's data mask: opening puts
+  // them there, and so does a refine, which replaces the layer's content with a decode.
+  EXPECT_TRUE(mm->hasDataMask(MeshModel::MM_VERTCOLOR));
+  mm->clearDataMask(MeshModel::MM_VERTCOLOR);
   selectFacesOf(*mm, {0, 1, 2});
   ASSERT_TRUE(refine(info_->levels.size())) << filter()->errorMsg().toStdString();
   expectFileColours(*mm);
+  EXPECT_TRUE(mm->hasDataMask(MeshModel::MM_VERTCOLOR));
   ASSERT_TRUE(apply(kShowClusters)) << filter()->errorMsg().toStdString();
   ASSERT_TRUE(apply(kShowLevels)) << filter()->errorMsg().toStdString();
   ASSERT_TRUE(apply(kShowOriginal)) << filter()->errorMsg().toStdString();

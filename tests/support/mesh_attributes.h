@@ -3,6 +3,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <random>
@@ -63,6 +64,48 @@ inline Mesh with_attributes(Mesh m, int has, uint32_t seed = 1) {
     }
     m.attributes.push_back(a);
     m.texture_files = {"skin.png", "detail map.jpg"};
+  }
+  return m;
+}
+
+/// The cube-map atlas of with_cube_map_texture: kCubeMapCellsU x kCubeMapCellsV cells.
+constexpr int kCubeMapCellsU = 3, kCubeMapCellsV = 2;
+
+/// `m` with a cube-map atlas: each face goes to the chart of its normal's dominant axis and
+/// sign, its corners projected onto that chart's plane in its cell of the atlas (seams
+/// between the charts); charts 0-2 are material 0, charts 3-5 material 1 (two textures).
+inline Mesh with_cube_map_texture(Mesh m) {
+  const size_t nf = m.triangle_count();
+  m.corner_texcoords.resize(6 * nf);
+  m.face_materials.resize(nf);
+  m.texture_files = {"atlas_a.png", "atlas b.jpg"};
+  m.materials = {{"front", 0, "Kd 1 1 1\nNs 10"}, {"back", 1, "Kd 0.8 0.8 0.8"}};
+  // (the corners' positions, as doubles)
+  auto p = [&](uint32_t v) {
+    return std::array<double, 3>{m.positions[3 * v], m.positions[3 * v + 1],
+                                 m.positions[3 * v + 2]};
+  };
+  for (size_t f = 0; f < nf; ++f) {
+    const uint32_t *t = &m.triangles[3 * f];
+    const std::array<double, 3> a = p(t[0]), b = p(t[1]), c = p(t[2]);
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
+                         u[0] * w[1] - u[1] * w[0]};
+    int axis = 0;
+    for (int k = 1; k < 3; ++k)
+      if (std::fabs(n[k]) > std::fabs(n[axis]))
+        axis = k;
+    const int chart = axis + (n[axis] < 0 ? 3 : 0);
+    m.face_materials[f] = chart < 3 ? 0 : 1;
+    for (int c = 0; c < 3; ++c) {
+      const std::array<double, 3> q = p(t[c]);
+      const double x = q[(axis + 1) % 3], y = q[(axis + 2) % 3]; // about -1.3..1.3
+      const double s = 0.5 + 0.35 * std::max(-1.4, std::min(1.4, x)) / 1.4;
+      const double r = 0.5 + 0.35 * std::max(-1.4, std::min(1.4, y)) / 1.4;
+      m.corner_texcoords[6 * f + 2 * c] = float((chart % kCubeMapCellsU + s) / kCubeMapCellsU);
+      m.corner_texcoords[6 * f + 2 * c + 1] = float((chart / kCubeMapCellsU + r) / kCubeMapCellsV);
+    }
   }
   return m;
 }

@@ -73,7 +73,8 @@ struct Handle {
   StagedSource *source = nullptr; // owned by the decoder
   std::unique_ptr<pomar::SelectiveDecoder> decoder;
   pomar::ClusterIndex index;
-  std::vector<uint32_t> adj_start, adj; // the cluster graph (edges of the base clustered mesh)
+  std::vector<uint32_t> adj_start, adj;   // the cluster graph (edges of the base clustered mesh)
+  std::vector<uint32_t> link_start, link; // clusters decoded to one level (texture seams)
   // Results kept alive for JavaScript to copy out of the heap.
   pomar::Mesh mesh;
   std::vector<uint32_t> vertex_cluster, vertex_level;
@@ -251,6 +252,7 @@ EMSCRIPTEN_KEEPALIVE Handle *pw_open(const uint8_t *data, size_t n, double file_
       const size_t hsize = pomar::header_size(data, n);
       const pomar::FileLayout layout = pomar::read_layout(data, hsize, size, true);
       h->index = pomar::read_cluster_index(data + layout.index_offset, layout);
+      h->decoder->cluster_links(h->link_start, h->link);
     }
     const pomar::Mesh base = h->decoder->mesh();
     h->textured = !base.corner_texcoords.empty();
@@ -306,8 +308,9 @@ EMSCRIPTEN_KEEPALIVE double pw_block_size(Handle *h, uint32_t c) {
 /// The completed level map for `wanted` (pw_levels_out), without decoding.
 EMSCRIPTEN_KEEPALIVE int pw_complete(Handle *h, const int32_t *wanted) {
   return guarded([&] {
-    const std::vector<int> target = pomar::complete_level_map(
-        to_levels(*h, wanted), h->adj_start, h->adj, h->decoder->base_clustered_level());
+    const std::vector<int> target =
+        pomar::complete_level_map(to_levels(*h, wanted), h->adj_start, h->adj,
+                                  h->decoder->base_clustered_level(), h->link_start, h->link);
     h->levels.assign(target.begin(), target.end());
     return 0;
   });

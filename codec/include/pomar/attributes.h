@@ -54,8 +54,9 @@ struct AttributeOptions {
   int normal_bits = 9;
   int scalar_bits = 16;   ///< bits over each scalar's range, 1..24
   int texcoord_bits = 12; ///< bits over the range of u and of v, 1..24
-  /// Store every float bit for bit (NaN, infinities, denormals and zero-length normals
-  /// included). Otherwise a NaN or infinite value, or a zero-length normal, is an error.
+  /// Store every float bit for bit (NaN, infinities, denormals and the sign of -0
+  /// included). Otherwise a NaN or infinite value is an error naming the vertex, and a
+  /// zero-length normal comes back as exactly (0, 0, 0).
   bool exact = false;
   AttributeMask keep; ///< kinds to store (the others are dropped)
 };

@@ -127,7 +127,7 @@ struct Mesh {
 
 /// Throw pomar::Error naming the attribute (and vertex) if an attribute does not fit the
 /// mesh: wrong component count, value count not matching the vertex count, empty or
-/// repeated name; with `quantized`, also NaN/infinite values and zero-length normals.
+/// repeated name; with `quantized`, also NaN/infinite values (zero-length normals are fine).
 /// Attributes whose kind `mask` drops are not checked.
 void validate_attributes(const Mesh &mesh, bool quantized, const AttributeMask &mask = {});
 

@@ -114,6 +114,10 @@ public:
   const FileInfo &info() const;
   uint32_t cluster_count() const;
   int base_clustered_level() const; ///< levels decoded for the whole mesh
+  /// Clusters that must be decoded to one level (CSR: the clusters linked to c are
+  /// link[start[c] .. start[c + 1])): in a file with texture seams, the clusters rooted at
+  /// copies of one seam vertex, whose twins split in the same level. Empty lists otherwise.
+  void cluster_links(std::vector<uint32_t> &start, std::vector<uint32_t> &link) const;
   int finest_level() const;
 
   // ----- requests: raise the wanted level of clusters (never lowers it) -----
@@ -189,5 +193,12 @@ private:
 std::vector<int> complete_level_map(const std::vector<int> &wanted,
                                     const std::vector<uint32_t> &start,
                                     const std::vector<uint32_t> &adj, int floor);
+/// The same with cluster links (SelectiveDecoder::cluster_links, CSR as `adj`): linked
+/// clusters get one level, the highest any of them needs.
+std::vector<int> complete_level_map(const std::vector<int> &wanted,
+                                    const std::vector<uint32_t> &start,
+                                    const std::vector<uint32_t> &adj, int floor,
+                                    const std::vector<uint32_t> &link_start,
+                                    const std::vector<uint32_t> &link);
 
 } // namespace pomar

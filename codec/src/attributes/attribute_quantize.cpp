@@ -109,14 +109,6 @@ void validate_attributes(const Mesh &mesh, bool quantized, const AttributeMask &
                     (std::isnan(a.values[k]) ? "NaN" : "infinite") +
                     ": quantized attributes must be finite (--exact-attributes keeps every "
                     "float bit for bit)");
-    if (a.kind == AttributeKind::Normal)
-      for (size_t v = 0; v < nv; ++v) {
-        const float *n = &a.values[3 * v];
-        if (n[0] == 0 && n[1] == 0 && n[2] == 0)
-          throw Error(what + " of vertex " + std::to_string(v) +
-                      " has length 0: a quantized normal needs a direction (--exact-attributes "
-                      "keeps it as it is)");
-      }
   }
 }
 
@@ -235,6 +227,10 @@ double StoredAttribute::bound() const {
   return b;
 }
 
+namespace {
+bool is_zero_length(const float n[3]) { return n[0] == 0 && n[1] == 0 && n[2] == 0; }
+} // namespace
+
 StoredAttribute describe(const VertexAttribute &a, const AttributeOptions &o) {
   StoredAttribute s;
   s.kind = a.kind;
@@ -251,8 +247,11 @@ StoredAttribute describe(const VertexAttribute &a, const AttributeOptions &o) {
     throw Error(std::string(kind_name(a.kind)) + " bits must be between " +
                 std::to_string(min_bits) + " and " + std::to_string(max_bits) + " (got " +
                 std::to_string(s.bits) + ")");
-  if (a.kind == AttributeKind::Normal)
+  if (a.kind == AttributeKind::Normal) {
+    for (size_t v = 0; v < a.vertex_count() && !s.zero_normals; ++v)
+      s.zero_normals = is_zero_length(&a.values[3 * v]);
     return s;
+  }
   s.lo.assign(a.components, 0.0f);
   s.hi.assign(a.components, 0.0f);
   const size_t nv = a.vertex_count();
@@ -283,7 +282,7 @@ void code_range(const StoredAttribute &s, uint32_t k, int64_t &lo, int64_t &hi) 
     hi = 0xFFFFFFFFll;
   } else if (s.kind == AttributeKind::Normal) {
     lo = 0;
-    hi = (1 << s.bits) - 2;
+    hi = (1 << s.bits) - (s.zero_normals ? 1 : 2);
   } else {
     lo = 0;
     hi = (1 << s.bits) - 1;
@@ -309,7 +308,10 @@ void to_codes(const StoredAttribute &s, const VertexAttribute &a, size_t v, int6
   }
   if (s.kind == AttributeKind::Normal) {
     uint32_t u, w;
-    octahedral_encode(x, s.bits, u, w);
+    if (s.zero_normals && is_zero_length(x))
+      u = w = octahedral_zero_code(s.bits);
+    else
+      octahedral_encode(x, s.bits, u, w);
     codes[0] = u;
     codes[1] = w;
     return;
@@ -338,6 +340,15 @@ void from_codes(const StoredAttribute &s, const int64_t *codes, VertexAttribute 
     return;
   }
   if (s.kind == AttributeKind::Normal) {
+    const int64_t zero = octahedral_zero_code(s.bits);
+    if (s.zero_normals && (codes[0] == zero || codes[1] == zero)) {
+      if (codes[0] != codes[1])
+        throw Error(Error::Kind::DamagedFile, "damaged .pomar file: normal attribute '" + s.name +
+                                                  "' of vertex " + std::to_string(v) +
+                                                  " has half of the zero-normal code");
+      x[0] = x[1] = x[2] = 0.0f;
+      return;
+    }
     octahedral_decode(uint32_t(codes[0]), uint32_t(codes[1]), s.bits, x);
     return;
   }

@@ -13,7 +13,7 @@ namespace pomar {
 namespace {
 
 [[noreturn]] void damaged(const std::string &what) {
-  throw Error("damaged .pomar file: ATTR section: " + what);
+  throw Error(Error::Kind::DamagedFile, "damaged .pomar file: ATTR section: " + what);
 }
 
 /// Range-code `count` vertices of codes, each predicted by the previous one (the first by
@@ -22,6 +22,12 @@ template <class Coder> void code_base(Coder &&code_one, uint32_t count, uint32_t
   for (uint32_t v = 0; v < count; ++v)
     for (uint32_t k = 0; k < n; ++k)
       code_one(v, k);
+}
+
+/// The flags byte of a descriptor (ATTR section version 2).
+constexpr uint8_t kZeroNormalsFlag = 1; // a quantized normal attribute with zero-length normals
+uint8_t descriptor_flags(const StoredAttribute &s) {
+  return s.kind == AttributeKind::Normal && s.bits && s.zero_normals ? kZeroNormalsFlag : 0;
 }
 
 /// kind, name, components, bits and bound of a stored attribute into a VertexAttribute or
@@ -116,10 +122,12 @@ void init_attributes(const AttributeTable &table, LevelMesh &lm, const Attribute
   lm.attr_lo.clear();
   lm.attr_hi.clear();
   lm.normal_code = -1;
+  lm.normal_zero = false;
   for (const StoredAttribute &s : table.stored) {
     if (s.kind == AttributeKind::Normal && s.bits && lm.normal_code < 0) {
       lm.normal_code = static_cast<int>(lm.attr_lo.size());
       lm.normal_bits = s.bits;
+      lm.normal_zero = s.zero_normals;
     }
     for (uint32_t k = 0; k < s.codes(); ++k) {
       int64_t lo, hi;
@@ -133,13 +141,20 @@ void init_attributes(const AttributeTable &table, LevelMesh &lm, const Attribute
 std::vector<uint8_t> write_attributes(const AttributeTable &t, uint32_t base_vertices) {
   std::vector<uint8_t> out;
   ByteWriter w(out);
-  w.u8(kAttributeSectionVersion);
+  // Version 1 unless a descriptor needs its flags byte (version 2): files whose attributes
+  // use no flag stay readable by readers of version 1.
+  bool flags = false;
+  for (const StoredAttribute &s : t.stored)
+    flags |= descriptor_flags(s) != 0;
+  w.u8(flags ? kAttributeSectionFlagsVersion : kAttributeSectionVersion);
   w.u8(static_cast<uint8_t>(t.stored.size()));
   for (size_t i = 0; i < t.stored.size(); ++i) {
     const StoredAttribute &s = t.stored[i];
     w.u8(static_cast<uint8_t>(s.kind));
     w.u8(static_cast<uint8_t>(s.components));
     w.u8(static_cast<uint8_t>(s.bits));
+    if (flags)
+      w.u8(descriptor_flags(s));
     w.u8(static_cast<uint8_t>(s.name.size()));
     w.bytes(reinterpret_cast<const uint8_t *>(s.name.data()), s.name.size());
     for (size_t k = 0; k < s.lo.size(); ++k) {
@@ -187,9 +202,10 @@ AttributeTable read_attributes(const uint8_t *data, size_t size, uint32_t base_v
   ByteReader r(data, size, "damaged .pomar file: ATTR section");
   AttributeTable t;
   const uint8_t version = r.u8();
-  if (version != kAttributeSectionVersion)
-    throw Error("ATTR section version " + std::to_string(version) +
-                " is not supported (this pomar reads version 1)");
+  if (version != kAttributeSectionVersion && version != kAttributeSectionFlagsVersion)
+    throw Error(Error::Kind::Unsupported, "ATTR section version " + std::to_string(version) +
+                                              " is not supported (this pomar reads versions 1 "
+                                              "and 2)");
   const uint32_t count = r.u8();
   auto read_string = [&](size_t len) {
     std::string s;
@@ -205,6 +221,8 @@ AttributeTable read_attributes(const uint8_t *data, size_t size, uint32_t base_v
     s.kind = static_cast<AttributeKind>(kind);
     s.components = r.u8();
     s.bits = r.u8();
+    const uint8_t flags = version == kAttributeSectionFlagsVersion ? r.u8() : 0;
+    s.zero_normals = flags & kZeroNormalsFlag;
     s.name = read_string(r.u8());
     const uint32_t want = s.kind == AttributeKind::Normal     ? 3
                           : s.kind == AttributeKind::TexCoord ? 2
@@ -215,7 +233,8 @@ AttributeTable read_attributes(const uint8_t *data, size_t size, uint32_t base_v
                              ? s.bits == 0 || (s.bits >= 4 && s.bits <= 16)
                              : s.bits <= 24;
     if (s.components != want || want < 1 || want > 4 ||
-        (s.kind == AttributeKind::Colour && want < 3) || !bits_ok || s.name.empty())
+        (s.kind == AttributeKind::Colour && want < 3) || !bits_ok || s.name.empty() ||
+        flags != descriptor_flags(s))
       damaged("attribute '" + s.name + "' has an invalid descriptor");
     if (s.bits && s.kind != AttributeKind::Normal)
       for (uint32_t k = 0; k < s.components; ++k) {

@@ -1,4 +1,4 @@
-// Per-vertex attributes in the bitstream (format version 4).
+// Per-vertex attributes in the bitstream (format version 4 on).
 //
 // Each vertex's attributes are integer codes (attribute_quantize.h). The codes of the base
 // mesh vertices are stored in the "ATTR" section, with the descriptors of the attributes;
@@ -25,6 +25,8 @@ struct LevelMesh;
 
 constexpr uint32_t kAttributeSectionTag = section_tag("ATTR"); // optional (flags 0)
 constexpr uint8_t kAttributeSectionVersion = 1;
+/// The version whose descriptors have a flags byte (written only when a flag is set).
+constexpr uint8_t kAttributeSectionFlagsVersion = 2;
 
 /// The attributes of a file: descriptors, texture files and the codes of the base mesh.
 struct AttributeTable {

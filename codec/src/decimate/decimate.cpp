@@ -125,6 +125,10 @@ public:
     return k != i && k != (from_.closed ? (i + m - 1) % m : i - 1);
   }
   bool link_ok(uint32_t i);
+  /// Whether collapse i of the loaded vertex is allowed (boundary rule), keeps the patch
+  /// normals and the link condition.
+  bool admissible(uint32_t i) { return allowed_direction(i) && normals_ok(i) && link_ok(i); }
+  void gather() { gather_positions(); }
 
   Ring from_;
   std::vector<Candidate> found; // scratch of the parallel evaluation (Decimator::candidates)
@@ -156,7 +160,8 @@ private:
 class Decimator {
 public:
   Decimator(CornerTable &ct, const std::vector<int32_t> &q, const DecimationOptions &opt)
-      : ct_(ct), target_mark_(ct.vertex_count(), 0), dirty_(ct.vertex_count(), 0) {
+      : ct_(ct), opt_(opt), target_mark_(ct.vertex_count(), 0), dirty_(ct.vertex_count(), 0),
+        twin_eval_(ct, q, opt) {
     if (opt.threads > 1 && ct.vertex_count() >= 2 * kSlice)
       pool_ = std::make_unique<ThreadPool>(opt.threads);
     for (unsigned t = 0; t < (pool_ ? pool_->size() : 1); ++t)
@@ -168,9 +173,11 @@ public:
 
 private:
   std::vector<Candidate> candidates(const std::vector<uint32_t> &alive);
-  Collapse collapse(uint32_t v_from, uint32_t i);
+  Collapse collapse(const Evaluator &e, uint32_t v_from, uint32_t i);
+  int twin_option(uint32_t v_to);
 
   CornerTable &ct_;
+  const DecimationOptions &opt_;
   std::vector<uint32_t> target_mark_; // level stamp of vertices already used as v_to
   std::vector<uint32_t> dirty_;       // level stamp of vertices whose ring changed
   uint32_t level_stamp_ = 0;
@@ -181,6 +188,7 @@ private:
   std::deque<Evaluator> eval_;                // per pool thread; eval_[0]: also the greedy pass's
   std::vector<std::vector<Candidate>> slice_; // per slice: its candidates
   std::vector<Candidate> sort_scratch_;
+  Evaluator twin_eval_; // the twin of a candidate on a texture seam
 };
 
 // Boundary rule: a boundary vertex may only slide along its boundary (onto the first or
@@ -373,8 +381,7 @@ bool Evaluator::best_option(Candidate &out) {
 }
 
 // Halfedge collapse v_from -> v_to = from_.neighbour[i] on the corner table.
-Collapse Decimator::collapse(uint32_t v_from, uint32_t i) {
-  const Evaluator &e = eval_[0];
+Collapse Decimator::collapse(const Evaluator &e, uint32_t v_from, uint32_t i) {
   const Ring &from_ = e.from_;
   const uint32_t m = from_.size();
   const uint32_t il = e.v_l_index(i), ir = e.v_r_index(i);
@@ -417,6 +424,29 @@ Collapse Decimator::collapse(uint32_t v_from, uint32_t i) {
   for (uint32_t n : from_.neighbour)
     dirty_[n] = level_stamp_;
   return op;
+}
+
+// The collapse of the twin loaded in twin_eval_ that goes with v_from -> v_to: onto the end
+// of its open fan that is a copy of v_to (another vertex than v_to, not yet a v_to of this
+// level, its ring unchanged or the link condition still true), if admissible; else -1.
+int Decimator::twin_option(uint32_t v_to) {
+  const Ring &r = twin_eval_.from_;
+  const uint32_t m = r.size();
+  if (r.closed || m < 3)
+    return -1;
+  const uint32_t origin = (*opt_.origin)[v_to];
+  bool gathered = false;
+  for (uint32_t i : {0u, m - 1}) {
+    const uint32_t t = r.neighbour[i];
+    if (t == v_to || (*opt_.origin)[t] != origin || target_mark_[t] == level_stamp_)
+      continue;
+    if (!gathered) // (the positions of the twin's ring, for the normal test)
+      twin_eval_.gather();
+    gathered = true;
+    if (twin_eval_.admissible(i))
+      return static_cast<int>(i);
+  }
+  return -1;
 }
 
 // Every alive vertex's best collapse. Evaluation only reads the mesh: `alive` is cut into
@@ -476,11 +506,25 @@ std::vector<Collapse> Decimator::run_level(std::vector<uint32_t> &alive) {
     const Candidate &c = candidates[j];
     if (dirty_[c.v_from] == level_stamp_ || target_mark_[c.v_to] == level_stamp_)
       continue;
+    const uint32_t twin = opt_.twin ? (*opt_.twin)[c.v_from] : kNone;
+    if (twin != kNone && dirty_[twin] == level_stamp_)
+      continue;
     e.load(c.v_from);
     const int i = from_.index_of(c.v_to);
     if (i < 0 || (dirty_[c.v_to] == level_stamp_ && !e.link_ok(static_cast<uint32_t>(i))))
       continue;
-    done.push_back(collapse(c.v_from, static_cast<uint32_t>(i)));
+    if (twin == kNone) {
+      done.push_back(collapse(e, c.v_from, static_cast<uint32_t>(i)));
+      continue;
+    }
+    // A seam vertex and its twin slide onto the copies of one vertex, both or neither (the
+    // two sides' fans share no face: the first collapse leaves the second's checks true).
+    twin_eval_.load(twin);
+    const int k = twin_option(c.v_to);
+    if (k < 0)
+      continue;
+    done.push_back(collapse(e, c.v_from, static_cast<uint32_t>(i)));
+    done.push_back(collapse(twin_eval_, twin, static_cast<uint32_t>(k)));
   }
   alive.erase(
       std::remove_if(alive.begin(), alive.end(), [&](uint32_t v) { return ct_.VC[v] == kNone; }),

@@ -30,6 +30,12 @@ struct DecimationOptions {
   /// Per vertex, optional: 1 = never v_from (the vertex stays to the base mesh; it may be
   /// v_to). Texture seams lock their vertices (lossless/seam_cut.h).
   const std::vector<uint8_t> *locked = nullptr;
+  /// Per vertex, optional (with `origin`): the other copy of a vertex on a simple texture
+  /// seam, or kNone. Twins collapse together or not at all: in one level, each along its
+  /// side of the seam onto the copies of one vertex (origin[] says which vertices are copies
+  /// of one: equal values), so both sides of the seam keep the same vertices.
+  const std::vector<uint32_t> *twin = nullptr;
+  const std::vector<uint32_t> *origin = nullptr;
 };
 
 struct Decimation {

@@ -3,6 +3,7 @@
 #include "decode/level_map.h"
 
 #include <algorithm>
+#include <array>
 
 #include "pomar/random_access.h"
 
@@ -20,9 +21,39 @@ ClusterGraph cluster_graph(const CornerTable &ct, uint32_t clusters) {
   return g;
 }
 
+void link_coincident_clusters(const std::vector<int32_t> &q, uint32_t clusters, ClusterGraph &g) {
+  std::vector<std::pair<std::array<int32_t, 3>, uint32_t>> at(clusters);
+  for (uint32_t c = 0; c < clusters; ++c)
+    at[c] = {{q[3 * size_t(c)], q[3 * size_t(c) + 1], q[3 * size_t(c) + 2]}, c};
+  std::sort(at.begin(), at.end());
+  std::vector<std::vector<uint32_t>> links(clusters);
+  for (size_t i = 0, j; i < at.size(); i = j) {
+    for (j = i + 1; j < at.size() && at[j].first == at[i].first; ++j)
+      ;
+    for (size_t a = i; a < j; ++a)
+      for (size_t b = i; b < j; ++b)
+        if (a != b)
+          links[at[a].second].push_back(at[b].second);
+  }
+  g.link_start.assign(clusters + 1, 0);
+  g.link.clear();
+  for (uint32_t c = 0; c < clusters; ++c) {
+    g.link.insert(g.link.end(), links[c].begin(), links[c].end());
+    g.link_start[c + 1] = static_cast<uint32_t>(g.link.size());
+  }
+}
+
 std::vector<int> complete_level_map(const std::vector<int> &wanted,
                                     const std::vector<uint32_t> &start,
                                     const std::vector<uint32_t> &adj, int floor) {
+  return complete_level_map(wanted, start, adj, floor, {}, {});
+}
+
+std::vector<int> complete_level_map(const std::vector<int> &wanted,
+                                    const std::vector<uint32_t> &start,
+                                    const std::vector<uint32_t> &adj, int floor,
+                                    const std::vector<uint32_t> &link_start,
+                                    const std::vector<uint32_t> &link) {
   const size_t n = wanted.size();
   std::vector<int> m(n);
   int top = floor;
@@ -41,6 +72,12 @@ std::vector<int> complete_level_map(const std::vector<int> &wanted,
       const uint32_t c = bucket[size_t(lvl - floor)][i];
       if (m[c] != lvl)
         continue;
+      if (!link_start.empty()) // linked clusters: the same level (this bucket grows)
+        for (uint32_t k = link_start[c]; k < link_start[c + 1]; ++k)
+          if (m[link[k]] < lvl) {
+            m[link[k]] = lvl;
+            bucket[size_t(lvl - floor)].push_back(link[k]);
+          }
       for (uint32_t k = start[c]; k < start[c + 1]; ++k) {
         const uint32_t nb = adj[k];
         if (m[nb] < lvl - 1) {
@@ -57,7 +94,9 @@ std::vector<int> complete_level_map(const std::vector<int> &wanted,
 // limit[x] = min over clusters c of cap[c] + d(c, x): buckets by value, lowest first (a
 // multi-source breadth-first search).
 std::vector<int> cap_distance_map(const std::vector<int> &cap, const std::vector<uint32_t> &start,
-                                  const std::vector<uint32_t> &adj, int top) {
+                                  const std::vector<uint32_t> &adj, int top,
+                                  const std::vector<uint32_t> &link_start,
+                                  const std::vector<uint32_t> &link) {
   std::vector<int> limit(cap.size(), top);
   int low = top;
   for (size_t c = 0; c < cap.size(); ++c) {
@@ -73,6 +112,12 @@ std::vector<int> cap_distance_map(const std::vector<int> &cap, const std::vector
       const uint32_t c = bucket[size_t(lvl - low)][i];
       if (limit[c] != lvl)
         continue;
+      if (!link_start.empty()) // linked clusters: capped alike (this bucket grows)
+        for (uint32_t k = link_start[c]; k < link_start[c + 1]; ++k)
+          if (limit[link[k]] > lvl) {
+            limit[link[k]] = lvl;
+            bucket[size_t(lvl - low)].push_back(link[k]);
+          }
       for (uint32_t k = start[c]; k < start[c + 1]; ++k)
         if (limit[adj[k]] > lvl + 1) {
           limit[adj[k]] = lvl + 1;

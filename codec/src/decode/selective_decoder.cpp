@@ -354,6 +354,8 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   s.levels.assign(n, s.global_levels);
   s.cap.assign(n, s.finest);
   s.graph = cluster_graph(s.mesh.ct, n);
+  if (s.materials) // texture seams: the clusters of a seam vertex's copies refine together
+    link_coincident_clusters(s.mesh.q, n, s.graph);
 }
 
 SelectiveDecoder::~SelectiveDecoder() = default;
@@ -363,6 +365,13 @@ uint32_t SelectiveDecoder::cluster_count() const {
   return static_cast<uint32_t>(s_->clusters.size());
 }
 int SelectiveDecoder::base_clustered_level() const { return s_->global_levels; }
+void SelectiveDecoder::cluster_links(std::vector<uint32_t> &start,
+                                     std::vector<uint32_t> &link) const {
+  start = s_->graph.link_start;
+  link = s_->graph.link;
+  if (start.empty())
+    start.assign(s_->clusters.size() + 1, 0);
+}
 int SelectiveDecoder::finest_level() const { return s_->finest; }
 const std::vector<int> &SelectiveDecoder::wanted() const { return s_->wanted; }
 const std::vector<int> &SelectiveDecoder::levels() const { return s_->levels; }
@@ -525,11 +534,13 @@ void SelectiveDecoder::update(const Progress &progress) {
 /// Bring the mesh to the level map completed from `wanted` and limited by the caps;
 /// `decoding` names the cluster being decoded (kNone between clusters).
 void SelectiveDecoder::State::decode_target(const Progress &progress, uint32_t &decoding) {
-  target = complete_level_map(wanted, graph.start, graph.adj, global_levels);
+  target = complete_level_map(wanted, graph.start, graph.adj, global_levels, graph.link_start,
+                              graph.link);
   if (!damaged.empty()) {
     // Each damaged cluster limits the others to its cap + their distance to it, the
     // largest map below both the request and the caps that keeps the level map rule.
-    const std::vector<int> limit = cap_distance_map(cap, graph.start, graph.adj, finest);
+    const std::vector<int> limit =
+        cap_distance_map(cap, graph.start, graph.adj, finest, graph.link_start, graph.link);
     for (size_t c = 0; c < target.size(); ++c)
       target[c] = std::min(target[c], limit[c]);
   }

@@ -230,12 +230,25 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
   auto t1 = std::chrono::steady_clock::now();
   DecimationOptions decimation;
   decimation.threads = resolve_threads(options.threads);
-  std::vector<uint8_t> locked; // (prepared numbering)
+  std::vector<uint8_t> locked; // texture seams (prepared numbering)
+  std::vector<uint32_t> twin, origin;
   if (hook && !hook->locked.empty()) {
     locked.resize(nv);
+    twin.assign(nv, kNone);
+    origin.resize(nv);
+    std::vector<uint32_t> prepared(hook->locked.size(), kNone);
     for (uint32_t v = 0; v < nv; ++v)
-      locked[v] = hook->locked[in.to_input[v]];
+      prepared[in.to_input[v]] = v;
+    for (uint32_t v = 0; v < nv; ++v) {
+      const uint32_t c = in.to_input[v];
+      locked[v] = hook->locked[c];
+      origin[v] = hook->origin[c];
+      if (hook->twin[c] != kNone)
+        twin[v] = prepared[hook->twin[c]];
+    }
     decimation.locked = &locked;
+    decimation.twin = &twin;
+    decimation.origin = &origin;
   }
   const Decimation dec = decimate(std::move(in.ct), in.q, decimation, options.progress);
   const double t_decimate = seconds_since(t1);

@@ -60,6 +60,7 @@ struct OffHeader {
 
 struct OffLayout {
   size_t vertices = 0, faces = 0, triangles = 0, polygons = 0;
+  bool alpha = false; // a vertex colour has 4 values (RGBA)
 };
 
 /// Walks an OFF file the way ImporterOFF reads it, refusing what it would read out of
@@ -77,6 +78,7 @@ public:
     for (uint64_t i = 0; i < h.vertices; ++i)
       vertex(h, i);
     OffLayout out;
+    out.alpha = alpha_;
     out.vertices = static_cast<size_t>(h.vertices);
     out.faces = static_cast<size_t>(h.faces);
     for (uint64_t f = 0; f < h.faces; ++f) {
@@ -162,6 +164,7 @@ private:
                             strip_cr(tokens_[k_ + size_t(j)]) + "' outside 0..1");
         }
       k_ += static_cast<size_t>(n);
+      alpha_ |= n == 4;
     }
     for (int j = 0; h.texcoords && j < 2; ++j)
       token("vertex texture coordinate", i);
@@ -193,6 +196,7 @@ private:
   OffLines lines_;
   std::vector<std::string> tokens_;
   size_t k_ = 0;
+  bool alpha_ = false; // a vertex colour of 4 values seen
 };
 
 using OffImporter = vcg::tri::io::ImporterOFF<IoMesh>;
@@ -347,7 +351,18 @@ Mesh load_off(const std::string &path, LoadReport &report, const SizeCheck &chec
   report.file_vertices = layout.vertices;
   report.file_faces = layout.faces;
   report.polygons_triangulated = layout.polygons;
-  return from_vcg(m, &report.unreferenced_vertices, kept, true); // unreferenced vertices kept
+  Mesh mesh = from_vcg(m, &report.unreferenced_vertices, kept, true); // unreferenced kept
+  // vcglib's colours are RGBA and from_vcg keeps an alpha only where one is not 255: a file
+  // with RGBA colours gives 4 channels whatever their values.
+  VertexAttribute *c = mesh.find(AttributeKind::Colour);
+  if (layout.alpha && c && c->components == 3) {
+    std::vector<uint8_t> rgba(c->colour.size() / 3 * 4, 255);
+    for (size_t v = 0; v < c->colour.size() / 3; ++v)
+      std::copy(&c->colour[3 * v], &c->colour[3 * v] + 3, &rgba[4 * v]);
+    c->colour = std::move(rgba);
+    c->components = 4;
+  }
+  return mesh;
 }
 
 void write_off(TextFileWriter &out, const Mesh &mesh) {

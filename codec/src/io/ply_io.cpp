@@ -953,8 +953,8 @@ bool read_simple_ply(FileReader &in, const PlyHeader &h, Mesh &out, size_t &unre
 /// The mesh of a walk that captured the positions and triangles (PlyCapture), as the
 /// general path would build it without vcglib's second read of the file: the attributes
 /// go through a vcglib mesh of the same vertices (put_attributes, then from_vcg's
-/// take_attributes), so that they come out exactly as there (a colour's alpha of 255
-/// dropped, quality, texture coordinates and named scalars in its order). False if the
+/// take_attributes), so that they come out exactly as there (quality, texture coordinates
+/// and named scalars in its order; the caller restores an alpha of 255, keep_alpha). False if the
 /// capture stopped or met a non-finite coordinate: the general path reads the file, and
 /// names the problem.
 bool mesh_from_capture(PlyCapture &capture, const PlyLayout &layout, const PlyVertexPlan &plan,
@@ -991,6 +991,50 @@ bool mesh_from_capture(PlyCapture &capture, const PlyLayout &layout, const PlyVe
   return true;
 }
 
+/// The RGBA colour of the file, in `mesh` (made through a vcglib mesh, whose colours are
+/// always RGBA: take_attributes keeps an alpha only where one differs from 255): a file with
+/// an alpha property gives 4 channels, whatever their values.
+void keep_alpha(PlyVertexPlan &plan, Mesh &mesh) {
+  for (VertexAttribute &a : plan.attributes)
+    if (a.kind == AttributeKind::Colour && a.components == 4)
+      if (VertexAttribute *c = mesh.find(AttributeKind::Colour, a.name))
+        if (c->components == 3 && a.vertex_count() == c->vertex_count()) {
+          c->components = 4;
+          c->colour = std::move(a.colour);
+        }
+}
+
+/// Names, in `ignored`, each property of the face (or tristrips) elements that is neither
+/// an index list nor one vcglib's mask `file_mask` already names (add_ignored_from_mask:
+/// face colour, normal, quality, flags, wedge texture coordinates and colours).
+void name_unkept_face_properties(const PlyHeader &h, int file_mask,
+                                 std::vector<std::string> &ignored) {
+  using M = vcg::tri::io::Mask;
+  static const struct {
+    const char *name;
+    int mask;
+  } kNamed[] = {{"flags", M::IOM_FACEFLAGS},       {"quality", M::IOM_FACEQUALITY},
+                {"nx", M::IOM_FACENORMAL},         {"ny", M::IOM_FACENORMAL},
+                {"nz", M::IOM_FACENORMAL},         {"red", M::IOM_FACECOLOR},
+                {"green", M::IOM_FACECOLOR},       {"blue", M::IOM_FACECOLOR},
+                {"alpha", M::IOM_FACECOLOR},       {"color", M::IOM_WEDGCOLOR},
+                {"texcoord", M::IOM_WEDGTEXCOORD}, {"texnumber", M::IOM_WEDGTEXMULTI}};
+  for (const PlyElement &e : h.elements) {
+    if (e.name != "face" && e.name != "tristrips")
+      continue;
+    for (const PlyProperty &p : e.props) {
+      if (p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index"))
+        continue;
+      bool named = false;
+      for (const auto &k : kNamed)
+        named |= p.name == k.name && (file_mask & k.mask);
+      if (!named)
+        add_unique(ignored,
+                   (e.name + (p.is_list ? " list" : "") + " property '" + p.name + "'").c_str());
+    }
+  }
+}
+
 } // namespace
 
 Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &check) {
@@ -998,9 +1042,10 @@ Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &chec
   PlyVertexPlan plan;
   PlyCapture capture;
   std::vector<std::string> texture_files;
+  PlyHeader header;
   {
     FileReader in(path);
-    const PlyHeader header = read_ply_header(in, path);
+    header = read_ply_header(in, path);
     const uint64_t faces = element_count(header, "face");
     report.text = header.encoding == PlyHeader::Ascii;
     run_size_check(check, path, element_count(header, "vertex"), faces);
@@ -1040,6 +1085,7 @@ Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &chec
                    M::IOM_VERTRADIUS | M::IOM_VERTFLAGS);
   }
   add_ignored_from_mask(file_mask, report.ignored_attributes);
+  name_unkept_face_properties(header, file_mask, report.ignored_attributes);
   if (layout.edges)
     add_unique(report.ignored_attributes, "edges");
   if (layout.camera)
@@ -1049,8 +1095,10 @@ Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &chec
   report.polygons_triangulated = layout.polygons;
   Mesh captured;
   if (mesh_from_capture(capture, layout, plan, texture_files, path, captured,
-                        report.unreferenced_vertices))
+                        report.unreferenced_vertices)) {
+    keep_alpha(plan, captured);
     return captured;
+  }
 
   IoMesh m;
   int mask = 0;
@@ -1068,6 +1116,7 @@ Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &chec
   const int attribute_mask = put_attributes(plan.attributes, texture_files, m);
   // Unreferenced vertices kept (the file stores them).
   Mesh mesh = from_vcg(m, &report.unreferenced_vertices, attribute_mask, true);
+  keep_alpha(plan, mesh);
   mesh.texture_files = texture_files; // also without per-vertex texture coordinates
   return mesh;
 }

@@ -336,6 +336,8 @@ std::vector<uint8_t> encode_any(const Mesh &mesh, const EncodeOptions &options,
         cut = mesh;
     }
     hook.locked.clear();
+    hook.twin.clear();
+    hook.origin.clear();
     hook.materials.clear();
     if (corners) { // the cut's faces get their corners' values, then it is cut at its seams
       if (coded != &cut) {
@@ -345,6 +347,8 @@ std::vector<uint8_t> encode_any(const Mesh &mesh, const EncodeOptions &options,
       corner_values_of_cut(mesh, map, cut);
       seams = cut_at_seams(cut, map, static_cast<uint32_t>(nv));
       hook.locked = std::move(seams.locked);
+      hook.twin = std::move(seams.twin);
+      hook.origin = std::move(seams.origin);
       MaterialTable materials;
       materials.corner_texcoords = !mesh.corner_texcoords.empty();
       materials.face_materials = !mesh.face_materials.empty();

@@ -26,6 +26,9 @@ struct LosslessHook {
   /// Per vertex of the mesh given to encode_manifold, optional: 1 = decimation keeps it (a
   /// texture seam's vertex, lossless/seam_cut.h).
   std::vector<uint8_t> locked;
+  /// Per vertex, optional (with `origin`): twins on a simple texture seam, which decimation
+  /// collapses together (DecimationOptions::twin, lossless/seam_cut.h).
+  std::vector<uint32_t> twin, origin;
   /// The body of the required MATL section (materials of per-corner values), or empty.
   std::vector<uint8_t> materials;
 };

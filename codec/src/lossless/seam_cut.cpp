@@ -121,10 +121,13 @@ SeamCut cut_at_seams(Mesh &mesh, RepairMap &map, uint32_t input_vertices) {
   std::iota(parent.begin(), parent.end(), 0u);
   SeamCut cut;
   cut.locked.assign(nv, 0);
+  std::vector<uint8_t> seam_edges_at(nv, 0), on_boundary(nv, 0);
   auto next = [](uint32_t c) { return c - c % 3 + (c + 1) % 3; };
-  for (uint32_t i = 0; i + 1 < nc; ++i) {
-    if (edges[i].key != edges[i + 1].key)
+  for (uint32_t i = 0; i < nc; ++i) {
+    if (i + 1 == nc || edges[i].key != edges[i + 1].key) { // a boundary edge
+      on_boundary[V[edges[i].id]] = on_boundary[V[next(edges[i].id)]] = 1;
       continue;
+    }
     // Face f has a -> b starting at corner cf, face g has b -> a starting at cg.
     const uint32_t cf = edges[i].id, cg = edges[i + 1].id;
     const uint32_t f_a = cf, f_b = next(cf), g_b = cg, g_a = next(cg);
@@ -137,7 +140,10 @@ SeamCut cut_at_seams(Mesh &mesh, RepairMap &map, uint32_t input_vertices) {
     }
     if (seam) {
       ++cut.seam_edges;
-      cut.locked[V[cf]] = cut.locked[V[next(cf)]] = 1;
+      for (uint32_t v : {V[cf], V[next(cf)]}) {
+        cut.locked[v] = 1;
+        seam_edges_at[v] = uint8_t(std::min(255, seam_edges_at[v] + 1));
+      }
     }
     ++i;
   }
@@ -200,8 +206,24 @@ SeamCut cut_at_seams(Mesh &mesh, RepairMap &map, uint32_t input_vertices) {
     }
   }
   cut.locked.resize(total, 0);
-  for (uint32_t i = 0; i < copy_source.size(); ++i)
-    cut.locked[nv + i] = cut.locked[copy_source[i]];
+  cut.twin.assign(total, kNone);
+  cut.origin.resize(total);
+  std::iota(cut.origin.begin(), cut.origin.begin() + nv, 0u);
+  std::vector<uint32_t> copies(nv, 0), last_copy(nv, kNone);
+  for (uint32_t i = 0; i < copy_source.size(); ++i) {
+    const uint32_t s = copy_source[i];
+    cut.locked[nv + i] = cut.locked[s];
+    cut.origin[nv + i] = s;
+    ++copies[s];
+    last_copy[s] = nv + i;
+  }
+  for (uint32_t v = 0; v < nv; ++v)
+    if (copies[v] == 1 && seam_edges_at[v] == 2 && !on_boundary[v]) { // a simple seam vertex
+      cut.twin[v] = last_copy[v];
+      cut.twin[last_copy[v]] = v;
+      cut.locked[v] = cut.locked[last_copy[v]] = 0;
+      cut.twins += 2;
+    }
   // Cut vertex v (v < nv) stands for input vertex v (< input_vertices) or for the copy
   // map.copy_of[v - input_vertices]; so does each of its wedge copies.
   if (map.copy_of.size() + input_vertices != nv)

@@ -9,12 +9,15 @@
 // decode welds them back; the cut faces are the input's, in its order, so the corners keep
 // their places.
 //
-// Seams never open: every vertex on a seam edge (an edge whose two faces disagree at either
-// end) is locked, decimation never removes it, so the seam's edges, which join two locked
-// vertices, are in every level and both sides of a seam have the same vertices at every
-// level. A coarse face comes from a finer face of the same wedges (a collapse removes only
-// unlocked vertices, whose corners all have one value), so its corners are valid lookups in
-// the chart of the face it replaces. docs/architecture.md, "Texture seams".
+// Seams never open. A vertex inside a seam's run (two wedges, two seam edges) has two copies,
+// twins, which decimation collapses together, each along its side of the seam onto the
+// copies of one neighbour, in one level; every other vertex on a seam edge (an edge whose
+// two faces disagree at either end: chart corners, seam ends, seams on the mesh's boundary)
+// is locked and never removed. So both sides of a seam have the same vertices and edges at
+// every level; a selective decode keeps the clusters of copies at one level (the decoder's
+// cluster links), so both sides also refine together there. A coarse face comes from a
+// finer face of the same wedges, so its corners are valid lookups in the chart of the face
+// it replaces. docs/architecture.md, "Texture seams".
 #pragma once
 
 #include <cstdint>
@@ -55,6 +58,13 @@ struct SeamCut {
   size_t wedge_copies = 0; ///< vertices added (one per wedge but the first)
   /// Per vertex of the cut: 1 if it is on a seam (decimation keeps it).
   std::vector<uint8_t> locked;
+  /// Per vertex of the cut: for the two copies of a vertex on a simple seam (two wedges,
+  /// two seam edges, not on the mesh's boundary), the other one; else kNone. Twins are not
+  /// locked: they collapse together (DecimationOptions::twin).
+  std::vector<uint32_t> twin;
+  /// Per vertex of the cut: the vertex it is a copy of (itself for the first wedge).
+  std::vector<uint32_t> origin;
+  size_t twins = 0; ///< vertices with a twin
 };
 
 /// Cut `mesh` (manifold and oriented: the lossless stage's cut) along its texture seams:

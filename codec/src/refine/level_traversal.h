@@ -126,7 +126,8 @@ inline void get_view_ring(const LevelMesh &mesh, uint32_t v, const LevelView &le
 /// predicted by the octahedral code of 3 x the unit area-weighted normal of v_from's patch
 /// faces (v_from at its decoded position with the patch ring; integer cross products) plus
 /// v_to's decoded normal, when neither sum is zero (horse, 9 bits: 11.8 bits per vertex
-/// with v_to's normal alone, 9.8 with the faces' alone, 9.0 with 3:1).
+/// with v_to's normal alone, 9.8 with the faces' alone, 9.0 with 3:1); by the faces' alone
+/// if v_to's normal is zero-length.
 inline void predict_attributes(const LevelMesh &mesh, uint32_t v_to, const Ring &ring,
                                const PatchRange &p, const int32_t position[3], int64_t *pred) {
   const uint32_t n = mesh.attr_codes;
@@ -151,9 +152,11 @@ inline void predict_attributes(const LevelMesh &mesh, uint32_t v_to, const Ring 
     return;
   const double len = std::sqrt(double(sum[0]) * double(sum[0]) + double(sum[1]) * double(sum[1]) +
                                double(sum[2]) * double(sum[2]));
-  float parent[3];
-  octahedral_decode(uint32_t(pred[mesh.normal_code]), uint32_t(pred[mesh.normal_code + 1]),
-                    mesh.normal_bits, parent);
+  float parent[3] = {0, 0, 0}; // a zero-length normal adds nothing to the faces' direction
+  if (!mesh.normal_zero ||
+      !is_zero_normal(pred[mesh.normal_code], pred[mesh.normal_code + 1], mesh.normal_bits))
+    octahedral_decode(uint32_t(pred[mesh.normal_code]), uint32_t(pred[mesh.normal_code + 1]),
+                      mesh.normal_bits, parent);
   float normal[3];
   for (int k = 0; k < 3; ++k)
     normal[k] = float(3.0 * double(sum[k]) / len + double(parent[k]));
