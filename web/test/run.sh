@@ -44,6 +44,7 @@ status=0
 node "$REPO/web/test/texture_test.mjs" "$samples/textured/textured.pomar" || status=$?
 if [ "$status" = 77 ]; then
   textured=()  # the tool's OBJ reader keeps no per-corner texture coordinates
+  echo "web tests: the browser test's textured session SKIPPED (no texture coordinates in the encoded cube)"
 elif [ "$status" != 0 ]; then
   exit "$status"
 fi
