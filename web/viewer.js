@@ -17,9 +17,10 @@ const params = new URLSearchParams(location.search);
 // One three.js mesh drawn with a small shader: flat shading from screen-space derivatives
 // (the decoded mesh has no normals), a headlight, and the colour of the material chosen in
 // the colour menu (MATERIALS below). A textured file is drawn in one geometry group per
-// material of the file, each with its own copy of the shader's material and texture. &shading=smooth shades with vertex normals instead
-// (area-weighted face normals, computed at each upload), e.g. to compare refinement
-// policies (bench/web_fidelity_bench.py --shading smooth).
+// material of the file, each with its own copy of the shader's material and texture.
+// &shading=smooth shades with vertex normals instead (area-weighted face normals, computed
+// at each upload), e.g. to compare refinement policies (bench/web_fidelity_bench.py
+// --shading smooth).
 const VS = `precision highp float;
 in vec3 position;
 in float cluster;
