@@ -147,7 +147,8 @@ export class Decoder {
    *  has `texcoords` (Float32Array, u and v per vertex, v = 0 at the bottom of the image;
    *  null when a vertex's corners disagree: `texcoordConflicts` counts those vertices),
    *  `faceMaterials` (Uint32Array, per triangle: an index into `materials`, or null),
-   *  `materials` ([{name, texture}]: texture an index into `textureFiles`, -1 for none) and
+   *  `materials` ([{name, texture, properties}]: texture an index into `textureFiles`, -1
+   *  for none; properties the material's other MTL lines, e.g. "Kd 0.8 0.2 0.2") and
    *  `textureFiles` (the names the file stores). `keepSeams`: at full resolution too, a
    *  textured file gives the coded mesh cut at its seams (one texture coordinate per
    *  vertex) rather than the welded input, whose seam vertices have two. */
@@ -163,7 +164,8 @@ export class Decoder {
     const faceMaterials = M._pw_face_materials(this.h);
     const materials = [];
     for (let i = 0; i < M._pw_material_count(this.h); ++i)
-      materials.push({ name: M.UTF8ToString(M._pw_material_name(this.h, i)), texture: M._pw_material_texture(this.h, i) });
+      materials.push({ name: M.UTF8ToString(M._pw_material_name(this.h, i)), texture: M._pw_material_texture(this.h, i),
+        properties: M.UTF8ToString(M._pw_material_properties(this.h, i)) });
     const textureFiles = [];
     for (let i = 0; i < M._pw_texture_count(this.h); ++i) textureFiles.push(M.UTF8ToString(M._pw_texture_file(this.h, i)));
     return {

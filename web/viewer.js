@@ -59,6 +59,7 @@ uniform vec3 eye;
 uniform highp int colourMode; // highp: the vertex shader's int precision (shared uniform)
 uniform int smoothShading;
 uniform sampler2D map;
+uniform vec3 diffuse;
 out vec4 colour;
 void main() {
   vec3 n = smoothShading == 1 && dot(vNormal, vNormal) > 0.0 ? normalize(vNormal)
@@ -66,8 +67,9 @@ void main() {
   vec3 l = normalize(eye - vPosition);
   float d = abs(dot(n, l));
   // Own colours (mode 3) are interpolated across the face, a texture (mode 4) is looked up
-  // at the interpolated texture coordinate; all are lit like the others.
-  vec3 base = colourMode == 3 ? vRgb : colourMode == 4 ? texture(map, vUv).rgb : vColour;
+  // at the interpolated texture coordinate, a material without one (mode 5) has its
+  // diffuse colour; all are lit like the others.
+  vec3 base = colourMode == 3 ? vRgb : colourMode == 4 ? texture(map, vUv).rgb : colourMode == 5 ? diffuse : vColour;
   colour = vec4(base * (0.25 + 0.75 * d), 1.0);
 }`;
 
@@ -230,15 +232,26 @@ function shaderMaterial(own) {
     uniforms: { ...sharedUniforms, ...own },
   });
 }
-/** The texture materials for `mesh`'s materials: each draws its texture (mode 4), or plain
- *  grey while it loads or if its material has none. */
+/** A material's diffuse colour (its MTL `Kd r g b` line), or null. */
+function diffuseOf(material) {
+  const kd = material && /^\s*Kd\s+(\S+)\s+(\S+)\s+(\S+)/m.exec(material.properties || '');
+  const rgb = kd ? kd.slice(1, 4).map(Number) : null;
+  return rgb && rgb.every((c) => Number.isFinite(c)) ? rgb.map((c) => Math.max(0, Math.min(1, c))) : null;
+}
+/** The texture materials for `mesh`'s materials: each draws its texture (mode 4); one
+ *  without a texture its diffuse colour (mode 5) if it has one; else, and while its image
+ *  loads, plain grey. */
 function updateTextureMaterials(mesh) {
   const count = Math.max(1, (mesh.materials || []).length);
-  while (textureMaterials.length < count) textureMaterials.push(shaderMaterial({ colourMode: { value: 0 }, map: { value: null } }));
+  while (textureMaterials.length < count) textureMaterials.push(shaderMaterial({ colourMode: { value: 0 }, map: { value: null }, diffuse: { value: new THREE.Vector3() } }));
   for (let m = 0; m < textureMaterials.length; ++m) {
     const texture = m < count ? textures.of(mesh, m) : null;
-    textureMaterials[m].uniforms.map.value = texture;
-    textureMaterials[m].uniforms.colourMode.value = texture ? 4 : 0;
+    const own = mesh.materials && mesh.materials[m];
+    const diffuse = own && own.texture < 0 ? diffuseOf(own) : null;
+    const u = textureMaterials[m].uniforms;
+    u.map.value = texture;
+    if (diffuse) u.diffuse.value.set(...diffuse);
+    u.colourMode.value = texture ? 4 : diffuse ? 5 : 0;
   }
 }
 /** The triangles of `mesh` ordered by material (a stable counting sort) and one geometry
@@ -268,7 +281,7 @@ function initGL() {
   renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
   renderer.setClearColor(new THREE.Color(0x20242a), 1);
   scene = new THREE.Scene();
-  plainMaterial = shaderMaterial({ colourMode: { value: 0 }, map: { value: null } });
+  plainMaterial = shaderMaterial({ colourMode: { value: 0 }, map: { value: null }, diffuse: { value: new THREE.Vector3() } });
   shown = new THREE.Mesh(new THREE.BufferGeometry(), plainMaterial);
   shown.frustumCulled = false; // the geometry changes with every decode
   scene.add(shown);

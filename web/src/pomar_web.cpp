@@ -450,6 +450,10 @@ EMSCRIPTEN_KEEPALIVE int pw_material_count(Handle *h) { return int(h->mesh.mater
 EMSCRIPTEN_KEEPALIVE const char *pw_material_name(Handle *h, int i) {
   return i >= 0 && size_t(i) < h->mesh.materials.size() ? h->mesh.materials[i].name.c_str() : "";
 }
+/// Its other MTL lines as the file keeps them (`Kd 0.8 0.2 0.2`, `Ns 10`, ...).
+EMSCRIPTEN_KEEPALIVE const char *pw_material_properties(Handle *h, int i) {
+  return i >= 0 && size_t(i) < h->mesh.materials.size() ? h->mesh.materials[i].properties.c_str() : "";
+}
 EMSCRIPTEN_KEEPALIVE int pw_material_texture(Handle *h, int i) {
   return i >= 0 && size_t(i) < h->mesh.materials.size() ? h->mesh.materials[i].texture : -1;
 }

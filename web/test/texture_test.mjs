@@ -6,7 +6,8 @@
 // Exit status 77: the file has no texture coordinates (skipped).
 // At the base clustered mesh, with one cluster refined, coarsened back and at full
 // resolution with keepSeams (as the viewer asks): one (u, v) per vertex, no vertex whose
-// corners disagree, a material per triangle, the file's two materials and texture names;
+// corners disagree, a material per triangle, the file's two materials (name, texture,
+// their `Kd 1 1 1` line) and texture names;
 // every triangle's three texture coordinates lie inside one chart (atlas cell, inside its
 // margin) of its own material's texture, so no face is drawn across a seam. At full
 // resolution without keepSeams the mesh is the welded input (1538 vertices): its seam
@@ -38,7 +39,8 @@ function checkMesh(mesh, what) {
   check(mesh.texcoords && mesh.texcoords.length === 2 * nv && mesh.texcoordConflicts === 0,
     `${what}: ${nv} vertices, ${mesh.texcoords ? mesh.texcoords.length / 2 : 'no'} texture coordinates, ${mesh.texcoordConflicts} in conflict`);
   check(mesh.faceMaterials && mesh.faceMaterials.length === nt, `${what}: a material per triangle (${nt})`);
-  check(JSON.stringify(mesh.materials) === JSON.stringify([{ name: 'sides', texture: 0 }, { name: 'caps', texture: 1 }]) &&
+  const materials = mesh.materials.map((m) => ({ name: m.name, texture: m.texture, kd: /^\s*Kd\s+1\s+1\s+1\s*$/m.test(m.properties) }));
+  check(JSON.stringify(materials) === JSON.stringify([{ name: 'sides', texture: 0, kd: true }, { name: 'caps', texture: 1, kd: true }]) &&
     JSON.stringify(mesh.textureFiles) === JSON.stringify(['a.png', 'maps/b.png']),
   `${what}: materials ${JSON.stringify(mesh.materials)}, textures ${JSON.stringify(mesh.textureFiles)}`);
   if (!mesh.texcoords || !mesh.faceMaterials) return;
