@@ -26,8 +26,8 @@ grey and the Y-up choice turns the model on its side (screenshots coloured_*).
 --textured DIR: the textured cube of web/test/textured_mesh.py, DIR/textured.pomar (run.sh
 encodes it) with its textures DIR/a.png and DIR/maps/b.png: the viewer opens it with its
 texture, the texture coordinates match the geometry after region refinement, coarsening
-and full resolution (two geometry groups: two materials), each visible face shows its
-chart's colour in its place (the +Z face's upper half blue above its lower half yellow:
+and full resolution (three geometry groups: three materials), each visible face shows its
+chart's colour in its place (the top face its material's Kd: it has no texture) (the +Z face's upper half blue above its lower half yellow:
 the texture's v = 0 at the bottom), hidden faces' colours absent, plain shows none of
 them; served without its images it says so in the page and draws plain (textured_*).
 Exit status 0 = pass, 1 = a check failed, 77 = Chromium or the WebAssembly build missing.
@@ -95,9 +95,9 @@ def textured_checks(check, t):
         s = t[name]
         d = s['drawn'] or {}
         check(d.get('texcoords') == d.get('vertices') == s['vertices'] == s['meshTexcoords'] and s['vertices'] > 0
-              and d.get('groups') == 2,
+              and d.get('groups') == 3,
               f"{name} (levels {s['minLevel']}..{s['maxLevel']}): {s['vertices']} vertices, {d.get('vertices')} drawn "
-              f"with {d.get('texcoords')} texture coordinates in {d.get('groups')} groups (2 materials)")
+              f"with {d.get('texcoords')} texture coordinates in {d.get('groups')} groups (3 materials)")
     check(t['full']['minLevel'] == t['full']['maxLevel'] and t['region']['minLevel'] < t['region']['maxLevel'],
           'the textured model went through a region, the base and full resolution')
     seen = ('+z top', '+z bottom', '+x', '+y')
@@ -109,11 +109,13 @@ def textured_checks(check, t):
               and all(p[c]['fraction'] < 0.01 for c in hidden),
               f"{name}: the faces in view show their charts' colours, the hidden ones' absent ({shown} of "
               f"{100 * p['covered']:.1f}% of the pixels)")
-        check(p['+z top']['y'] < p['+z bottom']['y'],
+        present = all(p[c]['fraction'] > 0 for c in seen)  # else the places below are -1
+        check(present and p['+z top']['y'] < p['+z bottom']['y'],
               f"{name}: the +Z face's upper chart half (blue, v > 0.5) above its lower half (yellow): v = 0 at the "
               f"image's bottom (mean heights from the top {p['+z top']['y']:.2f}, {p['+z bottom']['y']:.2f})")
-        check(p['+y']['y'] < min(p['+z top']['y'], p['+x']['y']) and p['+x']['x'] > p['+z bottom']['x'],
-              f"{name}: the top face's colour on top (mean height {p['+y']['y']:.2f}), +X's on the right "
+        check(present and p['+y']['y'] < min(p['+z top']['y'], p['+x']['y']) and p['+x']['x'] > p['+z bottom']['x'],
+              f"{name}: the top face's colour (green: its material's Kd, it has no texture) on top (mean height "
+              f"{p['+y']['y']:.2f}), +X's on the right "
               f"(mean x {p['+x']['x']:.2f} against +Z's {p['+z bottom']['x']:.2f})")
     g = t['plain']
     coloured = sum(g[c]['fraction'] for c in seen + hidden)

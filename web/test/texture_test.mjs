@@ -6,10 +6,10 @@
 // Exit status 77: the file has no texture coordinates (skipped).
 // At the base clustered mesh, with one cluster refined, coarsened back and at full
 // resolution with keepSeams (as the viewer asks): one (u, v) per vertex, no vertex whose
-// corners disagree, a material per triangle, the file's two materials (name, texture,
-// their `Kd 1 1 1` line) and texture names;
+// corners disagree, a material per triangle, the file's three materials (name, texture or
+// none, their `Kd` line) and two texture names;
 // every triangle's three texture coordinates lie inside one chart (atlas cell, inside its
-// margin) of its own material's texture, so no face is drawn across a seam. At full
+// margin) of its own material's atlas, so no face is drawn across a seam. At full
 // resolution without keepSeams the mesh is the welded input (1538 vertices): its seam
 // vertices have corners in two or three charts, no per-vertex value is given and they are
 // counted (the 12 x 15 + 8 = 188 vertices on the cube's edges).
@@ -27,9 +27,9 @@ const M = await loadModuleInNode();
 const result = checker();
 const check = result.check;
 
-// textured_mesh.py's atlases: material `sides` 2 x 2 cells, `caps` 2 x 1; a chart keeps a
+// textured_mesh.py's atlases: materials `sides` and `lid` 2 x 2 cells, `caps` 2 x 1; a chart keeps a
 // margin of 1/16 of its cell to the cell's border.
-const CELLS = { sides: [2, 2], caps: [2, 1] };
+const CELLS = { sides: [2, 2], caps: [2, 1], lid: [2, 2] };
 const MARGIN = 1 / 16;
 const EPS = 1e-3; // the decoded texture coordinates' grid (12 bits over their range)
 
@@ -39,8 +39,9 @@ function checkMesh(mesh, what) {
   check(mesh.texcoords && mesh.texcoords.length === 2 * nv && mesh.texcoordConflicts === 0,
     `${what}: ${nv} vertices, ${mesh.texcoords ? mesh.texcoords.length / 2 : 'no'} texture coordinates, ${mesh.texcoordConflicts} in conflict`);
   check(mesh.faceMaterials && mesh.faceMaterials.length === nt, `${what}: a material per triangle (${nt})`);
-  const materials = mesh.materials.map((m) => ({ name: m.name, texture: m.texture, kd: /^\s*Kd\s+1\s+1\s+1\s*$/m.test(m.properties) }));
-  check(JSON.stringify(materials) === JSON.stringify([{ name: 'sides', texture: 0, kd: true }, { name: 'caps', texture: 1, kd: true }]) &&
+  const materials = mesh.materials.map((m) => ({ name: m.name, texture: m.texture, kd: (/^\s*Kd\s+(.*\S)\s*$/m.exec(m.properties) || [])[1] }));
+  check(JSON.stringify(materials) === JSON.stringify([{ name: 'sides', texture: 0, kd: '1 1 1' }, { name: 'caps', texture: 1, kd: '1 1 1' },
+    { name: 'lid', texture: -1, kd: '0 1 0' }]) &&
     JSON.stringify(mesh.textureFiles) === JSON.stringify(['a.png', 'maps/b.png']),
   `${what}: materials ${JSON.stringify(mesh.materials)}, textures ${JSON.stringify(mesh.textureFiles)}`);
   if (!mesh.texcoords || !mesh.faceMaterials) return;

@@ -11,9 +11,11 @@ OUT_DIR/maps/b.png (a texture name with a directory part).
 The mesh is a unit cube centred at the origin, each face a grid of 16 x 16 quads split into
 triangles, vertices shared between faces (one position), texture coordinates per face
 chart: a cube-map atlas, so every cube edge is a texture seam. Material `sides` (a.png, a
-2 x 2 atlas) holds the faces +X (red), -X (cyan), +Y (green) and -Y (magenta); material
-`caps` (maps/b.png, two charts side by side) holds +Z, whose chart is blue in its upper half
-(v > 0.5) and yellow in its lower half, and -Z (orange). Texture coordinates follow the OBJ
+2 x 2 atlas) holds the faces +X (red), -X (cyan) and -Y (magenta); material `caps`
+(maps/b.png, two charts side by side) holds +Z, whose chart is blue in its upper half
+(v > 0.5) and yellow in its lower half, and -Z (orange); material `lid`, without a
+texture, `Kd 0 1 0` (green), holds +Y (its chart is a.png's fourth cell, painted green
+too but not used). Texture coordinates follow the OBJ
 convention: v = 0 at the bottom of the image. On the +Z face, v grows with y, so seen Y-up
 from the +Z side the blue half is at the top. Each chart keeps a margin of 1/16 of its cell
 to the cell's border, so filtering never mixes two charts.
@@ -34,12 +36,13 @@ CYAN, MAGENTA, YELLOW, ORANGE = (0, 255, 255), (255, 0, 255), (255, 255, 0), (25
 FACES = {
     '+x': (0, 1, ((2, -1), (1, 1)), 'sides', (0, 1)),
     '-x': (0, -1, ((2, 1), (1, 1)), 'sides', (1, 1)),
-    '+y': (1, 1, ((0, 1), (2, -1)), 'sides', (0, 0)),
+    '+y': (1, 1, ((0, 1), (2, -1)), 'lid', (0, 0)),
     '-y': (1, -1, ((0, 1), (2, 1)), 'sides', (1, 0)),
     '+z': (2, 1, ((0, 1), (1, 1)), 'caps', (0, 0)),
     '-z': (2, -1, ((0, -1), (1, 1)), 'caps', (1, 0)),
 }
-MATERIALS = {'sides': ('a.png', 2, 2), 'caps': ('maps/b.png', 2, 1)}  # texture, cells u x v
+# Material: texture (or None), atlas cells along u and v, diffuse colour.
+MATERIALS = {'sides': ('a.png', 2, 2, '1 1 1'), 'caps': ('maps/b.png', 2, 1, '1 1 1'), 'lid': (None, 2, 2, '0 1 0')}
 
 
 def cell_colour(material, column, row, v_in_cell):
@@ -64,7 +67,7 @@ def png(path, width, height, pixel):
 
 
 def texture(path, material):
-    _, columns, rows = MATERIALS[material]
+    _, columns, rows, _ = MATERIALS[material]
     width, height = columns * CELL, rows * CELL
 
     def pixel(x, y):
@@ -82,7 +85,7 @@ def mesh():
     positions = []
     faces = {m: [] for m in MATERIALS}  # material -> [((p, (u, v)), x3)]
     for name, (axis, sign, (ua, va), material, (column, row)) in FACES.items():
-        _, columns, rows = MATERIALS[material]
+        _, columns, rows, _ = MATERIALS[material]
         margin = 1 / 16
 
         def corner(i, j):
@@ -132,8 +135,8 @@ def main():
     positions, faces = mesh()
     faces = orientation_fix(positions, faces)
     with open(os.path.join(out, 'textured.mtl'), 'w') as f:
-        for material, (name, _, _) in MATERIALS.items():
-            f.write(f'newmtl {material}\nKd 1 1 1\nmap_Kd {name}\n\n')
+        for material, (name, _, _, kd) in MATERIALS.items():
+            f.write(f'newmtl {material}\nKd {kd}\n' + (f'map_Kd {name}\n' if name else '') + '\n')
     with open(os.path.join(out, 'textured.obj'), 'w') as f:
         f.write('# web/test/textured_mesh.py: a cube with a cube-map atlas in two textures\nmtllib textured.mtl\n')
         for p in positions:
@@ -148,8 +151,9 @@ def main():
             for t in tris:
                 f.write('f ' + ' '.join(f'{c[0] + 1}/{vt + k + 1}' for k, c in enumerate(t)) + '\n')
                 vt += 3
-    for material, (name, _, _) in MATERIALS.items():
-        texture(os.path.join(out, name), material)
+    for material, (name, _, _, _) in MATERIALS.items():
+        if name:
+            texture(os.path.join(out, name), material)
 
 
 if __name__ == '__main__':
