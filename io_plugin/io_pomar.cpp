@@ -283,9 +283,11 @@ bool PomarIOPlugin::open(const QString &format, const QString &fileName, MeshMod
 
     if (mesh.find(pomar::AttributeKind::TexCoord))
       m.updateDataMask(MeshModel::MM_VERTTEXCOORD); // optional in CMeshO: enable first
+    if (!mesh.corner_texcoords.empty())
+      m.updateDataMask(MeshModel::MM_WEDGTEXCOORD); // per-corner UVs: the wedges'
     // Also clears m's attributes. What was read goes into the layer's data mask too: the GUI
     // picks the rendering (vertex colour, ...) from that mask, not from the returned one.
-    mask = pomar::to_vcg(mesh, m.cm) & kKeptMask;
+    mask = pomar::to_vcg(mesh, m.cm) & (kKeptMask | vcg::tri::io::Mask::IOM_WEDGTEXCOORD);
     m.Enable(mask);
     if (!info.clustered())
       cluster.clear(); // a progressive file's vertices have no cluster

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -83,10 +84,10 @@ TEST_F(AttributeFiles, ObjTextureNamesAndUvsRoundTripThroughPomar) {
   save_mesh(out, decoded);
   EXPECT_TRUE(attributes_not_saved(out, decoded).empty());
   const std::string mtl = read_text(path("out dir.mtl"));
-  EXPECT_NE(mtl.find("map_Kd my skin.png\n"), std::string::npos) << mtl;
+  EXPECT_NE(mtl.find("newmtl skin\nKd 1 1 1\nmap_Kd my skin.png\n"), std::string::npos) << mtl;
   const std::string obj = read_text(out);
   EXPECT_NE(obj.find("mtllib out\\ dir.mtl\n"), std::string::npos);
-  EXPECT_NE(obj.find("\nusemtl texture_0\n"), std::string::npos);
+  EXPECT_NE(obj.find("\nusemtl skin\n"), std::string::npos); // the material, kept by the file
   EXPECT_NE(obj.find("\nvt "), std::string::npos);
 
   LoadReport back_report;
@@ -103,26 +104,33 @@ TEST_F(AttributeFiles, ObjTextureNamesAndUvsRoundTripThroughPomar) {
   EXPECT_EQ(decode(again.data(), again.size()).texture_files, original.texture_files);
 }
 
-TEST_F(AttributeFiles, ObjMaterialsNotKeptAreNamed) {
-  // Missing library: the names are lost, and said so.
+TEST_F(AttributeFiles, ObjMaterialsAreKeptAndMissingLibrariesNamed) {
+  // Missing library: its contents are lost, and said so; the usemtl name is kept.
   LoadReport r;
-  load_mesh(write("a.obj", uv_grid_obj(4, "nowhere.mtl", "m")), &r);
+  const Mesh lost = load_mesh(write("a.obj", uv_grid_obj(4, "nowhere.mtl", "m")), &r);
   EXPECT_NE(joined(r.ignored_attributes).find("material library 'nowhere.mtl' not found"),
             std::string::npos)
       << joined(r.ignored_attributes);
-  // Other properties and two materials: the texture names are kept, the rest named.
+  ASSERT_EQ(lost.materials.size(), 1u);
+  EXPECT_EQ(lost.materials[0].name, "m");
+  EXPECT_EQ(lost.materials[0].texture, -1);
+  // Other properties and two materials: all kept, per face, and nothing named.
   write("two.mtl", "newmtl m\nKa 0.2 0.2 0.2\nKd 1 1 1\nillum 2\nmap_Kd a.png\n"
                    "newmtl n\nmap_Kd b.png\n");
   std::string text = uv_grid_obj(4, "two.mtl", "m");
   text.insert(text.rfind("f "), "usemtl n\n");
   const Mesh m = load_mesh(write("b.obj", text), &r);
   EXPECT_EQ(m.texture_files, (std::vector<std::string>{"a.png", "b.png"}));
-  const std::string ignored = joined(r.ignored_attributes);
-  EXPECT_NE(ignored.find("material properties other than texture names (Ka illum)"),
-            std::string::npos)
-      << ignored;
-  EXPECT_NE(ignored.find("which material each face uses (2 materials"), std::string::npos)
-      << ignored;
+  EXPECT_TRUE(r.ignored_attributes.empty()) << joined(r.ignored_attributes);
+  ASSERT_EQ(m.materials.size(), 2u);
+  EXPECT_EQ(m.materials[0].name, "m");
+  EXPECT_EQ(m.materials[0].properties, "Ka 0.2 0.2 0.2\nKd 1 1 1\nillum 2\n");
+  EXPECT_EQ(m.materials[0].texture, 0);
+  EXPECT_EQ(m.materials[1].texture, 1);
+  ASSERT_EQ(m.face_materials.size(), m.triangle_count());
+  EXPECT_EQ(m.face_materials.back(), 1u);
+  EXPECT_EQ(std::count(m.face_materials.begin(), m.face_materials.end(), 0u),
+            long(m.triangle_count() - 1));
   // A library that is a directory, a device or a /proc file (which could block) is not read.
   ASSERT_EQ(mkdir(path("dir.mtl").c_str(), 0700), 0);
   for (const char *name : {"dir.mtl", "/dev/zero", "/proc/self/status"}) {

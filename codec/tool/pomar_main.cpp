@@ -150,6 +150,15 @@ void warn_dropped(const std::string &file, const std::vector<std::string> &what,
   std::fprintf(stderr, "pomar: warning: %s %s %s%s\n", file.c_str(), verb, list.c_str(), why);
 }
 
+/// What follows the list of what a mesh file cannot hold: where it would be kept.
+const char *not_written_hint(const std::string &path) {
+  std::string ext = path.size() >= 4 ? path.substr(path.size() - 4) : "";
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  return ext == ".ply" ? ": not written (.obj keeps them)"
+                       : ": not written (.ply keeps every attribute)";
+}
+
 int run_encode(const EncodeArgs &a) {
   const auto t0 = Clock::now();
   const uint64_t memory_limit = pomar::parse_memory_size(a.max_memory);
@@ -412,7 +421,7 @@ int run_selective_decode(const DecodeArgs &a) {
   pomar::save_mesh(a.out, mesh, !a.ascii);
   if (!a.quiet)
     warn_dropped(a.out, pomar::attributes_not_saved(a.out, mesh), "cannot hold",
-                 ": not written (.ply keeps every attribute)");
+                 not_written_hint(a.out));
   if (a.stats || !a.quiet) {
     const uint64_t file_size = d.info().total_bytes;
     std::printf("%s: %zu vertices, %zu faces; %u of %u clusters refined (levels %d..%d), %u "
@@ -450,7 +459,7 @@ int run_decode(const DecodeArgs &a) {
   pomar::save_mesh(a.out, mesh, !a.ascii);
   if (!a.quiet)
     warn_dropped(a.out, pomar::attributes_not_saved(a.out, mesh), "cannot hold",
-                 ": not written (.ply keeps every attribute)");
+                 not_written_hint(a.out));
   if (!a.quiet || a.stats)
     std::printf("%s: %zu vertices, %zu faces (decoded in %.3f s, %zu bytes read)\n", a.out.c_str(),
                 mesh.vertex_count(), mesh.triangle_count(), t_decode, data.size());
@@ -719,6 +728,118 @@ bool verify_attributes(const pomar::Mesh &ref, const pomar::Mesh &out, const pom
   return ok;
 }
 
+/// The texture coordinates of every corner of `m`: corner_texcoords, or the per-vertex ones
+/// at each corner (what the OBJ reader gives when no vertex has two); empty if none.
+std::vector<float> corner_uvs(const pomar::Mesh &m) {
+  if (!m.corner_texcoords.empty())
+    return m.corner_texcoords;
+  const pomar::VertexAttribute *uv = m.find(pomar::AttributeKind::TexCoord);
+  std::vector<float> out;
+  if (uv && uv->vertex_count() == m.vertex_count())
+    for (const uint32_t v : m.triangles)
+      out.insert(out.end(), {uv->values[2 * v], uv->values[2 * v + 1]});
+  return out;
+}
+
+/// Triangle f's material as "name|texture file|properties" (`names`: else the texture
+/// file only), "" without materials.
+std::string face_material_text(const pomar::Mesh &m, size_t f, bool names) {
+  if (m.face_materials.empty())
+    return "";
+  const pomar::Material &mat = m.materials[m.face_materials[f]];
+  const std::string file = mat.texture >= 0 ? m.texture_files[size_t(mat.texture)] : "";
+  return names ? mat.name + "|" + file + "|" + mat.properties : file;
+}
+
+/// verify: the per-corner texture coordinates and face materials of `ref` against `out`,
+/// faces matched by their corner positions (in their smallest rotation, the corners taken
+/// in that order; of several faces with the same corners, the closest). UVs within `bound`
+/// (0 = exact: bit for bit); materials by name, texture file and properties (`names`), else
+/// by texture file. Prints a line for each; false if one is missing or differs.
+bool verify_corners(const pomar::Mesh &ref, const pomar::Mesh &out, int bits, double bound,
+                    bool names) {
+  const std::vector<float> ru = corner_uvs(ref), ou = corner_uvs(out);
+  const bool uvs = !ref.corner_texcoords.empty(), materials = !ref.face_materials.empty();
+  if (!uvs && !materials)
+    return true;
+  if (uvs && ou.empty()) {
+    std::fprintf(stderr, "pomar: MISMATCH: the per-corner texture coordinates of the original "
+                         "are missing from the decoded mesh\n");
+    return false;
+  }
+  if (materials && out.face_materials.empty()) {
+    std::fprintf(stderr, "pomar: MISMATCH: the face materials of the original are missing from "
+                         "the decoded mesh\n");
+    return false;
+  }
+  // The smallest rotation of each face's corners, and that rotation.
+  auto key = [](const pomar::Mesh &m, size_t f, int &rotation) {
+    Triangle t;
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t v = m.triangles[3 * f + size_t(k)];
+      t[size_t(k)] = Point{m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]};
+    }
+    const Triangle r[3] = {t, {t[1], t[2], t[0]}, {t[2], t[0], t[1]}};
+    rotation = int(std::min_element(r, r + 3) - r);
+    return r[rotation];
+  };
+  std::map<Triangle, std::vector<std::pair<size_t, int>>> faces; // of ref: (face, rotation)
+  for (size_t f = 0; f < ref.triangle_count(); ++f) {
+    int rotation = 0;
+    const Triangle t = key(ref, f, rotation);
+    faces[t].push_back({f, rotation});
+  }
+  const bool exact = bound == 0;
+  double worst = 0;
+  size_t material_mismatches = 0;
+  for (size_t g = 0; g < out.triangle_count(); ++g) {
+    int rotation = 0;
+    const auto it = faces.find(key(out, g, rotation));
+    if (it == faces.end())
+      continue; // the geometry check reports it
+    double best = HUGE_VAL;
+    bool material_ok = !materials;
+    for (const auto &[f, r] : it->second) {
+      double e = 0;
+      for (int k = 0; uvs && k < 3; ++k) {
+        const float *a = &ru[6 * f + 2 * size_t((k + r) % 3)];
+        const float *b = &ou[6 * g + 2 * size_t((k + rotation) % 3)];
+        for (int c = 0; c < 2; ++c) {
+          const double d = std::fabs(double(a[c]) - double(b[c]));
+          e = std::max(e, exact           ? (std::memcmp(a + c, b + c, 4) == 0 ? 0 : HUGE_VAL)
+                          : std::isnan(d) ? HUGE_VAL
+                                          : d);
+        }
+      }
+      best = std::min(best, e);
+      material_ok |= face_material_text(ref, f, names) == face_material_text(out, g, names);
+    }
+    worst = std::max(worst, best);
+    material_mismatches += !material_ok;
+  }
+  bool ok = true;
+  if (uvs) {
+    const bool within = exact ? worst == 0 : worst <= bound;
+    ok &= within;
+    std::fprintf(within ? stdout : stderr,
+                 "%s  per-corner texture coordinates: %s, max error %.6g\n",
+                 within ? "" : "pomar: MISMATCH:",
+                 exact ? std::string("exact").c_str()
+                       : (std::to_string(bits) + " bits, within " + std::to_string(bound)).c_str(),
+                 worst);
+  }
+  if (materials) {
+    ok &= material_mismatches == 0;
+    std::fprintf(material_mismatches ? stderr : stdout, "%s  face materials: %zu materials, %s\n",
+                 material_mismatches ? "pomar: MISMATCH:" : "", ref.materials.size(),
+                 material_mismatches
+                     ? (std::to_string(material_mismatches) + " faces differ").c_str()
+                 : names ? "the same per face (names, textures, properties)"
+                         : "the same texture per face");
+  }
+  return ok;
+}
+
 /// The vertex positions of `m`, sorted: equal for meshes with the same vertices.
 std::vector<Point> point_multiset(const pomar::Mesh &m) {
   std::vector<Point> out(m.vertex_count());
@@ -755,7 +876,22 @@ int run_verify(const std::string &original, const std::string &file, const std::
                     (triangles_only || (ref.vertex_count() == out.vertex_count() &&
                                         point_multiset(ref) == point_multiset(out)));
   const std::string what = decoded.empty() ? file : decoded;
-  const bool attributes_ok = !same || verify_attributes(ref, out, info, parse_drop(drop));
+  const pomar::AttributeMask keep = parse_drop(drop);
+  bool attributes_ok = !same || verify_attributes(ref, out, info, keep);
+  if (same && keep.texcoords && (!ref.corner_texcoords.empty() || !ref.face_materials.empty())) {
+    // The precision of the stored corners: the decoded mesh's (a decoded mesh file has
+    // none: the file is decoded for it).
+    int corner_bits = out.corner_texcoord_bits;
+    double corner_bound = out.corner_texcoord_bound;
+    if (!decoded.empty()) {
+      const pomar::Mesh full = pomar::decode(data.data(), data.size());
+      corner_bits = full.corner_texcoord_bits;
+      corner_bound = full.corner_texcoord_bound;
+    }
+    // PLY keeps each face's texture, not the material's name and properties.
+    const bool names = ext != ".ply";
+    attributes_ok &= verify_corners(ref, out, corner_bits, corner_bound, names);
+  }
   if (!same) {
     std::fprintf(stderr,
                  "pomar: MISMATCH: %s differs from %s on the %d-bit grid (%zu vertices and %zu "

@@ -31,16 +31,25 @@ class Mesh:
     normals: float32 (n, 3), or None
     scalars: dict name -> float32 (n,) (MeshLab's "quality", PLY "confidence", ...)
     texcoords: float32 (n, 2) (u, v), or None; texture_files: the images they refer to
+
+    and, for textured meshes (photogrammetry scans, OBJ `f v/vt`, PLY face texcoord):
+
+    corner_texcoords: float32 (m, 3, 2), u, v of each corner of each face, or None
+    face_materials: uint32 (m,), each face's index into materials, or None
+    materials: list of dicts {"name": str, "texture": int (index into texture_files, -1
+        for none), "properties": str (an OBJ material's other MTL lines, as read)}
     attribute_info: of a decoded mesh, one dict per attribute with "kind", "name",
         "components", "bits" (0 = exact), "exact" and "bound" (the largest error against
         the input: normals in degrees, scalars and texcoords absolute per component)
     """
 
     __slots__ = ("vertices", "faces", "damaged", "colors", "normals", "scalars", "texcoords",
-                 "texture_files", "attribute_info")
+                 "texture_files", "corner_texcoords", "face_materials", "materials",
+                 "attribute_info")
 
     def __init__(self, vertices, faces, damaged=(), *, colors=None, normals=None, scalars=None,
-                 texcoords=None, texture_files=(), attribute_info=()):
+                 texcoords=None, texture_files=(), corner_texcoords=None, face_materials=None,
+                 materials=(), attribute_info=()):
         self.vertices = vertices
         self.faces = faces
         #: blocks a decode with skip_damaged=True decoded around: dicts with "block"
@@ -51,16 +60,22 @@ class Mesh:
         self.scalars = dict(scalars or {})
         self.texcoords = texcoords
         self.texture_files = list(texture_files)
+        self.corner_texcoords = corner_texcoords
+        self.face_materials = face_materials
+        self.materials = [dict(m) for m in materials]
         self.attribute_info = list(attribute_info)
 
     def _attributes(self):
         """The attribute fields as the keyword arguments of _pomar's encode/write_mesh."""
         return {key: getattr(self, key, None)
-                for key in ("colors", "normals", "scalars", "texcoords", "texture_files")}
+                for key in ("colors", "normals", "scalars", "texcoords", "texture_files",
+                            "corner_texcoords", "face_materials", "materials")}
 
     def __repr__(self):
-        kinds = [name for name in ("colors", "normals", "texcoords")
+        kinds = [name for name in ("colors", "normals", "texcoords", "corner_texcoords")
                  if getattr(self, name) is not None]
+        if self.materials:
+            kinds.append(f"{len(self.materials)} materials")
         kinds += [f"scalar {name!r}" for name in self.scalars]
         extra = f", {', '.join(kinds)}" if kinds else ""
         return f"pomar.Mesh({len(self.vertices)} vertices, {len(self.faces)} faces{extra})"
@@ -138,9 +153,10 @@ def decode(data, level=None, *, skip_damaged=False, memory_limit=None, progress=
 
 
 def read(path, level=None):
-    """Read a mesh file: .ply .obj .off .stl (positions, triangles and the per-vertex
-    colours, normals, scalars and texture coordinates the readers know), or .pomar
-    (decoded after `level` levels, None = all)."""
+    """Read a mesh file: .ply .obj .off .stl (positions, triangles, the per-vertex
+    colours, normals, scalars and texture coordinates the readers know, per-corner texture
+    coordinates and materials: OBJ + MTL, PLY face texcoord/texnumber), or .pomar (decoded
+    after `level` levels, None = all)."""
     path = os.fspath(path)
     if path.lower().endswith(".pomar"):
         with open(path, "rb") as f:
@@ -154,9 +170,10 @@ def read(path, level=None):
 def write(path, mesh, *, binary=True, **encode_options):
     """Write a Mesh, replacing `path` atomically: .ply .stl (binary unless binary=False),
     .obj .off, or .pomar (encode_options as for encode(), e.g. bits=14). PLY and .pomar
-    keep every attribute; OBJ colour (RGB), normals, texture coordinates and texture
-    files (a .mtl beside the file); OFF colour and normals; STL none. What a format cannot
-    hold is named in one UserWarning."""
+    keep every attribute (PLY of the materials only each face's texture); OBJ colour (RGB),
+    normals, texture coordinates (per vertex or per corner), materials and texture files
+    (a .mtl beside the file); OFF colour and normals; STL none. What a format cannot hold
+    is named in one UserWarning."""
     path = os.fspath(path)
     if path.lower().endswith(".pomar"):
         _pomar.write_bytes(path, encode(mesh, **encode_options))
@@ -165,8 +182,10 @@ def write(path, mesh, *, binary=True, **encode_options):
         raise TypeError(f"options {sorted(encode_options)} apply to .pomar files only")
     lost = _pomar.write_mesh(path, mesh.vertices, mesh.faces, binary, Mesh._attributes(mesh))
     if lost:
-        warnings.warn(f"{path} cannot hold {', '.join(lost)}: not written (.ply keeps every "
-                      "attribute)", stacklevel=2)
+        where = (".obj keeps them" if path.lower().endswith(".ply")
+                 else ".ply keeps every attribute")
+        warnings.warn(f"{path} cannot hold {', '.join(lost)}: not written ({where})",
+                      stacklevel=2)
 
 
 class SelectiveDecoder(_pomar.SelectiveDecoder):

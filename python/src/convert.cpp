@@ -130,6 +130,77 @@ void add_attributes(pomar::Mesh &mesh, const py::handle &colors, const py::handl
   }
 }
 
+void add_corner_data(pomar::Mesh &mesh, const py::handle &corner_texcoords,
+                     const py::handle &face_materials, const py::handle &materials) {
+  const auto m = static_cast<py::ssize_t>(mesh.triangles.size() / 3);
+  if (!corner_texcoords.is_none()) {
+    if (!py::isinstance<py::array>(corner_texcoords))
+      throw py::type_error("corner_texcoords must be a numpy array of float32, shape (m, 3, 2); "
+                           "got " +
+                           std::string(py::str(py::type::of(corner_texcoords))));
+    auto array = py::reinterpret_borrow<py::array>(corner_texcoords);
+    if (!array.dtype().is(py::dtype::of<float>()))
+      throw py::type_error("corner_texcoords must have dtype float32, not " +
+                           std::string(py::str(array.dtype())) +
+                           " (convert with corner_texcoords.astype(numpy.float32))");
+    if (array.ndim() != 3 || array.shape(1) != 3 || array.shape(2) != 2)
+      throw py::value_error("corner_texcoords must have shape (m, 3, 2), not " + shape_text(array));
+    if (array.shape(0) != m)
+      throw py::value_error("corner_texcoords has " + std::to_string(array.shape(0)) +
+                            " rows but there are " + std::to_string(m) +
+                            " faces: one row per face");
+    if (!(array.flags() & py::array::c_style))
+      throw py::value_error("corner_texcoords is not C-contiguous: pass "
+                            "numpy.ascontiguousarray(corner_texcoords)");
+    mesh.corner_texcoords = copy_values(py::reinterpret_borrow<py::array_t<float>>(array));
+  }
+  if (!face_materials.is_none()) {
+    const auto array =
+        checked_array<uint32_t>(face_materials, "face_materials", "uint32", "(m,)", 0);
+    if (array.shape(0) != m)
+      throw py::value_error("face_materials has " + std::to_string(array.shape(0)) +
+                            " entries but there are " + std::to_string(m) + " faces: one per face");
+    mesh.face_materials = copy_values(array);
+  }
+  if (!materials.is_none()) {
+    if (py::isinstance<py::str>(materials) || !py::isinstance<py::sequence>(materials))
+      throw py::type_error("materials must be a list of dicts {name, texture, properties}");
+    for (const py::handle &item : py::reinterpret_borrow<py::sequence>(materials)) {
+      if (!py::isinstance<py::dict>(item))
+        throw py::type_error("materials must be a list of dicts {name, texture, properties}, "
+                             "it holds a " +
+                             std::string(py::str(py::type::of(item))));
+      const auto d = py::reinterpret_borrow<py::dict>(item);
+      pomar::Material material;
+      for (const auto &[key, value] : d) {
+        const std::string k = py::isinstance<py::str>(key) ? key.cast<std::string>() : "";
+        if (k == "name" && py::isinstance<py::str>(value))
+          material.name = value.cast<std::string>();
+        else if (k == "properties" && py::isinstance<py::str>(value))
+          material.properties = value.cast<std::string>();
+        else if (k == "texture" && py::isinstance<py::int_>(value) &&
+                 !py::isinstance<py::bool_>(value))
+          material.texture = value.cast<int32_t>();
+        else
+          throw py::type_error("a material is a dict {name: str, texture: int, properties: "
+                               "str}; bad entry " +
+                               std::string(py::repr(key)));
+      }
+      mesh.materials.push_back(std::move(material));
+    }
+  }
+  const size_t textures = mesh.texture_files.size();
+  for (const pomar::Material &material : mesh.materials)
+    if (material.texture < -1 || (material.texture >= 0 && size_t(material.texture) >= textures))
+      throw py::value_error("material '" + material.name + "' has texture " +
+                            std::to_string(material.texture) + " but there are " +
+                            std::to_string(textures) + " texture_files (-1: none)");
+  for (const uint32_t f : mesh.face_materials)
+    if (f >= mesh.materials.size())
+      throw py::value_error("face_materials holds " + std::to_string(f) + " but there are " +
+                            std::to_string(mesh.materials.size()) + " materials");
+}
+
 py::tuple arrays_from_mesh(pomar::Mesh &&mesh) {
   py::dict attributes;
   py::dict scalars;
@@ -162,6 +233,36 @@ py::tuple arrays_from_mesh(pomar::Mesh &&mesh) {
   }
   attributes["scalars"] = scalars;
   attributes["texture_files"] = py::cast(mesh.texture_files);
+  if (!mesh.corner_texcoords.empty()) {
+    py::dict entry;
+    entry["kind"] = "corner texcoord";
+    entry["name"] = "corner_texcoords";
+    entry["components"] = 2;
+    entry["bits"] = mesh.corner_texcoord_bits;
+    entry["exact"] = mesh.corner_texcoord_bits == 0;
+    entry["bound"] = mesh.corner_texcoord_bound;
+    info.append(entry);
+    auto *owned = new std::vector<float>(std::move(mesh.corner_texcoords));
+    py::capsule owner(owned, [](void *p) { delete static_cast<std::vector<float> *>(p); });
+    const size_t faces = owned->size() / 6, f = sizeof(float);
+    attributes["corner_texcoords"] =
+        py::array_t<float>({faces, size_t(3), size_t(2)}, {6 * f, 2 * f, f}, owned->data(), owner);
+  } else {
+    attributes["corner_texcoords"] = py::none();
+  }
+  if (!mesh.face_materials.empty())
+    attributes["face_materials"] = array_from_vector(std::move(mesh.face_materials), 0);
+  else
+    attributes["face_materials"] = py::none();
+  py::list materials;
+  for (const pomar::Material &material : mesh.materials) {
+    py::dict d;
+    d["name"] = material.name;
+    d["texture"] = material.texture;
+    d["properties"] = material.properties;
+    materials.append(d);
+  }
+  attributes["materials"] = materials;
   attributes["attribute_info"] = info;
   return py::make_tuple(array_from_vector(std::move(mesh.positions), 3),
                         array_from_vector(std::move(mesh.triangles), 3), attributes);

@@ -40,9 +40,20 @@ void add_attributes(pomar::Mesh &mesh, const py::handle &colors, const py::handl
                     const py::handle &scalars, const py::handle &texcoords,
                     const py::handle &texture_files);
 
+/// The textured-mesh fields given to encode()/write() (each None when absent) added to
+/// `mesh` (whose triangles are set): corner_texcoords float32 (m, 3, 2) (u, v of each
+/// corner), face_materials uint32 (m,) (indices into materials), materials a sequence of
+/// dicts {"name": str, "texture": int (index into texture_files, -1 for none),
+/// "properties": str} ("texture" and "properties" optional). TypeError/ValueError (naming
+/// the argument) for a wrong type, dtype or shape.
+void add_corner_data(pomar::Mesh &mesh, const py::handle &corner_texcoords,
+                     const py::handle &face_materials, const py::handle &materials);
+
 /// (vertices, faces, attributes) taking over the mesh's storage: numpy arrays and a dict
 /// with the keyword arguments of pomar.Mesh for the attributes ("colors", "normals",
-/// "scalars", "texcoords", "texture_files", "attribute_info").
+/// "scalars", "texcoords", "texture_files", "corner_texcoords", "face_materials",
+/// "materials", "attribute_info"; per-corner texture coordinates have an entry of kind
+/// "corner texcoord" there).
 py::tuple arrays_from_mesh(pomar::Mesh &&mesh);
 
 /// A contiguous bytes-like object (bytes, bytearray, memoryview, numpy uint8 array) held

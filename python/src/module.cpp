@@ -21,7 +21,7 @@ void check_bits(const char *name, int bits, int low, int high) {
 }
 
 /// The mesh of write()/encode(): arrays plus attributes (a dict with the keys of
-/// add_attributes' arguments).
+/// add_attributes' and add_corner_data's arguments).
 pomar::Mesh mesh_with_attributes(const py::handle &vertices, const py::handle &faces,
                                  const py::dict &attributes) {
   pomar::Mesh mesh = mesh_from_arrays(vertices, faces);
@@ -32,6 +32,7 @@ pomar::Mesh mesh_with_attributes(const py::handle &vertices, const py::handle &f
   };
   add_attributes(mesh, field("colors"), field("normals"), field("scalars"), field("texcoords"),
                  field("texture_files"));
+  add_corner_data(mesh, field("corner_texcoords"), field("face_materials"), field("materials"));
   return mesh;
 }
 

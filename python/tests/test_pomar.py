@@ -674,3 +674,155 @@ def test_decode_threads_give_the_same_mesh(bunny):
         pomar.decode(data, threads=-1)
     with pytest.raises(ValueError, match="threads must be an integer >= 0"):
         pomar.SelectiveDecoder(data, threads=1.5)
+
+
+def textured_torus():
+    """The torus with a texture coordinate per corner (a seam where u and v wrap) and two
+    materials, one per half."""
+    vertices, faces = torus(rings=12, sides=8)
+    rings, sides = 12, 8
+    ring, side = np.divmod(faces.astype(np.int64), sides)
+    u = ring / rings
+    v = side / sides
+    # A corner on the wrap of a face that crosses it gets 1 instead of 0: the seam.
+    u = np.where((ring == 0) & (ring.max(axis=1, keepdims=True) == rings - 1), 1.0, u)
+    v = np.where((side == 0) & (side.max(axis=1, keepdims=True) == sides - 1), 1.0, v)
+    corners = np.ascontiguousarray(np.stack([u, v], axis=-1).astype(np.float32))
+    face_materials = (np.arange(len(faces)) % 2).astype(np.uint32)
+    materials = [{"name": "skin", "texture": 0, "properties": "Kd 1 1 1\nillum 2\n"},
+                 {"name": "plain", "texture": -1, "properties": "Kd 0.5 0.5 0.5\n"}]
+    return pomar.Mesh(vertices, faces, corner_texcoords=corners, face_materials=face_materials,
+                      materials=materials, texture_files=["skin.png"])
+
+
+def test_textured_files_round_trip(tmp_path):
+    mesh = textured_torus()
+    assert mesh.corner_texcoords.shape == (len(mesh.faces), 3, 2)
+    for name in ("t.obj", "t.ply", "t_ascii.ply"):
+        path = str(tmp_path / name)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error" if name.endswith(".obj") else "ignore")
+            pomar.write(path, mesh, binary=not name.endswith("_ascii.ply"))
+        back = pomar.read(path)
+        assert np.array_equal(back.vertices, mesh.vertices) and np.array_equal(back.faces,
+                                                                                 mesh.faces)
+        assert back.corner_texcoords.dtype == np.float32
+        assert back.corner_texcoords.shape == (len(mesh.faces), 3, 2)
+        assert np.array_equal(back.corner_texcoords, mesh.corner_texcoords), name
+        assert back.face_materials.dtype == np.uint32
+        textures = [back.materials[i]["texture"] for i in back.face_materials]
+        assert textures == [mesh.materials[i]["texture"] for i in mesh.face_materials], name
+        assert back.texture_files == ["skin.png"]
+        if name.endswith(".obj"):
+            assert back.materials == mesh.materials
+            assert np.array_equal(back.face_materials, mesh.face_materials)
+        else:  # PLY: one material per texture file
+            assert back.materials[0] == {"name": "texture_0", "texture": 0, "properties": ""}
+    plain = pomar.read(BUNNY)
+    assert plain.corner_texcoords is None and plain.face_materials is None
+    assert plain.materials == []
+
+
+def test_textured_sample_and_bad_corner_data(tmp_path):
+    sample = pomar.read(os.path.join(SAMPLES, "textured_sphere.obj"))
+    assert sample.corner_texcoords.shape == (440, 3, 2)
+    assert [m["name"] for m in sample.materials] == ["checker", "cap"]
+    assert sample.materials[0]["texture"] == 0 and sample.texture_files == ["textured_sphere.png"]
+    assert "Ns 10\n" in sample.materials[0]["properties"]
+    assert "2 materials" in repr(sample)
+    mesh = textured_torus()
+    path = str(tmp_path / "bad.obj")
+    with pytest.raises(ValueError, match=r"corner_texcoords must have shape \(m, 3, 2\)"):
+        pomar.write(path, pomar.Mesh(mesh.vertices, mesh.faces,
+                                     corner_texcoords=mesh.corner_texcoords.reshape(-1, 6)))
+    with pytest.raises(TypeError, match="corner_texcoords must have dtype float32"):
+        pomar.write(path, pomar.Mesh(mesh.vertices, mesh.faces,
+                                     corner_texcoords=mesh.corner_texcoords.astype(np.float64)))
+    with pytest.raises(ValueError, match="one row per face"):
+        pomar.write(path, pomar.Mesh(mesh.vertices, mesh.faces,
+                                     corner_texcoords=mesh.corner_texcoords[:-1].copy()))
+    with pytest.raises(ValueError, match="face_materials holds 5 but there are 2 materials"):
+        bad = np.full(len(mesh.faces), 5, dtype=np.uint32)
+        pomar.write(path, pomar.Mesh(mesh.vertices, mesh.faces, face_materials=bad,
+                                     materials=mesh.materials, texture_files=["skin.png"]))
+    with pytest.raises(ValueError, match="has texture 0 but there are 0 texture_files"):
+        pomar.write(path, pomar.Mesh(mesh.vertices, mesh.faces, materials=mesh.materials))
+    with pytest.raises(TypeError, match="a material is a dict"):
+        pomar.write(path, pomar.Mesh(mesh.vertices, mesh.faces, materials=[{"colour": 1}]))
+    assert not os.path.exists(path)
+
+
+@pytest.mark.skipif("POMAR_TOOL" not in os.environ, reason="needs the pomar tool")
+def test_tool_verify_compares_corners_and_materials(tmp_path):
+    """`pomar verify ORIGINAL FILE DECODED`: the decoded mesh file's per-corner texture
+    coordinates and materials against the original's, faces matched by their corners."""
+    sample = str(tmp_path / "torus.obj")
+    pomar.write(sample, textured_torus())
+    m = pomar.read(sample)
+    data = pomar.encode(m, keep_order=True)  # decoded vertices in the input order
+    (tmp_path / "s.pomar").write_bytes(data)
+    grid = pomar.decode(data).vertices
+
+    def verify(name, corners, face_materials):
+        path = str(tmp_path / name)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            pomar.write(path, pomar.Mesh(grid, m.faces, corner_texcoords=corners,
+                                         face_materials=face_materials, materials=m.materials,
+                                         texture_files=m.texture_files))
+        return subprocess.run([os.environ["POMAR_TOOL"], "verify", sample,
+                               str(tmp_path / "s.pomar"), path], capture_output=True, text=True)
+
+    for name in ("same.obj", "same.ply"):
+        run = verify(name, m.corner_texcoords, m.face_materials)
+        assert run.returncode == 0, run.stderr
+        assert "per-corner texture coordinates: 12 bits, within" in run.stdout
+        assert "max error 0\n" in run.stdout
+        assert "face materials: 2 materials, the same" in run.stdout
+    moved = m.corner_texcoords.copy()
+    moved[7, 1, 0] += 0.01
+    run = verify("moved.obj", moved, m.face_materials)
+    assert run.returncode == 3 and "MISMATCH:  per-corner texture coordinates" in run.stderr
+    other = m.face_materials.copy()
+    other[0] = 1
+    run = verify("other.obj", m.corner_texcoords, other)
+    assert run.returncode == 3 and "1 faces differ" in run.stderr
+
+
+def test_textured_mesh_through_the_codec(tmp_path):
+    mesh = textured_torus()
+    for exact in (True, False):
+        back = pomar.decode(pomar.encode(mesh, exact_attributes=exact, keep_order=True))
+        assert back.corner_texcoords.shape == mesh.corner_texcoords.shape
+        assert back.materials == mesh.materials and back.texture_files == ["skin.png"]
+        info = [a for a in back.attribute_info if a["kind"] == "corner texcoord"]
+        assert len(info) == 1 and info[0]["exact"] == exact
+        # Faces by their corner vertices (the numbering is kept), corners in that order.
+        def faces(m):
+            out = {}
+            for f, t in enumerate(m.faces.tolist()):
+                r = t.index(min(t))
+                key = tuple(t[r:] + t[:r])
+                out[key] = (np.roll(m.corner_texcoords[f], -r, axis=0), int(m.face_materials[f]))
+            return out
+        a, b = faces(mesh), faces(back)
+        assert a.keys() == b.keys()
+        bound = info[0]["bound"]
+        for key, (uv, material) in a.items():
+            assert material == b[key][1]
+            if exact:
+                assert np.array_equal(uv, b[key][0])
+            else:
+                assert np.abs(uv - b[key][0]).max() <= bound
+
+
+@pytest.mark.skipif("POMAR_TOOL" not in os.environ, reason="needs the pomar tool")
+def test_tool_encodes_and_verifies_a_textured_obj(tmp_path):
+    obj, file = str(tmp_path / "t.obj"), str(tmp_path / "t.pomar")
+    pomar.write(obj, textured_torus())
+    tool = os.environ["POMAR_TOOL"]
+    subprocess.run([tool, "encode", obj, file], check=True, capture_output=True)
+    run = subprocess.run([tool, "verify", obj, file], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    assert "per-corner texture coordinates: 12 bits" in run.stdout
+    assert "face materials: 2 materials, the same per face" in run.stdout

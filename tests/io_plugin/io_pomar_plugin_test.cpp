@@ -504,6 +504,56 @@ TEST_F(PomarPluginTest, OpenEnablesWhatItReadsOnTheLayer) {
   QFile::remove(path("attrs.pomar"));
 }
 
+// A textured file (per-corner texture coordinates, two materials): open enables the wedge
+// texture coordinates on the layer, fills them with the corners' values and the face's
+// texture, and returns IOM_WEDGTEXCOORD.
+TEST_F(PomarPluginTest, OpenTexturedFileFillsTheWedges) {
+  pomar::Mesh mesh = pomar::gen::noisy_sphere(400, 3);
+  const size_t nf = mesh.triangle_count();
+  mesh.texture_files = {"a.png", "b.png"};
+  mesh.materials = {{"a", 0, "Kd 1 1 1\n"}, {"b", 1, ""}};
+  for (size_t f = 0; f < nf; ++f) { // a chart per half: a seam around the equator
+    const float *p0 = &mesh.positions[3 * mesh.triangles[3 * f]];
+    const bool top = p0[2] >= 0;
+    mesh.face_materials.push_back(top ? 0 : 1);
+    for (int k = 0; k < 3; ++k) {
+      const float *p = &mesh.positions[3 * mesh.triangles[3 * f + size_t(k)]];
+      mesh.corner_texcoords.push_back(0.25f * p[0] + (top ? 0.25f : 0.75f));
+      mesh.corner_texcoords.push_back(0.25f * p[1] + 0.5f);
+    }
+  }
+  pomar::EncodeOptions exact;
+  exact.attributes.exact = true;
+  exact.keep_order = true;
+  pomar::EncodeReport report;
+  const std::vector<uint8_t> bytes = pomar::encode(mesh, exact, &report);
+  {
+    std::ofstream out(QFile::encodeName(path("tex.pomar")).toStdString(), std::ios::binary);
+    out.write(reinterpret_cast<const char *>(bytes.data()), std::streamsize(bytes.size()));
+  }
+  MeshModel *mm = doc_.addNewMesh(path("tex.pomar"), "tex", true);
+  ASSERT_FALSE(mm->hasDataMask(MeshModel::MM_WEDGTEXCOORD));
+  RichParameterList par;
+  plugin()->initPreOpenParameter("pomar", path("tex.pomar"), par);
+  int mask = 0;
+  ASSERT_TRUE(plugin()->open("pomar", path("tex.pomar"), *mm, mask, par))
+      << plugin()->errorMsg().toStdString();
+  EXPECT_TRUE(mask & vcg::tri::io::Mask::IOM_WEDGTEXCOORD);
+  EXPECT_TRUE(mm->hasDataMask(MeshModel::MM_WEDGTEXCOORD));
+  EXPECT_EQ(mm->cm.textures, mesh.texture_files);
+  const pomar::Mesh decoded = pomar::decode(bytes.data(), bytes.size());
+  ASSERT_EQ(size_t(mm->cm.fn), decoded.triangle_count());
+  for (size_t f = 0; f < decoded.triangle_count(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_EQ(mm->cm.face[f].WT(k).U(), decoded.corner_texcoords[6 * f + 2 * size_t(k)]);
+      ASSERT_EQ(mm->cm.face[f].WT(k).V(), decoded.corner_texcoords[6 * f + 2 * size_t(k) + 1]);
+      ASSERT_EQ(mm->cm.face[f].WT(k).N(), decoded.materials[decoded.face_materials[f]].texture);
+    }
+  mm->cm.ClearAttributes();
+  doc_.delMesh(mm);
+  QFile::remove(path("tex.pomar"));
+}
+
 TEST_F(PomarPluginTest, FailedSaveWritesNothing) {
   const QStringList before = dirEntries();
   pomar::Mesh degenerate = pomar::gen::tetrahedron(); // nothing but faces repeating a vertex

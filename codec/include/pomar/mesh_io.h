@@ -3,12 +3,23 @@
 // The format is chosen by the file extension (case-insensitive): .ply, .obj, .off, .stl.
 // Positions, triangles and per-vertex attributes (Mesh::attributes) are kept: PLY vertex
 // colour (8-bit), normals, texture coordinates, every other scalar property by its name and
-// "comment TextureFile" names; OBJ vertex colours (rounded to 8 bits) and the normals and
-// texture coordinates that are per vertex and the texture files of its materials (`mtllib`,
-// `map_Kd`); OFF vertex colours and normals. Everything else a file may carry (face data,
-// per-corner attributes, other material properties, ...) is dropped and named in
-// LoadReport::ignored_attributes. save_mesh writes what each format holds of the attributes
-// (attributes_not_saved names the rest).
+// "comment TextureFile" names; OBJ vertex colours (rounded to 8 bits) and the normals that
+// are per vertex; OFF vertex colours and normals.
+// Textured meshes are kept too (Mesh::corner_texcoords, face_materials, materials):
+//  - OBJ: texture coordinates are a per-vertex attribute when every corner has one and no
+//    vertex has two different ones, else per corner (`f v/vt`, polygons fan-triangulated);
+//    when some corner has none they are dropped. The materials are the `newmtl` blocks of the
+//    libraries (`mtllib`, beside the file) in the order read: name, `map_Kd` as the texture
+//    (an index into texture_files, each file once) and every other line as written in
+//    `properties`; then the `usemtl` names no library defines (no texture, no properties).
+//    face_materials (when the file has a `usemtl`) gives each face the material in force;
+//    faces before the first `usemtl` get a material with an empty name.
+//  - PLY: a face list `texcoord` (u, v per corner) gives corner_texcoords, a face
+//    `texnumber` face_materials, with one material "texture_<i>" per TextureFile comment
+//    (texture i) and, for a number naming no file, one with an empty name and no texture.
+// Everything else a file may carry (other face data, per-corner normals, ...) is dropped and
+// named in LoadReport::ignored_attributes. save_mesh writes what each format holds of the
+// attributes (attributes_not_saved names the rest).
 // PLY, OFF and ASCII STL are read through vcglib's importers (so a file loads as it does
 // in MeshLab), binary STL directly, OBJ through tinyobjloader. Every failure throws
 // pomar::Error with a one-line message that starts with the file's path.
@@ -89,11 +100,17 @@ Mesh load_mesh(const std::string &path, LoadReport *report = nullptr,
 /// pomar::Error on an unknown extension, an invalid mesh (index out of range, NaN/Inf
 /// coordinate) or an I/O failure; the destination is then left untouched.
 ///
-/// Attributes: PLY holds them all (vertex properties, "comment TextureFile"); OBJ vertex
-/// colour (RGB), normals and texture coordinates ("vt") and, when the mesh names texture
+/// Attributes: PLY holds them all (vertex properties, "comment TextureFile", face
+/// "texcoord" and "texnumber" as MeshLab writes them; of the materials only each face's
+/// texture); OBJ vertex colour (RGB), normals and texture coordinates ("vt": per corner,
+/// each distinct pair once, or per vertex) and, when the mesh has materials or names texture
 /// files, a material library beside the file ("<name>.mtl", replaced atomically like the
-/// file, one material with map_Kd per texture file; the images are not copied); OFF vertex
-/// colour (RGB or RGBA) and normals; STL none.
+/// file: each material's "newmtl", properties and "map_Kd", or without materials one
+/// material with map_Kd per texture file; the images are not copied), the faces in runs of
+/// one material after "usemtl" lines; OFF vertex colour (RGB or RGBA) and normals; STL none.
+/// Per-corner texture coordinates must be finite, 6 per triangle; face materials one per
+/// triangle, each a material; a material's texture -1 or a texture file; material names
+/// without white space.
 void save_mesh(const std::string &path, const Mesh &mesh, bool binary = true);
 
 /// What save_mesh(path, mesh) cannot write of the mesh's attributes in `path`'s format, one

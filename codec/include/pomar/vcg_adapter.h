@@ -36,13 +36,17 @@ size_t vertex_position(const MeshType &m, const typename MeshType::VertexType *v
 }
 /// from_vcg's attribute mask: vcg::tri::io::Mask bits IOM_VERTCOLOR (colour; RGBA when an
 /// alpha differs from 255), IOM_VERTNORMAL, IOM_VERTQUALITY (a scalar named "quality"),
-/// IOM_VERTTEXCOORD (texcoord + m.textures as texture files), plus kVcgCustomScalars:
-/// every named per-vertex float attribute becomes a scalar of that name.
+/// IOM_VERTTEXCOORD (texcoord + m.textures as texture files), IOM_WEDGTEXCOORD (the wedge
+/// texture coordinates WT(k) as corner_texcoords; with m.textures, also the texture files,
+/// one material "texture_<i>" per texture (texture i) and each face's WT(0).n() as its
+/// material, an index naming no texture giving a material with an empty name and no
+/// texture), plus kVcgCustomScalars: every named per-vertex float attribute becomes a scalar
+/// of that name.
 constexpr int kVcgCustomScalars = 1 << 30;
-constexpr int kVcgAllAttributes = vcg::tri::io::Mask::IOM_VERTCOLOR |
-                                  vcg::tri::io::Mask::IOM_VERTNORMAL |
-                                  vcg::tri::io::Mask::IOM_VERTQUALITY |
-                                  vcg::tri::io::Mask::IOM_VERTTEXCOORD | kVcgCustomScalars;
+constexpr int kVcgAllAttributes =
+    vcg::tri::io::Mask::IOM_VERTCOLOR | vcg::tri::io::Mask::IOM_VERTNORMAL |
+    vcg::tri::io::Mask::IOM_VERTQUALITY | vcg::tri::io::Mask::IOM_VERTTEXCOORD |
+    vcg::tri::io::Mask::IOM_WEDGTEXCOORD | kVcgCustomScalars;
 
 namespace vcg_detail {
 
@@ -127,6 +131,57 @@ void take_attributes(const MeshType &m, const std::vector<uint32_t> &remap, int 
   }
 }
 
+/// The wedge texture coordinates of the live faces (in order), their texture indices as
+/// face materials and m.textures as texture files and materials (see kVcgAllAttributes).
+template <class MeshType> void take_wedge_texcoords(const MeshType &m, Mesh &out) {
+  if (!vcg::tri::HasPerWedgeTexCoord(m))
+    return;
+  const size_t textures = m.textures.size();
+  if (textures) {
+    out.texture_files.assign(m.textures.begin(), m.textures.end());
+    out.materials.clear();
+    for (size_t i = 0; i < textures; ++i)
+      out.materials.push_back(Material{"texture_" + std::to_string(i), int32_t(i), {}});
+  }
+  for (size_t f = 0; f < m.face.size(); ++f) {
+    const auto &face = m.face[f];
+    if (face.IsD())
+      continue;
+    for (int k = 0; k < 3; ++k) {
+      out.corner_texcoords.push_back(static_cast<float>(face.cWT(k).U()));
+      out.corner_texcoords.push_back(static_cast<float>(face.cWT(k).V()));
+    }
+    if (!textures)
+      continue;
+    const int n = face.cWT(0).N();
+    if (n >= 0 && size_t(n) < textures) {
+      out.face_materials.push_back(uint32_t(n));
+      continue;
+    }
+    if (out.materials.size() == textures)
+      out.materials.push_back(Material{"", -1, {}});
+    out.face_materials.push_back(uint32_t(textures));
+  }
+}
+
+/// Throws pomar::Error unless src's per-corner texture coordinates and face materials fit
+/// its triangles and materials (empty, or one entry per triangle naming a material).
+inline void check_corner_data(const Mesh &src) {
+  const size_t nf = src.triangle_count();
+  if (!src.corner_texcoords.empty() && src.corner_texcoords.size() != 6 * nf)
+    throw Error(Error::Kind::InvalidMesh, "to_vcg: corner_texcoords does not hold 6 values per "
+                                          "triangle");
+  if (!src.face_materials.empty() && src.face_materials.size() != nf)
+    throw Error(Error::Kind::InvalidMesh,
+                "to_vcg: face_materials does not hold one material per triangle");
+  for (size_t f = 0; f < src.face_materials.size(); ++f)
+    if (src.face_materials[f] >= src.materials.size())
+      throw Error(Error::Kind::InvalidMesh,
+                  "to_vcg: triangle " + std::to_string(f) + " uses material " +
+                      std::to_string(src.face_materials[f]) + " but there are " +
+                      std::to_string(src.materials.size()));
+}
+
 } // namespace vcg_detail
 
 /// Convert a vcglib triangle mesh to a pomar::Mesh.
@@ -135,8 +190,9 @@ void take_attributes(const MeshType &m, const std::vector<uint32_t> &remap, int 
 /// are counted into `*unreferenced` (if given) and dropped, or kept with
 /// `keep_unreferenced` (pomar::encode stores them). The remaining vertices keep their
 /// relative order and are renumbered compactly; faces keep their order.
-/// Per-vertex attributes are taken as `attribute_mask` says (see kVcgCustomScalars; 0 =
-/// positions and triangles only), when the mesh type has them (vcg::tri::HasPerVertex*).
+/// Per-vertex attributes and wedge texture coordinates are taken as `attribute_mask` says
+/// (see kVcgAllAttributes; 0 = positions and triangles only), when the mesh type has them
+/// (vcg::tri::HasPerVertex*, HasPerWedgeTexCoord: for optional components, when enabled).
 /// Throws pomar::Error if a live face references a deleted vertex or a vertex outside
 /// m.vert, or if a face is not a triangle.
 template <class MeshType>
@@ -201,6 +257,8 @@ Mesh from_vcg(const MeshType &m, size_t *unreferenced = nullptr, int attribute_m
     *unreferenced = dropped;
   if (attribute_mask)
     vcg_detail::take_attributes(m, remap, attribute_mask, out);
+  if (attribute_mask & vcg::tri::io::Mask::IOM_WEDGTEXCOORD)
+    vcg_detail::take_wedge_texcoords(m, out);
   return out;
 }
 
@@ -278,11 +336,17 @@ int put_attributes(const std::vector<VertexAttribute> &attributes,
 /// Attributes of `src` go where the mesh type has room (vcg::tri::HasPerVertex*: for
 /// optional components, enable them first): colour (RGB gets alpha 255), normal, the scalar
 /// "quality" into Q(), texcoord into T() (and src.texture_files into m.textures), other
-/// scalars into per-vertex float attributes of their names. Returns the vcg::tri::io::Mask
+/// scalars into per-vertex float attributes of their names; corner_texcoords into the wedge
+/// texture coordinates WT(k) when the face type has them (vcg::tri::HasPerWedgeTexCoord: in
+/// CMeshO enable them first), with n() the face material's texture (-1 for none; 0 without
+/// face materials) and src.texture_files into m.textures. Returns the vcg::tri::io::Mask
 /// bits of what was written (IOM_VERTCOLOR, IOM_VERTNORMAL, IOM_VERTQUALITY,
-/// IOM_VERTTEXCOORD) plus kVcgCustomScalars if a named scalar was added.
+/// IOM_VERTTEXCOORD, IOM_WEDGTEXCOORD) plus kVcgCustomScalars if a named scalar was added.
+/// Material names and properties have no place in a vcglib mesh: from_vcg gives them back
+/// as "texture_<i>".
 /// Throws pomar::Error (leaving m untouched) if `src` is malformed: array sizes not a
-/// multiple of 3, an index out of range, or more elements than vcglib's int counters hold.
+/// multiple of 3, an index out of range, corner data that does not fit the triangles, or
+/// more elements than vcglib's int counters hold.
 template <class MeshType> int to_vcg(const Mesh &src, MeshType &m) {
   using CoordType = typename MeshType::CoordType;
   using ScalarType = typename MeshType::ScalarType;
@@ -300,6 +364,7 @@ template <class MeshType> int to_vcg(const Mesh &src, MeshType &m) {
                   "to_vcg: triangle " + std::to_string(i / 3) + " references vertex " +
                       std::to_string(src.triangles[i]) + " but the mesh has " + std::to_string(nv) +
                       " vertices");
+  vcg_detail::check_corner_data(src);
 
   m.Clear();
   m.ClearAttributes();
@@ -317,7 +382,21 @@ template <class MeshType> int to_vcg(const Mesh &src, MeshType &m) {
 
   vcg::tri::UpdateBounding<MeshType>::Box(m);
 
-  return put_attributes(src.attributes, src.texture_files, m);
+  int written = put_attributes(src.attributes, src.texture_files, m);
+  if (!src.corner_texcoords.empty() && vcg::tri::HasPerWedgeTexCoord(m)) {
+    for (size_t f = 0; f < nf; ++f) {
+      const int n = src.face_materials.empty() ? 0 : src.materials[src.face_materials[f]].texture;
+      for (int k = 0; k < 3; ++k) {
+        m.face[f].WT(k).U() = src.corner_texcoords[6 * f + 2 * k];
+        m.face[f].WT(k).V() = src.corner_texcoords[6 * f + 2 * k + 1];
+        m.face[f].WT(k).N() = static_cast<short>(n);
+      }
+    }
+    if (!src.texture_files.empty())
+      m.textures.assign(src.texture_files.begin(), src.texture_files.end());
+    written |= vcg::tri::io::Mask::IOM_WEDGTEXCOORD;
+  }
+  return written;
 }
 
 } // namespace pomar

@@ -122,8 +122,11 @@ void init_attributes(const AttributeTable &table, LevelMesh &lm, const Attribute
   lm.attr_lo.clear();
   lm.attr_hi.clear();
   lm.normal_code = -1;
+  lm.wedge_uv_code = -1;
   lm.normal_zero = false;
   for (const StoredAttribute &s : table.stored) {
+    if (s.kind == AttributeKind::TexCoord && s.name == kWedgeTexcoord && lm.wedge_uv_code < 0)
+      lm.wedge_uv_code = static_cast<int>(lm.attr_lo.size());
     if (s.kind == AttributeKind::Normal && s.bits && lm.normal_code < 0) {
       lm.normal_code = static_cast<int>(lm.attr_lo.size());
       lm.normal_bits = s.bits;

@@ -436,7 +436,9 @@ void save_ply_binary(const std::string &path, const Mesh &mesh);
 void save_ply_binary_vcg(const std::string &path, const Mesh &mesh);
 /// A PLY file (ASCII or binary little-endian) with the mesh's attributes as vertex
 /// properties (red green blue [alpha] uchar, nx ny nz, texture_u texture_v, one float per
-/// scalar by its name) and "comment TextureFile" lines.
+/// scalar by its name), "comment TextureFile" lines and, as MeshLab writes them, the
+/// per-corner texture coordinates as a face list "texcoord" (uchar 6, float u v per corner)
+/// and the face materials as a face "texnumber" (int: the material's texture, -1 for none).
 void write_ply_with_attributes(TextFileWriter &out, const Mesh &mesh, bool binary,
                                const std::string &path);
 // off_io.cpp
@@ -455,10 +457,16 @@ void save_stl_binary(const std::string &path, const Mesh &mesh);
 void save_stl_binary_vcg(const std::string &path, const Mesh &mesh);
 // obj_io.cpp
 Mesh load_obj(const std::string &path, LoadReport &report, const SizeCheck &check);
-/// The OBJ text; `mtllib` (if not empty) is the material library it names, whose material
-/// "texture_0" its faces use (mtl_text writes one material per texture file).
+/// The OBJ text; `mtllib` (if not empty) is the material library it names. Per-corner
+/// texture coordinates are written as "vt" lines (each distinct pair once) and "f v/vt"
+/// corners; faces go in runs of one material, each run after a "usemtl" line (a run of the
+/// material with the empty name: after a bare "usemtl", or first without one). A mesh
+/// without materials uses the library's material "texture_0".
 void write_obj(TextFileWriter &out, const Mesh &mesh, const std::string &mtllib);
-/// A material library with one material "texture_<i>" per texture file (map_Kd).
+/// The material library: per material (except the one with the empty name), "newmtl",
+/// its properties as they are and "map_Kd" with its texture file (unless the properties
+/// hold a map_Kd line). A mesh without materials gets one material "texture_<i>" per
+/// texture file.
 std::string mtl_text(const Mesh &mesh);
 
 } // namespace pomar::io

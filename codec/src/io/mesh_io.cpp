@@ -68,6 +68,37 @@ const char *format_name(Format f) {
   return "?";
 }
 
+/// Refuses per-corner texture coordinates, face materials and materials that do not fit the
+/// mesh: array sizes, indices out of range, non-finite coordinates, names and texture
+/// indices that cannot be written.
+void check_corner_data(const Mesh &mesh, const std::string &path) {
+  const size_t nt = mesh.triangle_count();
+  if (!mesh.corner_texcoords.empty() && mesh.corner_texcoords.size() != 6 * nt)
+    fail(path, "cannot save: " + num(mesh.corner_texcoords.size()) +
+                   " per-corner texture coordinate values for " + num(nt) +
+                   " triangles (6 per triangle)");
+  for (size_t i = 0; i < mesh.corner_texcoords.size(); ++i)
+    if (!std::isfinite(mesh.corner_texcoords[i]))
+      fail(path, "cannot save: corner " + num(i / 2 % 3) + " of triangle " + num(i / 6) +
+                     " has a non-finite texture coordinate");
+  if (!mesh.face_materials.empty() && mesh.face_materials.size() != nt)
+    fail(path, "cannot save: " + num(mesh.face_materials.size()) + " face materials for " +
+                   num(nt) + " triangles");
+  for (size_t f = 0; f < mesh.face_materials.size(); ++f)
+    if (mesh.face_materials[f] >= mesh.materials.size())
+      fail(path, "cannot save: triangle " + num(f) + " uses material " +
+                     num(mesh.face_materials[f]) + " but there are " + num(mesh.materials.size()) +
+                     " materials");
+  for (const Material &m : mesh.materials) {
+    if (m.texture < -1 || (m.texture >= 0 && size_t(m.texture) >= mesh.texture_files.size()))
+      fail(path, "cannot save: material '" + m.name + "' uses texture " +
+                     std::to_string(m.texture) + " but there are " +
+                     num(mesh.texture_files.size()) + " texture files");
+    if (m.name.find_first_of(" \t\r\n") != std::string::npos)
+      fail(path, "cannot save: material name '" + m.name + "' has white space");
+  }
+}
+
 /// Refuses meshes that cannot be written (or read back): bad sizes, indices out of range,
 /// NaN/Inf, more elements than vcglib's int counters.
 void check_mesh_for_save(const Mesh &mesh, const std::string &path) {
@@ -89,6 +120,7 @@ void check_mesh_for_save(const Mesh &mesh, const std::string &path) {
   for (const std::string &name : mesh.texture_files) // one line of a header or .mtl file
     if (name.empty() || name.find_first_of("\r\n") != std::string::npos)
       fail(path, "cannot save: texture file name '" + name + "' is empty or has a line break");
+  check_corner_data(mesh, path);
 }
 
 /// The material library written beside an OBJ file: its name with the extension .mtl.
@@ -172,13 +204,15 @@ Mesh load_mesh(const std::string &path, LoadReport *report, const SizeCheck &siz
 void save_mesh(const std::string &path, const Mesh &mesh, bool binary) {
   const Format format = format_of(path);
   check_mesh_for_save(mesh, path);
-  const bool attributes = !mesh.attributes.empty() || !mesh.texture_files.empty();
+  const bool attributes = !mesh.attributes.empty() || !mesh.texture_files.empty() ||
+                          !mesh.corner_texcoords.empty() || !mesh.face_materials.empty();
   if (format == Format::Ply && binary && !attributes)
     return save_ply_binary(path, mesh);
   if (format == Format::Stl && binary)
     return save_stl_binary(path, mesh);
   std::string mtllib;
-  if (format == Format::Obj && !mesh.texture_files.empty()) { // the library first: the OBJ names it
+  if (format == Format::Obj && (!mesh.texture_files.empty() || !mesh.materials.empty())) {
+    // the library first: the OBJ names it
     const std::string mtl = material_library_path(path), lib = mtl_text(mesh);
     write_file_atomic(mtl, lib.data(), lib.size());
     mtllib = file_name(mtl);
@@ -207,8 +241,18 @@ void save_mesh(const std::string &path, const Mesh &mesh, bool binary) {
 std::vector<std::string> attributes_not_saved(const std::string &path, const Mesh &mesh) {
   const Format format = format_of(path);
   std::vector<std::string> out;
-  if (format == Format::Ply)
+  if (format == Format::Ply) {
+    // PLY holds a texture index per face: one material per texture file, named by it.
+    bool plain = true;
+    for (size_t i = 0; i < mesh.materials.size(); ++i)
+      plain &= mesh.materials[i].properties.empty() &&
+               (mesh.materials[i].name == "texture_" + num(i) ||
+                (mesh.materials[i].name.empty() && mesh.materials[i].texture < 0)) &&
+               (mesh.materials[i].texture == int32_t(i) || mesh.materials[i].texture < 0);
+    if (!plain)
+      out.push_back("the material names and properties (each face's texture is written)");
     return out;
+  }
   std::string scalars;
   bool alpha = false;
   for (const VertexAttribute &a : mesh.attributes) {
@@ -230,6 +274,13 @@ std::vector<std::string> attributes_not_saved(const std::string &path, const Mes
     out.push_back("texture coordinates");
   if ((stl || off) && !mesh.texture_files.empty())
     out.push_back("texture file names");
+  const bool corners = !mesh.corner_texcoords.empty();
+  if ((stl || off) && corners)
+    out.push_back("per-corner texture coordinates");
+  if ((stl || off) && !mesh.materials.empty())
+    out.push_back("materials");
+  if (format == Format::Obj && corners && uv)
+    out.push_back("the per-vertex texture coordinates (the per-corner ones are written)");
   if (format == Format::Obj && (uv || mesh.find(AttributeKind::Normal))) {
     // OBJ gives normals and texture coordinates to face corners: a vertex no face uses
     // has none when read back.

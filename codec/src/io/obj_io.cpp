@@ -1,9 +1,19 @@
 // OBJ: the common case (positions and faces only) read here in one pass; anything else a
 // line scan with tinyobjloader's rules (it silently skips short faces and does not
-// range-check indices), then tinyobjloader itself (vcglib's OBJ importer drops faces), with
-// the material libraries (`mtllib`) beside the file for their texture names (`map_Kd`);
-// writing formatted here (vcglib's exporter needs material code), with a `.mtl` beside
-// the file when the mesh names texture files.
+// range-check indices; the scan also records which material each face uses), then
+// tinyobjloader itself (vcglib's OBJ importer drops faces) for positions, faces, normals,
+// texture coordinates and colours, with the material libraries (`mtllib`) beside the file,
+// which are parsed here (tinyobjloader's parser does not keep their lines as written);
+// writing formatted here (vcglib's exporter needs material code), with a `.mtl` beside the
+// file when the mesh has materials or names texture files.
+//
+// Texture coordinates: per vertex (a VertexAttribute "texcoord") when every corner has one
+// and the corners of each vertex agree, per corner (Mesh::corner_texcoords, fan-triangulated
+// like the faces) when some vertex has two different ones; dropped and named when some
+// corner has none. Materials: every `newmtl` block of the libraries in the order read, then
+// the `usemtl` names no library defines (no texture, no properties); faces before the first
+// `usemtl` of a file that has one use a material with an empty name (written back as faces
+// before any `usemtl`, or after a bare `usemtl` line).
 #include "io/io_common.h"
 
 #include <cmath>
@@ -12,10 +22,12 @@
 
 #include <algorithm>
 #include <climits>
+#include <cstring>
 #include <fstream>
 #include <istream>
 #include <map>
 #include <streambuf>
+#include <unordered_map>
 
 namespace pomar::io {
 namespace {
@@ -26,6 +38,12 @@ struct ObjScan {
   bool normals = false, texcoords = false, colors = false;
   bool mtllib = false, usemtl = false;
   size_t value_lines = 0; // 'vn' and 'vt' lines
+  /// The `usemtl` names in order of first use; per 'f' line (once a `usemtl` was seen),
+  /// the index of the name in force, kNoMaterial before the first.
+  std::vector<std::string> usemtl_names;
+  std::vector<uint32_t> face_material;
+  uint32_t current_material = kNoMaterial;
+  static constexpr uint32_t kNoMaterial = UINT32_MAX;
 };
 
 /// Splits at spaces and tabs (tinyobjloader's separators within a line).
@@ -70,6 +88,21 @@ void scan_obj_face(const std::vector<std::string> &tok, ObjScan &s, size_t line,
   ++s.faces;
   s.triangles += n - 2;
   s.polygons += n > 3;
+  if (s.usemtl)
+    s.face_material.push_back(s.current_material);
+}
+
+/// A `usemtl` line (as tinyobjloader reads it: the first word is the name; none: an empty
+/// name, which no library defines). The faces before the first one use no material.
+void scan_obj_usemtl(const std::vector<std::string> &tok, ObjScan &s) {
+  if (!s.usemtl)
+    s.face_material.assign(s.faces, ObjScan::kNoMaterial);
+  s.usemtl = true;
+  const std::string name = tok.size() > 1 ? tok[1] : std::string();
+  const auto at = std::find(s.usemtl_names.begin(), s.usemtl_names.end(), name);
+  s.current_material = static_cast<uint32_t>(at - s.usemtl_names.begin());
+  if (at == s.usemtl_names.end())
+    s.usemtl_names.push_back(name);
 }
 
 /// Scans the lines as tinyobjloader splits them (LF, CRLF or CR; text after a NUL byte is
@@ -101,7 +134,7 @@ ObjScan scan_obj(const std::vector<uint8_t> &bytes, const std::string &path) {
     } else if (key == "mtllib")
       s.mtllib = true;
     else if (key == "usemtl")
-      s.usemtl = true;
+      scan_obj_usemtl(tok, s);
   }
   return s;
 }
@@ -176,8 +209,36 @@ std::vector<float> per_vertex(const std::vector<tinyobj::shape_t> &shapes,
   return out;
 }
 
-/// The OBJ file's vertex colours (8-bit: round(255 c)), normals and texture coordinates that
-/// are per vertex; the others are named in `ignored`.
+/// Per-corner texture coordinates of the fan-triangulated faces (as fan_triangles splits
+/// them), u, v per corner; empty if a corner has none (`why` then says so).
+std::vector<float> per_corner_texcoords(const std::vector<tinyobj::shape_t> &shapes,
+                                        const std::vector<float> &table, size_t triangles,
+                                        std::string &why) {
+  std::vector<float> out;
+  out.reserve(6 * triangles);
+  for (const auto &shape : shapes) {
+    const auto &idx = shape.mesh.indices;
+    size_t at = 0;
+    for (const unsigned char n : shape.mesh.num_face_vertices) {
+      for (size_t c = 1; c + 1 < n; ++c)
+        for (const size_t k : {at, at + c, at + c + 1}) {
+          const int i = idx[k].texcoord_index;
+          if (i < 0 || 2 * size_t(i) + 2 > table.size()) {
+            why = "not given for every corner";
+            return {};
+          }
+          out.push_back(table[2 * size_t(i)]);
+          out.push_back(table[2 * size_t(i) + 1]);
+        }
+      at += n;
+    }
+  }
+  return out;
+}
+
+/// The OBJ file's vertex colours (8-bit: round(255 c)), the normals that are per vertex and
+/// the texture coordinates, per vertex when they are so, else per corner; what cannot be
+/// kept is named in `ignored`.
 void take_obj_attributes(const tinyobj::attrib_t &attrib,
                          const std::vector<tinyobj::shape_t> &shapes, const ObjScan &scan,
                          size_t vertices, Mesh &mesh, std::vector<std::string> &ignored) {
@@ -209,6 +270,13 @@ void take_obj_attributes(const tinyobj::attrib_t &attrib,
       continue;
     std::string why;
     std::vector<float> values = per_vertex(shapes, k.table, k.width, vertices, k.which, why);
+    if (values.empty() && k.kind == AttributeKind::TexCoord &&
+        why != "not given for every corner") { // a seam: one value per corner
+      why.clear();
+      mesh.corner_texcoords = per_corner_texcoords(shapes, k.table, scan.triangles, why);
+      if (!mesh.corner_texcoords.empty())
+        continue;
+    }
     if (values.empty()) {
       add_unique(ignored, (std::string(k.label) + " (" + why + ")").c_str());
       continue;
@@ -222,19 +290,67 @@ void take_obj_attributes(const tinyobj::attrib_t &attrib,
   }
 }
 
-/// Reads the material libraries an OBJ file names (`mtllib`), relative to the OBJ file's
-/// directory (or absolute), with tinyobjloader's MTL parser; records the ones it did not
-/// read and why. Only regular files of 1 byte to 64 MiB are read: a FIFO, a device, a
-/// directory or a /proc file (size 0; /proc/kmsg would block) is not, nor a huge file that
-/// cannot be a material library.
+/// The material blocks of an MTL text: per `newmtl`, its name (the rest of the line), its
+/// diffuse texture (`map_Kd`: the rest of the line; with options, "-s 1 1 1 name", the
+/// line is kept as a property and the name is its last word) and every other non-empty
+/// line as written. Text before the first `newmtl` (comments) is not kept.
+struct MtlBlock {
+  Material material;
+  std::string texture; ///< map_Kd's file name, or empty
+};
+
+std::string trim_blanks(const std::string &s) {
+  const size_t b = s.find_first_not_of(" \t\r");
+  if (b == std::string::npos)
+    return {};
+  const size_t e = s.find_last_not_of(" \t\r");
+  return s.substr(b, e + 1 - b);
+}
+
+void parse_mtl(const std::string &text, std::vector<MtlBlock> &blocks) {
+  size_t at = 0;
+  bool in_block = false;
+  while (at < text.size()) {
+    size_t eol = text.find_first_of("\n\r", at);
+    if (eol == std::string::npos)
+      eol = text.size();
+    const std::string line = text.substr(at, eol - at);
+    at = eol + 1;
+    const std::string trimmed = trim_blanks(line);
+    if (trimmed.empty())
+      continue;
+    const size_t key_end = std::min(trimmed.find_first_of(" \t"), trimmed.size());
+    const std::string key = trimmed.substr(0, key_end), rest = trim_blanks(trimmed.substr(key_end));
+    if (key == "newmtl") {
+      blocks.emplace_back();
+      blocks.back().material.name = rest;
+      in_block = true;
+    } else if (!in_block) {
+      continue;
+    } else if (key == "map_Kd" && !rest.empty() && rest[0] != '-') {
+      blocks.back().texture = rest;
+    } else {
+      if (key == "map_Kd" && !rest.empty()) // options: the name is the last word
+        blocks.back().texture = rest.substr(rest.find_last_of(" \t") + 1);
+      blocks.back().material.properties += trimmed + "\n";
+    }
+  }
+}
+
+/// Reads the material libraries an OBJ file names (`mtllib`, in tinyobjloader's order and
+/// with its rules: the first readable name of each line), relative to the OBJ file's
+/// directory (or absolute), into MTL blocks; records the ones it did not read and why. Only
+/// regular files of 1 byte to 64 MiB are read: a FIFO, a device, a directory or a /proc
+/// file (size 0; /proc/kmsg would block) is not, nor a huge file that cannot be a material
+/// library.
 class MaterialLibraries : public tinyobj::MaterialReader {
 public:
   explicit MaterialLibraries(const std::string &obj_path) {
     const size_t slash = obj_path.find_last_of('/');
     dir_ = slash == std::string::npos ? "" : obj_path.substr(0, slash + 1);
   }
-  bool operator()(const std::string &name, std::vector<tinyobj::material_t> *materials,
-                  std::map<std::string, int> *names, std::string *warn, std::string *err) override {
+  bool operator()(const std::string &name, std::vector<tinyobj::material_t> *,
+                  std::map<std::string, int> *, std::string *, std::string *) override {
     const std::string path = !name.empty() && name[0] == '/' ? name : dir_ + name;
     struct stat st;
     const char *why = nullptr;
@@ -245,80 +361,69 @@ public:
       why = "not a regular file of 1 byte to 64 MiB";
     else if (in.open(path, std::ios::binary), !in.is_open())
       why = "cannot be read";
+    std::string text;
+    if (!why) {
+      text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+      if (in.bad())
+        why = "cannot be read";
+    }
     if (why) {
       missing.push_back("material library '" + name + "' " + why);
       return false;
     }
-    tinyobj::LoadMtl(names, materials, &in, warn, err);
+    parse_mtl(text.substr(0, text.find('\0')), blocks);
     return true;
   }
   std::vector<std::string> missing; ///< "material library 'NAME' not found", ...
+  std::vector<MtlBlock> blocks;     ///< every library's blocks, in the order read
 
 private:
   std::string dir_;
 };
 
-/// Adds to `keys` the MTL keywords of what a material holds besides its name and diffuse
-/// texture (map_Kd). A diffuse colour of 1 1 1 (white: the texture as it is, what save_mesh
-/// writes) counts as nothing else.
-void other_material_properties(const tinyobj::material_t &m, std::vector<std::string> &keys) {
-  auto note = [&](bool differs, const char *key) {
-    if (differs)
-      add_unique(keys, key);
-  };
-  auto zero = [](const tinyobj::real_t *c) { return c[0] == 0 && c[1] == 0 && c[2] == 0; };
-  auto white = [](const tinyobj::real_t *c) { return c[0] == 1 && c[1] == 1 && c[2] == 1; };
-  note(!zero(m.ambient), "Ka");
-  note(!zero(m.diffuse) && !white(m.diffuse), "Kd");
-  note(!zero(m.specular), "Ks");
-  note(!zero(m.transmittance), "Tf");
-  note(!zero(m.emission), "Ke");
-  note(m.shininess != 1, "Ns");
-  note(m.ior != 1, "Ni");
-  note(m.dissolve != 1, "d");
-  note(m.illum != 0, "illum");
-  note(!(m.ambient_texname + m.specular_texname + m.specular_highlight_texname + m.bump_texname +
-         m.displacement_texname + m.alpha_texname + m.reflection_texname + m.roughness_texname +
-         m.metallic_texname + m.sheen_texname + m.emissive_texname + m.normal_texname)
-            .empty(),
-       "other maps");
-  note(!m.unknown_parameter.empty(), "other keywords");
-}
-
-/// The texture files of the materials (`map_Kd`, in material order, each once) go to the
-/// mesh's texture list; what else the materials say is named in `ignored`: libraries that
-/// could not be read, other material properties, which material each face uses.
-void take_obj_materials(const std::vector<tinyobj::material_t> &materials,
-                        const std::vector<tinyobj::shape_t> &shapes, const ObjScan &scan,
+/// The materials: the libraries' blocks, then the `usemtl` names they do not define, then
+/// (if faces come before the first `usemtl`) one with an empty name; their textures
+/// (`map_Kd`, in material order, each once) go to the mesh's texture list, the material of
+/// each face (fan-triangulated) to face_materials. Libraries that could not be read are
+/// named in `ignored`.
+void take_obj_materials(const std::vector<tinyobj::shape_t> &shapes, const ObjScan &scan,
                         const MaterialLibraries &libraries, Mesh &mesh,
                         std::vector<std::string> &ignored) {
-  for (const tinyobj::material_t &m : materials)
-    if (!m.diffuse_texname.empty() &&
-        std::find(mesh.texture_files.begin(), mesh.texture_files.end(), m.diffuse_texname) ==
-            mesh.texture_files.end())
-      mesh.texture_files.push_back(m.diffuse_texname);
+  for (const MtlBlock &b : libraries.blocks) {
+    Material m = b.material;
+    if (!b.texture.empty()) {
+      auto at = std::find(mesh.texture_files.begin(), mesh.texture_files.end(), b.texture);
+      if (at == mesh.texture_files.end())
+        at = mesh.texture_files.insert(at, b.texture);
+      m.texture = static_cast<int32_t>(at - mesh.texture_files.begin());
+    }
+    mesh.materials.push_back(std::move(m));
+  }
   for (const std::string &why : libraries.missing)
     add_unique(ignored, ("materials (" + why + ")").c_str());
-  std::vector<std::string> keys;
-  for (const tinyobj::material_t &m : materials)
-    other_material_properties(m, keys);
-  if (!keys.empty()) {
-    std::string list;
-    for (const std::string &k : keys)
-      list += (list.empty() ? "" : " ") + k;
-    add_unique(ignored, ("material properties other than texture names (" + list + ")").c_str());
-  }
-  std::vector<int> used;
+  if (!scan.usemtl)
+    return;
+  auto material_index = [&](const std::string &name) {
+    for (size_t i = 0; i < mesh.materials.size(); ++i)
+      if (mesh.materials[i].name == name)
+        return static_cast<uint32_t>(i);
+    mesh.materials.push_back(Material{name, -1, {}});
+    return static_cast<uint32_t>(mesh.materials.size() - 1);
+  };
+  std::vector<uint32_t> used(scan.usemtl_names.size());
+  for (size_t i = 0; i < used.size(); ++i)
+    used[i] = material_index(scan.usemtl_names[i]);
+  const bool before_first = std::find(scan.face_material.begin(), scan.face_material.end(),
+                                      ObjScan::kNoMaterial) != scan.face_material.end();
+  const uint32_t none = before_first ? material_index("") : 0;
+  mesh.face_materials.reserve(scan.triangles);
+  size_t face = 0;
   for (const auto &shape : shapes)
-    for (const int id : shape.mesh.material_ids)
-      if (id >= 0 && std::find(used.begin(), used.end(), id) == used.end())
-        used.push_back(id);
-  if (used.size() > 1)
-    add_unique(ignored, ("which material each face uses (" + num(used.size()) +
-                         " materials; their texture names are kept)")
-                            .c_str());
-  if (scan.usemtl && !scan.mtllib)
-    add_unique(ignored, "materials (usemtl without a material library)");
+    for (const unsigned char n : shape.mesh.num_face_vertices) {
+      const uint32_t f = scan.face_material[face++];
+      mesh.face_materials.insert(mesh.face_materials.end(), n - 2u,
+                                 f == ObjScan::kNoMaterial ? none : used[f]);
+    }
 }
 
 /// A coordinate as tinyobjloader reads it (so that both paths give the same floats):
@@ -452,7 +557,7 @@ Mesh load_obj(const std::string &path, LoadReport &report, const SizeCheck &chec
   std::vector<tinyobj::shape_t> shapes;
   std::vector<tinyobj::material_t> materials;
   std::string warn, err;
-  // Material libraries beside the file (for texture names), no triangulation
+  // Material libraries beside the file (parsed by `libraries`), no triangulation
   // (tinyobjloader's own picks a quad diagonal by geometry), no default vertex colors.
   MaterialLibraries libraries(path);
   const bool ok = guarded(path, [&] {
@@ -478,7 +583,7 @@ Mesh load_obj(const std::string &path, LoadReport &report, const SizeCheck &chec
                    " triangles, expected " + num(scan.triangles));
   mesh.positions.assign(attrib.vertices.begin(), attrib.vertices.end());
   take_obj_attributes(attrib, shapes, scan, scan.vertices, mesh, report.ignored_attributes);
-  take_obj_materials(materials, shapes, scan, libraries, mesh, report.ignored_attributes);
+  take_obj_materials(shapes, scan, libraries, mesh, report.ignored_attributes);
 
   report.file_vertices = scan.vertices;
   report.file_faces = scan.faces;
@@ -488,16 +593,33 @@ Mesh load_obj(const std::string &path, LoadReport &report, const SizeCheck &chec
 }
 
 std::string mtl_text(const Mesh &mesh) {
-  std::string s = "# pomar: the mesh's texture files\n";
-  for (size_t i = 0; i < mesh.texture_files.size(); ++i)
-    s += "newmtl texture_" + num(i) + "\nKd 1 1 1\nmap_Kd " + mesh.texture_files[i] + "\n";
+  std::string s;
+  if (mesh.materials.empty()) {
+    s = "# pomar: the mesh's texture files\n";
+    for (size_t i = 0; i < mesh.texture_files.size(); ++i)
+      s += "newmtl texture_" + num(i) + "\nKd 1 1 1\nmap_Kd " + mesh.texture_files[i] + "\n";
+    return s;
+  }
+  s = "# pomar\n";
+  for (const Material &m : mesh.materials) {
+    if (m.name.empty()) // "no material": faces outside any usemtl group
+      continue;
+    s += "newmtl " + m.name + "\n" + m.properties;
+    if (!m.properties.empty() && m.properties.back() != '\n')
+      s += '\n';
+    const bool map_kd = m.properties.compare(0, 7, "map_Kd ") == 0 ||
+                        m.properties.find("\nmap_Kd ") != std::string::npos;
+    if (m.texture >= 0 && !map_kd)
+      s += "map_Kd " + mesh.texture_files[size_t(m.texture)] + "\n";
+  }
   return s;
 }
 
 void write_obj(TextFileWriter &out, const Mesh &mesh, const std::string &mtllib) {
   const VertexAttribute *colour = mesh.find(AttributeKind::Colour);
   const VertexAttribute *normal = mesh.find(AttributeKind::Normal);
-  const VertexAttribute *uv = mesh.find(AttributeKind::TexCoord);
+  const bool corners = !mesh.corner_texcoords.empty();
+  const VertexAttribute *uv = corners ? nullptr : mesh.find(AttributeKind::TexCoord);
   std::string &s = out.text();
   s += "# pomar\n";
   if (!mtllib.empty()) { // tinyobjloader splits the names at spaces unless escaped
@@ -531,19 +653,46 @@ void write_obj(TextFileWriter &out, const Mesh &mesh, const std::string &mtllib)
     }
     return true;
   };
-  const bool vt = table(uv, "vt"), vn = table(normal, "vn");
-  if (!mtllib.empty())
+  // Per-corner texture coordinates: one "vt" line per distinct (u, v) bit pattern, in order
+  // of first use; corner_vt[c] is the vt number of corner c.
+  std::vector<uint32_t> corner_vt;
+  if (corners) {
+    std::unordered_map<uint64_t, uint32_t> seen;
+    corner_vt.resize(mesh.corner_texcoords.size() / 2);
+    for (size_t c = 0; c < corner_vt.size(); ++c) {
+      uint32_t bits[2];
+      std::memcpy(bits, &mesh.corner_texcoords[2 * c], 8);
+      const auto ins = seen.emplace(uint64_t(bits[0]) << 32 | bits[1], uint32_t(seen.size() + 1));
+      corner_vt[c] = ins.first->second;
+      if (!ins.second)
+        continue;
+      s += "vt ";
+      append_float(s, mesh.corner_texcoords[2 * c]);
+      s += ' ';
+      append_float(s, mesh.corner_texcoords[2 * c + 1]);
+      s += '\n';
+      out.done();
+    }
+  }
+  const bool vt = corners || table(uv, "vt"), vn = table(normal, "vn");
+  const bool groups = !mesh.materials.empty() && !mesh.face_materials.empty();
+  if (!mtllib.empty() && mesh.materials.empty())
     s += "usemtl texture_0\n";
   for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+    if (groups && (t == 0 || mesh.face_materials[t] != mesh.face_materials[t - 1])) {
+      const std::string &name = mesh.materials[mesh.face_materials[t]].name;
+      if (!name.empty() || t > 0) // a bare usemtl: no material (read back as the empty name)
+        s += name.empty() ? "usemtl\n" : "usemtl " + name + "\n";
+    }
     s += 'f';
-    for (int k = 0; k < 3; ++k) { // "f a b c", "f a/a ...", "f a//a ..." or "f a/a/a ..."
+    for (int k = 0; k < 3; ++k) { // "f a b c", "f a/t ...", "f a//a ..." or "f a/t/a ..."
       const uint64_t i = uint64_t(mesh.triangles[3 * t + k]) + 1;
       s += ' ';
       append_uint(s, i);
       if (vt || vn) {
         s += '/';
         if (vt)
-          append_uint(s, i);
+          append_uint(s, corners ? corner_vt[3 * t + k] : i);
         if (vn) {
           s += '/';
           append_uint(s, i);

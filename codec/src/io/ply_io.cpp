@@ -422,14 +422,40 @@ struct PlyCapture {
   std::vector<uint32_t> triangles;
 };
 
+/// The face element's texture data (MeshLab's layout): a float list "texcoord" of u, v per
+/// corner and an integer "texnumber", the face's texture. Read by the walk into per-triangle
+/// arrays (polygons fan-triangulated as vcglib does: corner 0 with each following edge).
+struct PlyFaceData {
+  const PlyProperty *texcoord = nullptr, *texnumber = nullptr;
+  std::vector<float> corner_texcoords; ///< 6 per triangle
+  std::vector<int64_t> numbers;        ///< texnumber, 1 per triangle
+  bool bad_texcoord = false;           ///< a list not of two values per corner
+};
+
+/// The face element's texcoord and texnumber properties, if it has them in a usable type.
+PlyFaceData plan_face_data(const PlyHeader &h) {
+  PlyFaceData d;
+  for (const PlyElement &e : h.elements)
+    if (e.name == "face") {
+      const PlyProperty *tc = e.find("texcoord"), *tn = e.find("texnumber");
+      if (tc && tc->is_list && (tc->type == PlyType::F32 || tc->type == PlyType::F64))
+        d.texcoord = tc;
+      if (tn && !tn->is_list)
+        d.texnumber = tn;
+      break;
+    }
+  return d;
+}
+
 /// Walks the rest of the PLY body, validating the connectivity element (and reading the
-/// vertex attributes of `plan`, if given).
+/// vertex attributes of `plan` and the face texture data of `faces`, if given).
 class PlyWalker {
 public:
   PlyWalker(FileReader &in, const PlyHeader &h, const std::string &path,
-            PlyVertexPlan *plan = nullptr, PlyCapture *capture = nullptr)
-      : in_(in), h_(h), path_(path), values_(in, h.encoding, path), plan_(plan), capture_(capture) {
-  }
+            PlyVertexPlan *plan = nullptr, PlyCapture *capture = nullptr,
+            PlyFaceData *faces = nullptr)
+      : in_(in), h_(h), path_(path), values_(in, h.encoding, path), plan_(plan), capture_(capture),
+        faces_(faces) {}
 
   PlyLayout run() {
     choose_elements();
@@ -546,8 +572,31 @@ private:
   /// Skips a property vcglib does not store (for our mesh type: every list except the
   /// face/strip indices). plylib skips a binary list by reading a one-byte count, whatever
   /// the declared count type, into a 512-byte stack buffer, and takes an empty list for the
-  /// end of the file (fread of 0 items); refuse lists it would misread.
-  bool skip_unstored(const PlyProperty &p) {
+  /// end of the file (fread of 0 items); refuse lists it would misread. With `values`, the
+  /// list's items are read into it instead of skipped (the same checks).
+  bool skip_unstored(const PlyProperty &p, std::vector<float> *values = nullptr) {
+    if (values) {
+      values->clear();
+      int64_t n = 0;
+      if (h_.encoding != PlyHeader::Ascii && type_size(p.count_type) != 1)
+        fail(path_, "PLY list '" + p.name +
+                        "' has a count wider than a byte, which vcglib misreads in binary files");
+      if (!values_.integer(p.count_type, n))
+        return false;
+      if (n < 0 ||
+          (h_.encoding != PlyHeader::Ascii && static_cast<uint64_t>(n) * type_size(p.type) > 512))
+        fail(path_,
+             "PLY list '" + p.name + "' of " + std::to_string(n) + " items is too long for vcglib");
+      if (n == 0 && h_.encoding != PlyHeader::Ascii)
+        fail(path_, "PLY list '" + p.name + "' is empty, which vcglib cannot skip in binary files");
+      if (!values_.fits(p.type, static_cast<uint64_t>(n)))
+        return false;
+      values->resize(static_cast<size_t>(n));
+      for (float &x : *values)
+        if (!values_.real(p.type, x))
+          return false;
+      return true;
+    }
     if (!p.is_list || h_.encoding == PlyHeader::Ascii)
       return values_.skip(p);
     if (type_size(p.count_type) != 1)
@@ -660,8 +709,23 @@ private:
                                                                    3 * type_size(conn_prop_->type);
       capture_->triangles.reserve(3 * size_t(std::min<uint64_t>(e.count, in_.remaining() / bytes)));
     }
-    for (uint64_t i = 0; i < e.count; ++i)
+    const bool texture = faces_ && !strips;
+    for (uint64_t i = 0; i < e.count; ++i) {
+      bool have_uv = false, have_number = false;
+      float number = 0;
       for (const auto &p : e.props) {
+        if (texture && &p == faces_->texcoord) {
+          if (!skip_unstored(p, &uv_))
+            truncated(e, i);
+          have_uv = true;
+          continue;
+        }
+        if (texture && &p == faces_->texnumber) {
+          if (!values_.real(p.type, number))
+            truncated(e, i);
+          have_number = true;
+          continue;
+        }
         if (&p != conn_prop_) {
           if (!skip_unstored(p))
             truncated(e, i);
@@ -682,6 +746,29 @@ private:
         else
           face(i);
       }
+      if (texture && conn_prop_)
+        face_texture(have_uv, have_number, number);
+    }
+  }
+
+  /// The texture data of the face just read (list_), per triangle of its fan.
+  void face_texture(bool have_uv, bool have_number, float number) {
+    const size_t n = list_.size();
+    if (have_uv && !faces_->bad_texcoord) {
+      if (uv_.size() != 2 * n) {
+        faces_->bad_texcoord = true;
+        faces_->corner_texcoords = std::vector<float>();
+      } else {
+        for (size_t c = 1; c + 1 < n; ++c)
+          for (const size_t k : {size_t(0), c, c + 1})
+            faces_->corner_texcoords.insert(faces_->corner_texcoords.end(),
+                                            {uv_[2 * k], uv_[2 * k + 1]});
+      }
+    }
+    if (have_number)
+      faces_->numbers.insert(
+          faces_->numbers.end(), n - 2,
+          std::isfinite(number) && std::fabs(number) < 2e9f ? static_cast<int64_t>(number) : -1);
   }
 
   /// Faces need 3..255 corners (vcglib keeps the count in a byte, the corners in int[512]).
@@ -741,6 +828,8 @@ private:
   PlyLayout layout_;
   PlyVertexPlan *plan_ = nullptr;
   PlyCapture *capture_ = nullptr;
+  PlyFaceData *faces_ = nullptr;
+  std::vector<float> uv_;    // the current face's texcoord list
   std::vector<int8_t> axis_; // per vertex property: the captured coordinate, or -1
 };
 
@@ -991,6 +1080,30 @@ bool mesh_from_capture(PlyCapture &capture, const PlyLayout &layout, const PlyVe
   return true;
 }
 
+/// The face texture data the walk read: corner_texcoords; face_materials from texnumber,
+/// with one material "texture_<i>" per texture file (texture i) and, for a texnumber that
+/// names no texture file, one with an empty name and no texture.
+void take_face_data(PlyFaceData &d, const PlyLayout &layout, Mesh &mesh) {
+  if (d.corner_texcoords.size() == 6 * layout.triangles && layout.triangles > 0)
+    mesh.corner_texcoords = std::move(d.corner_texcoords);
+  if (!d.numbers.empty() && d.numbers.size() == layout.triangles) {
+    const size_t textures = mesh.texture_files.size();
+    for (size_t i = 0; i < textures; ++i)
+      mesh.materials.push_back(Material{"texture_" + num(i), int32_t(i), {}});
+    mesh.face_materials.resize(d.numbers.size());
+    for (size_t f = 0; f < d.numbers.size(); ++f) {
+      const int64_t t = d.numbers[f];
+      if (t >= 0 && uint64_t(t) < textures) {
+        mesh.face_materials[f] = uint32_t(t);
+        continue;
+      }
+      if (mesh.materials.size() == textures)
+        mesh.materials.push_back(Material{"", -1, {}});
+      mesh.face_materials[f] = uint32_t(textures);
+    }
+  }
+}
+
 /// The RGBA colour of the file, in `mesh` (made through a vcglib mesh, whose colours are
 /// always RGBA: take_attributes keeps an alpha only where one differs from 255): a file with
 /// an alpha property gives 4 channels, whatever their values.
@@ -1005,9 +1118,10 @@ void keep_alpha(PlyVertexPlan &plan, Mesh &mesh) {
 }
 
 /// Names, in `ignored`, each property of the face (or tristrips) elements that is neither
-/// an index list nor one vcglib's mask `file_mask` already names (add_ignored_from_mask:
-/// face colour, normal, quality, flags, wedge texture coordinates and colours).
-void name_unkept_face_properties(const PlyHeader &h, int file_mask,
+/// an index list, nor read by the walk (`kept`: texcoord, texnumber), nor one vcglib's mask
+/// `file_mask` already names (add_ignored_from_mask: face colour, normal, quality, flags,
+/// wedge texture coordinates and colours).
+void name_unkept_face_properties(const PlyHeader &h, int file_mask, const PlyFaceData &kept,
                                  std::vector<std::string> &ignored) {
   using M = vcg::tri::io::Mask;
   static const struct {
@@ -1023,7 +1137,8 @@ void name_unkept_face_properties(const PlyHeader &h, int file_mask,
     if (e.name != "face" && e.name != "tristrips")
       continue;
     for (const PlyProperty &p : e.props) {
-      if (p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index"))
+      if ((p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index")) ||
+          &p == kept.texcoord || &p == kept.texnumber)
         continue;
       bool named = false;
       for (const auto &k : kNamed)
@@ -1041,6 +1156,7 @@ Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &chec
   PlyLayout layout;
   PlyVertexPlan plan;
   PlyCapture capture;
+  PlyFaceData face_data;
   std::vector<std::string> texture_files;
   PlyHeader header;
   {
@@ -1055,6 +1171,7 @@ Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &chec
         vertex = &e;
     plan = plan_vertex_attributes(vertex, report.ignored_attributes);
     texture_files = header.texture_files;
+    face_data = plan_face_data(header);
     const uint64_t data_start = in.pos();
     Mesh fast;
     size_t unreferenced = 0;
@@ -1068,11 +1185,11 @@ Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &chec
     // the file again.
     capture.ok = true;
     if (in.pos() == data_start) {
-      layout = PlyWalker(in, header, path, &plan, &capture).run();
+      layout = PlyWalker(in, header, path, &plan, &capture, &face_data).run();
     } else { // the general path reads the data from its start
       FileReader again(path);
       read_ply_header(again, path);
-      layout = PlyWalker(again, header, path, &plan, &capture).run();
+      layout = PlyWalker(again, header, path, &plan, &capture, &face_data).run();
     }
     if (layout.triangles > faces) // polygons or triangle strips
       run_size_check(check, path, layout.vertices, layout.triangles);
@@ -1083,9 +1200,16 @@ Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &chec
     using M = vcg::tri::io::Mask; // per-vertex data is read by the walk (plan)
     file_mask &= ~(M::IOM_VERTCOLOR | M::IOM_VERTNORMAL | M::IOM_VERTQUALITY | M::IOM_VERTTEXCOORD |
                    M::IOM_VERTRADIUS | M::IOM_VERTFLAGS);
+    if (face_data.texcoord) // face texture data: read by the walk (and named if unusable)
+      file_mask &= ~M::IOM_WEDGTEXCOORD;
+    if (face_data.texnumber)
+      file_mask &= ~M::IOM_WEDGTEXMULTI;
   }
+  if (face_data.bad_texcoord)
+    add_unique(report.ignored_attributes,
+               "texture coordinates (face texcoord lists not of two values per corner)");
   add_ignored_from_mask(file_mask, report.ignored_attributes);
-  name_unkept_face_properties(header, file_mask, report.ignored_attributes);
+  name_unkept_face_properties(header, file_mask, face_data, report.ignored_attributes);
   if (layout.edges)
     add_unique(report.ignored_attributes, "edges");
   if (layout.camera)
@@ -1096,6 +1220,7 @@ Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &chec
   Mesh captured;
   if (mesh_from_capture(capture, layout, plan, texture_files, path, captured,
                         report.unreferenced_vertices)) {
+    take_face_data(face_data, layout, captured);
     keep_alpha(plan, captured);
     return captured;
   }
@@ -1118,6 +1243,7 @@ Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &chec
   Mesh mesh = from_vcg(m, &report.unreferenced_vertices, attribute_mask, true);
   keep_alpha(plan, mesh);
   mesh.texture_files = texture_files; // also without per-vertex texture coordinates
+  take_face_data(face_data, layout, mesh);
   return mesh;
 }
 
@@ -1131,10 +1257,15 @@ void write_ply_ascii(TextFileWriter &out, const Mesh &mesh) {
 }
 
 namespace {
+/// The texture index PLY stores for triangle f (its material's texture, -1 for none).
+int32_t face_texture_number(const Mesh &mesh, size_t f) {
+  return mesh.materials[mesh.face_materials[f]].texture;
+}
+
 /// The binary little-endian body of write_ply_with_attributes: every vertex record (x y z,
-/// then each attribute's components in the header's order) and every face, written in runs
-/// of records into room made once per run (a byte at a time through std::string::operator+=
-/// was 10x slower).
+/// then each attribute's components in the header's order) and every face (indices, then
+/// texcoord and texnumber when the mesh has them), written in runs of records into room
+/// made once per run (a byte at a time through std::string::operator+= was 10x slower).
 void write_binary_body(TextFileWriter &out, const Mesh &mesh) {
   const size_t nv = mesh.vertex_count(), nt = mesh.triangle_count();
   size_t record = 12;
@@ -1174,14 +1305,23 @@ void write_binary_body(TextFileWriter &out, const Mesh &mesh) {
     }
     out.done();
   }
-  const size_t face_run = TextFileWriter::kChunk / 13;
+  const bool uv = !mesh.corner_texcoords.empty(), number = !mesh.face_materials.empty();
+  const size_t face_record = 13 + (uv ? 25 : 0) + (number ? 4 : 0);
+  const size_t face_run = TextFileWriter::kChunk / face_record;
   for (size_t first = 0; first < nt; first += face_run) {
     const size_t last = std::min(nt, first + face_run);
-    room(last - first, 13);
+    room(last - first, face_record);
     for (size_t t = first; t < last; ++t) {
       *p++ = static_cast<char>(3);
       for (int k = 0; k < 3; ++k)
         put32(mesh.triangles[3 * t + k]);
+      if (uv) {
+        *p++ = static_cast<char>(6);
+        for (int k = 0; k < 6; ++k)
+          put_float32(mesh.corner_texcoords[6 * t + k]);
+      }
+      if (number)
+        put32(static_cast<uint32_t>(face_texture_number(mesh, t)));
     }
     out.done();
   }
@@ -1230,8 +1370,13 @@ void write_ply_with_attributes(TextFileWriter &out, const Mesh &mesh, bool binar
       break;
     }
   }
-  s += "element face " + num(mesh.triangle_count()) +
-       "\nproperty list uchar int vertex_indices\nend_header\n";
+  const bool uv = !mesh.corner_texcoords.empty(), number = !mesh.face_materials.empty();
+  s += "element face " + num(mesh.triangle_count()) + "\nproperty list uchar int vertex_indices\n";
+  if (uv)
+    s += "property list uchar float texcoord\n";
+  if (number)
+    s += "property int texnumber\n";
+  s += "end_header\n";
   if (binary)
     return write_binary_body(out, mesh);
   for (size_t v = 0; v < nv; ++v) { // ASCII
@@ -1251,7 +1396,28 @@ void write_ply_with_attributes(TextFileWriter &out, const Mesh &mesh, bool binar
     s += '\n';
     out.done();
   }
-  append_triangles(out, mesh, "3 ", 0);
+  if (!uv && !number)
+    return append_triangles(out, mesh, "3 ", 0);
+  for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+    s += '3';
+    for (int k = 0; k < 3; ++k) {
+      s += ' ';
+      append_uint(s, mesh.triangles[3 * t + k]);
+    }
+    if (uv) {
+      s += " 6";
+      for (int k = 0; k < 6; ++k) {
+        s += ' ';
+        append_float(s, mesh.corner_texcoords[6 * t + k]);
+      }
+    }
+    if (number) {
+      s += ' ';
+      s += std::to_string(face_texture_number(mesh, t));
+    }
+    s += '\n';
+    out.done();
+  }
 }
 
 void save_ply_binary(const std::string &path, const Mesh &mesh) {

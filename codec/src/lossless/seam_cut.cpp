@@ -131,14 +131,14 @@ SeamCut cut_at_seams(Mesh &mesh, RepairMap &map, uint32_t input_vertices) {
     // Face f has a -> b starting at corner cf, face g has b -> a starting at cg.
     const uint32_t cf = edges[i].id, cg = edges[i + 1].id;
     const uint32_t f_a = cf, f_b = next(cf), g_b = cg, g_a = next(cg);
-    bool seam = false;
-    for (const auto &[x, y] : {std::pair<uint32_t, uint32_t>{f_a, g_a}, {f_b, g_b}}) {
-      if (same(x, y))
-        parent[find(parent, x)] = find(parent, y);
-      else
-        seam = true;
-    }
-    if (seam) {
+    // The faces stay neighbours in the cut only if they agree at both ends: a seam edge
+    // becomes two boundary edges (joining the corners at the end where they agree would
+    // leave the faces sharing a vertex and no edge there: a vertex of two fans).
+    const bool seam = !same(f_a, g_a) || !same(f_b, g_b);
+    if (!seam) {
+      parent[find(parent, f_a)] = find(parent, g_a);
+      parent[find(parent, f_b)] = find(parent, g_b);
+    } else {
       ++cut.seam_edges;
       for (uint32_t v : {V[cf], V[next(cf)]}) {
         cut.locked[v] = 1;

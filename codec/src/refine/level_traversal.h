@@ -127,11 +127,28 @@ inline void get_view_ring(const LevelMesh &mesh, uint32_t v, const LevelView &le
 /// faces (v_from at its decoded position with the patch ring; integer cross products) plus
 /// v_to's decoded normal, when neither sum is zero (horse, 9 bits: 11.8 bits per vertex
 /// with v_to's normal alone, 9.8 with the faces' alone, 9.0 with 3:1); by the faces' alone
-/// if v_to's normal is zero-length.
+/// if v_to's normal is zero-length. The seam cut's wedge texture coordinate (files with a
+/// MATL section) is predicted by the mean of the codes of v_from's neighbours to be (v_to
+/// and the patch ring, all in v_from's chart: the cut separates the charts), rounded half
+/// away from zero.
 inline void predict_attributes(const LevelMesh &mesh, uint32_t v_to, const Ring &ring,
                                const PatchRange &p, const int32_t position[3], int64_t *pred) {
   const uint32_t n = mesh.attr_codes;
   std::copy(&mesh.attr[size_t(v_to) * n], &mesh.attr[size_t(v_to) * n] + n, pred);
+  if (mesh.wedge_uv_code >= 0 && ring.size() > 0) {
+    const uint32_t k = uint32_t(mesh.wedge_uv_code), m = ring.size();
+    int64_t su = pred[k], sv = pred[k + 1], count = 1;
+    for (uint32_t t = 0, i = p.first_face; t <= p.faces; ++t, i = (i + 1) % m, ++count) {
+      const int64_t *c = &mesh.attr[size_t(ring.neighbour[i]) * n + k];
+      su += c[0];
+      sv += c[1];
+    }
+    const auto mean = [count](int64_t x) {
+      return (x >= 0 ? x + count / 2 : x - count / 2) / count;
+    };
+    pred[k] = mean(su);
+    pred[k + 1] = mean(sv);
+  }
   if (mesh.normal_code < 0)
     return;
   const auto &q = mesh.q;
