@@ -2,8 +2,7 @@
 // web/src/pomar_web.cpp through web/pomar_core.js), on the cube of web/test/textured_mesh.py.
 //
 //   node web/test/texture_test.mjs TEXTURED.pomar
-//
-// Exit status 77: the file has no texture coordinates (skipped).
+
 // At the base clustered mesh, with one cluster refined, coarsened back and at full
 // resolution with keepSeams (as the viewer asks): one (u, v) per vertex, no vertex whose
 // corners disagree, a material per triangle, the file's three materials (name, texture or
@@ -75,13 +74,6 @@ const open = (options) => new PomarStream(M, new RangeFile(new Blob([bytes]), { 
 const s = await open();
 const { clusters, baseLevel, finestLevel } = s.info;
 const cut = { keepSeams: true };
-if (!s.decoder.mesh(cut).texcoords && !s.decoder.mesh(cut).texcoordConflicts) {
-  // An OBJ reader that drops per-corner texture coordinates (`pomar encode` keeps only the
-  // texture names then): nothing to check; run.sh then leaves the browser test's textured
-  // session out.
-  console.log(`texture_test: SKIPPED: ${file} has no texture coordinates (pomar encode read none from the OBJ)`);
-  process.exit(77);
-}
 checkMesh(s.decoder.mesh(cut), 'base clustered mesh');
 const one = new Array(clusters).fill(baseLevel);
 one[0] = finestLevel;
