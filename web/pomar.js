@@ -12,7 +12,9 @@
 // `maxInFlight` requests at once) and decode them
 // on top of the current mesh. Meshes arrive as typed arrays: positions (Float32Array, xyz),
 // triangles (Uint32Array), vertexCluster, vertexLevel (Uint32Array), clusterBounds, and
-// colour ({components: 3 or 4, values: Uint8Array}, or null: the file has no colour).
+// colour ({components: 3 or 4, values: Uint8Array}, or null: the file has no colour);
+// a textured file's texcoords (Float32Array, u v per vertex), faceMaterials (Uint32Array),
+// materials ([{name, texture}]) and textureFiles (names as stored; pomar_core.js mesh()).
 // Errors (HTTP errors, servers without Range support, damaged or truncated files) reject
 // the promises with an Error whose message says what happened; damaged cluster blocks are
 // skipped (as `pomar decode --skip-damaged` does) and reported through `onWarning`.
@@ -28,7 +30,9 @@ import { chooseLevels, Convergence, sameLevels } from './view_refine.js';
  *   request), maxRequestBytes = 1 MiB, memoryBudget = 256 MiB (block bytes
  *   held; over it the worker rebuilds its decoder with only the blocks in use),
  *   firstRequestBytes = 16 KiB, tolerant = false (true: fetch whole blocks from the start;
- *   see pomar_stream.js)}
+ *   see pomar_stream.js), keepSeams = false (true: a textured file's mesh stays cut at its
+ *   texture seams at full resolution too, one texture coordinate per vertex, instead of
+ *   the welded input; the viewer draws textures so)}
  */
 export function open(source, options = {}) {
   const model = new PomarModel(options);

@@ -143,16 +143,38 @@ export class Decoder {
    *  BOUNDS_STRIDE floats per cluster (bbox min, max, longest edge, face count, normal cone,
    *  detail of its newest vertices and their count: see view_refine.js), and `colour`:
    *  the per-vertex colour, {components: 3 (RGB) or 4 (RGBA), values: Uint8Array of
-   *  vertices x components}, or null when the file has none. */
-  mesh() {
+   *  vertices x components}, or null when the file has none. A textured file's mesh also
+   *  has `texcoords` (Float32Array, u and v per vertex, v = 0 at the bottom of the image;
+   *  null when a vertex's corners disagree: `texcoordConflicts` counts those vertices),
+   *  `faceMaterials` (Uint32Array, per triangle: an index into `materials`, or null),
+   *  `materials` ([{name, texture, properties}]: texture an index into `textureFiles`, -1
+   *  for none; properties the material's other MTL lines, e.g. "Kd 0.8 0.2 0.2") and
+   *  `textureFiles` (the names the file stores). `keepSeams`: at full resolution too, a
+   *  textured file gives the coded mesh cut at its seams (one texture coordinate per
+   *  vertex) rather than the welded input, whose seam vertices have two. */
+  mesh({ keepSeams = false } = {}) {
     const M = this.M;
+    M._pw_keep_seams(this.h, keepSeams ? 1 : 0);
     if (M._pw_extract(this.h) < 0) throw new PomarError(lastError(M));
     const nv = M._pw_vertex_count(this.h);
     const nt = M._pw_triangle_count(this.h);
     const f32 = (ptr, n) => new Float32Array(M.HEAPF32.buffer, ptr, n).slice();
     const u32 = (ptr, n) => new Uint32Array(M.HEAPU32.buffer, ptr, n).slice();
+    const uv = M._pw_texcoords(this.h);
+    const faceMaterials = M._pw_face_materials(this.h);
+    const materials = [];
+    for (let i = 0; i < M._pw_material_count(this.h); ++i)
+      materials.push({ name: M.UTF8ToString(M._pw_material_name(this.h, i)), texture: M._pw_material_texture(this.h, i),
+        properties: M.UTF8ToString(M._pw_material_properties(this.h, i)) });
+    const textureFiles = [];
+    for (let i = 0; i < M._pw_texture_count(this.h); ++i) textureFiles.push(M.UTF8ToString(M._pw_texture_file(this.h, i)));
     return {
       colour: this.attribute(ATTRIBUTE_COLOUR, nv),
+      texcoords: uv ? f32(uv, 2 * nv) : null,
+      texcoordConflicts: M._pw_texcoord_conflicts(this.h),
+      faceMaterials: faceMaterials ? u32(faceMaterials, nt) : null,
+      materials,
+      textureFiles,
       positions: f32(M._pw_positions(this.h), 3 * nv),
       triangles: u32(M._pw_triangles(this.h), 3 * nt),
       vertexCluster: u32(M._pw_vertex_cluster(this.h), nv),

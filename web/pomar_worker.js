@@ -13,12 +13,15 @@ let damagedReported = 0;
 let warningsReported = 0;
 let busy = false;
 let pending = null; // the latest want not yet served (older ones are superseded)
+let keepSeams = false; // open's option: textured meshes stay cut at full resolution
 
 function post(type, id, extra) {
-  const mesh = stream.decoder.mesh();
+  const mesh = stream.decoder.mesh({ keepSeams });
   const transfer = [mesh.positions.buffer, mesh.triangles.buffer, mesh.vertexCluster.buffer,
     mesh.vertexLevel.buffer, mesh.clusterBounds.buffer];
   if (mesh.colour) transfer.push(mesh.colour.values.buffer);
+  if (mesh.texcoords) transfer.push(mesh.texcoords.buffer);
+  if (mesh.faceMaterials) transfer.push(mesh.faceMaterials.buffer);
   const stats = { ...stream.stats(), vertices: mesh.positions.length / 3, triangles: mesh.triangles.length / 3, ...extra };
   self.postMessage({ type, id, info: stream.info, mesh, levels: stream.levels, stats }, transfer);
 }
@@ -56,6 +59,7 @@ self.onmessage = async (event) => {
     try {
       const t0 = performance.now();
       const M = await loadModule();
+      keepSeams = !!(msg.options && msg.options.keepSeams);
       stream = await new PomarStream(M, new RangeFile(msg.source, msg.options), msg.options).open();
       post('opened', 0, { decodeMs: performance.now() - t0 });
     } catch (e) {

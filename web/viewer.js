@@ -16,15 +16,18 @@ const params = new URLSearchParams(location.search);
 // ------------------------------------------------------------------ renderer
 // One three.js mesh drawn with a small shader: flat shading from screen-space derivatives
 // (the decoded mesh has no normals), a headlight, and the colour of the material chosen in
-// the colour menu (MATERIALS below). &shading=smooth shades with vertex normals instead
-// (area-weighted face normals, computed at each upload), e.g. to compare refinement
-// policies (bench/web_fidelity_bench.py --shading smooth).
+// the colour menu (MATERIALS below). A textured file is drawn in one geometry group per
+// material of the file, each with its own copy of the shader's material and texture.
+// &shading=smooth shades with vertex normals instead (area-weighted face normals, computed
+// at each upload), e.g. to compare refinement policies (bench/web_fidelity_bench.py
+// --shading smooth).
 const VS = `precision highp float;
 in vec3 position;
 in float cluster;
 in float level;
 in vec3 normal;
 in vec3 rgb;
+in vec2 uv;
 uniform mat4 projectionMatrix;
 uniform mat4 modelViewMatrix;
 uniform int colourMode;
@@ -33,12 +36,14 @@ uniform float base;
 out vec3 vPosition;
 out vec3 vNormal;
 out vec3 vRgb;
+out vec2 vUv;
 flat out vec3 vColour;
 vec3 hue(float h) { return clamp(abs(mod(h * 6.0 + vec3(0, 4, 2), 6.0) - 3.0) - 1.0, 0.0, 1.0); }
 void main() {
   vPosition = position;
   vNormal = normal;
   vRgb = rgb;
+  vUv = uv;
   if (colourMode == 1) vColour = 0.35 + 0.65 * hue(fract(cluster * 0.61803));
   else if (colourMode == 2) vColour = 0.3 + 0.7 * hue(0.66 * (1.0 - (level - base) / max(1.0, finest - base)));
   else vColour = vec3(0.82, 0.80, 0.76);
@@ -48,18 +53,24 @@ const FS = `precision highp float;
 in vec3 vPosition;
 in vec3 vNormal;
 in vec3 vRgb;
+in vec2 vUv;
 flat in vec3 vColour;
 uniform vec3 eye;
 uniform highp int colourMode; // highp: the vertex shader's int precision (shared uniform)
 uniform int smoothShading;
+uniform sampler2D map;
+uniform vec3 diffuse;
 out vec4 colour;
 void main() {
   vec3 n = smoothShading == 1 && dot(vNormal, vNormal) > 0.0 ? normalize(vNormal)
                                                              : normalize(cross(dFdx(vPosition), dFdy(vPosition)));
   vec3 l = normalize(eye - vPosition);
   float d = abs(dot(n, l));
-  // Own colours (mode 3) are interpolated across the face and lit like the others.
-  colour = vec4((colourMode == 3 ? vRgb : vColour) * (0.25 + 0.75 * d), 1.0);
+  // Own colours (mode 3) are interpolated across the face, a texture (mode 4) is looked up
+  // at the interpolated texture coordinate, a material without one (mode 5) has its
+  // diffuse colour; all are lit like the others.
+  vec3 base = colourMode == 3 ? vRgb : colourMode == 4 ? texture(map, vUv).rgb : colourMode == 5 ? diffuse : vColour;
+  colour = vec4(base * (0.25 + 0.75 * d), 1.0);
 }`;
 
 const smoothShading = params.get('shading') === 'smooth';
@@ -89,11 +100,12 @@ function vertexNormals(p, t) {
 // whether it applies to a mesh (`available`, default: always) and the vertex attributes it
 // needs beside the positions (`attributes(mesh, model)`: name -> THREE.BufferAttribute,
 // built from the same decoded mesh at every upload, so they always match the geometry).
-// The first available one is chosen when a file opens: the file's own colours when it has
-// them. A texture is one more entry of this list: available when the mesh has a
-// "texcoord" attribute and texture files, its attributes the UVs, plus a sampler uniform
-// and a mode of the shader.
+// The first available one is chosen when a file opens: the file's texture when it has
+// texture coordinates and texture files (and they load), else its own colours when it has
+// them, else plain.
 const MATERIALS = [
+  { id: 'texture', label: 'texture', mode: 4, available: (mesh) => !!mesh.texcoords && textures.usable(mesh),
+    attributes: (mesh) => ({ uv: new THREE.BufferAttribute(mesh.texcoords, 2) }) },
   { id: 'own', label: 'own colours', mode: 3, available: (mesh) => !!mesh.colour,
     attributes: (mesh) => ({ rgb: new THREE.BufferAttribute(mesh.colour.values, mesh.colour.components, true) }) },
   { id: 'plain', label: 'plain', mode: 0 },
@@ -109,7 +121,7 @@ const MATERIALS = [
   } },
 ];
 const usable = (material, mesh) => !material.available || material.available(mesh);
-let drawnMesh = { positions: new Float32Array(0), vertexCluster: new Uint32Array(0), colour: null };
+let drawnMesh = { positions: new Float32Array(0), vertexCluster: new Uint32Array(0), colour: null, texcoords: null };
 /** The material of the colour menu, or the plain one if it does not apply to the mesh. */
 function material() {
   const chosen = MATERIALS.find((m) => m.id === $('colour').value);
@@ -125,21 +137,152 @@ function offerMaterials(mesh, chooseDefault) {
   if (chooseDefault) $('colour').value = MATERIALS.find((m) => usable(m, mesh)).id;
 }
 
+// ------------------------------------------------------------------ textures
+// The file's texture names are URLs relative to the .pomar file's own URL (as an OBJ's MTL
+// names its images relative to the MTL: a name with a directory part stays relative).
+// Each is loaded once per opened file as an image; v = 0 is the image's bottom row (OBJ),
+// which is three.js's default upload (flipY). A texture that does not load is named in
+// the page (#textures) and the texture entry is taken away: the model is drawn with its
+// own colours, or plain.
+/** A mesh whose vertices' corners disagree (a welded one) cannot be drawn with its texture. */
+function reportConflicts(mesh) {
+  if (!mesh.texcoords && mesh.texcoordConflicts) {
+    $('textures').textContent = `texture: ${mesh.texcoordConflicts} vertices have corners with different texture coordinates ` +
+      '(a welded mesh): the texture is not drawn';
+  }
+}
+const textures = {
+  base: null,     // the URL the names are relative to (null: a dropped file, no URL)
+  files: [],      // the file's texture names
+  loaded: [],     // per name: THREE.Texture, or null (loading, or failed)
+  failed: [],     // per name: a message, or ''
+  ready: Promise.resolve(),
+  /** Start loading the textures of a newly opened file (`source`: its URL or File). */
+  start(source, mesh) {
+    this.dispose();
+    this.files = mesh.textureFiles || [];
+    this.base = typeof source === 'string' ? new URL(source, location.href) : null;
+    this.loaded = this.files.map(() => null);
+    this.failed = this.files.map(() => '');
+    $('textures').textContent = '';
+    reportConflicts(mesh);
+    if (!mesh.texcoords || !this.files.length) return (this.ready = Promise.resolve());
+    const generation = ++this.generation;
+    this.ready = Promise.all(this.files.map((name, i) => this.load(name, i, generation))).then(() => {
+      if (generation !== this.generation) return;
+      const failed = this.failed.filter((f) => f);
+      $('textures').textContent = failed.length ? `${failed.join('\n')}\n(drawn ${material().id === 'own' ? 'with its own colours' : 'plain'} instead)` : '';
+    });
+    return this.ready;
+  },
+  generation: 0,
+  load(name, i, generation) {
+    if (!this.base) {
+      this.failed[i] = `texture ${name}: a dropped file's textures cannot be fetched (their names are relative to the file's URL: open it by URL)`;
+      return Promise.resolve();
+    }
+    const url = new URL(name.replace(/\\/g, '/').split('/').map(encodeURIComponent).join('/'), this.base).href;
+    return new THREE.TextureLoader().loadAsync(url).then((texture) => {
+      if (generation !== this.generation) return texture.dispose();
+      texture.flipY = true; // the image's first row at v = 1: OBJ's v = 0 at the bottom
+      texture.wrapS = texture.wrapT = THREE.RepeatWrapping;
+      texture.anisotropy = renderer ? renderer.capabilities.getMaxAnisotropy() : 1;
+      this.loaded[i] = texture;
+    }, () => {
+      if (generation === this.generation) this.failed[i] = `texture ${name}: cannot load ${url}`;
+    }).then(() => {
+      if (generation !== this.generation) return;
+      // A failed texture takes the entry away: choose again if it was shown.
+      if (this.failed[i] && $('colour').value === 'texture') offerMaterials(drawnMesh, true);
+      else offerMaterials(drawnMesh, false);
+      frame(model);
+    });
+  },
+  /** The texture entry applies: every texture of the file is loaded or loading. */
+  usable(mesh) {
+    return (mesh.textureFiles || []).length > 0 && this.failed.every((f) => !f);
+  },
+  /** The texture of material index m of the file (its materials, or texture 0 if it has none). */
+  of(mesh, m) {
+    const t = mesh.materials && mesh.materials.length ? (mesh.materials[m] || { texture: -1 }).texture : 0;
+    return t >= 0 && t < this.loaded.length ? this.loaded[t] : null;
+  },
+  dispose() {
+    ++this.generation;
+    for (const t of this.loaded) if (t) t.dispose();
+    this.loaded = [];
+    this.failed = [];
+    this.files = [];
+  },
+};
+
 let renderer = null;
 let scene = null;
 let shown = null; // the THREE.Mesh
+let plainMaterial = null; // the shader's material (every colour mode but the texture)
+let textureMaterials = []; // per material of the file: the shader's material with its texture
 const camera3 = new THREE.PerspectiveCamera();
+const sharedUniforms = { finest: { value: 1 }, base: { value: 0 }, eye: { value: new THREE.Vector3() },
+  smoothShading: { value: smoothShading ? 1 : 0 } };
+/** The shader as a three.js material: its own `own` uniforms, the others shared (one
+ *  update in frame() reaches every material). */
+function shaderMaterial(own) {
+  return new THREE.RawShaderMaterial({
+    glslVersion: THREE.GLSL3, vertexShader: VS, fragmentShader: FS, side: THREE.DoubleSide,
+    uniforms: { ...sharedUniforms, ...own },
+  });
+}
+/** A material's diffuse colour (its MTL `Kd r g b` line), or null. */
+function diffuseOf(material) {
+  const kd = material && /^\s*Kd\s+(\S+)\s+(\S+)\s+(\S+)/m.exec(material.properties || '');
+  const rgb = kd ? kd.slice(1, 4).map(Number) : null;
+  return rgb && rgb.every((c) => Number.isFinite(c)) ? rgb.map((c) => Math.max(0, Math.min(1, c))) : null;
+}
+/** The texture materials for `mesh`'s materials: each draws its texture (mode 4); one
+ *  without a texture its diffuse colour (mode 5) if it has one; else, and while its image
+ *  loads, plain grey. */
+function updateTextureMaterials(mesh) {
+  const count = Math.max(1, (mesh.materials || []).length);
+  while (textureMaterials.length < count) textureMaterials.push(shaderMaterial({ colourMode: { value: 0 }, map: { value: null }, diffuse: { value: new THREE.Vector3() } }));
+  for (let m = 0; m < textureMaterials.length; ++m) {
+    const texture = m < count ? textures.of(mesh, m) : null;
+    const own = mesh.materials && mesh.materials[m];
+    const diffuse = own && own.texture < 0 ? diffuseOf(own) : null;
+    const u = textureMaterials[m].uniforms;
+    u.map.value = texture;
+    if (diffuse) u.diffuse.value.set(...diffuse);
+    u.colourMode.value = texture ? 4 : diffuse ? 5 : 0;
+  }
+}
+/** The triangles of `mesh` ordered by material (a stable counting sort) and one geometry
+ *  group per material present: {index, groups}. Without face materials: as they are. */
+function trianglesByMaterial(mesh) {
+  const t = mesh.triangles;
+  const fm = mesh.faceMaterials;
+  if (!fm || !mesh.texcoords) return { index: t, groups: [] };
+  const count = Math.max(1, mesh.materials.length);
+  const start = new Uint32Array(count + 1);
+  for (let f = 0; f < fm.length; ++f) ++start[Math.min(fm[f], count - 1) + 1];
+  for (let m = 0; m < count; ++m) start[m + 1] += start[m];
+  const groups = [];
+  for (let m = 0; m < count; ++m) if (start[m + 1] > start[m]) groups.push({ start: 3 * start[m], count: 3 * (start[m + 1] - start[m]), materialIndex: m });
+  const next = start.slice(0, count);
+  const index = new Uint32Array(t.length);
+  for (let f = 0; f < fm.length; ++f) {
+    const to = 3 * next[Math.min(fm[f], count - 1)]++;
+    index[to] = t[3 * f];
+    index[to + 1] = t[3 * f + 1];
+    index[to + 2] = t[3 * f + 2];
+  }
+  return { index, groups };
+}
 function initGL() {
   THREE.ColorManagement.enabled = false; // colours as given, no sRGB conversions
   renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
   renderer.setClearColor(new THREE.Color(0x20242a), 1);
   scene = new THREE.Scene();
-  const material = new THREE.RawShaderMaterial({
-    glslVersion: THREE.GLSL3, vertexShader: VS, fragmentShader: FS, side: THREE.DoubleSide,
-    uniforms: { colourMode: { value: 0 }, finest: { value: 1 }, base: { value: 0 }, eye: { value: new THREE.Vector3() },
-      smoothShading: { value: smoothShading ? 1 : 0 } },
-  });
-  shown = new THREE.Mesh(new THREE.BufferGeometry(), material);
+  plainMaterial = shaderMaterial({ colourMode: { value: 0 }, map: { value: null }, diffuse: { value: new THREE.Vector3() } });
+  shown = new THREE.Mesh(new THREE.BufferGeometry(), plainMaterial);
   shown.frustumCulled = false; // the geometry changes with every decode
   scene.add(shown);
 }
@@ -155,10 +298,15 @@ function upload(mesh, model) {
     for (const [name, attribute] of Object.entries(m.attributes(mesh, model))) g.setAttribute(name, attribute);
   }
   if (smoothShading) g.setAttribute('normal', new THREE.BufferAttribute(vertexNormals(mesh.positions, mesh.triangles), 3));
-  g.setIndex(new THREE.BufferAttribute(mesh.triangles, 1));
+  // By material (a textured file: one group per material; the order of the triangles does
+  // not matter to the other colour modes).
+  const { index, groups } = trianglesByMaterial(mesh);
+  g.setIndex(new THREE.BufferAttribute(index, 1));
+  for (const group of groups) g.addGroup(group.start, group.count, group.materialIndex);
   shown.geometry.dispose();
   shown.geometry = g;
   drawnMesh = mesh;
+  reportConflicts(mesh);
   offerMaterials(mesh, false);
 }
 
@@ -199,11 +347,19 @@ function frame(model) {
   c.up.set(...upVector(camera));
   c.lookAt(...camera.target);
   c.updateProjectionMatrix();
-  const u = shown.material.uniforms;
+  const u = sharedUniforms;
   u.eye.value.set(...v.eye);
-  u.colourMode.value = material().mode;
   u.finest.value = model ? model.info.finestLevel : 1;
   u.base.value = model ? model.info.baseLevel : 0;
+  const chosen = material();
+  if (chosen.id === 'texture') {
+    // One material per group (a geometry without groups: the first material, all of it).
+    updateTextureMaterials(drawnMesh);
+    shown.material = shown.geometry.groups.length ? textureMaterials : textureMaterials[0];
+  } else {
+    plainMaterial.uniforms.colourMode.value = chosen.mode;
+    shown.material = plainMaterial;
+  }
   renderer.render(scene, c);
 }
 
@@ -259,9 +415,12 @@ async function openSource(source, extraOptions = {}) {
   $('warning').textContent = '';
   if (model) model.close();
   model = null;
-  upload({ positions: new Float32Array(0), triangles: new Uint32Array(0), vertexCluster: new Uint32Array(0), vertexLevel: new Uint32Array(0), colour: null });
+  textures.dispose();
+  $('textures').textContent = '';
+  upload({ positions: new Float32Array(0), triangles: new Uint32Array(0), vertexCluster: new Uint32Array(0), vertexLevel: new Uint32Array(0), colour: null, texcoords: null });
   frame(null);
   const m = await open(source, {
+    keepSeams: true, // a textured mesh: one texture coordinate per vertex at full resolution too
     ...extraOptions,
     onMesh: (mesh, m) => onMesh(mesh, m),
     onWarning: (message) => { $('warning').textContent = 'warning: ' + message; },
@@ -271,6 +430,7 @@ async function openSource(source, extraOptions = {}) {
   frameMesh(camera, m.mesh.positions, canvas.clientWidth / Math.max(1, canvas.clientHeight));
   modelExtents = extentsOf(m.mesh.positions);
   applyUp();
+  textures.start(source, m.mesh);
   offerMaterials(m.mesh, true);
   ++cameraVersion;
   onMesh(m.mesh, m);
@@ -335,10 +495,14 @@ window.addEventListener('drop', (e) => {
 
 // ------------------------------------------------------------------ start
 // For the console and the browser tests (web/test/mobile_test.py): the viewer's state.
-// drawn(): what the drawn geometry holds (vertices, colours uploaded, the material).
+// drawn(): what the drawn geometry holds (vertices, colours and texture coordinates
+// uploaded, geometry groups, the material); textures(): settles when the open file's
+// textures have loaded or failed.
 window.pomarViewer = { model: () => model, camera, refining: () => refining, upVector: () => upVector(camera),
   drawn: () => ({ vertices: shown.geometry.attributes.position.count, colours: shown.geometry.attributes.rgb ? shown.geometry.attributes.rgb.count : 0,
-    material: material().id }) };
+    texcoords: shown.geometry.attributes.uv ? shown.geometry.attributes.uv.count : 0, groups: shown.geometry.groups.length,
+    material: material().id }),
+  textures: () => textures.ready };
 try {
   initMaterials();
   initGL();

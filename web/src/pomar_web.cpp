@@ -78,6 +78,10 @@ struct Handle {
   // Results kept alive for JavaScript to copy out of the heap.
   pomar::Mesh mesh;
   std::vector<uint32_t> vertex_cluster, vertex_level;
+  bool textured = false;    // the file has per-corner texture coordinates
+  bool keep_seams = false;  // pw_keep_seams: a full-resolution extract stays cut
+  std::vector<float> texcoords; // per vertex of `mesh`: u, v (empty: none, or conflicts)
+  size_t texcoord_conflicts = 0;
   std::vector<float> bounds;
   std::vector<int32_t> levels;
   std::vector<double> info;
@@ -166,6 +170,34 @@ std::vector<float> detail_of(const pomar::Mesh &mesh) {
   return out;
 }
 
+/// The extracted mesh's per-corner texture coordinates as one (u, v) per vertex, the value
+/// of its corners, when all the corners of every vertex agree (the cut mesh: each vertex is
+/// one wedge). Otherwise (a welded mesh: a vertex on a seam has corners in two charts) no
+/// per-vertex value is right: none is given and the vertices in conflict are counted.
+void per_vertex_texcoords(Handle &h) {
+  const pomar::Mesh &m = h.mesh;
+  h.texcoords.clear();
+  h.texcoord_conflicts = 0;
+  if (m.corner_texcoords.size() != 2 * m.triangles.size())
+    return;
+  std::vector<float> uv(2 * m.vertex_count(), 0.f);
+  std::vector<uint8_t> seen(m.vertex_count(), 0);
+  for (size_t c = 0; c < m.triangles.size(); ++c) {
+    const uint32_t v = m.triangles[c];
+    const float u = m.corner_texcoords[2 * c], w = m.corner_texcoords[2 * c + 1];
+    if (!seen[v]) {
+      seen[v] = 1;
+      uv[2 * v] = u;
+      uv[2 * v + 1] = w;
+    } else if (seen[v] == 1 && (uv[2 * v] != u || uv[2 * v + 1] != w)) {
+      seen[v] = 2;
+      ++h.texcoord_conflicts;
+    }
+  }
+  if (h.texcoord_conflicts == 0)
+    h.texcoords = std::move(uv);
+}
+
 } // namespace
 
 extern "C" {
@@ -220,9 +252,12 @@ EMSCRIPTEN_KEEPALIVE Handle *pw_open(const uint8_t *data, size_t n, double file_
       const size_t hsize = pomar::header_size(data, n);
       const pomar::FileLayout layout = pomar::read_layout(data, hsize, size, true);
       h->index = pomar::read_cluster_index(data + layout.index_offset, layout);
-      cluster_graph(h->decoder->mesh(), clusters, h->adj_start, h->adj);
       h->decoder->cluster_links(h->link_start, h->link);
     }
+    const pomar::Mesh base = h->decoder->mesh();
+    h->textured = !base.corner_texcoords.empty();
+    if (clusters)
+      cluster_graph(base, clusters, h->adj_start, h->adj);
     out = h.release();
     return 0;
   });
@@ -334,16 +369,24 @@ EMSCRIPTEN_KEEPALIVE const char *pw_damaged(Handle *h) {
 EMSCRIPTEN_KEEPALIVE int pw_damaged_count(Handle *h) { return int(h->decoder->damaged().size()); }
 
 /// Extract the current mesh; then pw_positions (3 floats per vertex), pw_triangles (3
-/// indices per face), pw_vertex_cluster, pw_vertex_level and pw_attribute_values point at
-/// it until the next call.
+/// indices per face), pw_vertex_cluster, pw_vertex_level, pw_attribute_values,
+/// pw_texcoords and pw_face_materials point at it until the next call.
 EMSCRIPTEN_KEEPALIVE int pw_extract(Handle *h) {
   return guarded([&] {
     // Every cluster at the finest level: exactly the encoded input (a lossless record
-    // undone, as `pomar decode` gives it); otherwise the coded mesh. Cluster and level
-    // follow each vertex from the coded mesh (a vertex no coded face uses takes those of
-    // vertex 0: it draws nothing).
+    // undone, as `pomar decode` gives it; a textured file with pw_keep_seams: the coded,
+    // cut mesh still); otherwise the coded mesh. Cluster and level follow each vertex from
+    // the coded mesh (a vertex no coded face uses takes those of vertex 0: it draws
+    // nothing).
     std::vector<uint32_t> from;
-    h->mesh = h->decoder->exact_mesh(&from);
+    if (h->textured && h->keep_seams) {
+      h->mesh = h->decoder->mesh();
+      from.resize(h->mesh.vertex_count());
+      for (size_t v = 0; v < from.size(); ++v)
+        from[v] = uint32_t(v);
+    } else {
+      h->mesh = h->decoder->exact_mesh(&from);
+    }
     const std::vector<uint32_t> cluster = h->decoder->vertex_cluster();
     const std::vector<uint32_t> level = h->decoder->vertex_level();
     h->vertex_cluster.resize(from.size());
@@ -353,6 +396,7 @@ EMSCRIPTEN_KEEPALIVE int pw_extract(Handle *h) {
       h->vertex_cluster[v] = cluster.empty() ? 0 : cluster[f];
       h->vertex_level[v] = level.empty() ? 0 : level[f];
     }
+    per_vertex_texcoords(*h);
     return 0;
   });
 }
@@ -380,6 +424,42 @@ EMSCRIPTEN_KEEPALIVE const void *pw_attribute_values(Handle *h, int kind) {
     return nullptr;
   return a->kind == pomar::AttributeKind::Colour ? static_cast<const void *>(a->colour.data())
                                                  : static_cast<const void *>(a->values.data());
+}
+
+/// Texture coordinates and materials. pw_keep_seams(h, 1): once every cluster is at the
+/// finest level, pw_extract of a textured file still gives the coded mesh, cut at its
+/// texture seams (both sides of a seam separate vertices), instead of the welded input, so
+/// that every vertex keeps one texture coordinate (the viewer draws it so).
+EMSCRIPTEN_KEEPALIVE void pw_keep_seams(Handle *h, int keep) { h->keep_seams = keep != 0; }
+/// The extracted mesh's texture coordinates per vertex (2 floats, u and v, v = 0 at the
+/// bottom of the image as in OBJ), or null: no texture coordinates, or some vertex's corners
+/// disagree (pw_texcoord_conflicts counts those vertices; a welded full-resolution mesh).
+EMSCRIPTEN_KEEPALIVE const float *pw_texcoords(Handle *h) {
+  return h->texcoords.empty() ? nullptr : h->texcoords.data();
+}
+EMSCRIPTEN_KEEPALIVE int pw_texcoord_conflicts(Handle *h) { return int(h->texcoord_conflicts); }
+/// The extracted mesh's material per triangle (index into the materials), or null.
+EMSCRIPTEN_KEEPALIVE const uint32_t *pw_face_materials(Handle *h) {
+  return h->mesh.face_materials.size() == h->mesh.triangle_count() && !h->mesh.face_materials.empty()
+             ? h->mesh.face_materials.data()
+             : nullptr;
+}
+/// The materials (name; texture: an index into the texture files, -1 for none) and the
+/// texture file names, as the file stores them (e.g. relative paths from an OBJ's MTL).
+EMSCRIPTEN_KEEPALIVE int pw_material_count(Handle *h) { return int(h->mesh.materials.size()); }
+EMSCRIPTEN_KEEPALIVE const char *pw_material_name(Handle *h, int i) {
+  return i >= 0 && size_t(i) < h->mesh.materials.size() ? h->mesh.materials[i].name.c_str() : "";
+}
+/// Its other MTL lines as the file keeps them (`Kd 0.8 0.2 0.2`, `Ns 10`, ...).
+EMSCRIPTEN_KEEPALIVE const char *pw_material_properties(Handle *h, int i) {
+  return i >= 0 && size_t(i) < h->mesh.materials.size() ? h->mesh.materials[i].properties.c_str() : "";
+}
+EMSCRIPTEN_KEEPALIVE int pw_material_texture(Handle *h, int i) {
+  return i >= 0 && size_t(i) < h->mesh.materials.size() ? h->mesh.materials[i].texture : -1;
+}
+EMSCRIPTEN_KEEPALIVE int pw_texture_count(Handle *h) { return int(h->mesh.texture_files.size()); }
+EMSCRIPTEN_KEEPALIVE const char *pw_texture_file(Handle *h, int i) {
+  return i >= 0 && size_t(i) < h->mesh.texture_files.size() ? h->mesh.texture_files[i].c_str() : "";
 }
 
 /// Per cluster of the extracted mesh, kBoundsStride floats (web/view_refine.js reads them):

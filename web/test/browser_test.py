@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The web viewer in a real headless browser.
 
-    python3 web/test/browser_test.py FILE.pomar [--coloured COLOURED.pomar] [--images DIR] [--chromium PATH]
+    python3 web/test/browser_test.py FILE.pomar [--coloured COLOURED.pomar] [--textured DIR] [--images DIR] [--chromium PATH]
 
 Serves the repository's web/ folder and copies of FILE (intact, truncated in the global
 part, truncated in the cluster blocks, one cluster block damaged, and through a path that
@@ -23,6 +23,13 @@ makes it): the viewer picks Z as the up axis by itself and draws the model's own
 (red at the bottom of the picture, blue at its top), its colour buffer matches the
 geometry after region refinement, coarsening and full resolution, the plain material is
 grey and the Y-up choice turns the model on its side (screenshots coloured_*).
+--textured DIR: the textured cube of web/test/textured_mesh.py, DIR/textured.pomar (run.sh
+encodes it) with its textures DIR/a.png and DIR/maps/b.png: the viewer opens it with its
+texture, the texture coordinates match the geometry after region refinement, coarsening
+and full resolution (three geometry groups: three materials), each visible face shows its
+chart's colour in its place (the top face its material's Kd: it has no texture) (the +Z face's upper half blue above its lower half yellow:
+the texture's v = 0 at the bottom), hidden faces' colours absent, plain shows none of
+them; served without its images it says so in the page and draws plain (textured_*).
 Exit status 0 = pass, 1 = a check failed, 77 = Chromium or the WebAssembly build missing.
 """
 import argparse
@@ -76,6 +83,53 @@ def coloured_checks(check, c):
           f"up: Y lays it on its side (up {y['up']}, box height / width {y['pixels']['aspect']:.2f})")
 
 
+def textured_checks(check, t):
+    """What the page saw of the textured cube (page_test.js texturedSession)."""
+    if 'exception' in t:
+        check(False, 'the textured model: ' + t['exception'])
+        return
+    check(t['material'] == 'texture' and not t['message'],
+          f"a file with texture coordinates and textures opens with its texture (colour menu: {t['material']}; "
+          f"message: {t['message']!r})")
+    for name in ('base', 'region', 'coarsened', 'full'):
+        s = t[name]
+        d = s['drawn'] or {}
+        check(d.get('texcoords') == d.get('vertices') == s['vertices'] == s['meshTexcoords'] and s['vertices'] > 0
+              and d.get('groups') == 3,
+              f"{name} (levels {s['minLevel']}..{s['maxLevel']}): {s['vertices']} vertices, {d.get('vertices')} drawn "
+              f"with {d.get('texcoords')} texture coordinates in {d.get('groups')} groups (3 materials)")
+    check(t['full']['minLevel'] == t['full']['maxLevel'] and t['region']['minLevel'] < t['region']['maxLevel'],
+          'the textured model went through a region, the base and full resolution')
+    seen = ('+z top', '+z bottom', '+x', '+y')
+    hidden = ('-x', '-y', '-z')
+    for name in ('base', 'full'):
+        p = t[name]['pixels']
+        shown = ', '.join(f"{c} {100 * p[c]['fraction']:.1f}%" for c in seen + hidden)
+        check(p['covered'] > 0.02 and all(p[c]['fraction'] > 0.03 for c in seen)
+              and all(p[c]['fraction'] < 0.01 for c in hidden),
+              f"{name}: the faces in view show their charts' colours, the hidden ones' absent ({shown} of "
+              f"{100 * p['covered']:.1f}% of the pixels)")
+        present = all(p[c]['fraction'] > 0 for c in seen)  # else the places below are -1
+        check(present and p['+z top']['y'] < p['+z bottom']['y'],
+              f"{name}: the +Z face's upper chart half (blue, v > 0.5) above its lower half (yellow): v = 0 at the "
+              f"image's bottom (mean heights from the top {p['+z top']['y']:.2f}, {p['+z bottom']['y']:.2f})")
+        check(present and p['+y']['y'] < min(p['+z top']['y'], p['+x']['y']) and p['+x']['x'] > p['+z bottom']['x'],
+              f"{name}: the top face's colour (green: its material's Kd, it has no texture) on top (mean height "
+              f"{p['+y']['y']:.2f}), +X's on the right "
+              f"(mean x {p['+x']['x']:.2f} against +Z's {p['+z bottom']['x']:.2f})")
+    g = t['plain']
+    coloured = sum(g[c]['fraction'] for c in seen + hidden)
+    check(g['covered'] > 0.02 and coloured < 0.001, f"plain shows none of the texture's colours ({100 * coloured:.2f}%)")
+    m = t.get('missing')
+    if m is None:
+        return
+    coloured = sum(m['pixels'][c]['fraction'] for c in seen + hidden)
+    check('a.png' in m['message'] and 'maps/b.png' in m['message'] and 'cannot load' in m['message']
+          and m['material'] == 'plain' and m['drawn'] == 'plain' and coloured < 0.001,
+          f"textures missing: the page says so ({m['message']!r}) and draws {m['drawn']} "
+          f"({100 * coloured:.2f}% texture colours)")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     ap.add_argument('pomar', help='a clustered .pomar file')
@@ -89,6 +143,7 @@ def main():
     ap.add_argument('--no-compare', action='store_true', help='do not compare screenshots')
     ap.add_argument('--max-gap', type=int, help="pomar.js maxGap for the session (bytes; default: pomar.js's)")
     ap.add_argument('--coloured', help='a Z-up .pomar with per-vertex colour (web/test/coloured_mesh.py)')
+    ap.add_argument('--textured', help='a directory with textured.pomar and its textures (web/test/textured_mesh.py)')
     args = parse(ap, 'browser_test')
     if args is None:
         return 77
@@ -120,6 +175,12 @@ def main():
             f.write(bytes(damaged))
         if args.coloured:
             shutil.copy(args.coloured, os.path.join(data, 'coloured.pomar'))
+        if args.textured:
+            # With its textures beside it (one in a subdirectory), and alone.
+            for sub, files in (('textured', ('textured.pomar', 'a.png', 'maps/b.png')), ('untextured', ('textured.pomar',))):
+                for name in files:
+                    os.makedirs(os.path.dirname(os.path.join(data, sub, name)), exist_ok=True)
+                    shutil.copy(os.path.join(args.textured, name), os.path.join(data, sub, name))
         reports = os.path.join(work, 'reports')
         os.makedirs(reports)
         server = serve.make_server(root, 0, test=True, report_dir=reports)
@@ -130,6 +191,8 @@ def main():
             gap += '&ref=/ref/'
         if args.coloured:
             gap += '&coloured=/data/coloured.pomar'
+        if args.textured:
+            gap += '&textured=/data/textured/textured.pomar&texturedMissing=/data/untextured/textured.pomar'
         url = (f'{base}/web/index.html?test=1&file=/data/model.pomar{gap}'
                f'&target={args.target}&closeup={args.closeup}&missing=/data/missing.pomar'
                '&noRange=/no-range/data/model.pomar&singleRange=/single-range/data/model.pomar&truncatedGlobal=/data/truncated_global.pomar'
@@ -219,6 +282,8 @@ def main():
               f"the bunny (Y-up, no colour): up {r.get('up')}, material {r.get('material')}")
         if args.coloured:
             coloured_checks(check, r.get('coloured') or {'exception': 'the page ran no coloured session'})
+        if args.textured:
+            textured_checks(check, r.get('textured') or {'exception': 'the page ran no textured session'})
         compared = r.get('comparisons', {})
         for name, c in sorted(compared.items()):
             if 'missing' in c:
@@ -240,6 +305,8 @@ def main():
             names = ['base', 'closeup', 'closeup_levels', 'overview', 'overview_levels', 'zoomout', 'full']
             if args.coloured:
                 names += ['coloured_base', 'coloured_full', 'coloured_plain', 'coloured_y']
+            if args.textured:
+                names += ['textured_base', 'textured_full', 'textured_plain', 'textured_missing']
             for name in names:
                 shutil.copy(os.path.join(reports, name + '.png'), os.path.join(args.images, f'web_{name}.png'))
             print(f'screenshots: {args.images}/web_*.png')

@@ -2,7 +2,9 @@
 // the server and headless Chromium, then checks what this posts to /report/).
 // ?file=URL of an intact file; &missing=, &truncatedGlobal=, &truncatedBlocks=,
 // &damagedBlocks=, &noRange= URLs of the error cases; &coloured= URL of a Z-up model with
-// per-vertex colour (web/test/coloured_mesh.py: red, green, blue bands from bottom to top).
+// per-vertex colour (web/test/coloured_mesh.py: red, green, blue bands from bottom to top);
+// &textured= URL of the textured cube of web/test/textured_mesh.py (its textures beside
+// it), &texturedMissing= the same file where its textures are not.
 import { closeUp } from '../camera.js';
 
 const params = new URLSearchParams(location.search);
@@ -149,6 +151,90 @@ function pixelStats(v) {
   return { covered: covered / (w * h), aspect: covered ? (box[3] - box[1] + 1) / (box[2] - box[0] + 1) : 0, ...named };
 }
 
+/** The colours of web/test/textured_mesh.py's charts (face of the cube: colour). */
+const CHARTS = { '+z top': [0, 0, 255], '+z bottom': [255, 255, 0], '+x': [255, 0, 0], '+y': [0, 255, 0],
+  '-x': [0, 255, 255], '-y': [255, 0, 255], '-z': [255, 128, 0] };
+/** For each chart colour: the fraction of the drawn pixels of that colour (lighting scales
+ *  a colour: a pixel counts when its brightest channel is at least 60 and each channel
+ *  divided by the brightest is within 0.2 of the chart's), and their mean place in the
+ *  view (x from the left, y from the top, 0..1); and the fraction of pixels drawn. */
+function chartStats(v) {
+  v.frame();
+  const gl = $('view').getContext('webgl2');
+  const w = gl.drawingBufferWidth;
+  const h = gl.drawingBufferHeight;
+  const px = new Uint8Array(4 * w * h);
+  gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, px);
+  const names = Object.keys(CHARTS);
+  const found = names.map(() => ({ count: 0, x: 0, y: 0 }));
+  let covered = 0;
+  for (let y = 0; y < h; ++y) {
+    for (let x = 0; x < w; ++x) {
+      const i = 4 * (y * w + x);
+      const c = [px[i], px[i + 1], px[i + 2]];
+      if (Math.abs(c[0] - 32) + Math.abs(c[1] - 36) + Math.abs(c[2] - 42) <= 12) continue;
+      ++covered;
+      const top = Math.max(...c);
+      if (top < 60) continue;
+      const k = names.findIndex((n) => CHARTS[n].every((p, j) => Math.abs(c[j] / top - p / 255) < 0.2));
+      if (k < 0) continue;
+      ++found[k].count;
+      found[k].x += x / w;
+      found[k].y += (h - 1 - y) / h; // readPixels rows start at the bottom
+    }
+  }
+  const out = { covered: covered / (w * h) };
+  names.forEach((n, k) => {
+    const f = found[k];
+    out[n] = { fraction: f.count / Math.max(1, covered), x: f.count ? f.x / f.count : -1, y: f.count ? f.y / f.count : -1 };
+  });
+  return out;
+}
+
+/** The textured cube: opens with its texture (two materials, two images, one of them in a
+ *  subdirectory), the texture coordinates in step with the geometry through region
+ *  refinement, coarsening and full resolution, each chart's colour where its face is;
+ *  plain shows none of them; with its images missing, a message and no texture. */
+async function texturedSession(v) {
+  const out = {};
+  const viewer = window.pomarViewer;
+  const texturesLoaded = () => (viewer.textures ? viewer.textures() : Promise.resolve());
+  try {
+    const m = await within(20000, v.openSource(params.get('textured')), 'textured model');
+    await within(20000, texturesLoaded(), 'textured model: its textures');
+    // A view from the +Z side, a little from the right (+X) and from above (+Y), the whole
+    // cube in view (the session before may have orbited).
+    Object.assign(v.camera, { yaw: 0.6, pitch: 0.3, distance: 3 });
+    const state = () => ({ drawn: viewer.drawn(), vertices: m.mesh.positions.length / 3,
+      meshTexcoords: m.mesh.texcoords ? m.mesh.texcoords.length / 2 : 0, minLevel: Math.min(...m.levels), maxLevel: Math.max(...m.levels) });
+    out.material = $('colour').value;
+    out.message = $('textures') ? $('textures').textContent : '';
+    out.base = { ...state(), pixels: chartStats(v) };
+    await screenshot('textured_base', v);
+    await within(20000, m.want({ cluster: 0, level: m.info.finestLevel }), 'textured: one cluster');
+    out.region = state();
+    await within(20000, m.want({ all: m.info.baseLevel }), 'textured: coarsened');
+    out.coarsened = state();
+    await within(20000, m.want({ all: m.info.finestLevel }), 'textured: full resolution');
+    out.full = { ...state(), pixels: chartStats(v) };
+    await screenshot('textured_full', v);
+    $('colour').value = 'plain';
+    out.plain = chartStats(v);
+    await screenshot('textured_plain', v);
+    const missing = params.get('texturedMissing');
+    if (missing) {
+      await within(20000, v.openSource(missing), 'textured model without its images');
+      await within(20000, texturesLoaded(), 'textured model without its images: its textures');
+      out.missing = { material: $('colour').value, drawn: viewer.drawn().material, message: $('textures') ? $('textures').textContent : '', pixels: chartStats(v) };
+      await screenshot('textured_missing', v);
+    }
+  } catch (e) {
+    out.exception = String(e && e.stack ? e.stack : e);
+  }
+  note('textured model', JSON.stringify(out));
+  return out;
+}
+
 /** The coloured Z-up model: drawn with its own colours by default, the colour buffer in
  *  step with the geometry through region refinement, coarsening and full resolution, grey
  *  in the plain material, the camera Z-up by itself and Y-up when asked. */
@@ -283,6 +369,7 @@ export async function run(v) {
       note(key, JSON.stringify(result.errors[key]));
     }
     if (params.get('coloured')) result.coloured = await colouredSession(v);
+    if (params.get('textured')) result.textured = await texturedSession(v);
     result.ok = true;
   } catch (e) {
     result.exception = String(e && e.stack ? e.stack : e);

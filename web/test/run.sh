@@ -11,10 +11,12 @@
 #     (web/test/real_servers.sh);
 #  4. runs the viewer in headless Chromium (web/test/browser_test.py), screenshots compared
 #     with docs/images/web_test/, a coloured Z-up model (web/test/coloured_mesh.py, encoded
-#     here) drawn with its colours and stood up on Z; then on an emulated phone with touch
-#     input (web/test/mobile_test.py).
+#     here) drawn with its colours and stood up on Z, a textured cube
+#     (web/test/textured_mesh.py: OBJ + MTL + two PNGs, encoded here) drawn with its
+#     textures; then on an emulated phone with touch input (web/test/mobile_test.py).
 # (Plus web/test/unit_test.mjs: request coalescing and the choice of levels for a view;
-# web/test/detail_test.mjs: the detail measured per cluster on a flat + bumpy grid.)
+# web/test/detail_test.mjs: the detail measured per cluster on a flat + bumpy grid;
+# web/test/texture_test.mjs: the texture coordinates and materials of the decoded meshes.)
 # Each step is skipped with a message when emscripten, Node.js or Chromium is missing.
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
@@ -33,7 +35,11 @@ mkdir -p "$samples"
 "$TOOL" encode "$REPO/samples/bunny.ply" "$samples/bunny_progressive.pomar" --progressive -q
 python3 "$REPO/web/test/coloured_mesh.py" "$samples/coloured_zup.ply"
 "$TOOL" encode "$samples/coloured_zup.ply" "$samples/coloured_zup.pomar" -q
+python3 "$REPO/web/test/textured_mesh.py" "$samples/textured"
+"$TOOL" encode "$samples/textured/textured.obj" "$samples/textured/textured.pomar" -q
 node "$REPO/web/test/unit_test.mjs"
+echo "web tests: texture coordinates and materials (node web/test/texture_test.mjs)"
+node "$REPO/web/test/texture_test.mjs" "$samples/textured/textured.pomar"
 echo "web tests: the measured detail of each cluster (node web/test/detail_test.mjs)"
 node "$REPO/web/test/detail_test.mjs" "$TOOL"
 echo "web tests: WASM decode = native decode (node web/test/wasm_decode_test.mjs)"
@@ -55,6 +61,7 @@ in_browser() {
     exit "$status"
   fi
 }
-in_browser "the viewer in headless Chromium" browser_test.py --coloured "$samples/coloured_zup.pomar"
+in_browser "the viewer in headless Chromium" browser_test.py --coloured "$samples/coloured_zup.pomar" \
+  --textured "$samples/textured"
 in_browser "the viewer on an emulated phone, touch input" mobile_test.py
 echo "web tests: passed"
