@@ -377,6 +377,7 @@ py::dict info_dict(const pomar::FileInfo &i) {
   d["attributes"] = attributes;
   d["attribute_bytes"] = i.attribute_bytes;
   d["texture_files"] = py::list(py::cast(i.texture_files));
+  d["embedded_texture_bytes"] = py::list(py::cast(i.embedded_texture_bytes));
   return d;
 }
 
