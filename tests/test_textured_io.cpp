@@ -103,7 +103,7 @@ void expect_same_textured(const Mesh &a, const Mesh &b, bool names = true) {
   ASSERT_EQ(a.triangles, b.triangles);
   const std::vector<float> ua = corner_uvs(a), ub = corner_uvs(b);
   ASSERT_EQ(ua.size(), ub.size());
-  EXPECT_EQ(std::memcmp(ua.data(), ub.data(), 4 * ua.size()), 0);
+  EXPECT_TRUE(ua.empty() || std::memcmp(ua.data(), ub.data(), 4 * ua.size()) == 0);
   ASSERT_EQ(a.face_materials.size(), b.face_materials.size());
   for (size_t f = 0; f < a.face_materials.size(); ++f) {
     if (names) {

@@ -84,7 +84,7 @@ struct EncodeArgs {
   uint32_t clusters = 0;
   double cluster_ratio = 0.01;
   bool progressive = false, quiet = false, repair = false, strict = false, keep_order = false;
-  bool embed_textures = false;
+  bool embed_textures = false, force = false;
   std::string max_memory = "auto";
   unsigned threads = 0;
   pomar::AttributeOptions attributes;
@@ -192,6 +192,40 @@ bool safe_texture_name(const std::string &name) {
   return true;
 }
 
+/// Refuse an output that is the input (the same file, also through links: it would be
+/// overwritten) and, unless `force`, a .pomar file written under a mesh file's extension.
+void check_output(const std::string &in, const std::string &out, bool pomar_output, bool force) {
+  struct stat a, b;
+  if (::stat(in.c_str(), &a) == 0 && ::stat(out.c_str(), &b) == 0 && a.st_dev == b.st_dev &&
+      a.st_ino == b.st_ino)
+    throw pomar::Error(pomar::Error::Kind::Usage,
+                       "the output " + out + " is the input " + in +
+                           ": it would be overwritten; choose another output file");
+  if (!pomar_output || force)
+    return;
+  std::string ext = out.substr(
+      std::min(out.size(), out.rfind('.') == std::string::npos ? out.size() : out.rfind('.')));
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  if (ext == ".ply" || ext == ".obj" || ext == ".off" || ext == ".stl")
+    throw pomar::Error(pomar::Error::Kind::Usage,
+                       "the output " + out +
+                           " has a mesh file's extension, but pomar encode "
+                           "writes a .pomar file, which mesh readers cannot open: name it " +
+                           out.substr(0, out.size() - ext.size()) +
+                           ".pomar (or add --force to write it under this name)");
+}
+
+/// `e` with the .pomar file's name in front of its message, if it does not name it yet.
+pomar::Error naming(const pomar::Error &e, const std::string &path) {
+  const std::string what = e.what();
+  if (what.find(path) != std::string::npos)
+    return e;
+  pomar::Error named(e.kind(), path + ": " + what);
+  named.with_path(e.path().empty() ? path : e.path()).in_block(e.level(), e.cluster());
+  return named;
+}
+
 /// --embed-textures: each texture file's bytes, read beside the input mesh.
 void embed_textures(const std::string &in, pomar::Mesh &mesh) {
   mesh.texture_images.assign(mesh.texture_files.size(), {});
@@ -267,6 +301,7 @@ const char *not_written_hint(const std::string &path) {
 }
 
 int run_encode(const EncodeArgs &a) {
+  check_output(a.in, a.out, true, a.force);
   const auto t0 = Clock::now();
   const uint64_t memory_limit = pomar::parse_memory_size(a.max_memory);
   pomar::LoadReport load;
@@ -546,6 +581,7 @@ int run_selective_decode(const DecodeArgs &a) {
 }
 
 int run_decode(const DecodeArgs &a) {
+  check_output(a.in, a.out, false, false);
   if (a.selective())
     return run_selective_decode(a);
   const uint64_t memory_limit = pomar::parse_memory_size(a.max_memory);
@@ -564,7 +600,7 @@ int run_decode(const DecodeArgs &a) {
   try {
     mesh = pomar::decode(data.data(), data.size(), options, &report);
   } catch (const pomar::Error &e) {
-    rethrow_with_hint(e);
+    rethrow_with_hint(naming(e, a.in));
   }
   const double t_decode = since(t0);
   pomar::save_mesh(a.out, mesh, !a.ascii);
@@ -1110,6 +1146,10 @@ int main(int argc, char **argv) {
                 "materials or header give) in the .pomar, so that one file is the whole asset; "
                 "decode writes them beside its output (never over an existing file). Without "
                 "it, the names are kept and resolved relative to the file");
+  enc->add_flag("--force", ea.force,
+                "Write the .pomar file even under a mesh file's extension (.ply .obj .off "
+                ".stl), which is otherwise refused (an output that is the input is always "
+                "refused)");
   enc->add_flag("-q,--quiet", ea.quiet,
                 "Print nothing on success (what --repair changed is still printed)");
   enc->add_option("--drop", ea.drop,

@@ -863,6 +863,37 @@ expect_nonzero
 expect_contains "$ERR" "texture file 'textured_sphere.png'" "encode's error"
 expect_no_file "$TEX/missing.pomar"
 
+section "no command overwrites its input; a .pomar under a mesh extension needs --force"
+mkdir -p "$WORK/guard"
+cp "$BUNNY" "$WORK/guard/b.ply"
+ln -sf b.ply "$WORK/guard/link.ply"
+before="$(cksum <"$WORK/guard/b.ply")"
+run encode "$WORK/guard/b.ply" "$WORK/guard/b.ply"
+expect_rc 2
+expect_contains "$ERR" "is the input" "encode's error"
+run encode --force "$WORK/guard/b.ply" "$WORK/guard/b.ply"
+expect_rc 2
+expect_contains "$ERR" "is the input" "encode's error"
+run encode --force "$WORK/guard/b.ply" "$WORK/guard/link.ply"
+expect_rc 2
+expect_contains "$ERR" "is the input" "encode's error"
+[ "$(cksum <"$WORK/guard/b.ply")" = "$before" ] || fail "the input was changed"
+pass
+run encode "$WORK/guard/b.ply" "$WORK/guard/out.ply"
+expect_rc 2
+expect_contains "$ERR" "mesh file's extension" "encode's error"
+expect_no_file "$WORK/guard/out.ply"
+run encode --force -q "$WORK/guard/b.ply" "$WORK/guard/out.ply"
+expect_rc 0
+expect_file "$WORK/guard/out.ply"
+run encode -q "$WORK/guard/b.ply" "$WORK/guard/b.pomar"
+expect_rc 0
+run decode "$WORK/guard/b.pomar" "$WORK/guard/b.pomar"
+expect_nonzero
+run decode "$WORK/guard/b.ply" "$WORK/guard/back.ply"
+expect_nonzero
+expect_contains "$ERR" "b.ply: not a valid .pomar file" "decode's error naming the file"
+
 help_mentions() { # help_mentions SUBCOMMAND OPTION...
   local sub="$1"; shift
   section "$sub --help"
@@ -872,7 +903,7 @@ help_mentions() { # help_mentions SUBCOMMAND OPTION...
   for opt in "$@"; do expect_contains "$OUT" "$opt" "pomar $sub --help"; done
 }
 help_mentions encode --bits --progressive --clusters --cluster-ratio --repair --strict --keep-order --quiet --max-memory 512M input output \
-  --drop --normal-bits --scalar-bits --texcoord-bits --exact-attributes --embed-textures
+  --drop --normal-bits --scalar-bits --texcoord-bits --exact-attributes --embed-textures --force
 help_mentions decode --level --cluster --sphere --box --stats --ascii --quiet --skip-damaged --max-memory input output \
   --no-attributes
 help_mentions info --json --check input
