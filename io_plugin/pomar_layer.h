@@ -81,7 +81,7 @@ inline void warn(MeshLabInterface &plugin, const char *logPrefix, const QString 
 /// The message of a failure while working on a file: the codec's message as it is when it
 /// names the file already (pomar::Error::path()), else "<context>: <message>".
 inline QString errorText(const std::exception &e, const QString &context) {
-  const QString what = QString::fromStdString(e.what());
+  const QString what = QString::fromStdString(pomar::printable(e.what())); // (file-derived text)
   const auto *error = dynamic_cast<const pomar::Error *>(&e);
   if (error != nullptr && !error->path().empty())
     return what;

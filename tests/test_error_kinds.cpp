@@ -142,3 +142,22 @@ TEST(ErrorKinds, MissingFileIsAnIoErrorNamingThePath) {
 
 } // namespace
 } // namespace pomar
+
+namespace pomar {
+namespace {
+
+TEST(Printable, EscapesWhatATerminalWouldObey) {
+  EXPECT_EQ(printable("quality"), "quality");
+  EXPECT_EQ(printable("caf\xc3\xa9 \xe2\x82\xac \xf0\x9f\x98\x80"),
+            "caf\xc3\xa9 \xe2\x82\xac \xf0\x9f\x98\x80"); // valid UTF-8 stays
+  EXPECT_EQ(printable("a\x1b[31mred\x07"), "a\\x1b[31mred\\x07");
+  EXPECT_EQ(printable("line\nbreak\ttab\x7f"), "line\\x0abreak\\x09tab\\x7f");
+  EXPECT_EQ(printable("uality\x81\x8f"), "uality\\x81\\x8f"); // stray continuation bytes
+  EXPECT_EQ(printable("\xc0\xaf"), "\\xc0\\xaf");             // overlong
+  EXPECT_EQ(printable("\xed\xa0\x80"), "\\xed\\xa0\\x80");    // a surrogate
+  EXPECT_EQ(printable("\xe2\x82"), "\\xe2\\x82");             // cut short
+  EXPECT_EQ(printable(std::string("nul\0byte", 8)), "nul\\x00byte");
+}
+
+} // namespace
+} // namespace pomar

@@ -142,17 +142,19 @@ void print_attributes(const pomar::FileInfo &i) {
     else if (a.name == "pomar:face material")
       std::printf("  face materials %.2f bits/vertex (exact)\n", bpv(a.bytes, i.vertices));
     else
-      std::printf("  attribute %-10s %-8s %.2f bits/vertex (%s)\n", a.name.c_str(),
-                  pomar::kind_name(a.kind), bpv(a.bytes, i.vertices),
+      std::printf("  attribute %-10s %-8s %.2f bits/vertex (%s)\n",
+                  pomar::printable(a.name).c_str(), pomar::kind_name(a.kind),
+                  bpv(a.bytes, i.vertices),
                   describe_precision(a.kind, a.components, a.bits, a.bound).c_str());
   }
   for (size_t t = 0; t < i.texture_files.size(); ++t) {
     const uint64_t embedded = t < i.embedded_texture_bytes.size() ? i.embedded_texture_bytes[t] : 0;
     if (embedded)
-      std::printf("  texture file %s (embedded, %llu bytes)\n", i.texture_files[t].c_str(),
+      std::printf("  texture file %s (embedded, %llu bytes)\n",
+                  pomar::printable(i.texture_files[t]).c_str(),
                   static_cast<unsigned long long>(embedded));
     else
-      std::printf("  texture file %s\n", i.texture_files[t].c_str());
+      std::printf("  texture file %s\n", pomar::printable(i.texture_files[t]).c_str());
   }
 }
 
@@ -288,7 +290,8 @@ void warn_dropped(const std::string &file, const std::vector<std::string> &what,
   std::string list;
   for (const auto &s : what)
     list += (list.empty() ? "" : ", ") + s;
-  std::fprintf(stderr, "pomar: warning: %s %s %s%s\n", file.c_str(), verb, list.c_str(), why);
+  std::fprintf(stderr, "pomar: warning: %s %s %s%s\n", file.c_str(), verb,
+               pomar::printable(list).c_str(), why);
 }
 
 /// What follows the list of what a mesh file cannot hold: where it would be kept.
@@ -746,9 +749,9 @@ int run_info(const std::string &in, bool json) {
                   i.clusters, sizes.front(), sizes[sizes.size() / 2], sizes.back());
   }
   for (const pomar::FileInfo::Section &sec : i.sections)
-    std::printf("  section %s: %lu bytes = %.2f bits/vertex%s\n", sec.name.c_str(),
-                static_cast<unsigned long>(sec.bytes), bpv(sec.bytes, i.vertices),
-                sec.required ? " (required)" : "");
+    std::printf("  section %s: %lu bytes = %.2f bits/vertex%s\n",
+                pomar::printable(sec.name).c_str(), static_cast<unsigned long>(sec.bytes),
+                bpv(sec.bytes, i.vertices), sec.required ? " (required)" : "");
   if (i.lossless_bytes)
     std::printf("  lossless record (section LSLS): a full decode gives back the input's %lu "
                 "vertices and %lu faces exactly (levels and regions show the coded, cut mesh)\n",
@@ -1276,10 +1279,10 @@ int main(int argc, char **argv) {
     if (*ver)
       return run_verify(v_orig, v_file, v_decoded, v_repair, v_drop);
   } catch (const pomar::Error &e) {
-    std::fprintf(stderr, "pomar: error: %s\n", e.what());
+    std::fprintf(stderr, "pomar: error: %s\n", pomar::printable(e.what()).c_str());
     return exit_status(e);
   } catch (const std::exception &e) {
-    std::fprintf(stderr, "pomar: error: %s\n", e.what());
+    std::fprintf(stderr, "pomar: error: %s\n", pomar::printable(e.what()).c_str());
     return kExitError;
   }
   return 0;

@@ -9,7 +9,7 @@ PyObject *error_type = nullptr; // pomar.Error, alive as long as the module
 
 void raise(const std::string &kind, const pomar::Error &e) {
   py::object type = py::reinterpret_borrow<py::object>(error_type);
-  py::object error = type(e.what());
+  py::object error = type(pomar::printable(e.what())); // (the message may quote a file)
   error.attr("kind") = kind;
   error.attr("path") = e.path().empty() ? py::object(py::none()) : py::str(e.path());
   error.attr("level") =

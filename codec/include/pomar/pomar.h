@@ -379,6 +379,12 @@ struct DecodeReport {
 /// One line per block of blocks[first..], "  cluster 17 (kept at level 16): problem" (no
 /// level for damage that could not be located), at most `max_lines` of them, then
 /// "  ... and N more"; lines joined by '\n', no trailing newline. For warnings.
+/// `text` safe to print on a terminal or in a dialog: control characters, DEL and bytes
+/// that are not valid UTF-8 become "\xNN" (valid UTF-8 stays as it is). Every message and
+/// listing of the tool, the plugins and the Python module passes text that comes from a file
+/// (names, texture file names, materials) through it.
+std::string printable(const std::string &text);
+
 std::string describe_damage(const std::vector<DamagedBlock> &blocks, size_t first = 0,
                             size_t max_lines = 10);
 
