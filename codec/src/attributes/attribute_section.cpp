@@ -42,7 +42,61 @@ template <class Out> Out described(const StoredAttribute &s) {
   return a;
 }
 
+/// The wedge texture coordinate of base vertex v (codes k0, k0 + 1 of n a vertex in
+/// `codes`) predicted by the mean of its neighbours numbered below v in the base mesh `ct`
+/// (one chart: the seam cut separates the charts), rounded half away from zero, or by
+/// vertex v - 1's if it has none (zeros for vertex 0).
+void predict_wedge_base(const CornerTable &ct, const std::vector<int64_t> &codes, uint32_t n,
+                        int k0, uint32_t v, Ring &ring, int64_t pred[2]) {
+  int64_t su = 0, sv = 0, count = 0;
+  if (ct.VC[v] != kNone) {
+    get_ring(ct, v, ring);
+    for (uint32_t u : ring.neighbour)
+      if (u < v) {
+        su += codes[size_t(u) * n + size_t(k0)];
+        sv += codes[size_t(u) * n + size_t(k0) + 1];
+        ++count;
+      }
+  }
+  if (count == 0) {
+    pred[0] = v ? codes[size_t(v - 1) * n + size_t(k0)] : 0;
+    pred[1] = v ? codes[size_t(v - 1) * n + size_t(k0) + 1] : 0;
+    return;
+  }
+  const auto mean = [count](int64_t x) { return (x >= 0 ? x + count / 2 : x - count / 2) / count; };
+  pred[0] = mean(su);
+  pred[1] = mean(sv);
+}
+
+/// The first code of the wedge texture coordinate among the table's attributes, or -1.
+int wedge_code(const AttributeTable &t) {
+  int k = 0;
+  for (const StoredAttribute &s : t.stored) {
+    if (s.kind == AttributeKind::TexCoord && s.name == kWedgeTexcoord)
+      return k;
+    k += int(s.codes());
+  }
+  return -1;
+}
+
 } // namespace
+
+void plan_wedge_residuals(AttributeTable &t, const LevelMesh &base) {
+  t.wedge_uv = wedge_code(t);
+  t.wedge_residuals.clear();
+  if (t.wedge_uv < 0 || t.codes == 0)
+    return;
+  const uint32_t n = t.codes, count = static_cast<uint32_t>(t.base.size() / n);
+  t.wedge_residuals.resize(2 * size_t(count));
+  Ring ring;
+  for (uint32_t v = 0; v < count; ++v) {
+    int64_t pred[2];
+    predict_wedge_base(base.ct, t.base, n, t.wedge_uv, v, ring, pred);
+    for (int j = 0; j < 2; ++j)
+      t.wedge_residuals[2 * size_t(v) + j] =
+          t.base[size_t(v) * n + size_t(t.wedge_uv) + j] - pred[j];
+  }
+}
 
 AttributeTable plan_attributes(const Mesh &mesh, const AttributeOptions &options) {
   AttributeTable t;
@@ -119,6 +173,25 @@ void init_attributes(const AttributeTable &table, LevelMesh &lm, const Attribute
   lm.attr_skipped = 0;
   lm.attr_codes = table.codes;
   lm.attr = table.base;
+  if (table.wedge_pending) { // the wedge residuals of a file, resolved in vertex order
+    const uint32_t n = table.codes, count = static_cast<uint32_t>(table.base.size() / n);
+    int64_t lo[2], hi[2];
+    for (size_t i = 0, k = 0; i < table.stored.size(); k += table.stored[i++].codes())
+      if (int(k) == table.wedge_uv)
+        for (uint32_t j = 0; j < 2; ++j)
+          code_range(table.stored[i], j, lo[j], hi[j]);
+    Ring ring;
+    for (uint32_t v = 0; v < count; ++v) {
+      int64_t pred[2];
+      predict_wedge_base(lm.ct, lm.attr, n, table.wedge_uv, v, ring, pred);
+      for (int j = 0; j < 2; ++j) {
+        int64_t &c = lm.attr[size_t(v) * n + size_t(table.wedge_uv) + j];
+        c += pred[j];
+        if (c < lo[j] || c > hi[j])
+          damaged("a base mesh attribute lies outside its range");
+      }
+    }
+  }
   lm.attr_lo.clear();
   lm.attr_hi.clear();
   lm.normal_code = -1;
@@ -188,10 +261,13 @@ std::vector<uint8_t> write_attributes(const AttributeTable &t, uint32_t base_ver
   RangeEncoder rc(&stream);
   std::vector<AttributeCodeModels> m = attribute_models(t);
   std::vector<int64_t> r(n);
+  const int wedge = t.wedge_residuals.empty() ? -1 : t.wedge_uv;
   code_base(
       [&](uint32_t v, uint32_t k) {
         const int64_t pred = v ? t.base[size_t(v - 1) * n + k] : 0;
-        r[k] = t.base[size_t(v) * n + k] - pred;
+        r[k] = wedge >= 0 && (int(k) == wedge || int(k) == wedge + 1)
+                   ? t.wedge_residuals[2 * size_t(v) + (k - uint32_t(wedge))]
+                   : t.base[size_t(v) * n + k] - pred;
         put_signed(rc, m[k].classes[attribute_context(m[k], r.data(), k)], m[k].top, r[k]);
       },
       count, n);
@@ -269,9 +345,19 @@ AttributeTable read_attributes(const uint8_t *data, size_t size, uint32_t base_v
   for (size_t i = 0, k = 0; i < t.stored.size(); ++i)
     for (uint32_t c = 0; c < t.stored[i].codes(); ++c, ++k)
       code_range(t.stored[i], c, lo[k], hi[k]);
+  // The wedge texture coordinate's residuals stay residuals: init_attributes predicts them
+  // from the base mesh's connectivity.
+  t.wedge_uv = wedge_code(t);
+  t.wedge_pending = t.wedge_uv >= 0;
   code_base(
       [&](uint32_t v, uint32_t k) {
         res[k] = get_signed(rc, m[k].classes[attribute_context(m[k], res.data(), k)], m[k].top);
+        if (t.wedge_pending && (int(k) == t.wedge_uv || int(k) == t.wedge_uv + 1)) {
+          if (res[k] < lo[k] - hi[k] || res[k] > hi[k] - lo[k])
+            damaged("a base mesh attribute lies outside its range");
+          t.base[size_t(v) * n + k] = res[k];
+          return;
+        }
         const int64_t pred = v ? t.base[size_t(v - 1) * n + k] : 0;
         const int64_t c = pred + res[k];
         if (c < lo[k] || c > hi[k])

@@ -36,7 +36,19 @@ struct AttributeTable {
   uint32_t codes = 0;             // integer codes per vertex (all attributes)
   std::vector<int64_t> base;      // codes of the base mesh vertices
   uint64_t base_stream_bytes = 0; // the section's coded base codes
+  /// The seam cut's wedge texture coordinate (files with a MATL section): its first code
+  /// (-1: none). Its base codes are predicted from the base mesh's connectivity
+  /// (predict_wedge_base): the encoder keeps their residuals in `wedge_residuals` (2 a
+  /// vertex); a table read from a file holds the residuals in `base` until init_attributes
+  /// resolves them (`wedge_pending`).
+  int wedge_uv = -1;
+  std::vector<int64_t> wedge_residuals;
+  bool wedge_pending = false;
 };
+
+/// The encoder's side, once `table.base` holds the base mesh's codes and `base` is the base
+/// mesh: the residuals of the wedge texture coordinates (table.wedge_residuals).
+void plan_wedge_residuals(AttributeTable &table, const LevelMesh &base);
 
 /// The encoder's side: what is kept of `mesh`'s attributes and how (empty table: nothing).
 /// Throws pomar::Error if they need more than kMaxAttributeCodes codes per vertex.

@@ -266,6 +266,7 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
     attributes.base.insert(attributes.base.end(), codes.begin() + size_t(v) * attributes.codes,
                            codes.begin() + size_t(v + 1) * attributes.codes);
   init_attributes(attributes, rb.mesh);
+  plan_wedge_residuals(attributes, rb.mesh); // (the base mesh's connectivity predicts them)
   rb.attr_codes = &codes;
   rb.attr_codes_per_vertex = attributes.codes;
   rb.attr_models = attribute_models(attributes);
