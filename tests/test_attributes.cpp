@@ -166,6 +166,7 @@ void expect_error(const Mesh &m, bool quantized, const char *fragment) {
     ADD_FAILURE() << "no error, expected one containing: " << fragment;
   } catch (const Error &e) {
     EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    EXPECT_EQ(e.kind(), Error::Kind::InvalidMesh) << e.what(); // (the tool's exit status 5)
   }
 }
 

@@ -110,8 +110,9 @@ pomar::AttributeMask parse_drop(const std::string &list) {
     else if (w == "all")
       keep = pomar::AttributeMask::none();
     else
-      throw pomar::Error("bad --drop '" + list + "': '" + w +
-                         "' is not one of colour, normals, scalars, texcoords, all");
+      throw pomar::Error(pomar::Error::Kind::Usage,
+                         "bad --drop '" + list + "': '" + w +
+                             "' is not one of colour, normals, scalars, texcoords, all");
     start = comma + 1;
   }
   return keep;

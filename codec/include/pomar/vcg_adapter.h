@@ -274,7 +274,8 @@ int put_attributes(const std::vector<VertexAttribute> &attributes,
   int written = 0;
   for (const VertexAttribute &a : attributes) {
     if (a.vertex_count() != nv)
-      throw Error("to_vcg: attribute '" + a.name + "' does not have one value per vertex");
+      throw Error(Error::Kind::InvalidMesh,
+                  "to_vcg: attribute '" + a.name + "' does not have one value per vertex");
     switch (a.kind) {
     case AttributeKind::Colour:
       if (!vcg::tri::HasPerVertexColor(m) || (written & Mask::IOM_VERTCOLOR))

@@ -44,7 +44,8 @@ double normal_error_bound(int bits) {
                                   /*12*/ 0.0415, /*13*/ 0.0207, /*14*/ 0.0104, /*15*/ 0.0052,
                                   /*16*/ 0.0026};
   if (bits < 4 || bits > 16)
-    throw Error("normal bits must be between 4 and 16 (got " + std::to_string(bits) + ")");
+    throw Error(Error::Kind::Usage,
+                "normal bits must be between 4 and 16 (got " + std::to_string(bits) + ")");
   return kBound[bits - 4];
 }
 
@@ -67,11 +68,12 @@ void validate_attributes(const Mesh &mesh, bool quantized, const AttributeMask &
       continue;
     const std::string what = std::string(kind_name(a.kind)) + " attribute '" + a.name + "'";
     if (a.name.empty() || a.name.size() > 255)
-      throw Error(std::string(kind_name(a.kind)) + " attribute " + std::to_string(i) +
-                  ": a name of 1 to 255 bytes is required");
+      throw Error(Error::Kind::InvalidMesh, std::string(kind_name(a.kind)) + " attribute " +
+                                                std::to_string(i) +
+                                                ": a name of 1 to 255 bytes is required");
     for (size_t j = 0; j < i; ++j)
       if (mesh.attributes[j].name == a.name)
-        throw Error("two attributes are named '" + a.name + "'");
+        throw Error(Error::Kind::InvalidMesh, "two attributes are named '" + a.name + "'");
     uint32_t want = 1;
     switch (a.kind) {
     case AttributeKind::Colour:
@@ -87,28 +89,33 @@ void validate_attributes(const Mesh &mesh, bool quantized, const AttributeMask &
       want = 2;
       break;
     default:
-      throw Error("attribute '" + a.name + "' has an unknown kind " + std::to_string(int(a.kind)));
+      throw Error(Error::Kind::InvalidMesh,
+                  "attribute '" + a.name + "' has an unknown kind " + std::to_string(int(a.kind)));
     }
     if (a.components != want)
-      throw Error(what + " has " + std::to_string(a.components) + " components per vertex, " +
-                  (a.kind == AttributeKind::Colour ? std::string("colour needs 3 (RGB) or 4 (RGBA)")
-                                                   : "it needs " + std::to_string(want)));
+      throw Error(Error::Kind::InvalidMesh,
+                  what + " has " + std::to_string(a.components) + " components per vertex, " +
+                      (a.kind == AttributeKind::Colour
+                           ? std::string("colour needs 3 (RGB) or 4 (RGBA)")
+                           : "it needs " + std::to_string(want)));
     const bool colour = a.kind == AttributeKind::Colour;
     const size_t have = colour ? a.colour.size() : a.values.size();
     if (have != size_t(a.components) * nv || (colour ? !a.values.empty() : !a.colour.empty()))
-      throw Error(what + " has " + std::to_string(have) + " values, the mesh has " +
-                  std::to_string(nv) + " vertices x " + std::to_string(a.components) + " = " +
-                  std::to_string(size_t(a.components) * nv) +
-                  (colour ? " (colours are 8-bit bytes in VertexAttribute::colour)"
-                          : " (floats in VertexAttribute::values)"));
+      throw Error(Error::Kind::InvalidMesh,
+                  what + " has " + std::to_string(have) + " values, the mesh has " +
+                      std::to_string(nv) + " vertices x " + std::to_string(a.components) + " = " +
+                      std::to_string(size_t(a.components) * nv) +
+                      (colour ? " (colours are 8-bit bytes in VertexAttribute::colour)"
+                              : " (floats in VertexAttribute::values)"));
     if (!quantized || colour)
       continue;
     for (size_t k = 0; k < a.values.size(); ++k)
       if (!std::isfinite(a.values[k]))
-        throw Error(what + " of vertex " + std::to_string(k / a.components) + " is " +
-                    (std::isnan(a.values[k]) ? "NaN" : "infinite") +
-                    ": quantized attributes must be finite (--exact-attributes keeps every "
-                    "float bit for bit)");
+        throw Error(Error::Kind::InvalidMesh,
+                    what + " of vertex " + std::to_string(k / a.components) + " is " +
+                        (std::isnan(a.values[k]) ? "NaN" : "infinite") +
+                        ": quantized attributes must be finite (--exact-attributes keeps every "
+                        "float bit for bit)");
   }
 }
 
@@ -244,9 +251,10 @@ StoredAttribute describe(const VertexAttribute &a, const AttributeOptions &o) {
   const int max_bits = a.kind == AttributeKind::Normal ? 16 : 24;
   const int min_bits = a.kind == AttributeKind::Normal ? 4 : 1;
   if (s.bits < min_bits || s.bits > max_bits)
-    throw Error(std::string(kind_name(a.kind)) + " bits must be between " +
-                std::to_string(min_bits) + " and " + std::to_string(max_bits) + " (got " +
-                std::to_string(s.bits) + ")");
+    throw Error(Error::Kind::Usage, std::string(kind_name(a.kind)) + " bits must be between " +
+                                        std::to_string(min_bits) + " and " +
+                                        std::to_string(max_bits) + " (got " +
+                                        std::to_string(s.bits) + ")");
   if (a.kind == AttributeKind::Normal) {
     for (size_t v = 0; v < a.vertex_count() && !s.zero_normals; ++v)
       s.zero_normals = is_zero_length(&a.values[3 * v]);

@@ -116,13 +116,14 @@ AttributeTable plan_attributes(const Mesh &mesh, const AttributeOptions &options
       t.codes += t.stored.back().codes();
     }
   if (t.stored.size() > 255)
-    throw Error("at most 255 attributes can be stored (the mesh has " +
-                std::to_string(t.stored.size()) + ")");
+    throw Error(Error::Kind::InvalidMesh, "at most 255 attributes can be stored (the mesh has " +
+                                              std::to_string(t.stored.size()) + ")");
   if (t.codes > kMaxAttributeCodes)
-    throw Error("the attributes need " + std::to_string(t.codes) + " values per vertex; at most " +
-                std::to_string(kMaxAttributeCodes) +
-                " are supported (colour 3-4, quantized normal 2, texcoord 2, scalar 1): "
-                "drop some (--drop)");
+    throw Error(Error::Kind::InvalidMesh,
+                "the attributes need " + std::to_string(t.codes) + " values per vertex; at most " +
+                    std::to_string(kMaxAttributeCodes) +
+                    " are supported (colour 3-4, quantized normal 2, texcoord 2, scalar 1): "
+                    "drop some (--drop)");
   if (options.keep.texcoords)
     t.texture_files = mesh.texture_files;
   t.estimated_bytes.assign(t.stored.size(), 0);
@@ -241,11 +242,13 @@ std::vector<uint8_t> write_attributes(const AttributeTable &t, uint32_t base_ver
     w.u32(static_cast<uint32_t>(t.estimated_bytes[i] >> 32));
   }
   if (t.texture_files.size() > 0xFFFF)
-    throw Error("too many texture files (" + std::to_string(t.texture_files.size()) + ")");
+    throw Error(Error::Kind::InvalidMesh,
+                "too many texture files (" + std::to_string(t.texture_files.size()) + ")");
   w.u16(static_cast<uint16_t>(t.texture_files.size()));
   for (const std::string &f : t.texture_files) {
     if (f.size() > 0xFFFF)
-      throw Error("texture file name too long: " + f.substr(0, 64) + "...");
+      throw Error(Error::Kind::InvalidMesh,
+                  "texture file name too long: " + f.substr(0, 64) + "...");
     w.u16(static_cast<uint16_t>(f.size()));
     w.bytes(reinterpret_cast<const uint8_t *>(f.data()), f.size());
   }
@@ -389,7 +392,7 @@ void attach_attributes(const AttributeTable &t, const LevelMesh &lm, const Attri
   // (the vertex count of `out`: `lm` may have handed its arrays over, codes excepted)
   const uint32_t nv = static_cast<uint32_t>(out.vertex_count()), n = t.codes;
   if (lm.attr_codes != n || lm.attr.size() != size_t(nv) * n)
-    throw Error("internal error: the decoded mesh lacks attribute codes");
+    throw Error(Error::Kind::Internal, "internal error: the decoded mesh lacks attribute codes");
   for (size_t i = 0, first = 0; i < t.stored.size(); first += t.stored[i].codes(), ++i) {
     const StoredAttribute &s = t.stored[i];
     if (!keeps_attribute(s.name, s.kind, mask))
