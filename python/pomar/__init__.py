@@ -38,6 +38,8 @@ class Mesh:
     face_materials: uint32 (m,), each face's index into materials, or None
     materials: list of dicts {"name": str, "texture": int (index into texture_files, -1
         for none), "properties": str (an OBJ material's other MTL lines, as read)}
+    texture_images: per texture file, its image file's bytes or None: encode() embeds
+        them (one self-contained .pomar), decode() gives them back bit for bit
     attribute_info: of a decoded mesh, one dict per attribute with "kind", "name",
         "components", "bits" (0 = exact), "exact" and "bound" (the largest error against
         the input: normals in degrees, scalars and texcoords absolute per component)
@@ -45,11 +47,11 @@ class Mesh:
 
     __slots__ = ("vertices", "faces", "damaged", "colors", "normals", "scalars", "texcoords",
                  "texture_files", "corner_texcoords", "face_materials", "materials",
-                 "attribute_info")
+                 "texture_images", "attribute_info")
 
     def __init__(self, vertices, faces, damaged=(), *, colors=None, normals=None, scalars=None,
                  texcoords=None, texture_files=(), corner_texcoords=None, face_materials=None,
-                 materials=(), attribute_info=()):
+                 materials=(), texture_images=(), attribute_info=()):
         self.vertices = vertices
         self.faces = faces
         #: blocks a decode with skip_damaged=True decoded around: dicts with "block"
@@ -63,13 +65,15 @@ class Mesh:
         self.corner_texcoords = corner_texcoords
         self.face_materials = face_materials
         self.materials = [dict(m) for m in materials]
+        self.texture_images = list(texture_images)
         self.attribute_info = list(attribute_info)
 
     def _attributes(self):
         """The attribute fields as the keyword arguments of _pomar's encode/write_mesh."""
         return {key: getattr(self, key, None)
                 for key in ("colors", "normals", "scalars", "texcoords", "texture_files",
-                            "corner_texcoords", "face_materials", "materials")}
+                            "corner_texcoords", "face_materials", "materials",
+                            "texture_images")}
 
     def __repr__(self):
         kinds = [name for name in ("colors", "normals", "texcoords", "corner_texcoords")

@@ -130,6 +130,29 @@ void add_attributes(pomar::Mesh &mesh, const py::handle &colors, const py::handl
   }
 }
 
+void add_texture_images(pomar::Mesh &mesh, const py::handle &images) {
+  if (images.is_none())
+    return;
+  if (py::isinstance<py::str>(images) || !py::isinstance<py::sequence>(images))
+    throw py::type_error("texture_images must be a list of bytes (or None), one per texture file");
+  const auto list = py::reinterpret_borrow<py::sequence>(images);
+  if (list.size() > mesh.texture_files.size())
+    throw py::value_error("texture_images has " + std::to_string(list.size()) +
+                          " entries but there are " + std::to_string(mesh.texture_files.size()) +
+                          " texture files");
+  for (const py::handle &item : list) {
+    if (item.is_none()) {
+      mesh.texture_images.emplace_back();
+      continue;
+    }
+    if (!py::isinstance<py::bytes>(item))
+      throw py::type_error("texture_images must hold bytes or None, not " +
+                           std::string(py::str(py::type::of(item))));
+    const std::string b = item.cast<std::string>();
+    mesh.texture_images.emplace_back(b.begin(), b.end());
+  }
+}
+
 void add_corner_data(pomar::Mesh &mesh, const py::handle &corner_texcoords,
                      const py::handle &face_materials, const py::handle &materials) {
   const auto m = static_cast<py::ssize_t>(mesh.triangles.size() / 3);
@@ -233,6 +256,15 @@ py::tuple arrays_from_mesh(pomar::Mesh &&mesh) {
   }
   attributes["scalars"] = scalars;
   attributes["texture_files"] = py::cast(mesh.texture_files);
+  py::list images; // per texture file: its embedded image (bytes) or None
+  for (size_t t = 0; t < mesh.texture_files.size(); ++t) {
+    if (t < mesh.texture_images.size() && !mesh.texture_images[t].empty())
+      images.append(py::bytes(reinterpret_cast<const char *>(mesh.texture_images[t].data()),
+                              mesh.texture_images[t].size()));
+    else
+      images.append(py::none());
+  }
+  attributes["texture_images"] = images;
   if (!mesh.corner_texcoords.empty()) {
     py::dict entry;
     entry["kind"] = "corner texcoord";

@@ -46,6 +46,8 @@ void add_attributes(pomar::Mesh &mesh, const py::handle &colors, const py::handl
 /// dicts {"name": str, "texture": int (index into texture_files, -1 for none),
 /// "properties": str} ("texture" and "properties" optional). TypeError/ValueError (naming
 /// the argument) for a wrong type, dtype or shape.
+/// Embedded texture images (a list of bytes or None, one per texture file) into mesh.
+void add_texture_images(pomar::Mesh &mesh, const py::handle &images);
 void add_corner_data(pomar::Mesh &mesh, const py::handle &corner_texcoords,
                      const py::handle &face_materials, const py::handle &materials);
 

@@ -33,6 +33,7 @@ pomar::Mesh mesh_with_attributes(const py::handle &vertices, const py::handle &f
   add_attributes(mesh, field("colors"), field("normals"), field("scalars"), field("texcoords"),
                  field("texture_files"));
   add_corner_data(mesh, field("corner_texcoords"), field("face_materials"), field("materials"));
+  add_texture_images(mesh, field("texture_images"));
   return mesh;
 }
 

@@ -816,6 +816,23 @@ def test_textured_mesh_through_the_codec(tmp_path):
                 assert np.abs(uv - b[key][0]).max() <= bound
 
 
+def test_embedded_texture_images_come_back_bit_for_bit():
+    mesh = textured_torus()
+    png = bytes([0x89]) + b"PNG\r\n\x1a\n" + bytes(range(256))
+    mesh.texture_images = [png]
+    back = pomar.decode(pomar.encode(mesh))
+    assert back.texture_images == [png]
+    assert pomar.info(pomar.encode(mesh))["embedded_texture_bytes"] == [len(png)]
+    mesh.texture_images = [None]
+    assert pomar.decode(pomar.encode(mesh)).texture_images == [None]
+    mesh.texture_images = ["not bytes"]
+    with pytest.raises(TypeError):
+        pomar.encode(mesh)
+    mesh.texture_images = [png, png]  # more images than texture files
+    with pytest.raises(ValueError):
+        pomar.encode(mesh)
+
+
 @pytest.mark.skipif("POMAR_TOOL" not in os.environ, reason="needs the pomar tool")
 def test_tool_encodes_and_verifies_a_textured_obj(tmp_path):
     obj, file = str(tmp_path / "t.obj"), str(tmp_path / "t.pomar")
