@@ -302,3 +302,35 @@ mlgui_check_quadrants() {
       exit bad
     }'
 }
+
+# mlgui_gui_test NAME WORKDIR_PREFIX PLUGIN.so POMAR_CLI WORK_DIR [MESHLAB_LIBDIR]: the set-up of
+# a GUI test (tests/io_plugin/gui_*_test.sh): the arguments checked, PLUGIN, POMAR_CLI and
+# OUT_DIR set, the repository as the current folder, a private MeshLab tree with PLUGIN, and
+# exit 77 (ctest SKIP_RETURN_CODE) when Xvfb, xdotool, xwininfo, ImageMagick, meshlab or
+# MeshLab's library is missing.
+mlgui_gui_test() {
+  local name="$1" prefix="$2"
+  shift 2
+  if [ $# -lt 3 ] || [ $# -gt 4 ]; then
+    echo "usage: $0 PLUGIN.so POMAR_CLI WORK_DIR [MESHLAB_LIBDIR]" >&2
+    exit 2
+  fi
+  PLUGIN="$(abspath "$1")"
+  POMAR_CLI="$(abspath "$2")"
+  mkdir -p "$3"
+  OUT_DIR="$(cd "$3" && pwd)"
+  mlgui_init "$name" # (cd's to the repository)
+  SYS_MLLIB="${4:-$SYS_MLLIB}"
+  USE_INSTALLED=0 # the private tree (mlgui_pick_meshlab)
+  TIMEOUT=30      # seconds for each wait (X server, dialog, load)
+  local tool
+  for tool in Xvfb:xvfb xdotool:xdotool xwininfo:x11-utils import:imagemagick convert:imagemagick; do
+    skip_without "${tool%%:*}" "${tool%%:*} is not installed (package ${tool#*:})"
+  done
+  [ -x /usr/bin/meshlab ] || skip "/usr/bin/meshlab is not installed (package meshlab)"
+  skip_without_meshlab_lib "$SYS_MLLIB"
+  [ -f "$PLUGIN" ] || die "plugin not found: $PLUGIN"
+  [ -x "$POMAR_CLI" ] || die "pomar executable not found: $POMAR_CLI"
+  mlgui_make_workdir "$prefix"
+  mlgui_pick_meshlab "$PLUGIN"
+}

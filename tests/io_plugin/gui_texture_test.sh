@@ -24,33 +24,10 @@
 # MeshLab's library is missing; 1 with a message when a check fails. About 10 s.
 set -euo pipefail
 
-if [ $# -lt 3 ] || [ $# -gt 4 ]; then
-  echo "usage: $0 PLUGIN.so POMAR_CLI WORK_DIR [MESHLAB_LIBDIR]" >&2
-  exit 2
-fi
-
 # shellcheck source-path=SCRIPTDIR source=../../scripts/lib/meshlab_gui.sh
 . "$(dirname "${BASH_SOURCE[0]}")/../../scripts/lib/meshlab_gui.sh"
-PLUGIN="$(abspath "$1")"
-POMAR_CLI="$(abspath "$2")"
-mkdir -p "$3"
-OUT_DIR="$(cd "$3" && pwd)"
-mlgui_init gui_texture_test # (cd's to the repository)
-SYS_MLLIB="${4:-$SYS_MLLIB}"
-USE_INSTALLED=0   # the private tree (mlgui_pick_meshlab)
-TIMEOUT=30        # seconds for each wait (X server, dialog, load)
+mlgui_gui_test gui_texture_test pomar-gui-texture "$@"
 MIN_SHARE_PERCENT=5
-
-for tool in Xvfb:xvfb xdotool:xdotool xwininfo:x11-utils import:imagemagick convert:imagemagick; do
-  skip_without "${tool%%:*}" "${tool%%:*} is not installed (package ${tool#*:})"
-done
-[ -x /usr/bin/meshlab ] || skip "/usr/bin/meshlab is not installed (package meshlab)"
-skip_without_meshlab_lib "$SYS_MLLIB"
-[ -f "$PLUGIN" ] || die "plugin not found: $PLUGIN"
-[ -x "$POMAR_CLI" ] || die "pomar executable not found: $POMAR_CLI"
-
-mlgui_make_workdir pomar-gui-texture
-mlgui_pick_meshlab "$PLUGIN"
 
 # ---- the textured mesh ------------------------------------------------------------------------
 # The texture, 128 x 128: top row green | red, bottom row yellow | blue.
