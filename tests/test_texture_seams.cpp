@@ -6,10 +6,13 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <map>
 #include <random>
 #include <set>
 
+#include "attributes/material_section.h"
+#include "format/file_format.h"
 #include "pomar/mesh_io.h"
 #include "pomar/pomar.h"
 #include "pomar/random_access.h"
@@ -250,6 +253,29 @@ TEST(TextureSeams, EmbeddedImagesComeBackBitForBit) {
   too_many.texture_images.resize(3);
   too_many.texture_images[2] = {1};
   EXPECT_THROW(encode(too_many, EncodeOptions()), Error);
+}
+
+TEST(TextureSeams, CheckBlocksReadsTheSections) {
+  const Mesh m = cube_mapped(gen::noisy_sphere(600, 3, 0.05));
+  const std::vector<uint8_t> file = encode(m, EncodeOptions());
+  EXPECT_TRUE(check_blocks(file.data(), file.size()).empty());
+  // A MATL section whose material names a texture the file does not have (checksums right):
+  // check_blocks refuses it as a decode does, instead of calling the file whole.
+  MaterialTable bad;
+  bad.corner_texcoords = bad.face_materials = true;
+  bad.materials = {{"front", 0, ""}, {"back", 7, ""}};
+  const std::vector<uint8_t> hurt = with_sections(
+      file.data(), file.size(), {{kMaterialSectionTag, kSectionRequired, write_materials(bad)}});
+  for (const auto &run : {std::function<void()>([&] { check_blocks(hurt.data(), hurt.size()); }),
+                          std::function<void()>([&] { decode(hurt.data(), hurt.size()); })}) {
+    try {
+      run();
+      ADD_FAILURE() << "the damaged MATL section was not refused";
+    } catch (const Error &e) {
+      EXPECT_EQ(e.kind(), Error::Kind::DamagedFile) << e.what();
+      EXPECT_NE(std::string(e.what()).find("MATL section"), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(TextureSeams, BadCornerValuesAreNamed) {

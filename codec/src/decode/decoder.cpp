@@ -102,6 +102,20 @@ std::vector<DamagedBlock> check_blocks(const uint8_t *data, size_t size) {
   const FileLayout layout = read_layout(data, size, size, true);
   const FileHeader &h = layout.header;
   read_base_mesh(data, layout, false);
+  // The sections lie in the global part, which every decode needs: each is read as a decode
+  // reads it (the base mesh's attribute codes resolved on the base mesh), so that a file
+  // said to be whole decodes; a failure throws, as for the base mesh.
+  if (const auto attributes = load_attribute_table(data, layout)) {
+    const size_t textures = attributes->texture_files.size();
+    load_material_table(data, layout, textures);
+    texture_image_sizes(data, layout, textures);
+    LevelMesh lm = base_level_mesh(data, layout);
+    init_attributes(*attributes, lm);
+  }
+  {
+    FileInfo counts;
+    lossless_info(data, layout, counts);
+  }
   std::vector<DamagedBlock> damaged;
   const size_t global = h.clustered() ? h.global_levels : h.levels.size();
   for (size_t i = 0; i < global; ++i) {
