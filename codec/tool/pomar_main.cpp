@@ -159,6 +159,17 @@ void print_attributes(const pomar::FileInfo &i) {
   }
 }
 
+/// The extension of `path` in lower case (".ply"), "" if it has none.
+std::string lower_extension(const std::string &path) {
+  const size_t dot = path.rfind('.'), slash = path.rfind('/');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash))
+    return "";
+  std::string ext = path.substr(dot);
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
+
 /// The folder of `path` ("" for the current one), with a trailing '/'.
 std::string folder_of(const std::string &path) {
   const size_t slash = path.rfind('/');
@@ -206,10 +217,7 @@ void check_output(const std::string &in, const std::string &out, bool pomar_outp
                            ": it would be overwritten; choose another output file");
   if (!pomar_output || force)
     return;
-  std::string ext = out.substr(
-      std::min(out.size(), out.rfind('.') == std::string::npos ? out.size() : out.rfind('.')));
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return std::tolower(c); });
+  const std::string ext = lower_extension(out);
   if (ext == ".ply" || ext == ".obj" || ext == ".off" || ext == ".stl")
     throw pomar::Error(pomar::Error::Kind::Usage,
                        "the output " + out +
@@ -297,11 +305,8 @@ void warn_dropped(const std::string &file, const std::vector<std::string> &what,
 
 /// What follows the list of what a mesh file cannot hold: where it would be kept.
 const char *not_written_hint(const std::string &path) {
-  std::string ext = path.size() >= 4 ? path.substr(path.size() - 4) : "";
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return std::tolower(c); });
-  return ext == ".ply" ? ": not written (.obj keeps them)"
-                       : ": not written (.ply keeps every attribute)";
+  return lower_extension(path) == ".ply" ? ": not written (.obj keeps them)"
+                                         : ": not written (.ply keeps every attribute)";
 }
 
 int run_encode(const EncodeArgs &a) {

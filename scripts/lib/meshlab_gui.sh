@@ -334,3 +334,23 @@ mlgui_gui_test() {
   mlgui_make_workdir "$prefix"
   mlgui_pick_meshlab "$PLUGIN"
 }
+
+# mlgui_gui_session FILE: one GUI session of a GUI test (after mlgui_gui_test): MeshLab opens
+# FILE at full resolution under Xvfb, the main window is captured to $OUT_DIR/shot.png
+# (SHOT) and MeshLab's log copied to $OUT_DIR/meshlab.log; `viewer` is the 3D viewer's
+# geometry in the capture ("W H X Y").
+mlgui_gui_session() {
+  mlgui_start_xvfb
+  mlgui_open_full "$1" "$WORK/meshlab.log"
+  sleep "$RENDER_WAIT"
+  local mid
+  mid="$(xdotool search --name '^MeshLab [0-9]' 2>/dev/null | head -n1 || true)"
+  [ -n "$mid" ] || fail_log "MeshLab main window not found"
+  viewer="$(mlgui_viewer "$mid")"
+  SHOT="$OUT_DIR/shot.png"
+  mlgui_capture "$mid" "$SHOT" ""
+  cp "$ERRLOG" "$OUT_DIR/meshlab.log"
+  mlgui_stop_meshlab
+  [ -n "$viewer" ] || die "cannot find MeshLab's viewer inside the main window (xwininfo -tree)"
+  log "viewer $viewer (W H X Y) in $SHOT"
+}

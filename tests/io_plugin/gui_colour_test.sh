@@ -56,18 +56,7 @@ awk -v n="$N" 'BEGIN {
   die "pomar encode failed"
 
 # ---- one GUI session --------------------------------------------------------------------------
-mlgui_start_xvfb
-mlgui_open_full "$DATA/quadrants.pomar" "$WORK/meshlab.log"
-sleep "$RENDER_WAIT"
-mid="$(xdotool search --name '^MeshLab [0-9]' 2>/dev/null | head -n1 || true)"
-[ -n "$mid" ] || fail_log "MeshLab main window not found"
-viewer="$(mlgui_viewer "$mid")"
-SHOT="$OUT_DIR/shot.png"
-mlgui_capture "$mid" "$SHOT" ""
-cp "$ERRLOG" "$OUT_DIR/meshlab.log"
-mlgui_stop_meshlab
-[ -n "$viewer" ] || die "cannot find MeshLab's viewer inside the main window (xwininfo -tree)"
-log "viewer $viewer (W H X Y) in $SHOT"
+mlgui_gui_session "$DATA/quadrants.pomar" # (sets viewer and SHOT)
 
 # ---- the check (mlgui_check_quadrants) ----------------------------------------------------------
 mlgui_check_quadrants "$SHOT" "$viewer" "$MIN_SHARE_PERCENT" ||

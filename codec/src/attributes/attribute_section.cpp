@@ -82,7 +82,6 @@ int wedge_code(const AttributeTable &t) {
 } // namespace
 
 void plan_wedge_residuals(AttributeTable &t, const LevelMesh &base) {
-  t.wedge_uv = wedge_code(t);
   t.wedge_residuals.clear();
   if (t.wedge_uv < 0 || t.codes == 0)
     return;
@@ -127,6 +126,7 @@ AttributeTable plan_attributes(const Mesh &mesh, const AttributeOptions &options
   if (options.keep.texcoords)
     t.texture_files = mesh.texture_files;
   t.estimated_bytes.assign(t.stored.size(), 0);
+  t.wedge_uv = wedge_code(t);
   return t;
 }
 
@@ -174,33 +174,12 @@ void init_attributes(const AttributeTable &table, LevelMesh &lm, const Attribute
   lm.attr_skipped = 0;
   lm.attr_codes = table.codes;
   lm.attr = table.base;
-  if (table.wedge_pending) { // the wedge residuals of a file, resolved in vertex order
-    const uint32_t n = table.codes, count = static_cast<uint32_t>(table.base.size() / n);
-    int64_t lo[2], hi[2];
-    for (size_t i = 0, k = 0; i < table.stored.size(); k += table.stored[i++].codes())
-      if (int(k) == table.wedge_uv)
-        for (uint32_t j = 0; j < 2; ++j)
-          code_range(table.stored[i], j, lo[j], hi[j]);
-    Ring ring;
-    for (uint32_t v = 0; v < count; ++v) {
-      int64_t pred[2];
-      predict_wedge_base(lm.ct, lm.attr, n, table.wedge_uv, v, ring, pred);
-      for (int j = 0; j < 2; ++j) {
-        int64_t &c = lm.attr[size_t(v) * n + size_t(table.wedge_uv) + j];
-        c += pred[j];
-        if (c < lo[j] || c > hi[j])
-          damaged("a base mesh attribute lies outside its range");
-      }
-    }
-  }
   lm.attr_lo.clear();
   lm.attr_hi.clear();
   lm.normal_code = -1;
-  lm.wedge_uv_code = -1;
+  lm.wedge_uv_code = table.wedge_uv;
   lm.normal_zero = false;
   for (const StoredAttribute &s : table.stored) {
-    if (s.kind == AttributeKind::TexCoord && s.name == kWedgeTexcoord && lm.wedge_uv_code < 0)
-      lm.wedge_uv_code = static_cast<int>(lm.attr_lo.size());
     if (s.kind == AttributeKind::Normal && s.bits && lm.normal_code < 0) {
       lm.normal_code = static_cast<int>(lm.attr_lo.size());
       lm.normal_bits = s.bits;
@@ -211,6 +190,21 @@ void init_attributes(const AttributeTable &table, LevelMesh &lm, const Attribute
       code_range(s, k, lo, hi);
       lm.attr_lo.push_back(lo);
       lm.attr_hi.push_back(hi);
+    }
+  }
+  if (table.wedge_pending) { // the wedge residuals of a file, resolved in vertex order
+    const uint32_t n = table.codes, count = static_cast<uint32_t>(table.base.size() / n);
+    const size_t k0 = size_t(table.wedge_uv);
+    Ring ring;
+    for (uint32_t v = 0; v < count; ++v) {
+      int64_t pred[2];
+      predict_wedge_base(lm.ct, lm.attr, n, table.wedge_uv, v, ring, pred);
+      for (size_t j = 0; j < 2; ++j) {
+        int64_t &c = lm.attr[size_t(v) * n + k0 + j];
+        c += pred[j];
+        if (c < lm.attr_lo[k0 + j] || c > lm.attr_hi[k0 + j])
+          damaged("a base mesh attribute lies outside its range");
+      }
     }
   }
 }

@@ -3,6 +3,7 @@
 
 #include <string>
 
+#include "attributes/attribute_section.h"
 #include "format/bit_io.h"
 
 namespace pomar {
@@ -93,6 +94,12 @@ std::vector<std::vector<uint8_t>> load_texture_images(const uint8_t *data, const
   walk(p, size, textures,
        [&](uint32_t t, size_t at, uint32_t bytes) { images[t].assign(p + at, p + at + bytes); });
   return images;
+}
+
+void attach_texture_images(const uint8_t *data, const FileLayout &layout,
+                           const AttributeTable *attributes, const AttributeMask &mask, Mesh &out) {
+  if (attributes && mask.texcoords)
+    out.texture_images = load_texture_images(data, layout, attributes->texture_files.size());
 }
 
 std::vector<uint64_t> texture_image_sizes(const uint8_t *data, const FileLayout &layout,

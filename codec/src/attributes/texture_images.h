@@ -10,6 +10,8 @@
 
 namespace pomar {
 
+struct AttributeTable;
+
 constexpr uint32_t kTextureImagesTag = section_tag("TEXI"); // optional (flags 0)
 constexpr uint8_t kTextureImagesVersion = 1;
 
@@ -25,5 +27,10 @@ std::vector<std::vector<uint8_t>> load_texture_images(const uint8_t *data, const
 /// Per texture file, its image's size (0: not embedded), from the section (for inspect()).
 std::vector<uint64_t> texture_image_sizes(const uint8_t *data, const FileLayout &layout,
                                           size_t textures);
+
+/// A decode's last attribute step: `out` gets the file's embedded images when the file has
+/// attributes (`attributes`, nullptr: none) and `mask` keeps texture coordinates.
+void attach_texture_images(const uint8_t *data, const FileLayout &layout,
+                           const AttributeTable *attributes, const AttributeMask &mask, Mesh &out);
 
 } // namespace pomar

@@ -234,8 +234,7 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
     Mesh mesh = d.take_mesh(); // (no second copy of the mesh)
     if (complete)
       undo_cut_or_report(data, layout, options, r, mesh); // the full mesh: as it was input
-    if (attributes && options.attributes.texcoords)
-      mesh.texture_images = load_texture_images(data, layout, attributes->texture_files.size());
+    attach_texture_images(data, layout, attributes.get(), options.attributes, mesh);
     return mesh;
   }
   LevelMesh lm = base_level_mesh(data, layout);
@@ -256,8 +255,7 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
     attach_attributes(*attributes, lm, options.attributes, mesh);
   if (materials)
     attach_materials(*materials, options.attributes, mesh);
-  if (attributes && options.attributes.texcoords)
-    mesh.texture_images = load_texture_images(data, layout, attributes->texture_files.size());
+  attach_texture_images(data, layout, attributes.get(), options.attributes, mesh);
   if (r.level == static_cast<int>(levels))
     undo_cut_or_report(data, layout, options, r, mesh); // the full mesh: as it was input
   return mesh;

@@ -681,9 +681,8 @@ bool SelectiveDecoder::complete() const {
 
 Mesh SelectiveDecoder::exact_mesh(std::vector<uint32_t> *source) const {
   Mesh m = mesh();
-  if (s_->attributes && s_->attribute_mask.texcoords) // embedded images (TEXI), if any
-    m.texture_images =
-        load_texture_images(s_->global.data(), s_->layout, s_->attributes->texture_files.size());
+  attach_texture_images(s_->global.data(), s_->layout, s_->attributes.get(), s_->attribute_mask,
+                        m); // (the embedded images, TEXI)
   if (complete()) {
     undo_cut(s_->global.data(), s_->layout, m, source); // the record lies in the global part
   } else if (source) {
