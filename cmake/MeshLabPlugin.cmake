@@ -42,16 +42,15 @@ function(pomar_find_meshlab)
     Qt5::Core Qt5::Gui Qt5::Widgets Qt5::OpenGL Qt5::Xml Eigen3::Eigen)
 endfunction()
 
-# A plugin module linking pomar_core only. Its .cpp includes its own moc file (one heavy
-# translation unit); installed into MeshLab's plugin directory under the install prefix
+# A plugin module linking pomar_core only; what it does besides MeshLab's glue is in the
+# plugins' boundary headers codec/include/pomar/meshlab_*.h (found through pomar_core). Its .cpp
+# includes its own moc file (one heavy translation unit); installed into MeshLab's plugin directory under the install prefix
 # (/usr: Debian's MeshLab finds it).
 function(pomar_add_meshlab_plugin target)
   find_package(Qt5 5.15 REQUIRED COMPONENTS Core) # AUTOMOC needs Qt in this scope
   add_library(${target} MODULE ${ARGN})
   set_target_properties(${target} PROPERTIES AUTOMOC ON)
   target_link_libraries(${target} PRIVATE pomar_core pomar_meshlab_common)
-  # io_plugin/pomar_layer.h: what both plugins agree on about a .pomar layer.
-  target_include_directories(${target} PRIVATE "${PROJECT_SOURCE_DIR}/io_plugin")
   target_compile_options(${target} PRIVATE -Wall -Wextra)
   # Fail at link time on a missing symbol; keep pomar_core's symbols out of the dynamic table.
   target_link_options(${target} PRIVATE -Wl,--no-undefined -Wl,--exclude-libs,ALL)

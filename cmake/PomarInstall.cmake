@@ -8,9 +8,10 @@ include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
 set(POMAR_CMAKE_DIR "${CMAKE_INSTALL_LIBDIR}/cmake/pomar")
-# Every header of codec/include/pomar is public (internals live in codec/src).
+# Every header of codec/include/pomar is public (internals live in codec/src), except the
+# MeshLab plugins' boundary headers meshlab_*.h, which need MeshLab's headers of this build.
 install(DIRECTORY "${PROJECT_SOURCE_DIR}/codec/include/pomar" DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}"
-        COMPONENT library FILES_MATCHING PATTERN "*.h")
+        COMPONENT library FILES_MATCHING PATTERN "*.h" PATTERN "meshlab_*.h" EXCLUDE)
 
 # Shared libraries: libpomar_core.so.0.1 -> libpomar_core.so.0.1.0. Before 1.0 a minor
 # version may change the ABI, so the SONAME carries MAJOR.MINOR.

@@ -1,6 +1,7 @@
 // MeshLab 2020.09 IO plugin for .pomar files (libio_pomar.so).
 //
-// A thin wrapper over the pomar library (pomar_core + pomar/vcg_adapter.h):
+// A thin wrapper over the pomar library (pomar_core + pomar/meshlab_io.h, which holds what
+// open and save do):
 //   open():  full resolution by default (what meshlabserver always uses), or, from the
 //            "Pre-Open Options" dialog, the base clustered mesh or a global level N.
 //            Adds the per-vertex float attributes "pomar_cluster" (-1 in a pure progressive
@@ -24,9 +25,6 @@ class PomarIOPlugin : public QObject, public MeshIOInterface {
   Q_INTERFACES(MeshIOInterface)
 
 public:
-  /// Values of the "OpenAt" pre-open parameter.
-  enum OpenAt { OPEN_FULL = 0, OPEN_BASE_CLUSTERED = 1, OPEN_GLOBAL_LEVEL = 2 };
-
   QString pluginName() const override;
 
   QList<Format> importFormats() const override;

@@ -1,8 +1,9 @@
 // MeshLab 2020.09 filter plugin for layers opened from .pomar files (libfilter_pomar.so).
 //
-// A thin wrapper over pomar::SelectiveDecoder (pomar/random_access.h). It works on a layer
-// that libio_pomar.so opened: that plugin stores, per vertex, the float attributes
-// "pomar_cluster" and "pomar_level" and, per mesh, the std::string attribute
+// A thin wrapper over pomar::SelectiveDecoder (pomar/random_access.h); what the filters do is
+// in pomar/meshlab_filters.h, the decoders kept between calls in pomar/meshlab_session.h. It
+// works on a layer that libio_pomar.so opened: that plugin stores, per vertex, the float
+// attributes "pomar_cluster" and "pomar_level" and, per mesh, the std::string attribute
 // "pomar_source" (the absolute path of the file). Filters (the names are stable; scripts
 // use them):
 //
@@ -14,6 +15,7 @@
 //   "POMAR: Show Clusters"              per-vertex colour per cluster (hash palette).
 //   "POMAR: Show Levels"                per-vertex colour of the level map, blue (coarse)
 //                                       to red (fine).
+//   "POMAR: Show Original Colours"      the colours the layer had before the Show filters.
 //
 // The plugin keeps one decoder per source file. When the layer is still what that decoder
 // produced last (same vertex and face counts and the same positions and triangles), a
@@ -25,10 +27,7 @@
 
 #include <common/interfaces.h>
 
-#include <cstdint>
-#include <map>
-#include <memory>
-#include <string>
+#include <pomar/meshlab_session.h>
 
 class PomarFilterPlugin : public QObject, public MeshFilterInterface {
   Q_OBJECT
@@ -64,22 +63,15 @@ public:
   bool applyFilter(QAction *a, MeshDocument &md, const RichParameterList &par,
                    vcg::CallBackPos *cb) override;
 
-  /// One decoder per .pomar file (defined in the .cpp).
-  struct Session;
-
 private:
-  /// The session of `path`, created (or re-created when the file changed on disk) if
-  /// needed; nullptr with `error` set when the file cannot be read.
-  Session *session(const std::string &path, bool skipDamaged, QString &error);
-  void warnAboutNewDamage(Session &s);
-  bool refineOrCoarsen(bool refine, MeshModel &mm, Session &s, int level, vcg::CallBackPos *cb);
-  bool setLevel(MeshModel &mm, Session &s, int level, vcg::CallBackPos *cb);
-  bool showClusters(MeshModel &mm);
-  bool showLevels(MeshModel &mm, Session *s);
-  bool showOriginalColours(MeshModel &mm);
+  /// A filter that decodes (refine, coarsen, set level, show levels) on the layer `mm` from
+  /// `path`.
+  bool applyWithDecoder(int id, MeshModel &mm, const std::string &path,
+                        const RichParameterList &par, vcg::CallBackPos *cb);
   /// errorMessage = text, also logged (meshlabserver prints the log, not errorMessage).
   bool fail(const QString &text);
+  /// true if `refusal` is empty (the filter was done), else fail(refusal).
+  bool finish(const QString &refusal);
 
-  std::map<std::string, std::unique_ptr<Session>> sessions_;
-  uint64_t clock_ = 0; ///< for evicting the least recently used session
+  pomar::meshlab::Sessions sessions_; ///< one decoder per .pomar file
 };

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "pomar_layer.h" // io_plugin/: the attribute names
+#include <pomar/meshlab_layer.h> // the attribute names
 
 namespace pomar::test {
 

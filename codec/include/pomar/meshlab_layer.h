@@ -1,13 +1,20 @@
-// What the two MeshLab plugins share about a layer opened from a .pomar file: the names of
-// the attributes the IO plugin writes and the filter plugin reads (and writing them), the
-// relay of the codec's progress to MeshLab's callback, warnings, and error messages.
+// A MeshLab layer opened from a .pomar file: what the IO plugin (io_plugin/) and the filter
+// plugin (meshlab_plugin/) agree on about it. The names of the attributes the IO plugin
+// writes and the filters read, filling a layer from a decoded mesh, the layer's own colours
+// while a Show filter paints it, the relay of the codec's progress to MeshLab's callback,
+// warnings, and error messages.
+//
+// Part of the plugins' boundary layer (pomar/meshlab_*.h): compiled only against MeshLab
+// 2020.09's headers (MESHLAB_SCALAR=float, cmake/MeshLabPlugin.cmake) and not installed with
+// the library.
 #pragma once
 
 #include <pomar/pomar.h>
+#include <pomar/vcg_adapter.h>
 
 #include <common/interfaces.h>
+#include <common/meshmodel.h>
 #include <vcg/complex/allocate.h>
-#include <common/ml_mesh_type.h>
 #include <vcg/complex/complex.h>
 
 #include <QString>
@@ -18,8 +25,8 @@
 #include <cstdint>
 #include <exception>
 #include <string>
-#include <vector>
 #include <utility>
+#include <vector>
 
 namespace pomar::meshlab {
 
@@ -42,6 +49,8 @@ inline bool isPomarAttribute(const std::string &name) {
   return false;
 }
 
+// ---------------------------------------------------------------- the layer's attributes
+
 /// Writes the attributes of a layer decoded from `source`: per vertex its cluster and the
 /// level that created it (-1 where unknown: `cluster` / `level` not one per vertex, as for a
 /// pure progressive file's clusters), per mesh the source file and the damage policy.
@@ -62,6 +71,23 @@ void setLayerAttributes(MeshType &m, const std::vector<uint32_t> &cluster,
   Alloc::template GetPerMeshAttribute<int>(m, kSkipDamagedAttribute)() = skipDamaged ? 1 : 0;
 }
 
+/// The layer's source file (the per-mesh pomar_source attribute); false if it has none.
+inline bool sourceOf(CMeshO &m, std::string &path) {
+  auto h = vcg::tri::Allocator<CMeshO>::FindPerMeshAttribute<std::string>(m, kSourceAttribute);
+  if (!vcg::tri::Allocator<CMeshO>::IsValidHandle(m, h) || h().empty())
+    return false;
+  path = h();
+  return true;
+}
+
+/// Whether the layer was opened with "Skip damaged blocks".
+inline bool skipsDamage(CMeshO &m) {
+  auto h = vcg::tri::Allocator<CMeshO>::FindPerMeshAttribute<int>(m, kSkipDamagedAttribute);
+  return vcg::tri::Allocator<CMeshO>::IsValidHandle(m, h) && h() != 0;
+}
+
+// ---------------------------------------------------------------- filling a layer
+
 /// Enables the optional CMeshO data that pomar::to_vcg fills from `mesh` (per-vertex and
 /// per-wedge texture coordinates): to_vcg writes only where the mesh has room.
 inline void enableRoomFor(const pomar::Mesh &mesh, MeshModel &mm) {
@@ -70,6 +96,52 @@ inline void enableRoomFor(const pomar::Mesh &mesh, MeshModel &mm) {
   if (!mesh.corner_texcoords.empty())
     mm.updateDataMask(MeshModel::MM_WEDGTEXCOORD);
 }
+
+/// Replaces the layer's content by `mesh` with the pomar attributes (setLayerAttributes):
+/// m.Clear() and m.ClearAttributes() (pomar::to_vcg), the vertices and faces with the decoded
+/// attributes (colour, normals, quality, texture coordinates, named floats, each corner's
+/// texture coordinates in its wedge with the face's texture). What was written enters the
+/// layer's data mask as well (MeshModel::Enable): the GUI picks the rendering (vertex colour,
+/// wedge texture, ...) from that mask. Returns to_vcg's mask of what was written.
+inline int fillLayer(MeshModel &mm, const pomar::Mesh &mesh, const std::vector<uint32_t> &cluster,
+                     const std::vector<uint32_t> &level, const std::string &source,
+                     bool skipDamaged) {
+  enableRoomFor(mesh, mm);
+  const int written = pomar::to_vcg(mesh, mm.cm);
+  mm.Enable(written);
+  setLayerAttributes(mm.cm, cluster, level, source, skipDamaged);
+  return written;
+}
+
+// ---------------------------------------------------------------- the layer's own colours
+
+/// The layer's own colours saved by Show Clusters / Show Levels (invalid handle if none).
+inline CMeshO::PerVertexAttributeHandle<vcg::Color4b> savedColours(CMeshO &m) {
+  return vcg::tri::Allocator<CMeshO>::FindPerVertexAttribute<vcg::Color4b>(m,
+                                                                           kSavedColourAttribute);
+}
+
+/// Before Show Clusters / Show Levels paint the vertices: keep the layer's own colours aside
+/// (once: painting twice keeps the first, the user's).
+inline void keepOwnColours(CMeshO &m) {
+  if (vcg::tri::Allocator<CMeshO>::IsValidHandle(m, savedColours(m)))
+    return;
+  auto saved =
+      vcg::tri::Allocator<CMeshO>::AddPerVertexAttribute<vcg::Color4b>(m, kSavedColourAttribute);
+  for (size_t v = 0; v < m.vert.size(); ++v)
+    saved[v] = m.vert[v].C();
+}
+
+/// Swap the vertex colours with the saved ones (no-op without saved colours).
+inline void swapSavedColours(CMeshO &m) {
+  auto saved = savedColours(m);
+  if (!vcg::tri::Allocator<CMeshO>::IsValidHandle(m, saved))
+    return;
+  for (size_t v = 0; v < m.vert.size(); ++v)
+    std::swap(m.vert[v].C(), saved[v]);
+}
+
+// ---------------------------------------------------------------- messages and progress
 
 /// A warning in MeshLab's log (with `logPrefix`) and on stderr ("pomar: "): Log() is a
 /// no-op in meshlabserver.
@@ -86,21 +158,6 @@ inline QString errorText(const std::exception &e, const QString &context) {
   if (error != nullptr && !error->path().empty())
     return what;
   return QString("%1: %2").arg(context, what);
-}
-
-/// The layer's own colours saved by Show Clusters / Show Levels (invalid handle if none).
-inline CMeshO::PerVertexAttributeHandle<vcg::Color4b> savedColours(CMeshO &m) {
-  return vcg::tri::Allocator<CMeshO>::FindPerVertexAttribute<vcg::Color4b>(m,
-                                                                            kSavedColourAttribute);
-}
-
-/// Swap the vertex colours with the saved ones (no-op without saved colours).
-inline void swapSavedColours(CMeshO &m) {
-  auto saved = savedColours(m);
-  if (!vcg::tri::Allocator<CMeshO>::IsValidHandle(m, saved))
-    return;
-  for (size_t v = 0; v < m.vert.size(); ++v)
-    std::swap(m.vert[v].C(), saved[v]);
 }
 
 /// Forwards progress to MeshLab's callback at most every 10% (meshlabserver prints the
