@@ -35,18 +35,37 @@
 # Needs (Debian): meshlab xvfb xdotool imagemagick x11-utils (+ libgl1-mesa-dri for software GL),
 # and a configured build/ (scripts/demo.sh does that); the targets pomar, io_pomar and
 # filter_pomar are (re)built here. Works from any directory. Based on scripts/gui_screenshot.sh.
+#
+#   scripts/gui_refine_screenshots.sh --test IO.so:FILTER.so POMAR_CLI WORK_DIR [MESHLAB_LIBDIR]
+#
+# is the ctest test "meshlab_plugin_gui_refine" (tests/meshlab_plugin/CMakeLists.txt): the same
+# session with the given plugins and tool (nothing built), the screenshots in WORK_DIR, and a check
+# of the last one's viewer pixels: the level map must be drawn, the refined region in the finest
+# level's red and coarser clusters in green or yellow, each on at least MIN_SHARE_PERCENT of the
+# viewer (a grey mesh, or one showing only the red selection, fails). Exits 77 (ctest
+# SKIP_RETURN_CODE) when meshlab, Xvfb, xdotool, xwininfo, ImageMagick or MeshLab's library is
+# missing.
 set -euo pipefail
 
 # The steps shared with scripts/gui_screenshot.sh: scripts/lib/meshlab_gui.sh.
 # shellcheck source-path=SCRIPTDIR source=lib/meshlab_gui.sh
 . "$(dirname "${BASH_SOURCE[0]}")/lib/meshlab_gui.sh"
-mlgui_init gui_refine_screenshots
-mlgui_parse_args "${BASH_SOURCE[0]}" 37 "$@"   # --help: lines 2-37
-
-mlgui_require_tools
-mlgui_build io_pomar filter_pomar
-mlgui_make_workdir pomar-gui-refine
-mlgui_pick_meshlab "$BUILD/io_plugin/libio_pomar.so" "$BUILD/meshlab_plugin/libfilter_pomar.so"
+TEST_MODE=0
+MIN_SHARE_PERCENT=2
+if [ "${1:-}" = --test ]; then
+  shift
+  TEST_MODE=1
+  mlgui_gui_test gui_refine_test pomar-gui-refine "$@" # (the private tree with both plugins)
+  POMAR="$POMAR_CLI"
+  OUTDIR="$OUT_DIR"
+else
+  mlgui_init gui_refine_screenshots
+  mlgui_parse_args "${BASH_SOURCE[0]}" 47 "$@" # --help: lines 2-47
+  mlgui_require_tools
+  mlgui_build io_pomar filter_pomar
+  mlgui_make_workdir pomar-gui-refine
+  mlgui_pick_meshlab "$BUILD/io_plugin/libio_pomar.so" "$BUILD/meshlab_plugin/libfilter_pomar.so"
+fi
 mlgui_encode_bunny
 mlgui_start_xvfb
 
@@ -259,6 +278,17 @@ line="$(apply_filter 'POMAR: Show Levels' 'POMAR: levels shown' "$dlg")" || fail
 dialog_button "$dlg" close
 log "  ${line#LOG: [0-9] }"
 shot "$OUTDIR/meshlab_refine_levels.png"
+VIEWER="$(mlgui_viewer "$MAIN")"
 
 mlgui_stop_meshlab
+if [ "$TEST_MODE" -eq 1 ]; then
+  [ -n "$VIEWER" ] || die "cannot find MeshLab's viewer inside the main window (xwininfo -tree)"
+  shares="$(mlgui_colour_shares "$OUTDIR/meshlab_refine_levels.png" "$VIEWER")" ||
+    die "cannot read $OUTDIR/meshlab_refine_levels.png"
+  log "level map colours in the viewer ($VIEWER): $shares"
+  read -r red green yellow <<<"$(sed -E 's/red=([0-9.]+) green=([0-9.]+) blue=[0-9.]+ yellow=([0-9.]+)/\1 \2 \3/' <<<"$shares")"
+  awk -v r="$red" -v g="$green" -v y="$yellow" -v min="$MIN_SHARE_PERCENT" \
+    'BEGIN { exit !(r >= min && g + y >= min) }' ||
+    die "MeshLab does not draw the level map (finest red and coarser green/yellow on ${MIN_SHARE_PERCENT}% each; screenshot: $OUTDIR/meshlab_refine_levels.png)"
+fi
 log "ok: selection by $SELECTION; refined ${REFINED:-?} clusters in ${REFINE_MS:-?} ms (plugin's log)"

@@ -1,9 +1,9 @@
 # shellcheck shell=bash
 # Sourced function library (bash) of the scripted MeshLab 2020.09 GUI sessions under Xvfb:
 # scripts/gui_screenshot.sh, scripts/gui_refine_screenshots.sh and the ctest tests
-# tests/io_plugin/gui_colour_test.sh and tests/io_plugin/gui_texture_test.sh. It builds the
-# private MeshLab tree with tests/support/meshlab_tree.sh (recipe
-# /work/shared/docs/meshlab-plugins.md section 5b).
+# tests/io_plugin/gui_colour_test.sh, tests/io_plugin/gui_texture_test.sh and
+# scripts/gui_refine_screenshots.sh --test. It builds the private MeshLab tree with
+# tests/support/meshlab_tree.sh (recipe /work/shared/docs/meshlab-plugins.md section 5b).
 #
 # A script sources it, calls mlgui_init NAME (before any cd: it cd's to the repository) and
 # mlgui_parse_args, then the steps in this order: mlgui_require_tools, mlgui_build,
@@ -245,19 +245,12 @@ mlgui_viewer() {
     END { print out }'
 }
 
-# mlgui_check_quadrants SHOT "W H X Y" MIN_SHARE_PERCENT: checks the viewer region of the
-# screenshot SHOT for a mesh drawn as four quadrants of pure colour: red top left, green top right,
-# blue bottom left, yellow bottom right. Every pixel is classified as red, green, blue or yellow
-# when strongly saturated (its bright channels at least 128, each dark one at most a quarter of
-# the darkest bright one; for yellow red and green within a quarter of each other), anything else
-# (MeshLab's grey mesh, the blue background gradient with red = green = blue / 2) as none. Each
-# colour must cover at least MIN_SHARE_PERCENT of the viewer, and their mean positions must be
-# where the quadrants are (red and blue left of green and yellow, red and green above blue and
-# yellow). Prints the count and centre per colour; returns 1 after printing FAIL lines otherwise.
-mlgui_check_quadrants() {
-  local w h x y
-  read -r w h x y <<<"$2"
-  convert "$1" -crop "${w}x${h}+${x}+${y}" +repage -depth 8 txt:- | awk -v min="$3" '
+# The awk function classify(r, g, b) of mlgui_check_quadrants and mlgui_colour_shares: "red",
+# "green", "blue" or "yellow" for a strongly saturated pixel (its bright channels at least 128,
+# each dark one at most a quarter of the darkest bright one; for yellow red and green within a
+# quarter of each other), "" for anything else (MeshLab's grey mesh, the blue background
+# gradient with red = green = blue / 2).
+MLGUI_AWK_CLASSIFY='
     function classify(r, g, b,   lo) {
       if (r >= 128 && g >= 128) {
         lo = r < g ? r : g
@@ -268,6 +261,39 @@ mlgui_check_quadrants() {
       if (b >= 128) return (r * 4 <= b && g * 4 <= b) ? "blue" : ""
       return ""
     }
+'
+
+# mlgui_colour_shares SHOT "W H X Y": the share of each colour of classify among the pixels of
+# the viewer region of the screenshot SHOT, printed as "red=R green=G blue=B yellow=Y" (percent).
+mlgui_colour_shares() {
+  local w h x y
+  read -r w h x y <<<"$2"
+  convert "$1" -crop "${w}x${h}+${x}+${y}" +repage -depth 8 txt:- | awk "$MLGUI_AWK_CLASSIFY"'
+    /^#/ { next }
+    match($0, /^[0-9]+,[0-9]+: *\([^)]*\)/) {
+      pixel = substr($0, 1, RLENGTH)
+      gsub(/[ ()]/, "", pixel); split(pixel, c, /[,:]/) # x y r g b
+      ++total
+      k = classify(c[3] + 0, c[4] + 0, c[5] + 0)
+      if (k != "") ++n[k]
+    }
+    END {
+      if (total == 0) { print "no pixels read from the screenshot" > "/dev/stderr"; exit 1 }
+      printf "red=%.2f green=%.2f blue=%.2f yellow=%.2f\n", 100 * n["red"] / total,
+        100 * n["green"] / total, 100 * n["blue"] / total, 100 * n["yellow"] / total
+    }'
+}
+
+# mlgui_check_quadrants SHOT "W H X Y" MIN_SHARE_PERCENT: checks the viewer region of the
+# screenshot SHOT for a mesh drawn as four quadrants of pure colour: red top left, green top right,
+# blue bottom left, yellow bottom right. Every pixel is classified by classify
+# (MLGUI_AWK_CLASSIFY: red, green, blue, yellow or none). Each colour must cover at least MIN_SHARE_PERCENT of the viewer, and their mean positions must be
+# where the quadrants are (red and blue left of green and yellow, red and green above blue and
+# yellow). Prints the count and centre per colour; returns 1 after printing FAIL lines otherwise.
+mlgui_check_quadrants() {
+  local w h x y
+  read -r w h x y <<<"$2"
+  convert "$1" -crop "${w}x${h}+${x}+${y}" +repage -depth 8 txt:- | awk -v min="$3" "$MLGUI_AWK_CLASSIFY"'
     /^#/ { next }
     match($0, /^[0-9]+,[0-9]+: *\([^)]*\)/) {
       pixel = substr($0, 1, RLENGTH)
@@ -303,19 +329,22 @@ mlgui_check_quadrants() {
     }'
 }
 
-# mlgui_gui_test NAME WORKDIR_PREFIX PLUGIN.so POMAR_CLI WORK_DIR [MESHLAB_LIBDIR]: the set-up of
-# a GUI test (tests/io_plugin/gui_*_test.sh): the arguments checked, PLUGIN, POMAR_CLI and
-# OUT_DIR set, the repository as the current folder, a private MeshLab tree with PLUGIN, and
-# exit 77 (ctest SKIP_RETURN_CODE) when Xvfb, xdotool, xwininfo, ImageMagick, meshlab or
-# MeshLab's library is missing.
+# mlgui_gui_test NAME WORKDIR_PREFIX PLUGIN.so[:PLUGIN2.so...] POMAR_CLI WORK_DIR [MESHLAB_LIBDIR]:
+# the set-up of a GUI test (tests/io_plugin/gui_*_test.sh, scripts/gui_refine_screenshots.sh
+# --test): the arguments checked, PLUGINS (absolute), POMAR_CLI and OUT_DIR set, the repository
+# as the current folder, a private MeshLab tree with PLUGINS, and exit 77 (ctest
+# SKIP_RETURN_CODE) when Xvfb, xdotool, xwininfo, ImageMagick, meshlab or MeshLab's library is
+# missing.
 mlgui_gui_test() {
-  local name="$1" prefix="$2"
+  local name="$1" prefix="$2" so list
   shift 2
   if [ $# -lt 3 ] || [ $# -gt 4 ]; then
-    echo "usage: $0 PLUGIN.so POMAR_CLI WORK_DIR [MESHLAB_LIBDIR]" >&2
+    echo "usage: $0 PLUGIN.so[:PLUGIN2.so...] POMAR_CLI WORK_DIR [MESHLAB_LIBDIR]" >&2
     exit 2
   fi
-  PLUGIN="$(abspath "$1")"
+  PLUGINS=()
+  IFS=: read -r -a list <<<"$1"
+  for so in "${list[@]}"; do PLUGINS+=("$(abspath "$so")"); done
   POMAR_CLI="$(abspath "$2")"
   mkdir -p "$3"
   OUT_DIR="$(cd "$3" && pwd)"
@@ -329,10 +358,10 @@ mlgui_gui_test() {
   done
   [ -x /usr/bin/meshlab ] || skip "/usr/bin/meshlab is not installed (package meshlab)"
   skip_without_meshlab_lib "$SYS_MLLIB"
-  [ -f "$PLUGIN" ] || die "plugin not found: $PLUGIN"
+  for so in "${PLUGINS[@]}"; do [ -f "$so" ] || die "plugin not found: $so"; done
   [ -x "$POMAR_CLI" ] || die "pomar executable not found: $POMAR_CLI"
   mlgui_make_workdir "$prefix"
-  mlgui_pick_meshlab "$PLUGIN"
+  mlgui_pick_meshlab "${PLUGINS[@]}"
 }
 
 # mlgui_gui_session FILE: one GUI session of a GUI test (after mlgui_gui_test): MeshLab opens
