@@ -9,6 +9,7 @@
 //   pomar verify ORIGINAL IN.pomar [DECODED] [--repair]
 #include <CLI/CLI.hpp>
 
+#include <csignal>
 #include <cstdio>
 #include <exception>
 
@@ -212,6 +213,9 @@ int main(int argc, char **argv) {
              ".pomar version or section, 70 internal error.");
   // Ctrl-C or kill during a write: no temporary file left, the old output untouched.
   pomar::remove_temporary_files_on_signals();
+  // A write past the file size limit (ulimit -f) fails with EFBIG, an I/O error (exit 6,
+  // the temporary file removed), instead of killing the tool.
+  std::signal(SIGXFSZ, SIG_IGN);
   app.set_version_flag("--version",
                        "pomar 0.1.0 (writes .pomar format versions 1, 3 and 4, reads 1 to 4)");
 
