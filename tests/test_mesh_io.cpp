@@ -409,7 +409,7 @@ TEST_F(MeshIoTest, PlyAttributesRoundTrip) {
 }
 
 // A binary little-endian PLY with vertex attributes is read without vcglib (the walk takes
-// the positions and triangles too, io/ply_io.cpp mesh_from_capture): it must give what the
+// the positions and triangles too, io/ply_reader.cpp mesh_from_capture): it must give what the
 // general path gives for the same values in an ASCII file (vcglib reads its positions and
 // triangles): attributes in the same order with the same values (a colour whose alpha is
 // 255 everywhere kept as RGB, quality, texture coordinates, named scalars, a double
@@ -627,11 +627,11 @@ void expect_same_load(const Mesh &fast, const LoadReport &fast_report, const Mes
   EXPECT_EQ(fast_report.ignored_attributes, general_report.ignored_attributes);
 }
 
-// ASCII PLY of float x, y, z and uchar-counted int faces is read without vcglib (io/ply_io.cpp,
-// read_simple_ascii): it must give the floats fscanf gives (vcglib's general path, taken
-// here for the same data by an extra empty element) for every way of writing a number,
-// decline what it does not take ('+', hex, overflow, junk: the general path decides) and
-// count unreferenced vertices the same.
+// ASCII PLY of float x, y, z and uchar-counted int faces is read without vcglib
+// (io/ply_simple_read.cpp, read_simple_ascii): it must give the floats fscanf gives
+// (vcglib's general path, taken here for the same data by an extra empty element) for
+// every way of writing a number, decline what it does not take ('+', hex, overflow, junk:
+// the general path decides) and count unreferenced vertices the same.
 // parse_float (every general reader's decimal numbers: PLY ASCII walk, OFF, ASCII STL)
 // takes plain decimal text through from_chars and the rest through strtof: it must give
 // strtof's float, bit for bit, and accept and refuse what strtof does, for every way of
@@ -1298,7 +1298,7 @@ class M : public vcg::tri::TriMesh<std::vector<V>, std::vector<F>> {};
 } // namespace stl_reference
 
 // PLY files with vertex attributes: the walk takes their positions and triangles
-// (io/ply_io.cpp, PlyCapture) instead of vcglib's importer. For ASCII, binary little- and
+// (io/ply_walker.cpp, PlyCapture) instead of vcglib's importer. For ASCII, binary little- and
 // big-endian files of the same values, positions, triangles and unreferenced vertices must
 // be what vcglib's importer reads from the same file.
 TEST_F(MeshIoTest, PlyCapturedPositionsAndTrianglesAreVcglibs) {

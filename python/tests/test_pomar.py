@@ -257,6 +257,27 @@ def test_damaged_and_wrong_data_raise_clear_errors(tmp_path):
     assert e.value.kind == "usage"
 
 
+
+def test_a_damaged_attr_section_is_a_damaged_file(tmp_path):
+    vertices, faces = torus()
+    colors = (np.arange(3 * len(vertices)) % 256).astype(np.uint8).reshape(-1, 3)
+    data = bytearray(pomar.encode(vertices, faces, colors=colors))
+    i = pomar.info(bytes(data))
+    offset = i["header_bytes"] + i["base_bytes"]  # the section bodies, in table order
+    for s in i["sections"]:
+        if s["name"] == "ATTR":
+            break
+        offset += s["bytes"]
+    else:
+        pytest.fail("no ATTR section in a file with colours")
+    data[offset + s["bytes"] // 2] ^= 0x10
+    for read in (lambda: pomar.decode(bytes(data)), lambda: pomar.info(bytes(data)),
+                 lambda: pomar.decode(bytes(data), skip_damaged=True),
+                 lambda: pomar.SelectiveDecoder(bytes(data)).update()):
+        with pytest.raises(pomar.Error) as e:
+            read()
+        assert e.value.kind == "damaged_file" and "ATTR" in str(e.value)
+
 def test_gil_released_during_encode_and_decode():
     """Another Python thread runs while encode/decode work. With a 0.5 s switch interval a
     thread holding the GIL keeps it through a call shorter than that (these take a few

@@ -1,4 +1,4 @@
-// Internal to pomar_io: what the per-format readers and writers (ply_io.cpp, off_io.cpp,
+// Internal to pomar_io: what the per-format readers and writers (ply_*.cpp, off_io.cpp,
 // stl_io.cpp, obj_io.cpp) share: error messages that start with the path, number
 // parsing and printing, file handles, temporary files, and the vcglib mesh the importers
 // fill. The public API is <pomar/mesh_io.h>; mesh_io.cpp picks the format.
@@ -426,7 +426,7 @@ void check_written_size(const std::string &file, uint64_t expected, const std::s
 
 // ---- One reader and writer per format ----
 
-// ply_io.cpp
+// ply_reader.cpp (load_ply), ply_writer.cpp (the writers)
 Mesh load_ply(const std::string &path, LoadReport &report, const SizeCheck &check);
 void write_ply_ascii(TextFileWriter &out, const Mesh &mesh);
 /// Binary little-endian PLY, byte for byte what vcglib's exporter writes, from the flat

@@ -1,6 +1,6 @@
 // Mesh file I/O: picks the format from the extension and calls its reader or writer
-// (ply_io.cpp, obj_io.cpp, off_io.cpp, stl_io.cpp); reads whole files and writes them
-// atomically (temporary file, fsync, rename).
+// (ply_reader.cpp / ply_writer.cpp, obj_io.cpp, off_io.cpp, stl_io.cpp); reads whole
+// files and writes them atomically (temporary file, fsync, rename).
 //
 // PLY, OFF and ASCII STL are read through vcglib, OBJ through tinyobjloader, binary STL
 // directly; each reader first walks the file's structure and refuses what its importer
