@@ -894,6 +894,26 @@ run decode "$WORK/guard/b.ply" "$WORK/guard/back.ply"
 expect_nonzero
 expect_contains "$ERR" "b.ply: not a valid .pomar file" "decode's error naming the file"
 
+section "an output that is a pipe or a device is written in place, not replaced by a file"
+mkfifo "$WORK/guard/out.pomar.fifo"
+cat "$WORK/guard/out.pomar.fifo" >"$WORK/guard/from_fifo.pomar" &
+reader=$!
+run encode -q "$WORK/guard/b.ply" "$WORK/guard/out.pomar.fifo"
+wait "$reader"
+expect_rc 0
+[ -p "$WORK/guard/out.pomar.fifo" ] || fail "the FIFO was replaced by a regular file"
+pass
+cmp -s "$WORK/guard/from_fifo.pomar" "$WORK/guard/b.pomar" || fail "what came through the FIFO differs from the file encode writes"
+pass
+run encode -q "$WORK/guard/b.ply" /dev/null
+expect_rc 0
+[ -c /dev/null ] || fail "/dev/null is no longer a character device"
+pass
+mkdir -p "$WORK/guard/dir.ply"
+run decode -q "$WORK/guard/b.pomar" "$WORK/guard/dir.ply"
+expect_nonzero
+expect_contains "$ERR" "is a directory" "decode's error for a directory output"
+
 help_mentions() { # help_mentions SUBCOMMAND OPTION...
   local sub="$1"; shift
   section "$sub --help"

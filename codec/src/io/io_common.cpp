@@ -202,6 +202,18 @@ bool write_all(int fd, const char *data, size_t size) {
 }
 
 AtomicFile::AtomicFile(const std::string &target) : target_(target), tmp_(target) {
+  struct stat st;
+  if (::stat(target_.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
+    if (S_ISDIR(st.st_mode))
+      fail_io(target_, "is a directory");
+    // A device, a pipe or a socket (/dev/null, /dev/stdout, a FIFO) is written in place:
+    // renaming a file over it would replace the device with a regular file.
+    in_place_ = true;
+    fd_ = ::open(target_.c_str(), O_WRONLY | O_CLOEXEC);
+    if (fd_ < 0)
+      fail_io(target_, "cannot open for writing: " + errno_text(errno));
+    return;
+  }
   fd_ = ::open(tmp_.path().c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
   if (fd_ < 0)
     fail_io(target_, "cannot create temporary file '" + tmp_.path() + "': " + errno_text(errno));
@@ -216,14 +228,22 @@ void AtomicFile::write(const char *data, size_t size) {
   if (!write_all(fd_, data, size))
     fail_io(target_, "cannot write: " + errno_text(errno));
 #if defined(__linux__) && defined(SYNC_FILE_RANGE_WRITE)
-  // Start writing these bytes to the disk now, without waiting (commit()'s fsync then
+  if (!in_place_)
+    // Start writing these bytes to the disk now, without waiting (commit()'s fsync then
   // waits for less); a file system that cannot says so, and nothing changes.
-  ::sync_file_range(fd_, off_t(written_), off_t(size), SYNC_FILE_RANGE_WRITE);
+    ::sync_file_range(fd_, off_t(written_), off_t(size), SYNC_FILE_RANGE_WRITE);
 #endif
   written_ += size;
 }
 
 void AtomicFile::commit() {
+  if (in_place_) { // (a device or a pipe: nothing to sync or rename)
+    const int fd = fd_;
+    fd_ = -1;
+    if (::close(fd) != 0)
+      fail_io(target_, "cannot write (close): " + errno_text(errno));
+    return;
+  }
   if (::fsync(fd_) != 0)
     fail_io(target_, "fsync failed: " + errno_text(errno));
   const int fd = fd_;

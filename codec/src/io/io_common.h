@@ -281,7 +281,8 @@ bool write_all(int fd, const char *data, size_t size);
 /// TextFileWriter): write() appends to it, commit() fsyncs and closes it and renames it over
 /// the target. Every failure is an I/O error naming the target; destroyed without
 /// commit(), it removes the temporary file, so a failed write never leaves part of a file
-/// under the target's name.
+/// under the target's name. A target that exists and is not a regular file (a device such
+/// as /dev/null, a pipe, a socket) is written in place instead, and commit() closes it.
 class AtomicFile {
 public:
   explicit AtomicFile(const std::string &target);
@@ -296,6 +297,7 @@ private:
   TempFile tmp_;
   int fd_ = -1;
   uint64_t written_ = 0; // bytes written so far
+  bool in_place_ = false; // the target is not a regular file: written directly
 };
 
 /// Writes a file atomically from pieces, through a 1 MiB buffer: put() / reserve() fill
