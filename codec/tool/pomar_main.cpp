@@ -17,6 +17,7 @@
 #include <cstring>
 #include <map>
 #include <memory>
+#include <new>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -457,7 +458,7 @@ std::vector<double> parse_spec(const std::string &spec, size_t count, int finest
 // Exit statuses (README "Exit codes"): one per kind of failure, so that scripts can tell
 // a bad mesh from a damaged file from a full disk without reading the message.
 // exit_status() is the one place that maps pomar::Error kinds to statuses.
-constexpr int kExitError = 1;       // any other error
+constexpr int kExitError = 1;       // a pomar::Error without a kind (Kind::Other)
 constexpr int kExitUsage = 2;       // a value the command cannot use (level, cluster, size...)
 constexpr int kExitMismatch = 3;    // verify: the mesh differs
 constexpr int kExitDamaged = 4;     // a damaged or truncated .pomar file; info --check and
@@ -1287,9 +1288,16 @@ int main(int argc, char **argv) {
   } catch (const pomar::Error &e) {
     std::fprintf(stderr, "pomar: error: %s\n", pomar::printable(e.what()).c_str());
     return exit_status(e);
+  } catch (const std::bad_alloc &) {
+    // (Every size the codec allocates from is checked first: this is the machine's limit.)
+    std::fprintf(stderr, "pomar: error: out of memory (use --max-memory to be refused "
+                         "before the work starts)\n");
+    return kExitMemory;
   } catch (const std::exception &e) {
-    std::fprintf(stderr, "pomar: error: %s\n", pomar::printable(e.what()).c_str());
-    return kExitError;
+    // Every throw of the codec and the tool has a kind: anything else is a bug.
+    std::fprintf(stderr, "pomar: error: internal error: %s (please report it)\n",
+                 pomar::printable(e.what()).c_str());
+    return kExitInternal;
   }
   return 0;
 }
