@@ -7,7 +7,7 @@
 
 namespace pomar::tool {
 
-constexpr int kExitError = 1;       // any other error
+constexpr int kExitError = 1;       // a pomar::Error without a kind (Kind::Other)
 constexpr int kExitUsage = 2;       // a value the command cannot use (level, cluster, size...)
 constexpr int kExitMismatch = 3;    // verify: the mesh differs
 constexpr int kExitDamaged = 4;     // a damaged or truncated .pomar file; info --check and

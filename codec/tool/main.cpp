@@ -246,9 +246,16 @@ int main(int argc, char **argv) {
   } catch (const pomar::Error &e) {
     std::fprintf(stderr, "pomar: error: %s\n", pomar::printable(e.what()).c_str());
     return exit_status(e);
+  } catch (const std::bad_alloc &) {
+    // (Every size the codec allocates from is checked first: this is the machine's limit.)
+    std::fprintf(stderr, "pomar: error: out of memory (use --max-memory to be refused "
+                         "before the work starts)\n");
+    return kExitMemory;
   } catch (const std::exception &e) {
-    std::fprintf(stderr, "pomar: error: %s\n", pomar::printable(e.what()).c_str());
-    return kExitError;
+    // Every throw of the codec and the tool has a kind: anything else is a bug.
+    std::fprintf(stderr, "pomar: error: internal error: %s (please report it)\n",
+                 pomar::printable(e.what()).c_str());
+    return kExitInternal;
   }
   return 0;
 }

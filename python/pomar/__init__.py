@@ -43,15 +43,17 @@ class Mesh:
     attribute_info: of a decoded mesh, one dict per attribute with "kind", "name",
         "components", "bits" (0 = exact), "exact" and "bound" (the largest error against
         the input: normals in degrees, scalars and texcoords absolute per component)
+    source: the file read() or a SelectiveDecoder read it from (None otherwise): write()
+        refuses to replace that file unless overwrite=True
     """
 
     __slots__ = ("vertices", "faces", "damaged", "colors", "normals", "scalars", "texcoords",
                  "texture_files", "corner_texcoords", "face_materials", "materials",
-                 "texture_images", "attribute_info")
+                 "texture_images", "attribute_info", "source")
 
     def __init__(self, vertices, faces, damaged=(), *, colors=None, normals=None, scalars=None,
                  texcoords=None, texture_files=(), corner_texcoords=None, face_materials=None,
-                 materials=(), texture_images=(), attribute_info=()):
+                 materials=(), texture_images=(), attribute_info=(), source=None):
         self.vertices = vertices
         self.faces = faces
         #: blocks a decode with skip_damaged=True decoded around: dicts with "block"
@@ -67,6 +69,7 @@ class Mesh:
         self.materials = [dict(m) for m in materials]
         self.texture_images = list(texture_images)
         self.attribute_info = list(attribute_info)
+        self.source = source
 
     def _attributes(self):
         """The attribute fields as the keyword arguments of _pomar's encode/write_mesh."""
@@ -164,21 +167,45 @@ def read(path, level=None):
     path = os.fspath(path)
     if path.lower().endswith(".pomar"):
         with open(path, "rb") as f:
-            return decode(f.read(), level)
-    if level is not None:
-        raise ValueError("level applies to .pomar files only")
-    vertices, faces, _report, fields = _pomar.read_mesh(path)
-    return _mesh(vertices, faces, (), fields)
+            mesh = decode(f.read(), level)
+    else:
+        if level is not None:
+            raise ValueError("level applies to .pomar files only")
+        vertices, faces, _report, fields = _pomar.read_mesh(path)
+        mesh = _mesh(vertices, faces, (), fields)
+    mesh.source = path
+    return mesh
 
 
-def write(path, mesh, *, binary=True, **encode_options):
+def _refuse_source(path, mesh):
+    """pomar.Error (kind "usage") if `path` is the file `mesh` was read from (the same
+    file, also through links)."""
+    source = getattr(mesh, "source", None)
+    if source is None:
+        return
+    try:
+        same = os.path.samefile(path, source)
+    except OSError:  # one of them does not exist (yet)
+        return
+    if same:
+        error = Error(f"{path} is the file the mesh was read from ({source}): it would be "
+                      "overwritten; choose another file (or pass overwrite=True)")
+        error.kind, error.path, error.level, error.cluster = "usage", path, None, None
+        raise error
+
+
+def write(path, mesh, *, binary=True, overwrite=False, **encode_options):
     """Write a Mesh, replacing `path` atomically: .ply .stl (binary unless binary=False),
     .obj .off, or .pomar (encode_options as for encode(), e.g. bits=14). PLY and .pomar
     keep every attribute (PLY of the materials only each face's texture); OBJ colour (RGB),
     normals, texture coordinates (per vertex or per corner), materials and texture files
     (a .mtl beside the file); OFF colour and normals; STL none. What a format cannot hold
-    is named in one UserWarning."""
+    is named in one UserWarning. The file the mesh was read from (mesh.source: a coarse
+    level, a region, a mesh decoded around damage) is not replaced: pomar.Error, kind
+    "usage", unless overwrite=True."""
     path = os.fspath(path)
+    if not overwrite:
+        _refuse_source(path, mesh)
     if path.lower().endswith(".pomar"):
         _pomar.write_bytes(path, encode(mesh, **encode_options))
         return
@@ -215,8 +242,12 @@ class SelectiveDecoder(_pomar.SelectiveDecoder):
         _check_threads(threads)
         super().__init__(source, skip_damaged=skip_damaged, memory_limit=memory_limit,
                          threads=threads)
+        self._path = os.fspath(source) if isinstance(source, (str, os.PathLike)) else None
 
     def mesh(self):
-        """The current mesh (after the last update())."""
+        """The current mesh (after the last update()); its source is the file read, if
+        the decoder was given a path."""
         vertices, faces, fields = self.mesh_arrays()
-        return _mesh(vertices, faces, (), fields)
+        mesh = _mesh(vertices, faces, (), fields)
+        mesh.source = self._path
+        return mesh

@@ -136,6 +136,48 @@ def test_files(tmp_path, bunny):
         pomar.write(tmp_path / "c.ply", bunny, bits=14)
 
 
+def test_write_refuses_the_file_the_mesh_was_read_from(tmp_path, bunny):
+    assert bunny.source == BUNNY
+    for name, level in (("a.ply", None), ("a.pomar", 0)):
+        path = tmp_path / name
+        pomar.write(path, bunny)
+        before = path.read_bytes()
+        mesh = pomar.read(path, level)  # a .pomar at level 0: the base mesh
+        assert mesh.source == str(path)
+        link = tmp_path / ("link-" + name)
+        link.symlink_to(path)
+        hard = tmp_path / ("hard-" + name)
+        os.link(path, hard)
+        for target in (path, str(path), link, hard):
+            with pytest.raises(pomar.Error, match="the file the mesh was read from") as e:
+                pomar.write(target, mesh)
+            assert e.value.kind == "usage" and e.value.path == os.fspath(target)
+        assert path.read_bytes() == before
+        assert not [p for p in os.listdir(tmp_path) if ".tmp." in p]
+        other = tmp_path / ("other-" + name)
+        pomar.write(other, mesh)  # another file: written
+        assert pomar.read(other, level).faces.shape == mesh.faces.shape
+        mesh.source = None  # a mesh of no file: written anywhere
+        pomar.write(path, mesh)
+        path.write_bytes(before)
+        mesh.source = str(path)
+        pomar.write(path, mesh, overwrite=True)  # asked for
+        assert len(pomar.read(path).faces) == len(mesh.faces)
+        if level == 0:
+            assert path.read_bytes() != before
+    # A selective decoder's mesh comes from its file.
+    path = tmp_path / "s.pomar"
+    pomar.write(path, bunny)
+    d = pomar.SelectiveDecoder(path)
+    d.want_cluster(0)
+    d.update()
+    part = d.mesh()
+    assert part.source == str(path)
+    with pytest.raises(pomar.Error, match="read from"):
+        pomar.write(path, part)
+    assert pomar.SelectiveDecoder(path.read_bytes()).mesh().source is None
+
+
 def test_selective_decoder(tmp_path, bunny):
     data = pomar.encode(bunny)
     path = tmp_path / "bunny.pomar"

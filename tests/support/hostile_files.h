@@ -85,6 +85,23 @@ inline bool repair_checksums(std::vector<uint8_t> &b) {
   }
 }
 
+/// The image with its cluster index replaced by `index`'s sizes and checks (the header's
+/// index size and every checksum made to match; the blocks stay where they are, so a size
+/// changed moves where the decoder looks for every later block). `file` may be truncated
+/// after its global part.
+inline std::vector<uint8_t> with_cluster_index(const std::vector<uint8_t> &file,
+                                               const ClusterIndex &index) {
+  const FileLayout L = read_layout(file.data(), file.size(), file.size(), true);
+  const std::vector<uint8_t> packed = pack_cluster_index(index);
+  std::vector<uint8_t> b(file.begin(), file.begin() + long(L.index_offset));
+  b.insert(b.end(), packed.begin(), packed.end());
+  b.insert(b.end(), file.begin() + long(L.index_offset + L.header.index_bytes), file.end());
+  const size_t c = kFixedHeaderBytes + kLevelEntryBytes * L.header.levels.size();
+  put_le(b, c + 16, packed.size(), 4);
+  repair_checksums(b);
+  return b;
+}
+
 /// One header field: where it is, how wide, and whether it is a byte count.
 struct Field {
   std::string name;
@@ -96,11 +113,10 @@ struct Field {
 /// The fields of a valid image's header (sizes, counts, version, flags, bits, level table,
 /// cluster header).
 inline std::vector<Field> header_fields(const std::vector<uint8_t> &file) {
-  std::vector<Field> f = {{"version", 8, 2},          {"flags", 10, 2},
-                          {"bits", 12, 1},            {"extent", 28, 4},
-                          {"vertices", 32, 4},        {"faces", 36, 4},
-                          {"base_vertices", 40, 4},   {"base_faces", 44, 4},
-                          {"levels", 48, 4},          {"base_bytes", 52, 4, true}};
+  std::vector<Field> f = {{"version", 8, 2},          {"flags", 10, 2},      {"bits", 12, 1},
+                          {"extent", 28, 4},          {"vertices", 32, 4},   {"faces", 36, 4},
+                          {"base_vertices", 40, 4},   {"base_faces", 44, 4}, {"levels", 48, 4},
+                          {"base_bytes", 52, 4, true}};
   const uint32_t levels = uint32_t(std::min<uint64_t>(get_le(file, 48, 4), kMaxLevels));
   for (uint32_t i = 0; i < levels; ++i) {
     const size_t e = kFixedHeaderBytes + kLevelEntryBytes * i;
@@ -139,9 +155,8 @@ inline std::vector<uint64_t> interesting_values(const Field &f, const std::vecto
   const uint64_t cur = get_le(file, f.at, f.bytes);
   const uint64_t top = f.bytes == 8 ? ~uint64_t(0) : (uint64_t(1) << (8 * f.bytes)) - 1;
   const uint64_t n = file.size();
-  std::vector<uint64_t> v = {0,       1,       2,       3,       cur - 1, cur + 1,
-                             cur * 2, cur / 2, n - 1,   n,       n + 1,   n * 2,
-                             top,     top - 1, top / 2, top / 2 + 1};
+  std::vector<uint64_t> v = {0,     1, 2,     3,     cur - 1, cur + 1, cur * 2, cur / 2,
+                             n - 1, n, n + 1, n * 2, top,     top - 1, top / 2, top / 2 + 1};
   if (f.bytes >= 4) {
     v.push_back(uint64_t(1) << 31);
     v.push_back(0xFFFFFFFFull);

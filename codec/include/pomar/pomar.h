@@ -372,7 +372,8 @@ struct DecodeReport {
   /// Clustered files with damage: clusters decoded below the requested level.
   uint32_t clusters_below_request = 0;
   /// Clustered files: the level map's decode rounds (SelectiveDecoder::decode_rounds): 1,
-  /// plus one per damaged block that passed its checks and failed while it was decoded.
+  /// plus one per decode again from the base clustered mesh after blocks that passed their
+  /// checks failed while they were decoded.
   uint32_t decode_rounds = 0;
 };
 

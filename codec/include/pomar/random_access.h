@@ -181,9 +181,11 @@ public:
   uint64_t bytes_read() const;       ///< everything read from the source so far
   uint32_t blocks_read() const;      ///< cluster blocks read so far
   uint32_t clusters_decoded() const; ///< clusters above the base clustered level
-  /// Level maps decoded by update() so far: one per update() (clustered files), plus
-  /// one for each block that fails while it is decoded (a block missing from a truncated
-  /// file or failing its check is found before, and costs no round).
+  /// Passes over a level map by update() so far: one per update() (clustered files), plus
+  /// one each time blocks that fail while they are decoded leave a cluster finer than the
+  /// damage allows, so that the map is decoded again from the base clustered mesh (every
+  /// failure of a pass is met before it decodes again; a block missing from a truncated file
+  /// or failing its check is found before anything is decoded and costs no round).
   uint32_t decode_rounds() const;
 
 private:

@@ -274,7 +274,8 @@ std::vector<uint8_t> write_attributes(const AttributeTable &t, uint32_t base_ver
   return out;
 }
 
-AttributeTable read_attributes(const uint8_t *data, size_t size, uint32_t base_vertices) {
+AttributeTable read_attributes(const uint8_t *data, size_t size, uint32_t base_vertices,
+                               bool keep_base) {
   ByteReader r(data, size, "damaged .pomar file: ATTR section");
   AttributeTable t;
   const uint8_t version = r.u8();
@@ -336,8 +337,9 @@ AttributeTable read_attributes(const uint8_t *data, size_t size, uint32_t base_v
   t.base_stream_bytes = bytes;
   RangeDecoder rc(data + r.position(), bytes);
   std::vector<AttributeCodeModels> m = attribute_models(t);
-  t.base.resize(size_t(base_vertices) * n);
-  std::vector<int64_t> res(n);
+  if (keep_base)
+    t.base.resize(size_t(base_vertices) * n);
+  std::vector<int64_t> res(n), last(n, 0); // last: the previous vertex's codes
   std::vector<int64_t> lo(n), hi(n);
   for (size_t i = 0, k = 0; i < t.stored.size(); ++i)
     for (uint32_t c = 0; c < t.stored[i].codes(); ++c, ++k)
@@ -352,14 +354,16 @@ AttributeTable read_attributes(const uint8_t *data, size_t size, uint32_t base_v
         if (t.wedge_pending && (int(k) == t.wedge_uv || int(k) == t.wedge_uv + 1)) {
           if (res[k] < lo[k] - hi[k] || res[k] > hi[k] - lo[k])
             damaged("a base mesh attribute lies outside its range");
-          t.base[size_t(v) * n + k] = res[k];
+          if (keep_base)
+            t.base[size_t(v) * n + k] = res[k];
           return;
         }
-        const int64_t pred = v ? t.base[size_t(v - 1) * n + k] : 0;
-        const int64_t c = pred + res[k];
+        const int64_t c = last[k] + res[k];
         if (c < lo[k] || c > hi[k])
           damaged("a base mesh attribute lies outside its range");
-        t.base[size_t(v) * n + k] = c;
+        last[k] = c;
+        if (keep_base)
+          t.base[size_t(v) * n + k] = c;
       },
       base_vertices, n);
   if (rc.overrun())
@@ -367,14 +371,14 @@ AttributeTable read_attributes(const uint8_t *data, size_t size, uint32_t base_v
   return t;
 }
 
-std::unique_ptr<AttributeTable> load_attribute_table(const uint8_t *data,
-                                                     const FileLayout &layout) {
+std::unique_ptr<AttributeTable> load_attribute_table(const uint8_t *data, const FileLayout &layout,
+                                                     bool keep_base) {
   const int i = find_section(layout, kAttributeSectionTag);
   if (i < 0)
     return nullptr;
   const uint8_t *body = section_body(data, layout, size_t(i)); // checks its XXH32
-  return std::make_unique<AttributeTable>(
-      read_attributes(body, layout.header.sections[size_t(i)].bytes, layout.header.base_vertices));
+  return std::make_unique<AttributeTable>(read_attributes(
+      body, layout.header.sections[size_t(i)].bytes, layout.header.base_vertices, keep_base));
 }
 
 void attach_attributes(const AttributeTable &t, const LevelMesh &lm, const AttributeMask &mask,

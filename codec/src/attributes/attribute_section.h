@@ -73,9 +73,13 @@ void init_attributes(const AttributeTable &table, LevelMesh &lm,
 /// holds their codes: base_vertices * table.codes values).
 std::vector<uint8_t> write_attributes(const AttributeTable &table, uint32_t base_vertices);
 /// Parse a section body (bounds-checked; "damaged .pomar file: ATTR section ..." errors).
-AttributeTable read_attributes(const uint8_t *data, size_t size, uint32_t base_vertices);
+/// `keep_base` false checks the base mesh's codes without storing them (table.base stays
+/// empty: inspection, memory independent of the counts).
+AttributeTable read_attributes(const uint8_t *data, size_t size, uint32_t base_vertices,
+                               bool keep_base = true);
 /// The table of the file's ATTR section (checksum checked), or nullptr if it has none.
-std::unique_ptr<AttributeTable> load_attribute_table(const uint8_t *data, const FileLayout &layout);
+std::unique_ptr<AttributeTable> load_attribute_table(const uint8_t *data, const FileLayout &layout,
+                                                     bool keep_base = true);
 
 /// Add the attributes `mask` keeps of every vertex of `out` (made from `lm` by to_mesh) to `out`
 /// (and the texture files): the codes come from `lm`.

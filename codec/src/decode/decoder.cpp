@@ -31,7 +31,7 @@ FileInfo inspect(const uint8_t *data, size_t size) {
     const ClusterIndex index = read_cluster_index(data + layout.index_offset, layout);
     info.cluster_block_bytes = index.size;
   }
-  if (const auto table = load_attribute_table(data, layout)) {
+  if (const auto table = load_attribute_table(data, layout, false)) { // (no codes kept)
     describe_attributes(*table, info);
     info.embedded_texture_bytes = texture_image_sizes(data, layout, table->texture_files.size());
   }
@@ -103,14 +103,22 @@ std::vector<DamagedBlock> check_blocks(const uint8_t *data, size_t size) {
   const FileHeader &h = layout.header;
   read_base_mesh(data, layout, false);
   // The sections lie in the global part, which every decode needs: each is read as a decode
-  // reads it (the base mesh's attribute codes resolved on the base mesh), so that a file
-  // said to be whole decodes; a failure throws, as for the base mesh.
-  if (const auto attributes = load_attribute_table(data, layout)) {
+  // reads it, so that a file said to be whole decodes; a failure throws, as for the base
+  // mesh. The base mesh's attribute codes are checked as they are read, without being kept;
+  // only wedge texture coordinates, predicted from the base mesh's neighbours, need the base
+  // mesh and its codes (the memory a decode of the base mesh needs, checked first).
+  if (const auto attributes = load_attribute_table(data, layout, false)) {
     const size_t textures = attributes->texture_files.size();
     load_material_table(data, layout, textures);
     texture_image_sizes(data, layout, textures);
-    LevelMesh lm = base_level_mesh(data, layout);
-    init_attributes(*attributes, lm);
+    if (attributes->wedge_pending) {
+      FileInfo info = file_info(layout, size);
+      describe_attributes(*attributes, info);
+      check_decode_memory(info, 0, 0); // (the base mesh: level 0)
+      const auto kept = load_attribute_table(data, layout);
+      LevelMesh lm = base_level_mesh(data, layout);
+      init_attributes(*kept, lm);
+    }
   }
   {
     FileInfo counts;
@@ -191,8 +199,9 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
   const size_t levels = h.levels.size();
   if (options.level != -1) // -1: full resolution
     check_level_exists(options.level, static_cast<int>(levels));
-  // The ATTR section (descriptors, base mesh codes) first: the attributes count in the check.
-  const std::unique_ptr<AttributeTable> attributes = load_attribute_table(data, layout);
+  // The ATTR section's descriptors first (its base mesh codes checked, not kept): the
+  // attributes count in the check, which comes before the codes are stored.
+  std::unique_ptr<AttributeTable> attributes = load_attribute_table(data, layout, false);
   const std::unique_ptr<MaterialTable> materials =
       load_material_table(data, layout, attributes ? attributes->texture_files.size() : 0);
   FileInfo info = file_info(layout, size);
@@ -200,6 +209,8 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
     describe_attributes(*attributes, info);
   const unsigned threads = decode_threads(options.threads);
   check_decode_memory(info, options.level, options.memory_limit, options.attributes, threads);
+  if (attributes)
+    attributes = load_attribute_table(data, layout);
   const size_t target = options.level < 0 ? levels : static_cast<size_t>(options.level);
   const size_t global = h.clustered() ? h.global_levels : levels;
   // Clustered levels go through the selective decoder, unless a global level they build

@@ -90,12 +90,16 @@ struct SelectiveDecoder::State {
                              const std::function<void()> &applied, uint32_t &decoding);
   LevelSchedule schedule;
   DecoderCodec cluster_codec(uint32_t c, int level);
-  void decode_target(const Progress &progress, uint32_t &decoding);
+  void decode_target(const Progress &progress);
+  void limit_target(const std::vector<int> &request);
+  bool decode_levels(const std::vector<int> &request, const std::function<void()> &applied);
+  void decode_level(int level, uint32_t older_than, const std::function<void()> &applied,
+                    uint32_t &decoding);
   void check_target_memory() const;
   void check_cluster_data();
   bool skip_cluster(uint32_t c, const Error &e);
   void cap_failing_blocks();
-  uint32_t rounds = 0;     // decode_target calls (SelectiveDecoder::decode_rounds)
+  uint32_t rounds = 0;     // passes over a level map (SelectiveDecoder::decode_rounds)
   std::vector<int> target; // the level map being decoded
   int target_of(uint32_t c) const { return target.empty() ? finest : target[c]; }
 };
@@ -336,14 +340,16 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   const FileHeader &h = s.layout.header;
   s.finest = static_cast<int>(h.levels.size());
   s.mesh = base_level_mesh(s.global.data(), s.layout);
-  s.attributes = load_attribute_table(s.global.data(), s.layout);
+  s.attributes = load_attribute_table(s.global.data(), s.layout, false); // (no codes kept)
   s.materials = load_material_table(s.global.data(), s.layout,
                                     s.attributes ? s.attributes->texture_files.size() : 0);
   if (s.attributes) { // attribute codes come with the positions, whatever the mask says
     describe_attributes(*s.attributes, s.info);
-    // Checked again with the attributes, which only the global part describes.
+    // Checked again with the attributes, which only the global part describes, before the
+    // base mesh's codes are stored.
     check_decode_memory(s.info, s.clustered() ? int(h.global_levels) : 0, options.memory_limit,
                         options.attributes, s.threads);
+    s.attributes = load_attribute_table(s.global.data(), s.layout);
     init_attributes(*s.attributes, s.mesh, options.attributes);
     s.global_models.attr = attribute_models(*s.attributes);
   }
@@ -538,93 +544,135 @@ void SelectiveDecoder::update(const Progress &progress) {
       s.uniform_cap = int(reached);
     return;
   }
-  // Decode the completed level map. Blocks that are missing or fail their check are capped
-  // before it is decoded (cap_failing_blocks); a block that fails while it is decoded caps
-  // its cluster and the map is completed and decoded again (each such round skips one more
-  // block, so this ends).
-  for (;;) {
-    uint32_t decoding = kNone; // the cluster being decoded when an error is thrown
-    try {
-      s.decode_target(progress, decoding);
-      return;
-    } catch (const Error &e) {
-      if (!s.skip_cluster(decoding, e))
-        throw;
-    }
-  }
+  s.decode_target(progress);
 }
 
-/// Bring the mesh to the level map completed from `wanted` and limited by the caps;
-/// `decoding` names the cluster being decoded (kNone between clusters).
-void SelectiveDecoder::State::decode_target(const Progress &progress, uint32_t &decoding) {
-  ++rounds;
-  target = complete_level_map(wanted, graph.start, graph.adj, global_levels, graph.link_start,
-                              graph.link);
+/// Bring the mesh to the level map completed from `wanted` and limited by the caps. With
+/// skip_damaged, the blocks it needs that are missing or fail their check are capped
+/// before anything is decoded (cap_failing_blocks); a block that fails while it is decoded
+/// is capped where it fails (skip_cluster) and the pass goes on without it, so that one
+/// pass meets every such block the map needs. Only when a cap falls below a level already
+/// decoded (the failed cluster's own earlier levels, its suspect neighbours, clusters near
+/// it) is the map decoded again from the base clustered mesh, once, after the pass: a
+/// round (a block that passed in one round and fails in the next costs one more; each
+/// round skips at least one more block, so this ends).
+void SelectiveDecoder::State::decode_target(const Progress &progress) {
+  const std::vector<int> request = complete_level_map(wanted, graph.start, graph.adj, global_levels,
+                                                      graph.link_start, graph.link);
+  target = request;
   if (skip_damaged)
     cap_failing_blocks();
-  if (!damaged.empty()) {
-    // Each damaged cluster limits the others to its cap + their distance to it, the
-    // largest map below both the request and the caps that keeps the level map rule.
-    const std::vector<int> limit =
-        cap_distance_map(cap, graph.start, graph.adj, finest, graph.link_start, graph.link);
-    for (size_t c = 0; c < target.size(); ++c)
-      target[c] = std::min(target[c], limit[c]);
-  }
+  limit_target(request);
   check_target_memory();
-  bool coarser = false;
-  for (size_t c = 0; c < target.size(); ++c)
-    coarser = coarser || target[c] < clusters[c].level;
-  if (coarser)
-    reset_to_snapshot();
   size_t todo = 0, done = 0;
-  for (size_t c = 0; c < target.size(); ++c)
-    todo += size_t(target[c] - clusters[c].level);
   const std::function<void()> applied = [&] {
     if (progress && (++done % 64 == 0 || done == todo))
-      progress(double(done) / double(todo), "decode");
+      progress(std::min(1.0, double(done) / double(todo)), "decode");
   };
+  for (;;) {
+    ++rounds;
+    bool coarser = false;
+    for (size_t c = 0; c < target.size(); ++c)
+      coarser = coarser || target[c] < clusters[c].level;
+    if (coarser)
+      reset_to_snapshot();
+    for (size_t c = 0; c < target.size(); ++c)
+      todo += size_t(target[c] - clusters[c].level);
+    if (decode_levels(request, applied))
+      break;
+    limit_target(request); // (the map the caps allow, from the base clustered mesh)
+  }
+  levels = target;
+  check_cluster_data();
+}
+
+/// target = the largest map below `request` and the caps that keeps the level map rule:
+/// each damaged cluster limits the others to its cap + their distance to it.
+void SelectiveDecoder::State::limit_target(const std::vector<int> &request) {
+  target = request;
+  if (damaged.empty())
+    return;
+  const std::vector<int> limit =
+      cap_distance_map(cap, graph.start, graph.adj, finest, graph.link_start, graph.link);
+  for (size_t c = 0; c < target.size(); ++c)
+    target[c] = std::min(target[c], limit[c]);
+}
+
+/// One pass over the clustered levels towards `target`. A block that fails while it is
+/// decoded (skip_damaged) caps its cluster and the pass goes on with the map the caps
+/// allow, never below a level already decoded (the largest of two maps that keep the
+/// level map rule keeps it too); returns false if some cluster is then finer than the caps
+/// allow (the caller decodes again from the base clustered mesh, knowing every failure of
+/// the pass).
+bool SelectiveDecoder::State::decode_levels(const std::vector<int> &request,
+                                            const std::function<void()> &applied) {
   // The whole mesh to one level (a full decode): the level table gives the final counts.
   const auto [lo, hi] = std::minmax_element(target.begin(), target.end());
   if (!target.empty() && *lo == *hi && *hi > global_levels) {
     const LevelEntry &e = layout.header.levels[size_t(*hi - 1)];
     mesh.reserve(e.vertices, e.faces, source->size());
   }
+  bool too_fine = false; // a cluster is finer than the caps allow
   for (int level = global_levels + 1; level <= finest; ++level) {
     // Nothing finer than level-1 exists yet: every current vertex is older than `level`.
     int finest_now = global_levels;
     for (const auto &k : clusters)
       finest_now = std::max(finest_now, k.level);
     const uint32_t older_than = finest_now < level ? mesh.vertex_count() : 0;
-    std::vector<uint32_t> refine; // the clusters to refine to `level`
-    for (uint32_t c = 0; c < target.size(); ++c)
-      if (target[c] >= level && clusters[c].level < level)
-        refine.push_back(c);
-    // A level with little to refine (a region's outer rings: many clusters of a few
-    // vertices each) stays on this thread: the two phases' copies and hand-overs cost more
-    // than the traversals save (one dragon cluster at the finest level: 19 ms on one
-    // thread, 24-32 ms with every level on the pool). The work is estimated from the
-    // level table: the level's vertices per cluster times the clusters to refine.
-    const uint64_t work = uint64_t(refine.size()) *
-                          layout.header.levels[size_t(level - 1)].vertices /
-                          std::max<size_t>(clusters.size(), 1);
-    const bool parallel = threads > 1 && work >= min_parallel_vertices;
-    if (parallel && !pool) {
-      pool = std::make_unique<ThreadPool>(threads);
-      steps.resize(pool->size());
-    }
-    if (parallel && pool->size() > 1) {
-      decode_level_parallel(refine, level, older_than, applied, decoding);
-      continue;
-    }
-    for (uint32_t c : refine) {
-      decoding = c;
-      decode_cluster_level(c, level, older_than);
-      decoding = kNone;
-      applied();
+    for (;;) {
+      uint32_t decoding = kNone; // the cluster being decoded when an error is thrown
+      try {
+        decode_level(level, older_than, applied, decoding);
+        break;
+      } catch (const Error &e) {
+        if (!skip_cluster(decoding, e))
+          throw;
+      }
+      // The failed step applied nothing (the clusters before it in the level are applied,
+      // the others as they were): go on with the map the new caps allow, where it is below
+      // what is decoded already.
+      limit_target(request);
+      for (size_t c = 0; c < target.size(); ++c)
+        if (target[c] < clusters[c].level) {
+          target[c] = clusters[c].level;
+          too_fine = true;
+        }
     }
   }
-  levels = target;
-  check_cluster_data();
+  return !too_fine;
+}
+
+/// The clusters `target` refines to `level` (at level - 1 now), on the pool's threads or
+/// this one; `decoding` names the cluster being decoded when an error is thrown.
+void SelectiveDecoder::State::decode_level(int level, uint32_t older_than,
+                                           const std::function<void()> &applied,
+                                           uint32_t &decoding) {
+  std::vector<uint32_t> refine; // the clusters to refine to `level`
+  for (uint32_t c = 0; c < target.size(); ++c)
+    if (target[c] >= level && clusters[c].level < level)
+      refine.push_back(c);
+  // A level with little to refine (a region's outer rings: many clusters of a few
+  // vertices each) stays on this thread: the two phases' copies and hand-overs cost more
+  // than the traversals save (one dragon cluster at the finest level: 19 ms on one
+  // thread, 24-32 ms with every level on the pool). The work is estimated from the
+  // level table: the level's vertices per cluster times the clusters to refine.
+  const uint64_t work = uint64_t(refine.size()) * layout.header.levels[size_t(level - 1)].vertices /
+                        std::max<size_t>(clusters.size(), 1);
+  const bool parallel = threads > 1 && work >= min_parallel_vertices;
+  if (parallel && !pool) {
+    pool = std::make_unique<ThreadPool>(threads);
+    steps.resize(pool->size());
+  }
+  if (parallel && pool->size() > 1) {
+    decode_level_parallel(refine, level, older_than, applied, decoding);
+    return;
+  }
+  for (uint32_t c : refine) {
+    decoding = c;
+    decode_cluster_level(c, level, older_than);
+    decoding = kNone;
+    applied();
+  }
 }
 
 /// Refuse (pomar::Error, Kind::MemoryLimit) a level map `target` that would need more

@@ -95,13 +95,15 @@ struct SizeModels {
   BitModel top[33][2];
 };
 
+} // namespace
+
 /// The cluster index: block sizes (adaptive Elias-gamma) and check bytes, range coded.
-std::vector<uint8_t> pack_cluster_index(const std::vector<std::vector<uint8_t>> &blocks) {
+std::vector<uint8_t> pack_cluster_index(const ClusterIndex &index) {
   std::vector<uint8_t> out;
   RangeEncoder rc(&out);
   SizeModels m;
-  for (const auto &b : blocks) {
-    const uint32_t n = static_cast<uint32_t>(b.size());
+  for (size_t c = 0; c < index.size.size(); ++c) {
+    const uint32_t n = index.size[c];
     const int nb = bit_length(n);
     rc.encode(m.length, nb);
     // The two bits under the leading one are modelled (sizes cluster around a mean).
@@ -112,11 +114,13 @@ std::vector<uint8_t> pack_cluster_index(const std::vector<std::vector<uint8_t>> 
       else
         rc.encode_bypass(uint32_t(bit), 1);
     }
-    rc.encode_bypass(checksum(b.data(), b.size()) & 0xFF, 8);
+    rc.encode_bypass(index.check[c], 8);
   }
   rc.finish();
   return out;
 }
+
+namespace {
 
 [[noreturn]] void bad(const std::string &what) {
   throw Error(Error::Kind::DamagedFile, "not a valid .pomar file: " + what);
@@ -214,7 +218,12 @@ std::vector<uint8_t> write_file(FileHeader header, const std::vector<uint8_t> &b
     header.clusters = static_cast<uint32_t>(cluster_blocks.size());
     header.tables_bytes = static_cast<uint32_t>(tables.size());
     header.tables_checksum = checksum(tables.data(), tables.size());
-    index = pack_cluster_index(cluster_blocks);
+    ClusterIndex entries;
+    for (const auto &b : cluster_blocks) {
+      entries.size.push_back(static_cast<uint32_t>(b.size()));
+      entries.check.push_back(static_cast<uint8_t>(checksum(b.data(), b.size()) & 0xFF));
+    }
+    index = pack_cluster_index(entries);
     header.index_bytes = static_cast<uint32_t>(index.size());
     header.index_checksum = checksum(index.data(), index.size());
     header.cluster_bytes = 0;
@@ -262,16 +271,13 @@ size_t header_size(const uint8_t *data, size_t size) {
   return bytes + 4;
 }
 
-FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size, bool allow_truncated) {
-  if (file_size == 0)
-    file_size = size;
-  if (size < 8 || std::memcmp(data, kMagic, 8) != 0)
-    bad("the file does not start with the POMAR signature");
-  ByteReader r(data, size, "the .pomar header");
-  for (int i = 0; i < 8; ++i)
-    r.u8();
-  FileLayout L;
-  FileHeader &h = L.header;
+namespace {
+
+// read_layout's steps, in the order of the header's fields.
+
+/// The fixed header after the signature: version, flags, grid, counts, base block size;
+/// returns the level count (checked against kMaxLevels).
+uint32_t read_fixed_header(ByteReader &r, FileHeader &h) {
   h.version = r.u16();
   if (h.version < kFormatVersion || h.version > kSectionsFormatVersion)
     throw Error(Error::Kind::Unsupported, "unsupported .pomar version " +
@@ -300,7 +306,14 @@ FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size, boo
   h.base_checksum = r.u32();
   if (levels > kMaxLevels)
     bad("level count " + std::to_string(levels) + " exceeds " + std::to_string(kMaxLevels));
-  // The header's size: fixed part, level table, cluster header, (version 4) section table.
+  return levels;
+}
+
+/// The header's size (fixed part, level table, cluster header, version 4's section table,
+/// checksum) into L.header_bytes, and its checksum checked; returns the section count.
+uint32_t check_header_bytes(const uint8_t *data, size_t size, uint32_t levels, FileLayout &L) {
+  const FileHeader &h = L.header;
+  const bool v4 = h.version == kSectionsFormatVersion;
   const size_t table_at =
       kFixedHeaderBytes + kLevelEntryBytes * levels + (h.clustered() ? kClusterHeaderBytes : 0);
   uint32_t sections = 0;
@@ -315,12 +328,13 @@ FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size, boo
   L.header_bytes = table_at + (v4 ? 4 + kSectionEntryBytes * sections : 0) + 4;
   if (size < L.header_bytes)
     bad("header is truncated");
-  const uint32_t stored = [&] {
-    ByteReader c(data + L.header_bytes - 4, 4, "header checksum");
-    return c.u32();
-  }();
-  if (checksum(data, L.header_bytes - 4) != stored)
+  ByteReader c(data + L.header_bytes - 4, 4, "header checksum");
+  if (checksum(data, L.header_bytes - 4) != c.u32())
     bad("header checksum mismatch (the file is damaged)");
+  return sections;
+}
+
+void read_level_table(ByteReader &r, uint32_t levels, FileHeader &h) {
   h.levels.resize(levels);
   for (LevelEntry &e : h.levels) {
     e.vertices = r.u32();
@@ -329,49 +343,56 @@ FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size, boo
     e.geometry_bytes = r.u32();
     e.checksum = r.u32();
   }
-  if (h.clustered()) {
-    h.global_levels = r.u32();
-    h.clusters = r.u32();
-    h.tables_bytes = r.u32();
-    h.tables_checksum = r.u32();
-    h.index_bytes = r.u32();
-    h.index_checksum = r.u32();
-    h.cluster_bytes = r.u32();
-    h.cluster_bytes |= uint64_t(r.u32()) << 32;
-    h.cluster_connectivity_bytes = r.u32();
-    if (h.version == kClusteredFormatVersion2) {
-      h.cluster_connectivity_bytes |= uint64_t(r.u32()) << 32;
-    } else {
-      h.has_cluster_checksum = true;
-      h.cluster_checksum = r.u32();
-    }
-    if (h.cluster_connectivity_bytes > h.cluster_bytes)
-      bad("cluster connectivity share exceeds the cluster data");
-    if (h.global_levels >= levels)
-      bad("no clustered level after " + std::to_string(h.global_levels) + " global levels");
-    const uint32_t base_clustered =
-        h.global_levels == 0 ? h.base_vertices : h.levels[h.global_levels - 1].vertices;
-    if (h.clusters != base_clustered)
-      bad("cluster count differs from the base clustered mesh's vertex count");
+}
+
+/// Versions 2 and 3: the cluster header, its counts checked against the level table.
+void read_cluster_header(ByteReader &r, FileHeader &h) {
+  h.global_levels = r.u32();
+  h.clusters = r.u32();
+  h.tables_bytes = r.u32();
+  h.tables_checksum = r.u32();
+  h.index_bytes = r.u32();
+  h.index_checksum = r.u32();
+  h.cluster_bytes = r.u32();
+  h.cluster_bytes |= uint64_t(r.u32()) << 32;
+  h.cluster_connectivity_bytes = r.u32();
+  if (h.version == kClusteredFormatVersion2) {
+    h.cluster_connectivity_bytes |= uint64_t(r.u32()) << 32;
+  } else {
+    h.has_cluster_checksum = true;
+    h.cluster_checksum = r.u32();
   }
-  if (v4) {
-    r.u32(); // the count, read above
-    for (uint32_t i = 0; i < sections; ++i) {
-      SectionEntry e;
-      e.tag = r.u32();
-      e.flags = r.u32();
-      e.bytes = r.u32();
-      e.bytes |= uint64_t(r.u32()) << 32;
-      e.checksum = r.u32();
-      if (e.flags & ~kSectionRequired)
-        bad("section " + section_name(e.tag) + " has unknown flags " + std::to_string(e.flags));
-      for (const SectionEntry &o : h.sections)
-        if (o.tag == e.tag)
-          bad("section " + section_name(e.tag) + " appears twice");
-      h.sections.push_back(e);
-    }
+  if (h.cluster_connectivity_bytes > h.cluster_bytes)
+    bad("cluster connectivity share exceeds the cluster data");
+  if (h.global_levels >= h.levels.size())
+    bad("no clustered level after " + std::to_string(h.global_levels) + " global levels");
+  const uint32_t base_clustered =
+      h.global_levels == 0 ? h.base_vertices : h.levels[h.global_levels - 1].vertices;
+  if (h.clusters != base_clustered)
+    bad("cluster count differs from the base clustered mesh's vertex count");
+}
+
+/// Version 4: the section table (its count, read by check_header_bytes, skipped).
+void read_section_table(ByteReader &r, uint32_t sections, FileHeader &h) {
+  r.u32();
+  for (uint32_t i = 0; i < sections; ++i) {
+    SectionEntry e;
+    e.tag = r.u32();
+    e.flags = r.u32();
+    e.bytes = r.u32();
+    e.bytes |= uint64_t(r.u32()) << 32;
+    e.checksum = r.u32();
+    if (e.flags & ~kSectionRequired)
+      bad("section " + section_name(e.tag) + " has unknown flags " + std::to_string(e.flags));
+    for (const SectionEntry &o : h.sections)
+      if (o.tag == e.tag)
+        bad("section " + section_name(e.tag) + " appears twice");
+    h.sections.push_back(e);
   }
-  // Sanity of the counts before anybody allocates from them.
+}
+
+/// The counts' sanity, before anybody allocates from them.
+void check_counts(const FileHeader &h) {
   if (h.grid.bits < 1 || h.grid.bits > 24)
     bad("quantization bits " + std::to_string(h.grid.bits) + " outside 1..24");
   if (!std::isfinite(h.grid.extent) || h.grid.extent < 0 || !std::isfinite(h.grid.origin[0]) ||
@@ -403,7 +424,12 @@ FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size, boo
   if (h.base_vertices > 3 * uint64_t(h.base_faces))
     bad(std::to_string(h.base_vertices) + " base vertices for " + std::to_string(h.base_faces) +
         " base faces: more than three per face");
-  // Offsets: every addition is checked (advance), and nothing below subtracts sizes.
+}
+
+/// Every block's offset, each addition checked (advance; nothing subtracts sizes); returns
+/// the offset of the end of the file the header announces.
+uint64_t place_blocks(FileLayout &L) {
+  const FileHeader &h = L.header;
   uint64_t offset = L.header_bytes;
   L.base_offset = offset;
   advance(offset, h.base_bytes, "base mesh block");
@@ -431,19 +457,48 @@ FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size, boo
   } else {
     L.global_bytes = offset;
   }
-  L.file_size = file_size;
-  // With allow_truncated, only what every decode needs must be present; a strict reader
-  // needs every byte the header announces.
-  const uint64_t needed = !allow_truncated         ? offset
+  return offset;
+}
+
+/// With allow_truncated, only what every decode needs must be present; a strict reader
+/// needs every byte the header announces (`end`).
+void check_present(const FileLayout &L, uint64_t end, bool allow_truncated) {
+  const FileHeader &h = L.header;
+  const uint64_t needed = !allow_truncated         ? end
                           : h.clustered()          ? L.global_bytes
                           : L.level_offset.empty() ? L.global_bytes
                                                    : L.level_offset[0]; // base + sections
-  if (needed > file_size)
-    throw Error(Error::Kind::TruncatedFile, "truncated .pomar file: " + std::to_string(file_size) +
-                                                " bytes, the header announces " +
-                                                std::to_string(offset));
-  if (h.vertices > 512 * uint64_t(file_size) + 64)
+  if (needed > L.file_size)
+    throw Error(Error::Kind::TruncatedFile,
+                "truncated .pomar file: " + std::to_string(L.file_size) +
+                    " bytes, the header announces " + std::to_string(end));
+  if (h.vertices > 512 * uint64_t(L.file_size) + 64)
     bad("the announced vertex count is implausible for the file size");
+}
+
+} // namespace
+
+FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size, bool allow_truncated) {
+  if (file_size == 0)
+    file_size = size;
+  if (size < 8 || std::memcmp(data, kMagic, 8) != 0)
+    bad("the file does not start with the POMAR signature");
+  ByteReader r(data, size, "the .pomar header");
+  for (int i = 0; i < 8; ++i)
+    r.u8();
+  FileLayout L;
+  FileHeader &h = L.header;
+  const uint32_t levels = read_fixed_header(r, h);
+  const uint32_t sections = check_header_bytes(data, size, levels, L);
+  read_level_table(r, levels, h);
+  if (h.clustered())
+    read_cluster_header(r, h);
+  if (h.version == kSectionsFormatVersion)
+    read_section_table(r, sections, h);
+  check_counts(h);
+  const uint64_t end = place_blocks(L);
+  L.file_size = file_size;
+  check_present(L, end, allow_truncated);
   return L;
 }
 

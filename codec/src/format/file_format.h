@@ -151,6 +151,9 @@ FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size = 0,
                        bool allow_truncated = false);
 /// Decode the cluster index block (`data` = the whole index block).
 ClusterIndex read_cluster_index(const uint8_t *data, const FileLayout &layout);
+/// The cluster index block of `index`'s sizes and checks (its offsets are not stored: each
+/// block follows the one before it).
+std::vector<uint8_t> pack_cluster_index(const ClusterIndex &index);
 /// Check the base block's checksum and unpack it; `keep` false checks it without storing
 /// anything (inspection: memory independent of the counts).
 BaseMesh read_base_mesh(const uint8_t *data, const FileLayout &layout, bool keep = true);
