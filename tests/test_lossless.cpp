@@ -1,7 +1,7 @@
 // Lossless for every mesh (codec/src/lossless): messy meshes encode by default and a full
 // decode gives back exactly the input — vertex count, oriented faces as a multiset
 // (duplicates and faces repeating a vertex included), every vertex on its grid position —
-// while clean meshes give the same bytes as before (format version 1/3).
+// while clean meshes give the same bytes as with `strict` (format version 1/3).
 #include <gtest/gtest.h>
 
 #include <algorithm>

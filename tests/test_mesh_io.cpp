@@ -614,7 +614,7 @@ TEST_F(MeshIoTest, PlyBinaryBigEndianAndIndexTypes) {
   EXPECT_NE(msg.find("misreads"), std::string::npos) << msg;
 }
 
-/// A fast reading path gave what the general one gives: the same floats bit for bit, the
+/// A fast reading path gives what the general one gives: the same floats bit for bit, the
 /// same faces and the same report (two unreferenced vertices in the tests' files).
 void expect_same_load(const Mesh &fast, const LoadReport &fast_report, const Mesh &general,
                       const LoadReport &general_report) {

@@ -18,8 +18,8 @@
 // whole mesh is refined): the faces and vertices a thread reads in its traversals
 // are the ones it wrote when it applied its clusters at the level before, so they stay in
 // its core's cache. (When one thread applied every cluster, the others read lines that
-// core had written: on a machine whose cores do not share a cache that doubled their cost
-// per split; bench/README.md, eleventh session.)
+// core had written: on a machine whose cores do not share a cache that doubles their cost
+// per split; bench/README.md, "Threads".)
 //
 // Why the result does not depend on the threads. A traversal reads the level-(l-1) view,
 // the same whichever clusters of the level are applied (refine/level_step.h); during phase 1

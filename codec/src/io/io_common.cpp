@@ -85,7 +85,7 @@ bool parse_int(const std::string &token, int64_t &value) {
 
 bool parse_float(const std::string &token, float &value) {
   // Plain decimal text, the common case: from_chars rounds it as strtof does, at a fraction
-  // of the cost; what it does not take (out of range included) goes to strtof as before.
+  // of the cost; what it does not take (out of range included) goes to strtof.
   const char *b = token.data(), *e = b + token.size();
   if (plain_decimal(b, e)) {
     float x;

@@ -3,15 +3,14 @@
 // Two sorts with equal elements leave them in an order that depends on the algorithm: the
 // edge ranking of a split vertex with more than 16 edges (refine/patch.h: a view ring can
 // name one neighbour twice, and the two entries tie) and the encoder's face order
-// (mesh/reorder.cpp: faces tie on their smallest vertex). Files were written by encoders
-// built with GCC's standard library, whose std::sort is an introsort; the browser decoder
-// is built by Emscripten, whose library (libc++) sorts small ranges otherwise. On 96,230
-// random rings of 17-40 entries with one tie, GCC's std::sort left about half of the ties
-// in another order than a stable sort, and the Emscripten build's std::sort did not give
-// GCC's orders (a hash of all of them differed): a browser decode of such a file would
-// have taken another edge. `introsort` is that algorithm, written out so that every build
-// sorts alike and files already written keep their meaning (the Emscripten build of it
-// gives GCC's orders on those rings):
+// (mesh/reorder.cpp: faces tie on their smallest vertex). The bitstream follows the order
+// of GCC's std::sort, an introsort; the browser decoder is built by Emscripten, whose
+// library (libc++) sorts small ranges otherwise. On 96,230 random rings of 17-40 entries
+// with one tie, GCC's std::sort leaves about half of the ties in another order than a
+// stable sort, and the Emscripten build's std::sort does not give GCC's orders (a hash of
+// all of them differs): a browser decode of such a file would take another edge.
+// `introsort` is that algorithm, written out so that every build sorts alike and every
+// file keeps its meaning (the Emscripten build of it gives GCC's orders on those rings):
 //
 // - while more than 16 elements remain: the median of the second, middle and last
 //   elements is swapped to the front and the rest partitioned around it (Hoare's scheme,
