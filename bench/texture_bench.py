@@ -12,6 +12,11 @@ Draco 1.5.5: `draco_encoder -qp 12 -qt 12 -cl 10` on the OBJ against the same OB
 its `vt`, `mtllib` and `usemtl` lines (the faces' `/vt` removed). Also: the seam edges and
 wedge copies (`pomar encode` prints them), the base mesh vertices with and without
 texture coordinates (`pomar info --json`), and a `pomar verify` of the decoded file.
+A second table breaks pomar's cost down (bytes with minus bytes without, from `pomar info
+--json`): the base mesh block, the ATTR section (the base mesh's attribute codes), the
+encoder's estimate of the wedge texture coordinates in the levels and cluster blocks,
+the rest of the levels and blocks (the copies' positions and connectivity, the blocks'
+own ends), the cluster index, the model tables, the MATL and LSLS sections and the header.
 Markdown on stdout, progress on stderr.
 """
 import argparse
@@ -103,6 +108,31 @@ def cube_mapped_sphere(path, n, seed=3):
             out.write('f ' + ' '.join('%d/%d' % (v + 1, t) for v, t in zip(fa, cs)) + '\n')
 
 
+def breakdown(w, o):
+    """Where the bytes of the file with texture coordinates (`pomar info --json` w) go
+    beyond those of the file without (o)."""
+    def section(d, tag):
+        return sum(x['bytes'] for x in d.get('sections', []) if x['name'] == tag)
+
+    def levels(d):  # global levels and cluster blocks
+        return sum(l.get('connectivity_bytes', 0) + l.get('geometry_bytes', 0)
+                   for l in d['levels'][1:]) + d['cluster_bytes']
+    uv = sum(a['bytes'] for a in w.get('attributes', []) if a['name'] == 'pomar:corner texcoord')
+    d = {
+        'base mesh': w['base_bytes'] - o['base_bytes'],
+        'ATTR': section(w, 'ATTR') - section(o, 'ATTR'),
+        'UV in levels': uv,
+        'rest of levels': levels(w) - levels(o) - uv,
+        'cluster index': w['index_bytes'] - o['index_bytes'],
+        'model tables': w['tables_bytes'] - o['tables_bytes'],
+        'MATL + LSLS': sum(section(w, t) - section(o, t) for t in ('MATL', 'LSLS')),
+        'header': w['header_bytes'] - o['header_bytes'],
+    }
+    rest = (w['total_bytes'] - o['total_bytes']) - sum(d.values())
+    d['header'] += rest  # (anything else: other sections)
+    return '%d / %d' % (o['clusters'], w['clusters']), d
+
+
 def main():
     here = os.path.dirname(os.path.abspath(__file__))
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -127,7 +157,7 @@ def main():
         g = os.path.join(tmp, 'sphere.obj')
         cube_mapped_sphere(g, a.generated)
         meshes.append(('cube-mapped sphere', g))
-    rows = []
+    rows, parts = [], []
     for name, path in meshes:
         print('texture_bench: %s' % name, file=sys.stderr)
         plain = os.path.join(tmp, name.replace(' ', '_') + '_plain.obj')
@@ -144,6 +174,7 @@ def main():
         drc_with, drc_without = os.path.join(tmp, 'with.drc'), os.path.join(tmp, 'without.drc')
         run(['draco_encoder', '-i', path, '-o', drc_with, '-qp', '12', '-qt', '12', '-cl', '10'])
         run(['draco_encoder', '-i', plain, '-o', drc_without, '-qp', '12', '-cl', '10'])
+        parts.append((name, nv, breakdown(info_with, info_without)))
         pc = os.path.getsize(with_uv) - os.path.getsize(without)
         dc = os.path.getsize(drc_with) - os.path.getsize(drc_without)
         rows.append((name, nv, seams.group(1) if seams else '0', seams.group(2) if seams else '0',
@@ -159,6 +190,14 @@ def main():
         print('| %s | %d | %s | %s | %d / %d | %d / %d | %d / %d | %.2f | %.2f | %.2f |' %
               (name, nv, se, wc, bw, bu, pw, pu, dw, du, 8.0 * pc / nv, 8.0 * dc / nv,
                pc / dc if dc else float('nan')))
+    keys = ['base mesh', 'ATTR', 'UV in levels', 'rest of levels', 'cluster index',
+            'model tables', 'MATL + LSLS', 'header']
+    print()
+    print('| mesh | clusters without / with | ' + ' | '.join(keys) + ' | total (bpv) |')
+    print('|---|--:|' + '--:|' * len(keys) + '--:|')
+    for name, nv, (clusters, d) in parts:
+        print('| %s | %s | %s | %.2f |' % (name, clusters, ' | '.join('%+d' % d[k] for k in keys),
+                                          8.0 * sum(d.values()) / nv))
     shutil.rmtree(tmp)
 
 

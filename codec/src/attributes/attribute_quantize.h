@@ -29,6 +29,10 @@ struct StoredAttribute {
   /// Quantized normals: some are zero-length (coded as octahedral_zero_code(bits) twice,
   /// decoded as exactly (0, 0, 0)). Without it the codes stay on the grid.
   bool zero_normals = false;
+  /// The seam cut's wedge texture coordinate (quantized): predicted from the positions
+  /// (attributes/wedge_prediction.h) instead of by its neighbours' mean, in the levels and
+  /// in the base mesh.
+  bool from_positions = false, base_from_positions = false;
   /// Integer codes per vertex.
   uint32_t codes() const { return kind == AttributeKind::Normal && bits ? 2 : components; }
   /// Largest error of a decoded value (degrees for normals, absolute otherwise).

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <string>
 
+#include "attributes/wedge_prediction.h"
 #include "format/bit_io.h"
 #include "lossless/seam_cut.h"
 #include "refine/level_traversal.h"
@@ -24,10 +25,22 @@ template <class Coder> void code_base(Coder &&code_one, uint32_t count, uint32_t
       code_one(v, k);
 }
 
-/// The flags byte of a descriptor (ATTR section version 2).
+/// The flags byte of a descriptor (ATTR section versions 2 and 3).
 constexpr uint8_t kZeroNormalsFlag = 1; // a quantized normal attribute with zero-length normals
+// The wedge texcoord predicted from the positions (version 3): in the levels, in the base mesh.
+constexpr uint8_t kPositionsFlag = 2, kBasePositionsFlag = 4;
+bool is_wedge_grid(const StoredAttribute &s) {
+  return s.kind == AttributeKind::TexCoord && s.bits && s.name == kWedgeTexcoord;
+}
+bool positions_predict(const StoredAttribute &s) { return is_wedge_grid(s) && s.from_positions; }
+bool base_positions_predict(const StoredAttribute &s) {
+  return is_wedge_grid(s) && s.base_from_positions;
+}
 uint8_t descriptor_flags(const StoredAttribute &s) {
-  return s.kind == AttributeKind::Normal && s.bits && s.zero_normals ? kZeroNormalsFlag : 0;
+  return uint8_t(
+      (s.kind == AttributeKind::Normal && s.bits && s.zero_normals ? kZeroNormalsFlag : 0) |
+      (positions_predict(s) ? kPositionsFlag : 0) |
+      (base_positions_predict(s) ? kBasePositionsFlag : 0));
 }
 
 /// kind, name, components, bits and bound of a stored attribute into a VertexAttribute or
@@ -42,15 +55,48 @@ template <class Out> Out described(const StoredAttribute &s) {
   return a;
 }
 
+/// Whether the table's wedge texture coordinate is predicted from the positions in the
+/// levels (or, `base`, in the base mesh).
+bool wedge_positions(const AttributeTable &t, bool base = false) {
+  for (const StoredAttribute &s : t.stored)
+    if (base ? base_positions_predict(s) : positions_predict(s))
+      return true;
+  return false;
+}
+
 /// The wedge texture coordinate of base vertex v (codes k0, k0 + 1 of n a vertex in
 /// `codes`) predicted by the mean of its neighbours numbered below v in the base mesh `ct`
 /// (one chart: the seam cut separates the charts), rounded half away from zero, or by
-/// vertex v - 1's if it has none (zeros for vertex 0).
+/// vertex v - 1's if it has none (zeros for vertex 0). With positions `q` (a file whose
+/// wedge texture coordinate is predicted from the positions), from the faces of v's
+/// neighbours a < v whose vertices are all numbered below v, if any, in the order of v's
+/// ring and of each a's ring (attributes/wedge_prediction.h); `lo` and `hi` are the codes'
+/// ranges.
 void predict_wedge_base(const CornerTable &ct, const std::vector<int64_t> &codes, uint32_t n,
-                        int k0, uint32_t v, Ring &ring, int64_t pred[2]) {
+                        int k0, uint32_t v, Ring &ring, int64_t pred[2],
+                        const std::vector<int32_t> *q = nullptr, const int64_t *lo = nullptr,
+                        const int64_t *hi = nullptr) {
   int64_t su = 0, sv = 0, count = 0;
   if (ct.VC[v] != kNone) {
     get_ring(ct, v, ring);
+    if (q) {
+      const auto uv = [&](uint32_t u) { return &codes[size_t(u) * n + size_t(k0)]; };
+      const auto at = [&](uint32_t u) { return &(*q)[3 * size_t(u)]; };
+      WedgeFromPositions w(at(v));
+      Ring fan;
+      for (uint32_t a : ring.neighbour) {
+        if (a >= v)
+          continue;
+        get_ring(ct, a, fan);
+        for (uint32_t i = 0; i < fan.faces(); ++i) {
+          const uint32_t b = fan.neighbour[i], c = fan.neighbour[(i + 1) % fan.size()];
+          if (b < v && c < v)
+            w.add(at(a), at(b), at(c), uv(a), uv(b), uv(c));
+        }
+      }
+      if (w.get(lo, hi, pred))
+        return;
+    }
     for (uint32_t u : ring.neighbour)
       if (u < v) {
         su += codes[size_t(u) * n + size_t(k0)];
@@ -79,6 +125,28 @@ int wedge_code(const AttributeTable &t) {
   return -1;
 }
 
+/// The base mesh's codes stream of a table (the wedge texture coordinate's residuals from
+/// `wedge_residuals` if it has them).
+std::vector<uint8_t> base_codes_stream(const AttributeTable &t, uint32_t count) {
+  const uint32_t n = t.codes;
+  std::vector<uint8_t> stream;
+  RangeEncoder rc(&stream);
+  std::vector<AttributeCodeModels> m = attribute_models(t);
+  std::vector<int64_t> r(n);
+  const int wedge = t.wedge_residuals.empty() ? -1 : t.wedge_uv;
+  code_base(
+      [&](uint32_t v, uint32_t k) {
+        const int64_t pred = v ? t.base[size_t(v - 1) * n + k] : 0;
+        r[k] = wedge >= 0 && (int(k) == wedge || int(k) == wedge + 1)
+                   ? t.wedge_residuals[2 * size_t(v) + (k - uint32_t(wedge))]
+                   : t.base[size_t(v) * n + k] - pred;
+        put_signed(rc, m[k].classes[attribute_context(m[k], r.data(), k)], m[k].top, r[k]);
+      },
+      count, n);
+  rc.finish();
+  return stream;
+}
+
 } // namespace
 
 void plan_wedge_residuals(AttributeTable &t, const LevelMesh &base) {
@@ -86,18 +154,35 @@ void plan_wedge_residuals(AttributeTable &t, const LevelMesh &base) {
   if (t.wedge_uv < 0 || t.codes == 0)
     return;
   const uint32_t n = t.codes, count = static_cast<uint32_t>(t.base.size() / n);
-  t.wedge_residuals.resize(2 * size_t(count));
-  Ring ring;
-  for (uint32_t v = 0; v < count; ++v) {
-    int64_t pred[2];
-    predict_wedge_base(base.ct, t.base, n, t.wedge_uv, v, ring, pred);
-    for (int j = 0; j < 2; ++j)
-      t.wedge_residuals[2 * size_t(v) + j] =
-          t.base[size_t(v) * n + size_t(t.wedge_uv) + j] - pred[j];
-  }
+  const size_t k0 = size_t(t.wedge_uv);
+  const auto residuals = [&](bool positions) {
+    std::vector<int64_t> out(2 * size_t(count));
+    Ring ring;
+    for (uint32_t v = 0; v < count; ++v) {
+      int64_t pred[2];
+      predict_wedge_base(base.ct, t.base, n, t.wedge_uv, v, ring, pred,
+                         positions ? &base.q : nullptr, &base.attr_lo[k0], &base.attr_hi[k0]);
+      for (int j = 0; j < 2; ++j)
+        out[2 * size_t(v) + j] = t.base[size_t(v) * n + k0 + j] - pred[j];
+    }
+    return out;
+  };
+  t.wedge_residuals = residuals(false);
+  for (StoredAttribute &s : t.stored)
+    if (is_wedge_grid(s) && s.base_from_positions) {
+      // From the positions or by the mean, whichever codes smaller.
+      const size_t mean_bytes = base_codes_stream(t, count).size();
+      std::vector<int64_t> other = residuals(true);
+      t.wedge_residuals.swap(other);
+      if (base_codes_stream(t, count).size() >= mean_bytes) {
+        t.wedge_residuals.swap(other);
+        s.base_from_positions = false;
+      }
+    }
 }
 
-AttributeTable plan_attributes(const Mesh &mesh, const AttributeOptions &options) {
+AttributeTable plan_attributes(const Mesh &mesh, const AttributeOptions &options,
+                               bool wedge_from_positions) {
   AttributeTable t;
   for (const VertexAttribute &a : mesh.attributes)
     if (keeps_attribute(a.name, a.kind, options.keep)) {
@@ -111,6 +196,10 @@ AttributeTable plan_attributes(const Mesh &mesh, const AttributeOptions &options
         t.stored.push_back(describe(a, exact_integers));
       } else {
         t.stored.push_back(describe(a, options));
+        // (plan_wedge_residuals keeps the base mesh's prediction from the positions only
+        // if it codes smaller)
+        t.stored.back().from_positions = wedge_from_positions && a.name == kWedgeTexcoord;
+        t.stored.back().base_from_positions = a.name == kWedgeTexcoord;
       }
       t.codes += t.stored.back().codes();
     }
@@ -178,6 +267,7 @@ void init_attributes(const AttributeTable &table, LevelMesh &lm, const Attribute
   lm.attr_hi.clear();
   lm.normal_code = -1;
   lm.wedge_uv_code = table.wedge_uv;
+  lm.wedge_uv_positions = wedge_positions(table);
   lm.normal_zero = false;
   for (const StoredAttribute &s : table.stored) {
     if (s.kind == AttributeKind::Normal && s.bits && lm.normal_code < 0) {
@@ -195,10 +285,12 @@ void init_attributes(const AttributeTable &table, LevelMesh &lm, const Attribute
   if (table.wedge_pending) { // the wedge residuals of a file, resolved in vertex order
     const uint32_t n = table.codes, count = static_cast<uint32_t>(table.base.size() / n);
     const size_t k0 = size_t(table.wedge_uv);
+    const bool base_positions = wedge_positions(table, true);
     Ring ring;
     for (uint32_t v = 0; v < count; ++v) {
       int64_t pred[2];
-      predict_wedge_base(lm.ct, lm.attr, n, table.wedge_uv, v, ring, pred);
+      predict_wedge_base(lm.ct, lm.attr, n, table.wedge_uv, v, ring, pred,
+                         base_positions ? &lm.q : nullptr, &lm.attr_lo[k0], &lm.attr_hi[k0]);
       for (size_t j = 0; j < 2; ++j) {
         int64_t &c = lm.attr[size_t(v) * n + k0 + j];
         c += pred[j];
@@ -214,10 +306,15 @@ std::vector<uint8_t> write_attributes(const AttributeTable &t, uint32_t base_ver
   ByteWriter w(out);
   // Version 1 unless a descriptor needs its flags byte (version 2): files whose attributes
   // use no flag stay readable by readers of version 1.
-  bool flags = false;
-  for (const StoredAttribute &s : t.stored)
+  // Version 3 only when the wedge texture coordinate is predicted from the positions.
+  bool flags = false, positions = false;
+  for (const StoredAttribute &s : t.stored) {
     flags |= descriptor_flags(s) != 0;
-  w.u8(flags ? kAttributeSectionFlagsVersion : kAttributeSectionVersion);
+    positions |= positions_predict(s) || base_positions_predict(s);
+  }
+  w.u8(positions ? kAttributeSectionPositionsVersion
+       : flags   ? kAttributeSectionFlagsVersion
+                 : kAttributeSectionVersion);
   w.u8(static_cast<uint8_t>(t.stored.size()));
   for (size_t i = 0; i < t.stored.size(); ++i) {
     const StoredAttribute &s = t.stored[i];
@@ -254,21 +351,7 @@ std::vector<uint8_t> write_attributes(const AttributeTable &t, uint32_t base_ver
         Error::Kind::Internal,
         "internal encoder error: the base mesh's attribute codes do not match its vertices");
   w.u32(count);
-  std::vector<uint8_t> stream;
-  RangeEncoder rc(&stream);
-  std::vector<AttributeCodeModels> m = attribute_models(t);
-  std::vector<int64_t> r(n);
-  const int wedge = t.wedge_residuals.empty() ? -1 : t.wedge_uv;
-  code_base(
-      [&](uint32_t v, uint32_t k) {
-        const int64_t pred = v ? t.base[size_t(v - 1) * n + k] : 0;
-        r[k] = wedge >= 0 && (int(k) == wedge || int(k) == wedge + 1)
-                   ? t.wedge_residuals[2 * size_t(v) + (k - uint32_t(wedge))]
-                   : t.base[size_t(v) * n + k] - pred;
-        put_signed(rc, m[k].classes[attribute_context(m[k], r.data(), k)], m[k].top, r[k]);
-      },
-      count, n);
-  rc.finish();
+  const std::vector<uint8_t> stream = base_codes_stream(t, count);
   w.u32(static_cast<uint32_t>(stream.size()));
   w.bytes(stream.data(), stream.size());
   return out;
@@ -279,10 +362,11 @@ AttributeTable read_attributes(const uint8_t *data, size_t size, uint32_t base_v
   ByteReader r(data, size, "damaged .pomar file: ATTR section");
   AttributeTable t;
   const uint8_t version = r.u8();
-  if (version != kAttributeSectionVersion && version != kAttributeSectionFlagsVersion)
+  if (version != kAttributeSectionVersion && version != kAttributeSectionFlagsVersion &&
+      version != kAttributeSectionPositionsVersion)
     throw Error(Error::Kind::Unsupported, "ATTR section version " + std::to_string(version) +
                                               " is not supported (this pomar reads versions 1 "
-                                              "and 2)");
+                                              "to 3)");
   const uint32_t count = r.u8();
   auto read_string = [&](size_t len) {
     std::string s;
@@ -298,8 +382,11 @@ AttributeTable read_attributes(const uint8_t *data, size_t size, uint32_t base_v
     s.kind = static_cast<AttributeKind>(kind);
     s.components = r.u8();
     s.bits = r.u8();
-    const uint8_t flags = version == kAttributeSectionFlagsVersion ? r.u8() : 0;
+    const uint8_t flags = version != kAttributeSectionVersion ? r.u8() : 0;
     s.zero_normals = flags & kZeroNormalsFlag;
+    s.from_positions = version == kAttributeSectionPositionsVersion && (flags & kPositionsFlag);
+    s.base_from_positions =
+        version == kAttributeSectionPositionsVersion && (flags & kBasePositionsFlag);
     s.name = read_string(r.u8());
     const uint32_t want = s.kind == AttributeKind::Normal     ? 3
                           : s.kind == AttributeKind::TexCoord ? 2

@@ -27,6 +27,9 @@ constexpr uint32_t kAttributeSectionTag = section_tag("ATTR"); // optional (flag
 constexpr uint8_t kAttributeSectionVersion = 1;
 /// The version whose descriptors have a flags byte (written only when a flag is set).
 constexpr uint8_t kAttributeSectionFlagsVersion = 2;
+/// The version whose descriptors may also have the positions flag (the wedge texture
+/// coordinate predicted from the positions; written only when it is set).
+constexpr uint8_t kAttributeSectionPositionsVersion = 3;
 
 /// The attributes of a file: descriptors, texture files and the codes of the base mesh.
 struct AttributeTable {
@@ -47,12 +50,18 @@ struct AttributeTable {
 };
 
 /// The encoder's side, once `table.base` holds the base mesh's codes and `base` is the base
-/// mesh: the residuals of the wedge texture coordinates (table.wedge_residuals).
+/// mesh: the residuals of the wedge texture coordinates (table.wedge_residuals), predicted
+/// from the positions if that codes smaller than the neighbours' mean (else the
+/// descriptor's base_from_positions is cleared).
 void plan_wedge_residuals(AttributeTable &table, const LevelMesh &base);
 
 /// The encoder's side: what is kept of `mesh`'s attributes and how (empty table: nothing).
 /// Throws pomar::Error if they need more than kMaxAttributeCodes codes per vertex.
-AttributeTable plan_attributes(const Mesh &mesh, const AttributeOptions &options);
+/// `wedge_from_positions`: the seam cut's wedge texture coordinate, if quantized, is
+/// predicted in the levels from the positions (attributes/wedge_prediction.h), else by its
+/// neighbours' mean (in the base mesh: whichever codes smaller, plan_wedge_residuals).
+AttributeTable plan_attributes(const Mesh &mesh, const AttributeOptions &options,
+                               bool wedge_from_positions = true);
 /// Codes of every vertex, in the order of `to_input` (to_input[i] = the mesh's vertex).
 std::vector<int64_t> attribute_codes(const Mesh &mesh, const AttributeTable &table,
                                      const AttributeOptions &options,

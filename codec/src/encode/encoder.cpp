@@ -221,7 +221,8 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
   const double t_quantize = seconds_since(t0);
   // Attributes: codes of every vertex (prepared numbering); the base mesh's go to the ATTR
   // section, the others are coded with their positions by the level steps.
-  AttributeTable attributes = plan_attributes(mesh, options.attributes);
+  AttributeTable attributes =
+      plan_attributes(mesh, options.attributes, !hook || hook->wedge_from_positions);
   const std::vector<int64_t> codes =
       attributes.codes ? attribute_codes(mesh, attributes, options.attributes, in.to_input)
                        : std::vector<int64_t>();

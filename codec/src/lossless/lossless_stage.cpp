@@ -361,13 +361,35 @@ std::vector<uint8_t> encode_any(const Mesh &mesh, const EncodeOptions &options,
       throw Error(Error::Kind::InvalidMesh, "the mesh has no valid triangle: all " +
                                                 std::to_string(mesh.triangle_count()) +
                                                 " faces repeat a vertex");
-    if (!cut_needed) // (the topology is not known to be valid: a refusal is not named)
-      return encode_manifold(*coded, options, report, &hook, {}, false);
-    try { // (the encoder's corner table checks the cut, see repair/cut.h)
-      return encode_manifold(cut, options, report, &hook);
-    } catch (const TopologyError &e) {
-      throw still_invalid(e);
+    const auto encode_once = [&](const EncodeOptions &o) {
+      if (!cut_needed) // (the topology is not known to be valid: a refusal is not named)
+        return encode_manifold(*coded, o, report, &hook, {}, false);
+      try { // (the encoder's corner table checks the cut, see repair/cut.h)
+        return encode_manifold(cut, o, report, &hook);
+      } catch (const TopologyError &e) {
+        throw still_invalid(e);
+      }
+    };
+    hook.wedge_from_positions = true;
+    std::vector<uint8_t> file = encode_once(options);
+    if (corners && !mesh.corner_texcoords.empty() && !options.attributes.exact) {
+      // The positions predict the (u, v) of charts that map the surface affinely far better
+      // than the neighbours' mean, which does better on charts that do not: both files,
+      // the smaller kept (bench/README.md, "Textured scans"). The cut, the decimation, the
+      // numbering and so the record are the same; only the wedge residuals differ.
+      EncodeReport first;
+      if (report)
+        first = *report;
+      EncodeOptions quiet = options;
+      quiet.progress = nullptr;
+      hook.wedge_from_positions = false;
+      std::vector<uint8_t> mean = encode_once(quiet);
+      if (mean.size() < file.size())
+        file.swap(mean);
+      else if (report)
+        *report = std::move(first);
     }
+    return file;
   };
   std::vector<uint8_t> file;
   if (valid) {

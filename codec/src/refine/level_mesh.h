@@ -36,8 +36,10 @@ struct LevelMesh {
   // A decode that returns no attribute: the codes per split vertex read and dropped (the
   // residuals share the streams of the positions), with attr_codes = 0 and attr empty.
   uint32_t attr_skipped = 0;
-  int normal_code = -1;     // first code of a quantized normal attribute (-1: none)
-  int wedge_uv_code = -1;   // first code of the seam cut's wedge texcoord (-1: none)
+  int normal_code = -1;   // first code of a quantized normal attribute (-1: none)
+  int wedge_uv_code = -1; // first code of the seam cut's wedge texcoord (-1: none)
+  bool wedge_uv_positions =
+      false;                // it is predicted from the positions (attributes/wedge_prediction.h)
   int normal_bits = 0;      // its octahedral bits
   bool normal_zero = false; // its codes may be the zero-length normal's (octahedral_zero_code)
   uint32_t vertex_count() const { return ct.vertex_count(); }

@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "attributes/attribute_quantize.h"
+#include "attributes/wedge_prediction.h"
 #include "entropy/models.h"
 #include "geometry/predict.h"
 #include "mesh/corner_table.h"
@@ -130,12 +131,13 @@ inline void get_view_ring(const LevelMesh &mesh, uint32_t v, const LevelView &le
 /// if v_to's normal is zero-length. The seam cut's wedge texture coordinate (files with a
 /// MATL section) is predicted by the mean of the codes of v_from's neighbours to be (v_to
 /// and the patch ring, all in v_from's chart: the cut separates the charts), rounded half
-/// away from zero.
+/// away from zero, or, in files that say so, from the positions (predict_wedge_from_positions).
 inline void predict_attributes(const LevelMesh &mesh, uint32_t v_to, const Ring &ring,
                                const PatchRange &p, const int32_t position[3], int64_t *pred) {
   const uint32_t n = mesh.attr_codes;
   std::copy(&mesh.attr[size_t(v_to) * n], &mesh.attr[size_t(v_to) * n] + n, pred);
-  if (mesh.wedge_uv_code >= 0 && ring.size() > 0) {
+  if (mesh.wedge_uv_code >= 0 && ring.size() > 0 &&
+      !predict_wedge_from_positions(mesh, v_to, ring, p, position, pred)) {
     const uint32_t k = uint32_t(mesh.wedge_uv_code), m = ring.size();
     int64_t su = pred[k], sv = pred[k + 1], count = 1;
     for (uint32_t t = 0, i = p.first_face; t <= p.faces; ++t, i = (i + 1) % m, ++count) {
