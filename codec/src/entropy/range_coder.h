@@ -197,6 +197,15 @@ public:
     return bit;
   }
   uint32_t decode_bypass(int nbits);
+  /// decode_bypass(1), inline (a residual's sign).
+  uint32_t decode_bypass_bit() {
+    range_ >>= 1;
+    const uint32_t bit = code_ >= range_;
+    if (bit)
+      code_ -= range_;
+    normalize();
+    return bit;
+  }
   uint32_t decode_uniform(uint32_t total); ///< mirror of RangeEncoder::encode_uniform
   /// True when the decoder has asked for more bytes than the stream holds by more than
   /// the final flush can explain: the stream is truncated or corrupt.
