@@ -221,7 +221,7 @@ inline int64_t get_signed(RangeDecoder &rc, FrequencyModel &classes, BitModel *t
   const int n = rc.decode(classes);
   if (n == 0)
     return 0;
-  const bool negative = rc.decode_bypass(1) != 0;
+  const bool negative = rc.decode_bypass_bit() != 0;
   uint64_t a = 1;
   int rest = n - 1;
   if (top && n >= 2) {

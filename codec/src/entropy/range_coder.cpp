@@ -20,7 +20,6 @@ void FrequencyModel::freeze_from_counts(const uint32_t *counts) {
   uint64_t sum = 0;
   for (int i = 0; i < n_; ++i)
     sum += counts[i];
-  frozen_ = true;
   total_ = 0;
   for (int i = 0; i < n_; ++i) {
     uint32_t f = 1; // uniform when nothing was counted
@@ -32,6 +31,14 @@ void FrequencyModel::freeze_from_counts(const uint32_t *counts) {
     freq_[i] = static_cast<uint16_t>(f);
     total_ += f;
   }
+  freeze();
+}
+
+void FrequencyModel::freeze() {
+  frozen_ = true;
+  cum_[0] = 0;
+  for (int i = 0; i < n_; ++i)
+    cum_[i + 1] = cum_[i] + freq_[i];
 }
 
 bool FrequencyModel::freeze_with(const uint16_t *freq) {
@@ -43,7 +50,7 @@ bool FrequencyModel::freeze_with(const uint16_t *freq) {
   for (int i = 0; i < n_; ++i)
     freq_[i] = freq[i];
   total_ = total;
-  frozen_ = true;
+  freeze();
   return true;
 }
 

@@ -44,15 +44,25 @@ public:
   uint32_t total() const { return total_; }
   uint32_t freq(int s) const { return freq_[s]; }
   uint32_t cumulative(int s) const { // sum of freq of symbols < s
+    if (frozen_)
+      return cum_[s];
     uint32_t c = 0;
     for (int i = 0; i < s; ++i)
       c += freq_[i];
     return c;
   }
-  /// Find the symbol whose cumulative interval holds `target`; sets its cumulative start.
+  /// Find the symbol whose cumulative interval holds `target` (< total()); sets its
+  /// cumulative start. (A frozen model looks it up in its cumulative table, whose last
+  /// entry, the total, stops the scan.)
   int find(uint32_t target, uint32_t *start) const {
-    uint32_t c = 0;
     int s = 0;
+    if (frozen_) {
+      while (cum_[s + 1] <= target)
+        ++s;
+      *start = cum_[s];
+      return s;
+    }
+    uint32_t c = 0;
     while (s < n_ - 1 && c + freq_[s] <= target)
       c += freq_[s++];
     *start = c;
@@ -81,10 +91,12 @@ public:
 
 private:
   void halve(int s, uint32_t f); // update() past kMaxTotal: symbol s at f, all halved
+  void freeze();                 // frozen_ set, cum_ from freq_
   int n_;
   uint32_t total_;
   bool frozen_ = false;
   uint16_t freq_[kMaxSymbols];
+  uint32_t cum_[kMaxSymbols + 1] = {}; // a frozen model's: cum_[s] = cumulative(s), cum_[n_] = total_
 };
 
 // The per-symbol functions of both coders are defined in this header: they run a few
@@ -185,6 +197,15 @@ public:
     return bit;
   }
   uint32_t decode_bypass(int nbits);
+  /// decode_bypass(1), inline (a residual's sign).
+  uint32_t decode_bypass_bit() {
+    range_ >>= 1;
+    const uint32_t bit = code_ >= range_;
+    if (bit)
+      code_ -= range_;
+    normalize();
+    return bit;
+  }
   uint32_t decode_uniform(uint32_t total); ///< mirror of RangeEncoder::encode_uniform
   /// True when the decoder has asked for more bytes than the stream holds by more than
   /// the final flush can explain: the stream is truncated or corrupt.

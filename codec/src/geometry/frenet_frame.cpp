@@ -20,11 +20,9 @@ int64_t fixed_round(double x) {
   return static_cast<double>(t) > y ? t - 1 : t;
 }
 
-/// Rotation in plane (i,j) that maps direction (a,b) onto the positive i axis.
-Givens givens_from_pair(int i, int j, double a, double b) {
+/// Rotation in its plane (x,y) that maps direction (a,b) onto the positive x axis.
+Givens givens_from_pair(double a, double b) {
   Givens g;
-  g.i = static_cast<uint8_t>(i);
-  g.j = static_cast<uint8_t>(j);
   if (a == 0.0 && b == 0.0)
     return g;
   // Quarter turns bring the direction within 45 degrees of +i.
@@ -40,7 +38,6 @@ Givens givens_from_pair(int i, int j, double a, double b) {
   const double r = std::sqrt(a * a + b * b);
   g.t = fixed_round(b / (r + a)); // tan(beta/2)
   g.s = fixed_round(-b / r);      // -sin(beta)
-  g.active = true;
   return g;
 }
 
@@ -52,14 +49,14 @@ FrenetFrame make_frenet_frame(const int64_t normal[3], const int64_t edge[3]) {
   const double ny = static_cast<double>(normal[1]);
   const double nz = static_cast<double>(normal[2]);
   // 1) about z: bring the normal into the xz half-plane x >= 0.
-  f.g[0] = givens_from_pair(0, 1, nx, ny);
+  f.g[0] = givens_from_pair(nx, ny);
   // 2) in the (z,x) plane: bring it onto +z. After step 1 it is (hypot(nx,ny), 0, nz).
-  f.g[1] = givens_from_pair(2, 0, nz, std::sqrt(nx * nx + ny * ny));
+  f.g[1] = givens_from_pair(nz, std::sqrt(nx * nx + ny * ny));
   // 3) about the new z: bring the edge's tangential part onto +x (integer-rotated edge).
   int64_t e[3] = {edge[0], edge[1], edge[2]};
-  apply(f.g[0], e);
-  apply(f.g[1], e);
-  f.g[2] = givens_from_pair(0, 1, static_cast<double>(e[0]), static_cast<double>(e[1]));
+  apply<kPlane[0][0], kPlane[0][1]>(f.g[0], e);
+  apply<kPlane[1][0], kPlane[1][1]>(f.g[1], e);
+  f.g[2] = givens_from_pair(static_cast<double>(e[0]), static_cast<double>(e[1]));
   return f;
 }
 

@@ -15,18 +15,20 @@
 
 namespace pomar {
 
-/// One plane rotation: `quarter_turns` times (x,y) -> (y,-x) on axes (i,j), then shears.
+/// One plane rotation: `quarter_turns` times (x,y) -> (y,-x) on its plane's axes (x,y),
+/// then shears (t = s = 0: none; the shears then add nothing).
 struct Givens {
-  uint8_t i = 0, j = 1;
   uint8_t quarter_turns = 0;
-  bool active = false;  // residual shears present
   int64_t t = 0, s = 0; // Q16 shear coefficients
 };
 
-/// The local frame of one vertex split, as three Givens rotations.
+/// The local frame of one vertex split, as three Givens rotations, each in a fixed plane:
+/// g[0] in (x,y), g[1] in (z,x), g[2] in (x,y) (kPlane; fixed planes let the maps keep the
+/// three components in registers).
 struct FrenetFrame {
   Givens g[3];
 };
+constexpr int kPlane[3][2] = {{0, 1}, {2, 0}, {0, 1}};
 
 /// Build the frame whose third axis is along `normal` and whose first axis is along the
 /// projection of `edge` (v_ref - v_to) on the tangent plane. Degenerate inputs (zero
@@ -56,36 +58,36 @@ template <class T> inline void quarter_turns(int turns, T &x, T &y) {
   }
 }
 
-inline void apply(const Givens &g, int64_t v[3]) {
-  int64_t &x = v[g.i], &y = v[g.j];
+template <int I, int J> inline void apply(const Givens &g, int64_t v[3]) {
+  int64_t &x = v[I], &y = v[J];
   quarter_turns(g.quarter_turns, x, y);
-  if (g.active) {
-    x += shear(g.t, y);
-    y += shear(g.s, x);
-    x += shear(g.t, y);
-  }
+  x += shear(g.t, y);
+  y += shear(g.s, x);
+  x += shear(g.t, y);
 }
 
-inline void unapply(const Givens &g, int64_t v[3]) {
-  int64_t &x = v[g.i], &y = v[g.j];
-  if (g.active) {
-    x -= shear(g.t, y);
-    y -= shear(g.s, x);
-    x -= shear(g.t, y);
-  }
+template <int I, int J> inline void unapply(const Givens &g, int64_t v[3]) {
+  int64_t &x = v[I], &y = v[J];
+  x -= shear(g.t, y);
+  y -= shear(g.s, x);
+  x -= shear(g.t, y);
   quarter_turns(4 - g.quarter_turns, x, y); // (4 - k turns undo k)
 }
 } // namespace frenet_detail
 
 /// Global residual -> local (t1, t2, n) components. Exact inverse of to_global().
 inline void to_local(const FrenetFrame &f, int64_t v[3]) {
-  for (int k = 0; k < 3; ++k)
-    frenet_detail::apply(f.g[k], v);
+  using namespace frenet_detail;
+  apply<kPlane[0][0], kPlane[0][1]>(f.g[0], v);
+  apply<kPlane[1][0], kPlane[1][1]>(f.g[1], v);
+  apply<kPlane[2][0], kPlane[2][1]>(f.g[2], v);
 }
 /// Local components -> global residual.
 inline void to_global(const FrenetFrame &f, int64_t v[3]) {
-  for (int k = 2; k >= 0; --k)
-    frenet_detail::unapply(f.g[k], v);
+  using namespace frenet_detail;
+  unapply<kPlane[2][0], kPlane[2][1]>(f.g[2], v);
+  unapply<kPlane[1][0], kPlane[1][1]>(f.g[1], v);
+  unapply<kPlane[0][0], kPlane[0][1]>(f.g[0], v);
 }
 
 } // namespace pomar

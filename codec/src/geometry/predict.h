@@ -40,13 +40,14 @@ inline void predict(const int32_t at[3], const Ring &ring, const Spoke *spokes, 
                     Prediction &out) {
   const uint32_t m = ring.size();
   // Barycentre of v_to and the patch ring: sum = count * at + the spokes' offsets.
-  int64_t sum[3] = {0, 0, 0};
-  int64_t count = 1;
+  int64_t sx = 0, sy = 0, sz = 0; // (components spelled out: the -O2 build kept the loops)
   for (uint32_t t = 0, i = p.first_face; t <= p.faces; ++t, i = i + 1 == m ? 0 : i + 1) {
-    for (int k = 0; k < 3; ++k)
-      sum[k] += spokes[i].d[k];
-    ++count;
+    sx += spokes[i].d[0];
+    sy += spokes[i].d[1];
+    sz += spokes[i].d[2];
   }
+  int64_t sum[3] = {sx, sy, sz};
+  const int64_t count = int64_t(p.faces) + 2;
   for (int k = 0; k < 3; ++k) { // round to nearest; sums are non-negative
     sum[k] += count * at[k];
     out.barycentre[k] = static_cast<int32_t>((2 * sum[k] + count) / (2 * count));
@@ -61,12 +62,13 @@ inline void predict(const int32_t at[3], const Ring &ring, const Spoke *spokes, 
   out.frame = make_frenet_frame(normal, edge);
   out.context = geometry_context(spokes[j].len2);
   // v_to's umbrella vector (integer mean, truncated), in the local frame.
-  int64_t umbrella[3] = {0, 0, 0};
-  for (uint32_t i = 0; i < m; ++i)
-    for (int k = 0; k < 3; ++k)
-      umbrella[k] += spokes[i].d[k];
-  for (int k = 0; k < 3; ++k)
-    umbrella[k] /= int64_t(m);
+  int64_t ux = 0, uy = 0, uz = 0;
+  for (uint32_t i = 0; i < m; ++i) {
+    ux += spokes[i].d[0];
+    uy += spokes[i].d[1];
+    uz += spokes[i].d[2];
+  }
+  int64_t umbrella[3] = {ux / int64_t(m), uy / int64_t(m), uz / int64_t(m)};
   to_local(out.frame, umbrella);
   out.offset[0] = 0;
   out.offset[1] = 0;

@@ -76,8 +76,10 @@ public:
   }
   /// Room for at least `n` elements (the count is unchanged); returns the storage.
   uint32_t *grow_to(size_t n) {
-    if (n > buf_.size())
+    if (n > cap_) {
       buf_.resize(std::max<size_t>(2 * buf_.size(), std::max<size_t>(n, 32)));
+      cap_ = buf_.size();
+    }
     return buf_.data();
   }
   /// Set the count (elements past the old count must have been written).
@@ -85,11 +87,12 @@ public:
     grow_to(n);
     n_ = n;
   }
-  size_t capacity() const { return buf_.size(); }
+  size_t capacity() const { return cap_; }
 
 private:
   std::vector<uint32_t> buf_;
   uint32_t n_ = 0;
+  size_t cap_ = 0; // buf_.size(), kept beside it (read by every walk)
 };
 
 /// The one-ring of a vertex in counter-clockwise order. For a closed ring there are as

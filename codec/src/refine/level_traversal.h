@@ -371,14 +371,22 @@ void traverse_cluster(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32
       from = n;
   marks.vertex(root)->queued = s.stamp;
   s.queue.emplace_back(root, from);
+  const uint32_t *claimed = s.claimed.data();
+  const uint16_t *face_claim = mesh.face_claim.data();
   for (size_t head = 0; head < s.queue.size();) {
     prefetch_ahead(mesh, s, head);
     const auto [v, came_from] = s.queue[head++];
     get_view_ring(mesh, v, level, s.ring);
-    for (uint32_t c : s.ring.corner) { // (read by sv_context and code_vertex)
-      __builtin_prefetch(&s.claimed[c / 3]);
-      if (!s.defer_claims)
-        __builtin_prefetch(&mesh.face_claim[c / 3]);
+    const uint32_t *corner = s.ring.corner.data(), faces = s.ring.faces();
+    if (s.defer_claims) { // (what sv_context and code_vertex read)
+      for (uint32_t i = 0; i < faces; ++i)
+        __builtin_prefetch(&claimed[corner[i] / 3]);
+    } else {
+      for (uint32_t i = 0; i < faces; ++i) {
+        const uint32_t f = corner[i] / 3;
+        __builtin_prefetch(&claimed[f]);
+        __builtin_prefetch(&face_claim[f]);
+      }
     }
     const uint32_t split = queue_neighbours(s, v, came_from, s.ring, marks);
     code_vertex(mesh, codec, s, v, s.ring, level.level, key, marks, split, splits);

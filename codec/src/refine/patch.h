@@ -40,12 +40,13 @@ inline void load_spokes(const std::vector<int32_t> &q, uint32_t v, const Ring &r
   if (spokes.size() < m)
     spokes.resize(m);
   const int32_t *at = &q[3 * size_t(v)];
-  for (uint32_t i = 0; i < m; ++i) {
-    const int32_t *n = &q[3 * size_t(ring.neighbour[i])];
-    Spoke &s = spokes[i];
-    for (int k = 0; k < 3; ++k)
-      s.d[k] = int64_t(n[k]) - at[k];
-    s.len2 = s.d[0] * s.d[0] + s.d[1] * s.d[1] + s.d[2] * s.d[2];
+  const int64_t x = at[0], y = at[1], z = at[2];
+  const uint32_t *neighbour = ring.neighbour.data();
+  Spoke *out = spokes.data();
+  for (uint32_t i = 0; i < m; ++i) { // (components spelled out: the -O2 build kept the loop)
+    const int32_t *n = &q[3 * size_t(neighbour[i])];
+    const int64_t dx = n[0] - x, dy = n[1] - y, dz = n[2] - z;
+    out[i] = {{dx, dy, dz}, dx * dx + dy * dy + dz * dz};
   }
 }
 
