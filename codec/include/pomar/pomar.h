@@ -166,8 +166,8 @@ struct EncodeOptions {
   /// duplicate or degenerate faces) and drop unreferenced vertices, as before format
   /// version 4. Off: such meshes are cut and the cut is stored (LosslessReport).
   bool strict = false;
-  /// Store the input vertex numbering too (messy and clean meshes alike: the file is then
-  /// version 4): a full decode gives the vertices back in the input order.
+  /// Store the input vertex numbering too (messy and clean meshes alike: the file then
+  /// carries a lossless record): a full decode gives the vertices back in the input order.
   bool keep_order = false;
   /// The format to write: 5 (each split's patch coded as a placement rank, about 1 bit per
   /// vertex smaller), or 4: the layout of versions 1, 3 and 4 (readers that predate
