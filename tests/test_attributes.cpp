@@ -363,7 +363,7 @@ TEST(AttributeRoundTrip, EveryCombinationProgressiveAndClustered) {
       SCOPED_TRACE("attributes " + std::to_string(has) + (clustered ? " clustered" : ""));
       const Coded c = encode_with(with_attributes(sphere, has), clustered);
       const FileInfo info = inspect(c.file.data(), c.file.size());
-      EXPECT_EQ(info.version, 4u);
+      EXPECT_EQ(info.version, 5u);
       EXPECT_EQ(info.clustered(), clustered);
       EXPECT_EQ(info.attributes.size(), c.input.attributes.size());
       EXPECT_GT(info.attribute_bytes, 0u);
@@ -583,7 +583,7 @@ TEST(AttributeRoundTrip, DropAndSkip) {
   EXPECT_EQ(encode_with(m, true, drop_all).file, encode_with(plain, true).file);
   EXPECT_EQ(
       inspect(encode_with(plain, false).file.data(), encode_with(plain, false).file.size()).version,
-      1u);
+      5u);
 }
 
 // A decode that returns no attribute reads past their codes (no prediction, no storage):

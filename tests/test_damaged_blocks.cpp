@@ -26,10 +26,11 @@ struct Encoded {
   FileInfo info;
 };
 
-Encoded encode_with(const Mesh &m, double ratio, bool progressive = false) {
+Encoded encode_with(const Mesh &m, double ratio, bool progressive = false, int format_version = 5) {
   EncodeOptions o;
   o.cluster_ratio = ratio;
   o.progressive = progressive;
+  o.format_version = format_version;
   Encoded e;
   e.file = encode(m, o);
   e.info = inspect(e.file.data(), e.file.size());
@@ -544,7 +545,7 @@ TEST(DamagedBlocks, EveryTruncationAndFlipGivesAValidMeshOrAnError) {
 TEST(DamagedBlocks, VersionTwoFilesStillDecode) {
   // Version 2 = version 3 without the cluster data checksum (its header field held the
   // high half of the informative connectivity estimate, 0 in practice).
-  const Encoded &e = sphere();
+  const Encoded e = encode_with(gen::icosphere(5), 0.02, false, 4); // (the version 3 layout)
   std::vector<uint8_t> v2 = e.file;
   ASSERT_EQ(v2[8], kClusteredFormatVersion);
   v2[8] = kClusteredFormatVersion2;

@@ -11,29 +11,68 @@
 namespace pomar {
 namespace {
 
-std::vector<uint8_t> file_of(const Mesh &m, bool progressive) {
+std::vector<uint8_t> file_of(const Mesh &m, bool progressive, int format_version = 5) {
   EncodeOptions o;
   o.progressive = progressive;
   o.clusters = progressive ? 0 : 8;
   o.memory_limit = kNoMemoryLimit;
+  o.format_version = format_version;
   return encode(m, o);
 }
 
 const Section kOptional{section_tag("TST1"), 0, {10, 20, 30}};
 const Section kRequired{section_tag("TST2"), kSectionRequired, {1}};
 
-TEST(FormatSections, FilesWithoutSectionsKeepVersion1And3) {
-  EXPECT_EQ(inspect(file_of(gen::icosphere(2), true).data(), file_of(gen::icosphere(2), true).size()).version, 1u);
-  const std::vector<uint8_t> c = file_of(gen::icosphere(2), false);
+TEST(FormatSections, TheVersion4LayoutWithoutSectionsKeepsVersion1And3) {
+  const std::vector<uint8_t> p = file_of(gen::icosphere(2), true, 4);
+  EXPECT_EQ(inspect(p.data(), p.size()).version, 1u);
+  const std::vector<uint8_t> c = file_of(gen::icosphere(2), false, 4);
   EXPECT_EQ(inspect(c.data(), c.size()).version, 3u);
   // Re-assembling without sections gives back the same bytes.
   EXPECT_EQ(with_sections(c.data(), c.size(), {}), c);
+  EXPECT_EQ(with_sections(p.data(), p.size(), {}), p);
+  // Both decode to what version 5 files of the same mesh decode to.
+  for (bool progressive : {true, false}) {
+    const std::vector<uint8_t> old = progressive ? p : c,
+                               v5 = file_of(gen::icosphere(2), progressive);
+    EXPECT_EQ(inspect(v5.data(), v5.size()).version, 5u);
+    const Mesh a = decode(old.data(), old.size()), b = decode(v5.data(), v5.size());
+    EXPECT_EQ(a.positions, b.positions);
+    EXPECT_EQ(a.triangles, b.triangles);
+  }
+}
+
+TEST(FormatSections, Version5FilesHaveASectionTableAndKeepTheirVersion) {
+  for (bool progressive : {true, false}) {
+    const std::vector<uint8_t> f = file_of(gen::icosphere(2), progressive);
+    const FileLayout layout = read_layout(f.data(), f.size());
+    EXPECT_EQ(layout.header.version, kPatchRankFormatVersion);
+    EXPECT_TRUE(layout.header.flags & kFlagSections);
+    EXPECT_TRUE(layout.header.sections.empty());
+    EXPECT_EQ(with_sections(f.data(), f.size(), {}), f);
+    const std::vector<uint8_t> g = with_sections(f.data(), f.size(), {kOptional});
+    EXPECT_EQ(inspect(g.data(), g.size()).version, 5u);
+    EXPECT_EQ(g.size(), f.size() + kSectionEntryBytes + 3);
+    EXPECT_EQ(decode(g.data(), g.size()).triangles, decode(f.data(), f.size()).triangles);
+  }
+}
+
+TEST(FormatSections, TheEncoderRefusesAnUnknownFormatVersion) {
+  for (int version : {1, 3, 6}) {
+    try {
+      file_of(gen::icosphere(1), true, version);
+      ADD_FAILURE() << "version " << version << " accepted";
+    } catch (const Error &e) {
+      EXPECT_EQ(e.kind(), Error::Kind::Usage);
+      EXPECT_NE(std::string(e.what()).find("format version 4 or 5"), std::string::npos);
+    }
+  }
 }
 
 TEST(FormatSections, SectionsAreListedAndTheMeshDecodesUnchanged) {
   for (bool progressive : {true, false}) {
     const Mesh m = gen::torus(16, 10);
-    const std::vector<uint8_t> plain = file_of(m, progressive);
+    const std::vector<uint8_t> plain = file_of(m, progressive, 4);
     const std::vector<uint8_t> v4 = with_sections(plain.data(), plain.size(), {kOptional});
     const FileInfo info = inspect(v4.data(), v4.size());
     EXPECT_EQ(info.version, 4u);

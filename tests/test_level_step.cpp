@@ -22,6 +22,9 @@ struct ScriptedCodec {
       corrupt("scripted failure");
     return visits <= splits;
   }
+  bool ranks_patches() const { return false; } // (the version 1-4 symbols)
+  uint32_t patch_faces(uint32_t, const Ring &) { return 1; }
+  uint32_t patch_placement(const Ring &, uint32_t, const PatchPlacements &) { return 0; }
   void split_symbols(uint32_t, const Ring &, const uint32_t *, SplitSymbols &s) {
     s.s_e = 0;
     s.s_l = 1;

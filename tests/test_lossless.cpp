@@ -70,7 +70,7 @@ EncodeReport expect_exact(const Mesh &input, EncodeOptions options = {}) {
   }
   EXPECT_EQ(faces(out, [&](uint32_t v) { return map[v]; }),
             faces(input, [](uint32_t v) { return v; }));
-  EXPECT_EQ(info.version, report.lossless.stored ? 4u : info.clustered() ? 3u : 1u);
+  EXPECT_EQ(info.version, 5u);
   EXPECT_EQ(info.lossless_bytes, report.lossless.bytes);
   EXPECT_EQ(info.input_vertices, input.vertex_count());
   EXPECT_EQ(info.input_faces, input.triangle_count());
@@ -262,7 +262,7 @@ TEST(Lossless, CleanMeshesGiveTheSameBytesAsStrict) {
     EXPECT_FALSE(r.lossless.stored);
     EXPECT_EQ(r.lossless.summary(), "");
     const FileInfo info = inspect(a.data(), a.size());
-    EXPECT_EQ(info.version, info.clustered() ? 3u : 1u);
+    EXPECT_EQ(info.version, 5u);
     EXPECT_EQ(info.lossless_bytes, 0u);
   }
 }

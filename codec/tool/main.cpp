@@ -59,7 +59,7 @@ CLI::App *add_encode_command(CLI::App &app, EncodeArgs &a) {
   enc->add_flag("--strict", a.strict,
                 "Refuse a mesh that needs cutting (non-manifold, inconsistently oriented, "
                 "duplicate or degenerate faces) and drop unreferenced vertices: for pipelines "
-                "that want clean input (the file is then format version 1 or 3)");
+                "that want clean input (the file then carries no lossless record)");
   enc->add_flag("--keep-order", a.keep_order,
                 "Also store the input's vertex numbering (a full decode gives the vertices back "
                 "in the input order, e.g. for per-vertex data kept elsewhere); costs a few bits "

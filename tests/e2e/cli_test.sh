@@ -249,7 +249,7 @@ expect_rc 0
 expect_contains "$OUT" "the same 6 vertices and 8 oriented triangles" "stdout"
 run info "$WORK/nm/out.pomar"
 expect_rc 0
-expect_contains "$OUT" ".pomar version 4" "stdout"
+expect_contains "$OUT" ".pomar version 5" "stdout"
 expect_contains "$OUT" "a full decode gives back the input's 6 vertices and 8 faces exactly" "stdout"
 run info --json "$WORK/nm/out.pomar"
 expect_rc 0
@@ -672,7 +672,7 @@ expect_contains "$OUT" "attribute quality" "encode output"
 run info --json "$WORK/attr/c.pomar"
 expect_rc 0
 printf '%s' "$OUT" >"$WORK/attr/info.json"
-[ "$(json_get "$WORK/attr/info.json" "d['version']")" = 4 ] || fail "an attribute file is version 4"; pass
+[ "$(json_get "$WORK/attr/info.json" "d['version']")" = 5 ] || fail "an attribute file is version 5"; pass
 [ "$(json_get "$WORK/attr/info.json" "len(d['attributes'])")" = 3 ] || fail "3 attributes"; pass
 [ "$(json_get "$WORK/attr/info.json" "[a['kind'] for a in d['attributes']]")" = "['colour', 'normal', 'scalar']" ] ||
   fail "attribute kinds in info --json"; pass

@@ -166,9 +166,13 @@ struct EncodeOptions {
   /// duplicate or degenerate faces) and drop unreferenced vertices, as before format
   /// version 4. Off: such meshes are cut and the cut is stored (LosslessReport).
   bool strict = false;
-  /// Store the input vertex numbering too (messy and clean meshes alike: the file is then
-  /// version 4): a full decode gives the vertices back in the input order.
+  /// Store the input vertex numbering too (messy and clean meshes alike: the file then
+  /// carries a lossless record): a full decode gives the vertices back in the input order.
   bool keep_order = false;
+  /// The format to write: 5 (each split's patch coded as a placement rank, about 1 bit per
+  /// vertex smaller), or 4: the layout of versions 1, 3 and 4 (readers that predate
+  /// version 5 read it).
+  int format_version = 5;
 };
 
 /// What the codec stored to give a mesh back exactly although it had to cut it (the
@@ -271,6 +275,7 @@ struct SymbolBits {
   double s_e = 0;        ///< which ring edge is v_to-v_ref
   double faces = 0;      ///< patch size s_l + s_r
   double s_l = 0;        ///< where the patch starts
+  double rank = 0;       ///< version 5: the patch's placement (in place of s_e and s_l)
   double tangential = 0; ///< geometry residuals in the tangent plane (two per split)
   double normal = 0;     ///< geometry residual along the normal
 };

@@ -43,6 +43,19 @@ public:
     s.s_r = faces - s.s_l;
   }
 
+  /// Version 5 (the models say): the patch as s_l + s_r and a placement rank.
+  bool ranks_patches() const { return m_->conn.patch_rank; }
+  uint32_t patch_faces(uint32_t, const Ring &ring) {
+    return get_small(*conn_, m_->conn.faces[faces_context(ring.size(), ring.closed)]);
+  }
+  uint32_t patch_placement(const Ring &ring, uint32_t faces, const PatchPlacements &p) {
+    const uint32_t r =
+        get_small(*conn_, m_->conn.rank[rank_context(faces, ring.size(), ring.closed)]);
+    if (r >= p.count)
+      corrupt("split symbols do not fit the vertex's neighbourhood");
+    return placement_of_rank(p, r);
+  }
+
   void geometry(uint32_t, const Prediction &p, int32_t position[3]) {
     int64_t r[3];
     r[0] = get_residual(*geom_, m_->geom, 0, p.context) + p.offset[0];

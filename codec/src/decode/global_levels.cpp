@@ -56,6 +56,7 @@ size_t decode_global_levels(const uint8_t *data, const FileLayout &layout, size_
                             LevelMesh &lm, Models &models, const Progress &progress,
                             std::vector<DamagedBlock> *damaged) {
   const FileHeader &h = layout.header;
+  models.conn.patch_rank = h.ranks_patches(); // (the models' set of a file's version)
   DecoderCodec codec(h.grid.bits);
   LevelStep step;
   RangeDecoder conn, geom;

@@ -362,8 +362,9 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   s.global_levels = static_cast<int>(h.global_levels);
   check_block(s.global.data() + s.layout.tables_offset, h.tables_bytes, h.tables_checksum,
               "static model tables");
-  s.level_models = read_tables(s.global.data() + s.layout.tables_offset, h.tables_bytes,
-                               h.levels.size() - h.global_levels, s.global_models.attr);
+  s.level_models =
+      read_tables(s.global.data() + s.layout.tables_offset, h.tables_bytes,
+                  h.levels.size() - h.global_levels, h.ranks_patches(), s.global_models.attr);
   s.index = read_cluster_index(s.global.data() + s.layout.index_offset, s.layout);
   s.info.cluster_block_bytes = s.index.size;
   decode_global_levels(s.global.data(), s.layout, 0, h.global_levels, s.mesh, s.global_models, {});

@@ -139,8 +139,10 @@ ClusteredLevels encode_clustered_levels(Rebuild &rb, size_t global, FileHeader &
   lm.root_clusters();
   std::vector<uint32_t> next_local(clusters, 1);
   std::vector<Models> level_models(L - global);
-  for (Models &m : level_models)
+  for (Models &m : level_models) {
+    m.conn.patch_rank = header.ranks_patches();
     m.attr = rb.attr_models;
+  }
   // Level after level: record every cluster's symbols of the level, freeze the level's
   // models on them, code them into each cluster's own range coder (which lives across
   // levels: one stream per cluster block) and forget them. Only one level's symbols are

@@ -70,6 +70,9 @@ void check_input(const Mesh &mesh, const EncodeOptions &options) {
   if (options.bits < 4 || options.bits > 24)
     throw Error(Error::Kind::Usage, "quantization bits must be between 4 and 24 (got " +
                                         std::to_string(options.bits) + ")");
+  if (options.format_version != 4 && options.format_version != 5)
+    throw Error(Error::Kind::Usage, "the encoder writes format version 4 or 5 (got " +
+                                        std::to_string(options.format_version) + ")");
   if (mesh.positions.size() % 3 || mesh.triangles.size() % 3)
     throw Error(Error::Kind::InvalidMesh,
                 "position and triangle arrays must hold multiples of 3 values");
@@ -178,6 +181,7 @@ std::vector<std::vector<uint8_t>> encode_global_levels(Rebuild &rb, size_t globa
                                                        FileHeader &header, SymbolBits &bits,
                                                        const Progress &progress) {
   Models models;
+  models.conn.patch_rank = header.ranks_patches();
   models.attr = rb.attr_models;
   EncoderCodec<RangeEncoder> codec(rb.q, rb.dec_to_input, rb.input_to_dec);
   codec.set_attribute_codes(rb.attr_codes, rb.attr_codes_per_vertex);
@@ -273,6 +277,8 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
   rb.attr_models = attribute_models(attributes);
   rb.attr_bits.assign(attributes.codes, 0.0);
   FileHeader header;
+  // Version 5: patches as placement ranks; else version 1, 3 or 4 (write_file decides).
+  header.version = options.format_version == 5 ? kPatchRankFormatVersion : kFormatVersion;
   header.grid = in.grid;
   header.vertices = nv;
   header.faces = nf;

@@ -115,6 +115,29 @@ public:
     bits.s_l += put_small(*conn_, m_->conn.sl[sl_context(faces)], s.s_l);
   }
 
+  /// Version 5: the patch as s_l + s_r and the rank of its placement (refine/patch_rank.h).
+  bool ranks_patches() const { return m_->conn.patch_rank; }
+  uint32_t patch_faces(uint32_t v, const Ring &ring) {
+    (void)v;
+    const Collapse &c = (*level_)[current_];
+    const uint32_t m = ring.size();
+    const uint32_t il = ring_index(ring, c.v_l), ir = ring_index(ring, c.v_r);
+    // v_l and v_r in the extended index of PatchPlacements (open fans: -1 / m = none).
+    const int32_t l = il == kNone ? -1 : int32_t(il), r = ir == kNone ? int32_t(m) : int32_t(ir);
+    const uint32_t faces = ring.closed ? (ir + m - il) % m : uint32_t(r - l);
+    true_il_ = l;
+    bits.faces += put_small(*conn_, m_->conn.faces[faces_context(m, ring.closed)], faces);
+    return faces;
+  }
+  uint32_t patch_placement(const Ring &ring, uint32_t faces, const PatchPlacements &p) {
+    const uint32_t k = placement_index(p, true_il_);
+    if (k == kNone)
+      corrupt("the collapse's patch is not a placement of its size");
+    bits.rank += put_small(*conn_, m_->conn.rank[rank_context(faces, ring.size(), ring.closed)],
+                           placement_rank(p, k));
+    return k;
+  }
+
   void geometry(uint32_t v_to, const Prediction &p, int32_t position[3]) {
     (void)v_to;
     const uint32_t v_from = (*level_)[current_].v_from;
@@ -188,6 +211,7 @@ private:
   Sink *conn_ = nullptr, *geom_ = nullptr;
   const std::vector<int64_t> *attr_codes_ = nullptr;
   uint32_t current_ = kNone;
+  int32_t true_il_ = 0; // the patch_faces split's v_l (extended index, see PatchPlacements)
   size_t emitted_ = 0;
 };
 

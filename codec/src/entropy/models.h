@@ -8,6 +8,9 @@
 //  s_l, s_r  steps from v_ref to v_l / v_r, coded as their sum (the number of faces
 //       that move to v_from; context: valence of v_to, open/closed fan), then s_l
 //       (context: that sum); s_r follows.
+//  rank (version 5, in place of s_e and s_l): the rank of the true patch placement among
+//       those possible for s_l + s_r (refine/patch_rank.h), context: that sum and v_to's
+//       valence (rank_context).
 //  geometry residual components (t1,t2 share a model; n has its own), each coded as a
 //  magnitude class (bit length) with a context from the local edge length, then sign and
 //  mantissa bits (the top one modelled, the rest equiprobable).
@@ -25,6 +28,7 @@ constexpr int kSvContexts = 48;      // 12 (held faces x split neighbours) x 4 v
 constexpr int kSmallSymbols = 16;    // values 0..15 coded directly, 16 = escape
 constexpr int kValenceContexts = 16; // ring sizes 0..14, 15+
 constexpr int kSlContexts = 12;
+constexpr int kRankContexts = 40;     // 5 patch sizes x 8 fan classes
 constexpr int kGeomContexts = 26;     // edge-length classes (octaves)
 constexpr int kMagnitudeSymbols = 40; // bit length of a residual component (<= 39)
 
@@ -36,10 +40,15 @@ double cost_bits(const FrequencyModel &m, int s);
 double cost_bits(const BitModel &m, int bit);
 
 struct ConnectivityModels {
+  /// Version 5: the patch is coded as s_l + s_r then a rank (`rank`); versions 1-4: s_e,
+  /// s_l + s_r, s_l (`se`, `sl`). Set once per file; for_each_model visits the models the
+  /// file's version uses only.
+  bool patch_rank = false;
   BitModel sv[kSvContexts];
   std::vector<FrequencyModel> se{kValenceContexts, FrequencyModel(kSmallSymbols + 1)};
   std::vector<FrequencyModel> faces{2 * kValenceContexts, FrequencyModel(kSmallSymbols + 1)};
   std::vector<FrequencyModel> sl{kSlContexts, FrequencyModel(kSmallSymbols + 1)};
+  std::vector<FrequencyModel> rank{kRankContexts, FrequencyModel(kSmallSymbols + 1)};
 };
 
 /// Contexts of the split symbols, from v_to's ring (known to the decoder).
@@ -51,6 +60,13 @@ inline int faces_context(uint32_t ring_size, bool closed) {
 }
 inline int sl_context(uint32_t faces) {
   return static_cast<int>(faces < kSlContexts ? faces : kSlContexts - 1);
+}
+/// Context of the patch rank: s_l + s_r (1, 2, 3, 4, 5+) and the fan (open; closed of
+/// valence <= 4, 5, 6, 7, 8, 9, 10+).
+inline int rank_context(uint32_t faces, uint32_t ring_size, bool closed) {
+  const uint32_t f = faces < 1 ? 0 : (faces > 5 ? 4 : faces - 1);
+  const uint32_t fan = !closed ? 0 : ring_size <= 4 ? 1 : ring_size >= 10 ? 7 : ring_size - 3;
+  return static_cast<int>(f * 8 + fan);
 }
 
 struct GeometryModels {
@@ -84,12 +100,19 @@ template <class OnFrequency, class OnBit>
 void for_each_model(Models &m, OnFrequency &&on_frequency, OnBit &&on_bit) {
   for (BitModel &b : m.conn.sv)
     on_bit(b);
-  for (FrequencyModel &f : m.conn.se)
-    on_frequency(f);
-  for (FrequencyModel &f : m.conn.faces)
-    on_frequency(f);
-  for (FrequencyModel &f : m.conn.sl)
-    on_frequency(f);
+  if (m.conn.patch_rank) {
+    for (FrequencyModel &f : m.conn.faces)
+      on_frequency(f);
+    for (FrequencyModel &f : m.conn.rank)
+      on_frequency(f);
+  } else {
+    for (FrequencyModel &f : m.conn.se)
+      on_frequency(f);
+    for (FrequencyModel &f : m.conn.faces)
+      on_frequency(f);
+    for (FrequencyModel &f : m.conn.sl)
+      on_frequency(f);
+  }
   for (auto &kind : m.geom.magnitude)
     for (FrequencyModel &f : kind)
       on_frequency(f);

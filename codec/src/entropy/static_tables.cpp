@@ -333,11 +333,13 @@ std::vector<uint8_t> write_tables(std::vector<Models> &models) {
   return out;
 }
 
-std::vector<Models> read_tables(const uint8_t *data, size_t size, size_t levels,
+std::vector<Models> read_tables(const uint8_t *data, size_t size, size_t levels, bool patch_rank,
                                 const std::vector<AttributeCodeModels> &attributes) {
   std::vector<Models> models(levels);
-  for (Models &m : models)
+  for (Models &m : models) {
+    m.conn.patch_rank = patch_rank;
     m.attr = attributes;
+  }
   RangeDecoder rc(data, size);
   TableModels t;
   History history;

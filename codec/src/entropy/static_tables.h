@@ -153,9 +153,11 @@ uint32_t log_code_reference(uint32_t f);
 
 /// Serialize / read back the frozen models of every clustered level.
 std::vector<uint8_t> write_tables(std::vector<Models> &models);
-/// Throws pomar::Error on damaged tables. `attributes`: the file's attribute code models
-/// (Models::attr; their frozen tables follow the geometry's in each level).
-std::vector<Models> read_tables(const uint8_t *data, size_t size, size_t levels,
+/// Throws pomar::Error on damaged tables. `patch_rank`: the file's version ranks patches
+/// (FileHeader::ranks_patches: which connectivity models the tables hold). `attributes`:
+/// the file's attribute code models (Models::attr; their frozen tables follow the
+/// geometry's in each level).
+std::vector<Models> read_tables(const uint8_t *data, size_t size, size_t levels, bool patch_rank,
                                 const std::vector<AttributeCodeModels> &attributes = {});
 
 } // namespace pomar

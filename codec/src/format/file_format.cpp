@@ -200,11 +200,15 @@ std::vector<uint8_t> write_file(FileHeader header, const std::vector<uint8_t> &b
   if (sections.size() > kMaxSections)
     throw Error(Error::Kind::Internal,
                 "internal error: more than " + std::to_string(kMaxSections) + " sections");
-  header.version = !sections.empty()    ? kSectionsFormatVersion
+  // Version 5 (the header says so: its level streams rank patches) always has a section
+  // table; the older ones only when there are sections.
+  const bool v5 = header.ranks_patches();
+  header.version = v5                   ? kPatchRankFormatVersion
+                   : !sections.empty()  ? kSectionsFormatVersion
                    : header.clustered() ? kClusteredFormatVersion
                                         : kFormatVersion;
   header.flags = static_cast<uint16_t>((header.flags & kFlagClustered) |
-                                       (sections.empty() ? 0 : kFlagSections));
+                                       (sections.empty() && !v5 ? 0 : kFlagSections));
   header.sections.clear();
   for (const Section &sec : sections)
     header.sections.push_back(
@@ -279,12 +283,12 @@ namespace {
 /// returns the level count (checked against kMaxLevels).
 uint32_t read_fixed_header(ByteReader &r, FileHeader &h) {
   h.version = r.u16();
-  if (h.version < kFormatVersion || h.version > kSectionsFormatVersion)
+  if (h.version < kFormatVersion || h.version > kPatchRankFormatVersion)
     throw Error(Error::Kind::Unsupported, "unsupported .pomar version " +
                                               std::to_string(h.version) +
-                                              " (this build reads versions 1 to 4)");
+                                              " (this build reads versions 1 to 5)");
   h.flags = r.u16();
-  const bool v4 = h.version == kSectionsFormatVersion;
+  const bool v4 = h.version >= kSectionsFormatVersion; // (4 and 5: a section table)
   const bool flags_ok =
       v4 ? (h.flags & ~(kFlagClustered | kFlagSections)) == 0 && (h.flags & kFlagSections)
          : (h.flags & ~kFlagClustered) == 0 && (h.version != kFormatVersion) == h.clustered();

@@ -1,4 +1,4 @@
-// The .pomar container, versions 1 to 4 (byte layout: docs/format.md).
+// The .pomar container, versions 1 to 5 (byte layout: docs/format.md).
 //   header (fixed part + level table [+ cluster header] [+ section table] + checksum)
 //   | base mesh block | [section bodies] | global level blocks | [tables | index | cluster blocks]
 // Every block carries an XXH32 checksum so damage is reported, never mis-decoded.
@@ -19,8 +19,11 @@ constexpr uint16_t kClusteredFormatVersion2 = 2; // read only: no cluster data c
 /// Files carrying sections (what version 1/3 cannot hold: lossless record, attributes).
 /// Progressive or clustered (kFlagClustered); files without sections stay version 1 or 3.
 constexpr uint16_t kSectionsFormatVersion = 4;
+/// What the encoder writes: version 4's container (the section table always present), the
+/// patch of every split coded as s_l + s_r and a placement rank (refine/patch_rank.h).
+constexpr uint16_t kPatchRankFormatVersion = 5;
 constexpr uint16_t kFlagClustered = 1;
-constexpr uint16_t kFlagSections = 2; // set exactly in version 4: the header has a section table
+constexpr uint16_t kFlagSections = 2; // set exactly in versions 4 and 5: a section table
 constexpr size_t kSectionEntryBytes = 20;
 constexpr uint32_t kMaxSections = 64;
 /// Section flag: a reader that does not know the section's tag must refuse the file
@@ -85,6 +88,8 @@ struct FileHeader {
   // Version 4: the section table (bodies follow the base mesh block, in this order).
   std::vector<SectionEntry> sections;
   bool clustered() const { return (flags & kFlagClustered) != 0; }
+  /// Version 5: the level streams code each patch as s_l + s_r and a placement rank.
+  bool ranks_patches() const { return version >= kPatchRankFormatVersion; }
 };
 
 /// Where each cluster's block is, and its 8-bit check (low byte of its XXH32).
@@ -132,8 +137,8 @@ std::vector<uint8_t> write_file(FileHeader header, const std::vector<uint8_t> &b
                                 const std::vector<std::vector<uint8_t>> &cluster_blocks = {},
                                 const std::vector<Section> &sections = {});
 /// The same file with `sections` added (replacing any of the same tags): version 4 (the
-/// input may be version 1, 3 or 4). Stages that run after encode() (e.g. the lossless
-/// record, which needs the decoder's numbering) attach their data this way.
+/// input may be version 1, 3 or 4) or 5 (a version 5 input). Stages that run after encode() (e.g.
+/// the lossless record, which needs the decoder's numbering) attach their data this way.
 std::vector<uint8_t> with_sections(const uint8_t *file, size_t size,
                                    const std::vector<Section> &sections);
 

@@ -4,16 +4,22 @@
 // Starting from the first halfedge of the first base face, a vertex is processed when the
 // first halfedge pointing to it leaves the FIFO; then its outgoing halfedges are queued in
 // clockwise order, starting from the one back to where it came from. For each vertex the
-// codec codes s_v; for a split vertex (v_to) also s_e, s_l, s_r and the position of
+// codec codes s_v; for a split vertex (v_to) also s_e, s_l, s_r (version 5: s_l + s_r and
+// the rank of the patch's placement, refine/patch_rank.h) and the position of
 // v_from as a residual to the patch barycentre in the local Frenet frame. The splits are
 // only collected here; refine/level_step.h runs a traversal, its checks and then applies
 // them (Figure 3, step 4): that step is the only caller.
 //
 // The Codec policy provides (encoder: writes what it knows; decoder: reads):
 //   int  split_flag(uint32_t v, int context);
+//   bool ranks_patches();              // version 5: patch_faces + patch_placement
 //   void split_symbols(uint32_t v, const Ring& ring, const uint32_t* ranked,
-//                      SplitSymbols& s);      // ranked = ring indices, longest edge first
+//                      SplitSymbols& s);      // versions 1-4: s_e, s_l, s_r; ranked = ring
+//                                     indices, longest edge first
 //                                     (nullptr if Codec::kSelectsSplitEdge: see code_vertex)
+//   uint32_t patch_faces(uint32_t v, const Ring& ring);  // version 5: s_l + s_r
+//   uint32_t patch_placement(const Ring& ring, uint32_t faces,
+//                            const PatchPlacements& p);  // the patch's placement (index in p)
 //   void geometry(uint32_t v_to, const Prediction& prediction, int32_t position[3]);
 //                                     // prediction: geometry/predict.h
 //   void attributes(const LevelMesh& mesh, const int64_t* prediction, int64_t* codes); // if any
@@ -202,6 +208,21 @@ template <class Codec, class = void> struct SelectsSplitEdge : std::false_type {
 template <class Codec>
 struct SelectsSplitEdge<Codec, std::enable_if_t<Codec::kSelectsSplitEdge>> : std::true_type {};
 
+/// Version 5's patch symbols (refine/patch_rank.h): s_l + s_r, then the rank of the patch's
+/// placement among those of that size in `ring`; gives v_ref's ring index `j` and the
+/// symbols resolve_patch turns into the patch.
+template <class Codec, class Key>
+void code_patch_rank(Codec &codec, TraversalScratch &s, uint32_t v, const Ring &ring,
+                     const Key &key, uint32_t &j, SplitSymbols &sym) {
+  const uint32_t m = ring.size();
+  const uint32_t faces = codec.patch_faces(v, ring);
+  if (faces == 0 || uint64_t(faces) + (ring.closed ? 1 : 0) > m)
+    codec.corrupt("split symbols do not fit the vertex's neighbourhood");
+  score_placements(ring, s.spokes.data(), faces, s.placements);
+  const uint32_t k = codec.patch_placement(ring, faces, s.placements);
+  patch_symbols(ring, s.spokes.data(), s.placements.il[k], faces, key, j, sym);
+}
+
 /// Code (or decode) s_v at v and, for a split vertex, the split: symbols, patch, claim of
 /// its faces, prediction and position. `ring` is v's ring as the level sees it.
 template <class Codec, class Key, class Marks>
@@ -214,8 +235,10 @@ void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v,
   marks.vertex(v)->split = s.stamp;
   load_spokes(mesh.q, v, ring, s.spokes);
   SplitSymbols sym;
-  uint32_t j = kNone; // the ring index of edge v_to-v_ref (rank s_e)
-  if constexpr (SelectsSplitEdge<Codec>::value) {
+  uint32_t j = kNone;          // the ring index of edge v_to-v_ref (rank s_e)
+  if (codec.ranks_patches()) { // version 5: s_l + s_r, then the placement's rank
+    code_patch_rank(codec, s, v, ring, key, j, sym);
+  } else if constexpr (SelectsSplitEdge<Codec>::value) {
     codec.split_symbols(v, ring, nullptr, sym);
     if (sym.s_e < ring.size() && ring.size() <= 16)
       j = ranked_edge(ring, s.spokes.data(), sym.s_e, key);

@@ -19,6 +19,7 @@
 #include "mesh/corner_table.h"
 #include "refine/level_mesh.h"
 #include "refine/patch.h"
+#include "refine/patch_rank.h"
 
 namespace pomar {
 
@@ -42,6 +43,7 @@ struct TraversalScratch {
   Ring ring;
   std::vector<Spoke> spokes;    // of the split vertex being coded
   std::vector<uint32_t> ranked; // its ring's edges, longest first
+  PatchPlacements placements;   // its patch's possible placements (version 5)
   /// Start a traversal of a mesh of `faces` faces, with marks by id for `vertices`
   /// vertices (a global level's; 0 for a cluster's traversal).
   void begin(uint32_t vertices, uint32_t faces) {
