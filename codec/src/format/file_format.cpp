@@ -313,11 +313,11 @@ uint32_t read_fixed_header(ByteReader &r, FileHeader &h) {
   return levels;
 }
 
-/// The header's size (fixed part, level table, cluster header, version 4's section table,
+/// The header's size (fixed part, level table, cluster header, the section table of versions 4 and 5,
 /// checksum) into L.header_bytes, and its checksum checked; returns the section count.
 uint32_t check_header_bytes(const uint8_t *data, size_t size, uint32_t levels, FileLayout &L) {
   const FileHeader &h = L.header;
-  const bool v4 = h.version == kSectionsFormatVersion;
+  const bool v4 = h.version >= kSectionsFormatVersion; // (4 and 5: a section table)
   const size_t table_at =
       kFixedHeaderBytes + kLevelEntryBytes * levels + (h.clustered() ? kClusterHeaderBytes : 0);
   uint32_t sections = 0;
@@ -497,7 +497,7 @@ FileLayout read_layout(const uint8_t *data, size_t size, uint64_t file_size, boo
   read_level_table(r, levels, h);
   if (h.clustered())
     read_cluster_header(r, h);
-  if (h.version == kSectionsFormatVersion)
+  if (h.version >= kSectionsFormatVersion) // (4 and 5)
     read_section_table(r, sections, h);
   check_counts(h);
   const uint64_t end = place_blocks(L);
