@@ -169,6 +169,15 @@ struct EncodeOptions {
   /// Store the input vertex numbering too (messy and clean meshes alike: the file is then
   /// version 4): a full decode gives the vertices back in the input order.
   bool keep_order = false;
+  /// Random-access files: store the cluster blocks in the Morton order of the clusters'
+  /// roots (section BLKO, required: the file is then version 4), so that the blocks of
+  /// one region lie together in the file. Off by default for now: files stay byte for
+  /// byte as before.
+  bool spatial_layout = false;
+  /// Random-access files: store a geometric error per cluster and level (section CERR,
+  /// optional; the file is then version 4), measured by decoding the file level by level,
+  /// for view-dependent decoding (SelectiveDecoder::want_view). Off by default for now.
+  bool cluster_errors = false;
 };
 
 /// What the codec stored to give a mesh back exactly although it had to cut it (the
