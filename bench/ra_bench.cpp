@@ -7,8 +7,8 @@
 //       against the progressive file and encode time.
 //
 //   pomar_ra_bench one MESH [--bits N] [--clusters N | --ratio R] [--repeat K] [--verbose]
-//       Encodes MESH (default: the codec's default ratio) to a temporary .pomar file, then decodes K
-//       (default 20) evenly spaced clusters at the finest level, each with a fresh
+//       Encodes MESH (default: the codec's default ratio) to a temporary .pomar file, then decodes
+//       K (default 20) evenly spaced clusters at the finest level, each with a fresh
 //       SelectiveDecoder over a FileSource; prints min/median/max times, bytes and blocks
 //       read, and the same for the constructor alone and for a full decode. --verbose
 //       prints one line per cluster on stderr.
@@ -28,6 +28,7 @@
 #include <exception>
 #include <filesystem>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <system_error>
 #include <vector>
@@ -73,7 +74,9 @@ std::string base_name(const std::string &path) {
   std::fprintf(stderr,
                "usage: pomar_ra_bench curve MESH [--bits N]\n"
                "       pomar_ra_bench one MESH [--bits N] [--clusters N | --ratio R] "
-               "[--repeat K] [--verbose]\n");
+               "[--repeat K] [--verbose]\n"
+               "       pomar_ra_bench view FILE.pomar PIXELS CAMERA(23 numbers) [LEVELS]\n"
+               "       pomar_ra_bench encode MESH OUT.pomar [RATIO]  (with CERR and BLKO)\n");
   std::exit(2);
 }
 
@@ -174,7 +177,8 @@ int run_curve(const Args &a) {
     if (r.ratio == 0)
       std::snprintf(ratio, sizeof ratio, "progressive");
     else
-      std::snprintf(ratio, sizeof ratio, "%.3f%s", r.ratio, r.ratio == pomar::EncodeOptions{}.cluster_ratio ? " (default)" : "");
+      std::snprintf(ratio, sizeof ratio, "%.3f%s", r.ratio,
+                    r.ratio == pomar::EncodeOptions{}.cluster_ratio ? " (default)" : "");
     const double overhead = 100.0 * (double(i.total_bytes) / double(prog.total_bytes) - 1.0);
     std::printf("| %s | %s | %u | %.2f | %.2f | %.2f | %s | %s | %+.1f%% | %.3f |\n", ratio,
                 with_commas(i.clusters).c_str(), i.global_levels, bpv(i.total_bytes, i.vertices),
@@ -289,8 +293,8 @@ int run_one(const Args &a) {
   std::printf("- file: %s bytes (%.2f bpv), %s clusters (%s), global levels 0..%d of %d, "
               "global part %s bytes (%.1f%%), encode %.3f s\n",
               with_commas(file_bytes).c_str(), bpv(file_bytes, info.vertices),
-              with_commas(n).c_str(), how,
-              global_levels, finest, with_commas(info.global_bytes).c_str(),
+              with_commas(n).c_str(), how, global_levels, finest,
+              with_commas(info.global_bytes).c_str(),
               100.0 * double(info.global_bytes) / double(file_bytes), encode_s);
   std::printf("- %u clusters (ids evenly spaced: %u, %u, ..., %u), each with a fresh "
               "SelectiveDecoder(FileSource), after one untimed warm-up; full decode: %d runs\n\n",
@@ -317,7 +321,91 @@ int run_one(const Args &a) {
 
 } // namespace
 
+/// `view FILE.pomar PIXELS CAMERA [LEVELS]`: SelectiveDecoder::view_levels for a camera given
+/// as 23 comma-separated numbers (eye xyz, view-projection 16 column-major, vertical fov,
+/// width, height, near: the web client's viewOf), after decoding the level map LEVELS
+/// (comma-separated, one per cluster; default the base clustered mesh); prints the levels,
+/// then after want_view + update the bytes read. The web tests compare the WebAssembly
+/// decoder's selection with it.
+int run_view(int argc, char **argv) {
+  if (argc < 5)
+    usage("view needs FILE.pomar PIXELS CAMERA [LEVELS]");
+  const auto numbers = [](const std::string &text) {
+    std::vector<double> out;
+    size_t at = 0;
+    while (at <= text.size()) {
+      const size_t end = std::min(text.find(',', at), text.size());
+      out.push_back(std::stod(text.substr(at, end - at)));
+      at = end + 1;
+    }
+    return out;
+  };
+  const std::vector<double> cam = numbers(argv[4]);
+  if (cam.size() != 23)
+    usage("the camera is 23 numbers");
+  pomar::ViewCamera camera;
+  for (int k = 0; k < 3; ++k)
+    camera.eye[k] = float(cam[size_t(k)]);
+  for (int k = 0; k < 16; ++k)
+    camera.view_proj[k] = float(cam[size_t(3 + k)]);
+  camera.fov_y = float(cam[19]);
+  camera.width = float(cam[20]);
+  camera.height = float(cam[21]);
+  camera.near_distance = float(cam[22]);
+  pomar::SelectiveDecoder d(std::make_unique<pomar::FileSource>(argv[2]));
+  if (argc > 5) {
+    std::vector<int> levels;
+    for (double l : numbers(argv[5]))
+      levels.push_back(int(l));
+    d.set_wanted(levels);
+    d.update();
+  }
+  const std::vector<int> levels = d.view_levels(camera, std::stof(argv[3]));
+  std::printf("levels:");
+  for (int l : levels)
+    std::printf(" %d", l);
+  d.want_view(camera, std::stof(argv[3]));
+  d.update();
+  std::printf("\nbytes read: %llu of %llu\n", (unsigned long long)d.bytes_read(),
+              (unsigned long long)d.info().total_bytes);
+  return 0;
+}
+
+/// `encode MESH OUT.pomar [RATIO]`: a random-access file with a stored error per cluster and
+/// level (CERR) and its blocks in spatial order (BLKO), as the view benches and tests use.
+int run_encode(int argc, char **argv) {
+  if (argc < 4)
+    usage("encode needs MESH OUT.pomar [RATIO]");
+  pomar::EncodeOptions o;
+  o.spatial_layout = true;
+  o.cluster_errors = true;
+  if (argc > 4)
+    o.cluster_ratio = std::stod(argv[4]);
+  const std::vector<uint8_t> file = pomar::encode(pomar::load_mesh(argv[2]), o);
+  std::FILE *f = std::fopen(argv[3], "wb");
+  if (!f || std::fwrite(file.data(), 1, file.size(), f) != file.size() || std::fclose(f) != 0)
+    throw std::runtime_error(std::string("cannot write ") + argv[3]);
+  std::printf("%s: %zu bytes\n", argv[3], file.size());
+  return 0;
+}
+
 int main(int argc, char **argv) {
+  if (argc > 1 && std::string(argv[1]) == "encode") {
+    try {
+      return run_encode(argc, argv);
+    } catch (const std::exception &e) {
+      std::fprintf(stderr, "pomar_ra_bench: %s\n", e.what());
+      return 1;
+    }
+  }
+  if (argc > 1 && std::string(argv[1]) == "view") {
+    try {
+      return run_view(argc, argv);
+    } catch (const std::exception &e) {
+      std::fprintf(stderr, "pomar_ra_bench: %s\n", e.what());
+      return 1;
+    }
+  }
   const Args a = parse(argc, argv);
   try {
     return a.mode == "curve" ? run_curve(a) : run_one(a);

@@ -4,7 +4,7 @@
 //
 //   node bench/web_view_bench.mjs FILE.pomar [--closeup 0.1] [--target 3] [--size 800x457]
 //        [--clusters 1000,2000] [--maxGap B] [--wholeBlockBytes B] [--estimateMargin F]
-//        [--backface] [--no-occlusion] [--errorModel measured [--detailSafety K] [--maxTilt T]]
+//        [--backface] [--no-occlusion] [--errorModel auto|stored|edge|measured [--detailSafety K] [--maxTilt T]]
 //
 // Reports, each from a fresh stream: the base clustered mesh (open), the overview (whole
 // model framed as the viewer frames it, refined to `target` pixels), a close-up (the
@@ -39,7 +39,7 @@ const fetchOptions = { maxGap: 128 }; // pomar.js's default
 for (const name of ['maxGap', 'maxRanges', 'wholeBlockBytes', 'estimateMargin', 'estimateSlack'])
   if (opt(name) !== undefined) fetchOptions[name] = Number(opt(name));
 const settings = { targetPixels: Number(opt('target', 3)), backface: args.includes('--backface'),
-  occlusion: !args.includes('--no-occlusion'), errorModel: opt('errorModel', 'edge') };
+  occlusion: !args.includes('--no-occlusion'), errorModel: opt('errorModel', 'auto') };
 for (const name of ['detailSafety', 'maxTilt']) if (opt(name) !== undefined) settings[name] = Number(opt(name));
 const M = await loadModuleInNode();
 const blob = new Blob([readFileSync(file)]);

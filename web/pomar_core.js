@@ -66,10 +66,17 @@ export class Decoder {
     const d = new Float64Array(M.HEAPF64.buffer, M._pw_info(this.h), n).slice();
     const levels = [];
     for (let i = 18; i + 1 < n; i += 2) levels.push({ vertices: d[i], faces: d[i + 1] });
+    if (this.clusterErrors === undefined) {
+      // The stored error bounds (section CERR), level-major from the base clustered level
+      // to the one below the finest; null when the file stores none.
+      const ptr = M._pw_cluster_errors(this.h);
+      this.clusterErrors = ptr ? new Float32Array(M.HEAPF32.buffer, ptr, d[0] * (d[2] - d[1])).slice() : null;
+    }
     this.info = {
       clusters: d[0], baseLevel: d[1], finestLevel: d[2], vertices: d[3], faces: d[4],
       fileBytes: d[5], globalBytes: d[6], bboxMin: [d[7], d[8], d[9]], bboxMax: [d[10], d[11], d[12]],
       version: d[13], decoderBytesRead: d[14], blocksRead: d[15], baseVertices: d[16], baseFaces: d[17], levels,
+      clusterErrors: this.clusterErrors,
     };
     return this.info;
   }
@@ -98,6 +105,22 @@ export class Decoder {
     if (this.withLevels(wanted, (p) => M._pw_complete(this.h, p)) < 0)
       throw new PomarError(lastError(M));
     return new Int32Array(M.HEAP32.buffer, M._pw_levels(this.h), this.info.clusters).slice();
+  }
+
+  /** SelectiveDecoder::view_levels for `view` (camera.js viewOf: eye, viewProj, fovY,
+   *  width, height, near) and a budget of `pixels`: the level per cluster the library's
+   *  want_view would ask for, from the current mesh (no occlusion), without decoding. */
+  viewLevels(view, pixels) {
+    const M = this.M;
+    const cam = [...view.eye, ...view.viewProj, view.fovY, view.width, view.height, view.near];
+    const ptr = M._malloc(4 * cam.length);
+    try {
+      M.HEAPF32.set(Float32Array.from(cam), ptr >> 2);
+      if (M._pw_view_levels(this.h, ptr, pixels) < 0) throw new PomarError(lastError(M));
+    } finally {
+      M._free(ptr);
+    }
+    return new Int32Array(M.HEAP32.buffer, M._pw_levels(this.h), Math.max(1, this.info.clusters)).slice();
   }
 
   /** Hand over the first bytes of cluster c's block (all of it, or what its levels need). */

@@ -1,6 +1,8 @@
 // View-dependent refinement: which level each cluster should have for a camera.
 //
-// The file stores no geometric error per cluster and level, so the error of a cluster at
+// A file with a CERR section stores an error bound per cluster and level: errorModel 'auto'
+// (the default) then uses it (chooseStored: every level's error known, straight to the
+// coarsest level within the target). Without one, the error of a cluster at
 // its current level is bounded from what is decoded: the longest edge between two of its
 // vertices (`clusterBounds[8c+6]`, computed in WebAssembly from the current mesh; a cluster
 // that is a single vertex, as at the base clustered level, takes its incident edges). The
@@ -224,13 +226,17 @@ function backFacing(eye, centre, radius, axis, cosWidth, margin) {
  */
 export function chooseLevels(state, view, {
   targetPixels = 3, coarsenFraction = 0.5, triangleBudget = 2e6, backface = false, backfaceMargin = 0.3,
-  occlusion = true, occlusionWidth = 128, errorModel = 'edge', detailSafety = 1, maxTilt = Infinity,
+  occlusion = true, occlusionWidth = 128, errorModel = 'auto', detailSafety = 1, maxTilt = Infinity,
 } = {}) {
   const { info, levels, clusterBounds: b, errorSeen } = state;
   const S = BOUNDS_STRIDE;
   const n = info.clusters;
   const base = info.baseLevel;
   const finest = info.finestLevel;
+  const stored = info.clusterErrors;
+  if (errorModel === 'auto') errorModel = stored ? 'stored' : 'edge';
+  if (errorModel === 'stored' && !stored) errorModel = 'edge';
+  if (errorModel === 'stored') return chooseStored(state, view, { targetPixels, coarsenFraction, triangleBudget, occlusion, occlusionWidth });
   // The detail measured per cluster and level, kept for the decay (state.detailSeen, made
   // here when the caller keeps none).
   const detailSeen = state.detailSeen ?? (state.detailSeen = new Map());
@@ -311,6 +317,81 @@ export function chooseLevels(state, view, {
     if (triangles + more(to) > triangleBudget) break;
     triangles += more(to);
     wanted[c] = to;
+    ++refine;
+  }
+  const changed = refine > 0 || coarsen > 0 || hidden > 0;
+  return { levels: wanted, changed, refine, coarsen, hidden, culled };
+}
+
+/** The stored error bound of cluster c at level l (info.clusterErrors, section CERR). */
+export function storedError(info, c, l) {
+  if (l >= info.finestLevel) return 0;
+  return info.clusterErrors[(Math.max(l, info.baseLevel) - info.baseLevel) * info.clusters + c];
+}
+
+/** chooseLevels with the file's stored errors (errorModel 'stored'): every level's error is
+ *  known, so each cluster in view goes straight to the coarsest level whose error, projected
+ *  at the distance to its box (grown by its error at the current level), is within the
+ *  target, and coarsens straight to the coarsest under `coarsenFraction` of it; outside the
+ *  frustum: the base level; occluded: one level coarser per step. */
+function chooseStored(state, view, { targetPixels, coarsenFraction, triangleBudget, occlusion, occlusionWidth }) {
+  const { info, levels, clusterBounds: b } = state;
+  const S = BOUNDS_STRIDE;
+  const n = info.clusters;
+  const base = info.baseLevel;
+  const finest = info.finestLevel;
+  const faces = (l) => (l === 0 ? info.baseFaces : info.levels[l - 1].faces);
+  const pixelsPerUnit = view.height / (2 * Math.tan(view.fovY / 2));
+  const buffer = occlusion && state.mesh && view.width ? occlusionBuffer(state.mesh, view, occlusionWidth) : null;
+  const wanted = Int32Array.from(levels);
+  let triangles = 0;
+  for (let c = 0; c < n; ++c) triangles += b[S * c + 7];
+  const candidates = [];
+  let coarsen = 0;
+  let hidden = 0;
+  let culled = 0;
+  for (let c = 0; c < n; ++c) {
+    const l = levels[c];
+    const grow = storedError(info, c, l);
+    const lo = [b[S * c] - grow, b[S * c + 1] - grow, b[S * c + 2] - grow];
+    const hi = [b[S * c + 3] + grow, b[S * c + 4] + grow, b[S * c + 5] + grow];
+    if (outsideFrustum(view.viewProj, lo, hi)) {
+      if (l > base) ++hidden;
+      wanted[c] = base;
+      continue;
+    }
+    if (buffer && occluded(buffer, view, lo, hi)) {
+      ++culled;
+      if (l > base) {
+        wanted[c] = l - 1;
+        ++coarsen;
+      }
+      continue;
+    }
+    const toPixels = pixelsPerUnit / Math.max(view.near, distanceToBox(view.eye, lo, hi));
+    let to = base;
+    while (to < finest && storedError(info, c, to) * toPixels > targetPixels) ++to;
+    if (to > l) {
+      candidates.push({ c, to, pixels: storedError(info, c, l) * toPixels });
+    } else if (to < l) {
+      let down = l;
+      while (down > base && storedError(info, c, down - 1) * toPixels < coarsenFraction * targetPixels) --down;
+      if (down < l) {
+        wanted[c] = down;
+        ++coarsen;
+      }
+    }
+  }
+  candidates.sort((x, y) => y.pixels - x.pixels);
+  let refine = 0;
+  for (const { c, to } of candidates) {
+    const l = levels[c];
+    const more = (level) => b[S * c + 7] * (faces(level) / faces(l) - 1);
+    let level = to;
+    while (level > l + 1 && triangles + more(level) > triangleBudget) --level;
+    if (triangles + more(level) > triangleBudget) break;
+    triangles += more(level);
+    wanted[c] = level;
     ++refine;
   }
   const changed = refine > 0 || coarsen > 0 || hidden > 0;

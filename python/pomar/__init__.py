@@ -229,6 +229,14 @@ class SelectiveDecoder(_pomar.SelectiveDecoder):
         part = d.mesh()                          # + d.vertex_cluster(), d.vertex_level()
         d.bytes_read
 
+    View-dependent decoding: d.want_view(eye, view_proj, fov_y, width, height, near,
+    pixel_error) then d.update() refines every cluster in the view frustum until its error
+    (the file's stored bound, or the longest edge of a file without one) projects to at
+    most pixel_error pixels; view_proj is a 4x4 view-projection matrix, column-major (16
+    numbers, OpenGL clip volume), fov_y in radians, width and height in pixels.
+    d.view_levels(...) (same arguments) returns those levels without asking for them;
+    d.cluster_error(c, level) is the stored bound (-1 without one, has_cluster_errors).
+
     memory_limit (as for decode()) is checked by the constructor for the base clustered
     mesh and by update() for each level map before it is decoded (pomar.Error, kind
     "memory_limit", the mesh as it was).

@@ -91,6 +91,22 @@ std::vector<float> point(const py::handle &value, const char *name) {
   return p;
 }
 
+/// A camera as pomar::ViewCamera (and the web client's viewOf) describes it.
+pomar::ViewCamera view_camera(const py::handle &eye, const std::vector<float> &view_proj,
+                              float fov_y, float width, float height, float near_distance) {
+  pomar::ViewCamera camera;
+  const std::vector<float> e = point(eye, "eye");
+  std::copy(e.begin(), e.end(), camera.eye);
+  if (view_proj.size() != 16)
+    throw py::type_error("view_proj must be 16 numbers (a 4x4 matrix, column-major)");
+  std::copy(view_proj.begin(), view_proj.end(), camera.view_proj);
+  camera.fov_y = fov_y;
+  camera.width = width;
+  camera.height = height;
+  camera.near_distance = near_distance;
+  return camera;
+}
+
 using D = pomar::SelectiveDecoder;
 
 } // namespace
@@ -176,6 +192,37 @@ void register_selective_decoder(py::module_ &m) {
                                std::vector<int> w = s.locked([](D &d) { return d.wanted(); });
                                return array_from_vector(std::move(w), 0);
                              })
+      .def(
+          "want_view",
+          [](Decoder &s, const py::handle &eye, const std::vector<float> &view_proj, float fov_y,
+             float width, float height, float near_distance, float pixel_error) {
+            const pomar::ViewCamera camera =
+                view_camera(eye, view_proj, fov_y, width, height, near_distance);
+            s.locked([&](D &d) { d.want_view(camera, pixel_error); });
+          },
+          py::arg("eye"), py::arg("view_proj"), py::arg("fov_y"), py::arg("width"),
+          py::arg("height"), py::arg("near"), py::arg("pixel_error"))
+      .def(
+          "view_levels",
+          [](Decoder &s, const py::handle &eye, const std::vector<float> &view_proj, float fov_y,
+             float width, float height, float near_distance, float pixel_error) {
+            const pomar::ViewCamera camera =
+                view_camera(eye, view_proj, fov_y, width, height, near_distance);
+            return array_from_vector(
+                s.locked([&](D &d) { return d.view_levels(camera, pixel_error); }), 0);
+          },
+          py::arg("eye"), py::arg("view_proj"), py::arg("fov_y"), py::arg("width"),
+          py::arg("height"), py::arg("near"), py::arg("pixel_error"))
+      .def_property_readonly(
+          "has_cluster_errors",
+          [](Decoder &s) { return s.locked([](D &d) { return d.has_cluster_errors(); }); })
+      .def(
+          "cluster_error",
+          [](Decoder &s, uint32_t cluster, int level) {
+            const uint32_t c = s.checked_cluster(cluster);
+            return s.locked([&](D &d) { return d.cluster_error(c, level); });
+          },
+          py::arg("cluster"), py::arg("level"))
       .def("update", [](Decoder &s) { s.locked([](D &d) { d.update(); }); })
       .def_property_readonly("levels",
                              [](Decoder &s) {

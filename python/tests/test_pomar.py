@@ -906,3 +906,94 @@ def test_tool_encodes_and_verifies_a_textured_obj(tmp_path):
     assert run.returncode == 0, run.stderr
     assert "per-corner texture coordinates: 12 bits" in run.stdout
     assert "face materials: 2 materials, the same per face" in run.stdout
+
+
+def _look_at(eye, target, fov_y, width, height, near=0.01, far=100.0):
+    """The view-projection matrix of camera.js (lookAt, perspective), column-major."""
+    eye, target = np.asarray(eye, float), np.asarray(target, float)
+    f = target - eye
+    f /= np.linalg.norm(f)
+    s = np.cross(f, [0.0, 1.0, 0.0])
+    s /= np.linalg.norm(s)
+    u = np.cross(s, f)
+    view = np.eye(4)
+    view[0, :3], view[1, :3], view[2, :3] = s, u, -f
+    view[:3, 3] = -view[:3, :3] @ eye
+    t = 1 / np.tan(fov_y / 2)
+    proj = np.zeros((4, 4))
+    proj[0, 0], proj[1, 1] = t * height / width, t
+    proj[2, 2], proj[2, 3] = (far + near) / (near - far), 2 * far * near / (near - far)
+    proj[3, 2] = -1
+    return (proj @ view).T.reshape(-1).astype(np.float32)  # column-major
+
+
+def _view_levels_in_python(d, eye, view_proj, fov_y, height, near, pixels):
+    """SelectiveDecoder.view_levels recomputed from what the module exposes (the stored
+    bounds, the current mesh and its clusters): in the frustum, the coarsest level whose
+    bound, at the distance to the cluster's box of faces grown by its current bound, is
+    within `pixels`."""
+    m = d.mesh()
+    vc = np.asarray(d.vertex_cluster())
+    levels = np.asarray(d.levels)
+    n, base, finest = d.cluster_count, d.base_clustered_level, d.finest_level
+    lo = np.full((n, 3), np.inf)
+    hi = np.full((n, 3), -np.inf)
+    for tri in m.faces:
+        p = m.vertices[tri].astype(np.float64)
+        for v in tri:
+            c = vc[v]
+            lo[c] = np.minimum(lo[c], p.min(axis=0))
+            hi[c] = np.maximum(hi[c], p.max(axis=0))
+    mat = np.asarray(view_proj, np.float64).reshape(4, 4).T  # clip = mat @ [x y z 1]
+    planes = [mat[3] + sign * mat[axis] for axis in range(3) for sign in (-1, 1)]
+    per_unit = height / (2 * np.tan(np.float64(np.float32(fov_y)) / 2))
+    out = np.full(n, base)
+    for c in range(n):
+        grow = d.cluster_error(c, int(levels[c]))
+        a, b = lo[c] - grow, hi[c] + grow
+        if any(pl[0] * (b[0] if pl[0] >= 0 else a[0]) + pl[1] * (b[1] if pl[1] >= 0 else a[1])
+               + pl[2] * (b[2] if pl[2] >= 0 else a[2]) + pl[3] < 0 for pl in planes):
+            continue
+        gap = np.maximum(np.maximum(a - eye, 0), eye - b)
+        to_pixels = per_unit / max(np.float64(np.float32(near)), float(np.linalg.norm(gap)))
+        level = base
+        while level < finest and d.cluster_error(c, level) * to_pixels > pixels:
+            level += 1
+        out[c] = level
+    return out
+
+
+def test_want_view_uses_the_stored_errors(tmp_path):
+    vertices, faces = torus(120, 60)
+    # A file with stored errors (CERR): written by `pomar_ra_bench encode`, beside the tool.
+    tool = os.environ.get("POMAR_TOOL", "")
+    bench = os.path.join(os.path.dirname(tool), "..", "bench", "pomar_ra_bench")
+    if not os.path.exists(bench):
+        pytest.skip("no pomar_ra_bench beside POMAR_TOOL")
+    pomar.write(str(tmp_path / "torus.ply"), pomar.Mesh(vertices, faces))
+    subprocess.check_call([bench, "encode", str(tmp_path / "torus.ply"),
+                           str(tmp_path / "torus.pomar"), "0.03"], stdout=subprocess.DEVNULL)
+    d = pomar.SelectiveDecoder(str(tmp_path / "torus.pomar"))
+    assert not pomar.SelectiveDecoder(pomar.encode(vertices, faces)).has_cluster_errors
+    assert d.has_cluster_errors
+    base, finest = d.base_clustered_level, d.finest_level
+    assert d.cluster_error(0, finest) == 0
+    assert d.cluster_error(0, base) >= d.cluster_error(0, base + 1) >= 0
+    eye = np.array([1.3, 0.0, 0.45], np.float32)
+    view_proj = _look_at(eye, [1.3, 0.0, 0.0], 0.8, 800, 457)
+    args = dict(eye=eye, view_proj=view_proj, fov_y=0.8, width=800, height=457, near=0.01,
+                pixel_error=3.0)
+    for step in range(2):  # from the base clustered mesh, then from what it decoded
+        levels = np.asarray(d.view_levels(**args))
+        ref = _view_levels_in_python(d, eye.astype(np.float64), view_proj, 0.8, 457, 0.01, 3.0)
+        # (float rounding of the box and distances may move a cluster at a threshold)
+        assert np.mean(levels == ref) > 0.99, step
+        assert levels.max() > base + 1
+        d.want_view(**args)
+        d.update()
+        assert list(d.wanted) == list(levels)
+    near_side = np.asarray(d.levels)[: d.cluster_count]
+    assert near_side.max() == finest or near_side.max() > base + 2
+    with pytest.raises(TypeError):
+        d.want_view(eye=eye, view_proj=view_proj[:9], fov_y=0.8, width=800, height=457, near=0.01,
+                    pixel_error=3.0)

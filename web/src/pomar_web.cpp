@@ -78,8 +78,9 @@ struct Handle {
   // Results kept alive for JavaScript to copy out of the heap.
   pomar::Mesh mesh;
   std::vector<uint32_t> vertex_cluster, vertex_level;
-  bool textured = false;    // the file has per-corner texture coordinates
-  bool keep_seams = false;  // pw_keep_seams: a full-resolution extract stays cut
+  std::vector<float> errors;    // pw_cluster_errors
+  bool textured = false;        // the file has per-corner texture coordinates
+  bool keep_seams = false;      // pw_keep_seams: a full-resolution extract stays cut
   std::vector<float> texcoords; // per vertex of `mesh`: u, v (empty: none, or conflicts)
   size_t texcoord_conflicts = 0;
   std::vector<float> bounds;
@@ -252,6 +253,8 @@ EMSCRIPTEN_KEEPALIVE Handle *pw_open(const uint8_t *data, size_t n, double file_
       const size_t hsize = pomar::header_size(data, n);
       const pomar::FileLayout layout = pomar::read_layout(data, hsize, size, true);
       h->index = pomar::read_cluster_index(data + layout.index_offset, layout);
+      for (uint32_t c = 0; c < clusters; ++c) // (the decoder's: a BLKO file's block order)
+        h->index.offset[c] = h->decoder->block_offset(c);
       h->decoder->cluster_links(h->link_start, h->link);
     }
     const pomar::Mesh base = h->decoder->mesh();
@@ -358,6 +361,39 @@ EMSCRIPTEN_KEEPALIVE int pw_update(Handle *h, const int32_t *wanted) {
   });
 }
 
+/// The stored error bound of every cluster at every level from the base clustered level
+/// to the one below the finest (level-major: [(l - base) * clusters + c]; section CERR),
+/// or null when the file stores none.
+EMSCRIPTEN_KEEPALIVE const float *pw_cluster_errors(Handle *h) {
+  const uint32_t n = h->decoder->cluster_count();
+  if (!n || !h->decoder->has_cluster_errors())
+    return nullptr;
+  const int base = h->decoder->base_clustered_level(), finest = h->decoder->finest_level();
+  h->errors.resize(size_t(finest - base) * n);
+  for (int l = base; l < finest; ++l)
+    for (uint32_t c = 0; c < n; ++c)
+      h->errors[size_t(l - base) * n + c] = float(h->decoder->cluster_error(c, l));
+  return h->errors.data();
+}
+
+/// SelectiveDecoder::view_levels for the camera `cam` (eye xyz, view-projection 16
+/// column-major, vertical fov in radians, width, height, near: 23 floats) into pw_levels,
+/// without decoding. Returns 0, or -1 on error.
+EMSCRIPTEN_KEEPALIVE int pw_view_levels(Handle *h, const float *cam, float pixel_error) {
+  return guarded([&] {
+    pomar::ViewCamera camera;
+    std::copy(cam, cam + 3, camera.eye);
+    std::copy(cam + 3, cam + 19, camera.view_proj);
+    camera.fov_y = cam[19];
+    camera.width = cam[20];
+    camera.height = cam[21];
+    camera.near_distance = cam[22];
+    const std::vector<int> levels = h->decoder->view_levels(camera, pixel_error);
+    h->levels.assign(levels.begin(), levels.end());
+    return 0;
+  });
+}
+
 /// The level of every cluster after pw_update (or the map of pw_complete).
 EMSCRIPTEN_KEEPALIVE const int32_t *pw_levels(Handle *h) { return h->levels.data(); }
 
@@ -440,7 +476,8 @@ EMSCRIPTEN_KEEPALIVE const float *pw_texcoords(Handle *h) {
 EMSCRIPTEN_KEEPALIVE int pw_texcoord_conflicts(Handle *h) { return int(h->texcoord_conflicts); }
 /// The extracted mesh's material per triangle (index into the materials), or null.
 EMSCRIPTEN_KEEPALIVE const uint32_t *pw_face_materials(Handle *h) {
-  return h->mesh.face_materials.size() == h->mesh.triangle_count() && !h->mesh.face_materials.empty()
+  return h->mesh.face_materials.size() == h->mesh.triangle_count() &&
+                 !h->mesh.face_materials.empty()
              ? h->mesh.face_materials.data()
              : nullptr;
 }
@@ -452,7 +489,8 @@ EMSCRIPTEN_KEEPALIVE const char *pw_material_name(Handle *h, int i) {
 }
 /// Its other MTL lines as the file keeps them (`Kd 0.8 0.2 0.2`, `Ns 10`, ...).
 EMSCRIPTEN_KEEPALIVE const char *pw_material_properties(Handle *h, int i) {
-  return i >= 0 && size_t(i) < h->mesh.materials.size() ? h->mesh.materials[i].properties.c_str() : "";
+  return i >= 0 && size_t(i) < h->mesh.materials.size() ? h->mesh.materials[i].properties.c_str()
+                                                        : "";
 }
 EMSCRIPTEN_KEEPALIVE int pw_material_texture(Handle *h, int i) {
   return i >= 0 && size_t(i) < h->mesh.materials.size() ? h->mesh.materials[i].texture : -1;

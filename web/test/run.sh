@@ -45,6 +45,16 @@ node "$REPO/web/test/detail_test.mjs" "$TOOL"
 echo "web tests: WASM decode = native decode (node web/test/wasm_decode_test.mjs)"
 node "$REPO/web/test/wasm_decode_test.mjs" "$TOOL" "$samples/bunny.pomar" "$samples/bunny_c5.pomar" \
   "$samples/bunny_progressive.pomar" "$samples/coloured_zup.pomar"
+RA_BENCH="$(dirname "$TOOL")/../bench/pomar_ra_bench"
+if [ -x "$RA_BENCH" ]; then
+  echo "web tests: view selection in WASM = native (node web/test/view_test.mjs)"
+  "$RA_BENCH" encode "$REPO/samples/bunny.ply" "$samples/bunny_view.pomar" >/dev/null
+  "$RA_BENCH" encode "$REPO/samples/bunny.ply" "$samples/bunny_view_c5.pomar" 0.05 >/dev/null
+  node "$REPO/web/test/view_test.mjs" "$RA_BENCH" "$samples/bunny_view.pomar" \
+    "$samples/bunny_view_c5.pomar" "$samples/bunny.pomar"
+else
+  echo "web tests: view selection SKIPPED: no $RA_BENCH"
+fi
 bash "$REPO/web/test/real_servers.sh" "$samples/bunny_c5.pomar"
 if ! command -v chromium >/dev/null 2>&1; then
   echo "web tests: browser test SKIPPED: chromium not installed"

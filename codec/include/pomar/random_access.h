@@ -96,6 +96,19 @@ struct SelectiveOptions {
   uint32_t min_parallel_vertices = 4096;
 };
 
+/// A camera for view-dependent decoding, as the web client describes it (camera.js viewOf):
+/// the eye, the view-projection matrix (column-major, clip = view_proj * [x y z 1], OpenGL
+/// clip volume -w <= x, y, z <= w), the vertical field of view, the viewport in pixels and
+/// the near distance (clusters nearer than it are measured at it).
+struct ViewCamera {
+  float eye[3] = {0, 0, 0};
+  float view_proj[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  float fov_y = 0.8f; ///< radians
+  float width = 800;  ///< pixels
+  float height = 457; ///< pixels
+  float near_distance = 0.01f;
+};
+
 /// Selective, incremental decoder of a .pomar file. Levels are numbered as everywhere
 /// else (0 = base mesh, info().levels.size() = full resolution); clusters can be refined
 /// from base_clustered_level() to finest_level(). A pure progressive file has no
@@ -133,6 +146,29 @@ public:
   void clear_wanted();
   /// Set the wanted levels exactly (one per cluster); lower values coarsen.
   void set_wanted(const std::vector<int> &levels);
+  /// View-dependent request: set the wanted levels (as set_wanted) to view_levels(camera,
+  /// pixel_error); update() then decodes them. Call again after update() for a new camera
+  /// (or the same one: the boxes are then those of the decoded levels).
+  void want_view(const ViewCamera &camera, float pixel_error);
+  /// The level per cluster a view needs, without requesting it: a cluster outside the view
+  /// frustum gets the base clustered level; any other the coarsest level whose error,
+  /// projected at the distance from the eye to the cluster, is at most `pixel_error`
+  /// pixels. The error is the stored bound (cluster_error) when the file has one, otherwise
+  /// the longest edge of the cluster's faces at its current level, scaled to the other
+  /// levels by sqrt(faces at the current level / faces at that level) from the level table
+  /// (0 at the finest level). The cluster is the box of the current mesh's faces that touch
+  /// it, grown by its error at its current level.
+  std::vector<int> view_levels(const ViewCamera &camera, float pixel_error) const;
+  /// The file stores a geometric error per cluster and level (section CERR).
+  bool has_cluster_errors() const;
+  /// Its bound for cluster c decoded to `level` (in model units: the deviation of the
+  /// cluster's full-resolution vertices from the level's surface, docs/format.md); 0 at the
+  /// finest level; -1 if the file stores none.
+  double cluster_error(uint32_t cluster, int level) const;
+  /// Where cluster c's block lies in the file (from the cluster index and, in a file with
+  /// a BLKO section, the block order).
+  uint64_t block_offset(uint32_t cluster) const;
+  uint32_t block_size(uint32_t cluster) const;
   const std::vector<int> &wanted() const;
 
   /// Complete the level map (at most one level between neighbouring clusters, section 6)

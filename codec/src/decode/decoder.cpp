@@ -12,6 +12,8 @@
 #include "decode/decoder_codec.h"
 #include "decode/global_levels.h"
 #include "entropy/models.h"
+#include "format/block_order.h"
+#include "format/cluster_errors.h"
 #include "format/file_format.h"
 #include "lossless/lossless_stage.h"
 #include "parallel/thread_pool.h"
@@ -137,7 +139,20 @@ std::vector<DamagedBlock> check_blocks(const uint8_t *data, size_t size) {
     return damaged;
   check_block(data + layout.tables_offset, h.tables_bytes, h.tables_checksum,
               "static model tables");
-  const ClusterIndex index = read_cluster_index(data + layout.index_offset, layout);
+  ClusterIndex index = read_cluster_index(data + layout.index_offset, layout);
+  if (has_block_order(data, layout)) { // the blocks lie in the Morton order of their roots
+    LevelMesh lm = base_level_mesh(data, layout);
+    Models models;
+    if (const auto attributes = load_attribute_table(data, layout)) {
+      init_attributes(*attributes, lm, AttributeMask::none()); // read past, not kept
+      models.attr = attribute_models(*attributes);
+    }
+    if (!damaged.empty()) // a damaged global level: the roots, so the blocks, are unknown
+      return damaged;
+    decode_global_levels(data, layout, 0, h.global_levels, lm, models, {});
+    place_blocks(index, morton_block_order(lm.q, h.clusters, h.grid.bits), layout);
+  }
+  load_cluster_errors(data, layout); // (the global part: a failure throws)
   for (uint32_t c = 0; c < h.clusters; ++c) {
     const char *problem = nullptr;
     if (index.offset[c] + index.size[c] > size)

@@ -18,6 +18,8 @@
 #include "decode/level_map.h"
 #include "decode/level_schedule.h"
 #include "entropy/static_tables.h"
+#include "format/block_order.h"
+#include "format/cluster_errors.h"
 #include "format/file_format.h"
 #include "geometry/quantize.h"
 #include "lossless/lossless_stage.h"
@@ -47,6 +49,8 @@ struct SelectiveDecoder::State {
   // Clustered part.
   std::vector<Models> level_models;
   ClusterIndex index;
+  ClusterErrors errors;              // the CERR section (empty without one)
+  std::vector<uint32_t> block_order; // the blocks' order in the file (BLKO; empty: id order)
   ClusterGraph graph;
   // (Cache-line aligned: the clusters of a batch are decoded on several threads, each
   // writing its cluster's stream state at every symbol.)
@@ -370,6 +374,12 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   decode_global_levels(s.global.data(), s.layout, 0, h.global_levels, s.mesh, s.global_models, {});
   const uint32_t n = h.clusters;
   s.mesh.root_clusters();
+  // Blocks stored in the Morton order of their roots (BLKO): the offsets follow that order.
+  if (has_block_order(s.global.data(), s.layout)) {
+    s.block_order = morton_block_order(s.mesh.q, n, h.grid.bits);
+    place_blocks(s.index, s.block_order, s.layout);
+  }
+  s.errors = load_cluster_errors(s.global.data(), s.layout);
   s.snapshot = s.mesh;
   s.clusters.resize(n);
   for (uint32_t c = 0; c < n; ++c) {
@@ -697,7 +707,8 @@ void SelectiveDecoder::State::check_cluster_data() {
   if (data_checked || !h.has_cluster_checksum || !damaged.empty())
     return; // (damage found already: the cluster data cannot match)
   std::vector<const std::vector<uint8_t> *> blocks;
-  for (const Cluster &k : clusters) {
+  for (size_t i = 0; i < clusters.size(); ++i) { // in file order (BLKO: block_order)
+    const Cluster &k = clusters[block_order.empty() ? i : block_order[i]];
     const std::vector<uint8_t> *block = k.stream.whole_block();
     if (!block)
       return; // not everything was read
@@ -772,5 +783,23 @@ std::vector<uint32_t> SelectiveDecoder::vertex_level() const {
     out[v] = s_->mesh.level_of(v);
   return out;
 }
+
+// ---------------------------------------------------------------- stored errors, blocks
+
+bool SelectiveDecoder::has_cluster_errors() const { return !s_->errors.empty(); }
+double SelectiveDecoder::cluster_error(uint32_t cluster, int level) const {
+  if (s_->errors.empty())
+    return -1;
+  if (cluster >= s_->clusters.size())
+    throw Error(Error::Kind::Usage, "cluster " + std::to_string(cluster) +
+                                        " does not exist: the file has " +
+                                        std::to_string(s_->clusters.size()));
+  check_level_exists(level, s_->finest);
+  return s_->errors.bound(cluster, level);
+}
+uint64_t SelectiveDecoder::block_offset(uint32_t cluster) const {
+  return s_->index.offset.at(cluster);
+}
+uint32_t SelectiveDecoder::block_size(uint32_t cluster) const { return s_->index.size.at(cluster); }
 
 } // namespace pomar

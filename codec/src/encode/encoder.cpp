@@ -13,9 +13,12 @@
 #include "attributes/material_section.h"
 #include "attributes/texture_images.h"
 #include "decimate/decimate.h"
+#include "encode/cluster_error_measure.h"
 #include "encode/clusters.h"
 #include "encode/encoder_codec.h"
 #include "entropy/models.h"
+#include "format/block_order.h"
+#include "format/cluster_errors.h"
 #include "format/file_format.h"
 #include "geometry/quantize.h"
 #include "lossless/lossless_stage.h"
@@ -320,8 +323,22 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
     // Required: a reader that ignored it would give the cut mesh for the input.
     sections.push_back({kLosslessTag, kSectionRequired, hook->record(decoded_to_cut)});
   }
-  std::vector<uint8_t> file = write_file(header, pack_base_mesh(base, in.grid.bits), blocks,
-                                         clustered.tables, clustered.blocks, sections);
+  // Random access: the blocks in the Morton order of their roots (section BLKO, required:
+  // a reader that does not know it would look for the blocks in id order).
+  std::vector<uint32_t> block_order;
+  if (header.clustered() && options.spatial_layout) {
+    block_order =
+        morton_block_order(rb.mesh.q, static_cast<uint32_t>(clustered.blocks.size()), in.grid.bits);
+    sections.push_back({kBlockOrderTag, kSectionRequired, write_block_order()});
+  }
+  std::vector<uint8_t> file =
+      write_file(header, pack_base_mesh(base, in.grid.bits), blocks, clustered.tables,
+                 clustered.blocks, sections, block_order.empty() ? nullptr : &block_order);
+  // The error per cluster and level (section CERR, optional), measured on the file itself.
+  if (header.clustered() && options.cluster_errors) {
+    std::vector<uint8_t> errors = measure_cluster_errors(file, decode_threads(options.threads));
+    file = with_sections(file.data(), file.size(), {{kClusterErrorsTag, 0, std::move(errors)}});
+  }
   if (report) {
     // The report is read from the file just written: a failure here is the encoder's own
     // inconsistency, never a damaged file.

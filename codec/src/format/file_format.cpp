@@ -192,11 +192,16 @@ std::vector<uint8_t> pack_base_mesh(const BaseMesh &base, int bits) {
   return out;
 }
 
-std::vector<uint8_t> write_file(FileHeader header, const std::vector<uint8_t> &base_block,
-                                const std::vector<std::vector<uint8_t>> &level_blocks,
-                                const std::vector<uint8_t> &tables,
-                                const std::vector<std::vector<uint8_t>> &cluster_blocks,
-                                const std::vector<Section> &sections) {
+namespace {
+
+/// The file image from its parts; `header`'s clustered fields already describe `index` and
+/// `cluster_data` (the blocks, in file order).
+std::vector<uint8_t> assemble(FileHeader header, const std::vector<uint8_t> &base_block,
+                              const std::vector<std::vector<uint8_t>> &level_blocks,
+                              const std::vector<uint8_t> &tables, const std::vector<uint8_t> &index,
+                              const std::vector<const uint8_t *> &data,
+                              const std::vector<size_t> &data_bytes,
+                              const std::vector<Section> &sections) {
   if (sections.size() > kMaxSections)
     throw Error(Error::Kind::Internal,
                 "internal error: more than " + std::to_string(kMaxSections) + " sections");
@@ -217,27 +222,11 @@ std::vector<uint8_t> write_file(FileHeader header, const std::vector<uint8_t> &b
   header.base_checksum = checksum(base_block.data(), base_block.size());
   for (size_t i = 0; i < level_blocks.size(); ++i)
     header.levels[i].checksum = checksum(level_blocks[i].data(), level_blocks[i].size());
-  std::vector<uint8_t> index;
   if (header.clustered()) {
-    header.clusters = static_cast<uint32_t>(cluster_blocks.size());
     header.tables_bytes = static_cast<uint32_t>(tables.size());
     header.tables_checksum = checksum(tables.data(), tables.size());
-    ClusterIndex entries;
-    for (const auto &b : cluster_blocks) {
-      entries.size.push_back(static_cast<uint32_t>(b.size()));
-      entries.check.push_back(static_cast<uint8_t>(checksum(b.data(), b.size()) & 0xFF));
-    }
-    index = pack_cluster_index(entries);
     header.index_bytes = static_cast<uint32_t>(index.size());
     header.index_checksum = checksum(index.data(), index.size());
-    header.cluster_bytes = 0;
-    std::vector<const std::vector<uint8_t> *> blocks;
-    for (const auto &b : cluster_blocks) {
-      header.cluster_bytes += b.size();
-      blocks.push_back(&b);
-    }
-    header.has_cluster_checksum = true;
-    header.cluster_checksum = checksum(blocks);
   }
   std::vector<uint8_t> out;
   write_header(header, out);
@@ -249,10 +238,44 @@ std::vector<uint8_t> write_file(FileHeader header, const std::vector<uint8_t> &b
   if (header.clustered()) {
     out.insert(out.end(), tables.begin(), tables.end());
     out.insert(out.end(), index.begin(), index.end());
-    for (const auto &b : cluster_blocks)
-      out.insert(out.end(), b.begin(), b.end());
+    for (size_t i = 0; i < data.size(); ++i)
+      out.insert(out.end(), data[i], data[i] + data_bytes[i]);
   }
   return out;
+}
+
+} // namespace
+
+std::vector<uint8_t> write_file(FileHeader header, const std::vector<uint8_t> &base_block,
+                                const std::vector<std::vector<uint8_t>> &level_blocks,
+                                const std::vector<uint8_t> &tables,
+                                const std::vector<std::vector<uint8_t>> &cluster_blocks,
+                                const std::vector<Section> &sections,
+                                const std::vector<uint32_t> *block_order) {
+  std::vector<uint8_t> index;
+  std::vector<const uint8_t *> data;
+  std::vector<size_t> data_bytes;
+  if (header.clustered()) {
+    header.clusters = static_cast<uint32_t>(cluster_blocks.size());
+    ClusterIndex entries; // sizes and checks in cluster id order
+    for (const auto &b : cluster_blocks) {
+      entries.size.push_back(static_cast<uint32_t>(b.size()));
+      entries.check.push_back(static_cast<uint8_t>(checksum(b.data(), b.size()) & 0xFF));
+    }
+    index = pack_cluster_index(entries);
+    header.cluster_bytes = 0;
+    std::vector<const std::vector<uint8_t> *> blocks; // in file order
+    for (size_t i = 0; i < cluster_blocks.size(); ++i) {
+      const auto &b = cluster_blocks[block_order ? (*block_order).at(i) : i];
+      header.cluster_bytes += b.size();
+      blocks.push_back(&b);
+      data.push_back(b.data());
+      data_bytes.push_back(b.size());
+    }
+    header.has_cluster_checksum = true;
+    header.cluster_checksum = checksum(blocks);
+  }
+  return assemble(header, base_block, level_blocks, tables, index, data, data_bytes, sections);
 }
 
 size_t header_size(const uint8_t *data, size_t size) {
@@ -647,7 +670,8 @@ const uint8_t *section_body(const uint8_t *data, const FileLayout &L, size_t i) 
 const std::vector<uint32_t> &known_sections() {
   // The sections this build's decoders honour.
   static const std::vector<uint32_t> known = {section_tag("ATTR"), kLosslessTag,
-                                              section_tag("MATL"), section_tag("TEXI")};
+                                              section_tag("MATL"), section_tag("TEXI"),
+                                              section_tag("CERR"), section_tag("BLKO")};
   return known;
 }
 
@@ -678,15 +702,19 @@ std::vector<uint8_t> with_sections(const uint8_t *file, size_t size,
   for (size_t i = 0; i < L.level_offset.size(); ++i)
     levels.push_back(bytes(L.level_offset[i],
                            uint64_t(h.levels[i].connectivity_bytes) + h.levels[i].geometry_bytes));
-  std::vector<uint8_t> tables;
-  std::vector<std::vector<uint8_t>> blocks;
+  // The clustered part is copied as it is (tables, index, the blocks in their file order,
+  // which a BLKO section defines from the decoded roots: never re-derived here).
+  std::vector<uint8_t> tables, index;
+  std::vector<const uint8_t *> data;
+  std::vector<size_t> data_bytes;
   if (h.clustered()) {
     tables = bytes(L.tables_offset, h.tables_bytes);
-    const ClusterIndex index = read_cluster_index(file + L.index_offset, L);
-    for (uint32_t c = 0; c < h.clusters; ++c)
-      blocks.push_back(bytes(index.offset[c], index.size[c]));
+    index = bytes(L.index_offset, h.index_bytes);
+    read_cluster_index(index.data(), L); // checked before it is copied
+    data.push_back(file + L.clusters_offset);
+    data_bytes.push_back(h.cluster_bytes);
   }
-  return write_file(h, base, levels, tables, blocks, sections);
+  return assemble(h, base, levels, tables, index, data, data_bytes, sections);
 }
 
 void check_block(const uint8_t *data, size_t size, uint32_t expected, const char *what) {

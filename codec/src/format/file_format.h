@@ -135,7 +135,8 @@ std::vector<uint8_t> write_file(FileHeader header, const std::vector<uint8_t> &b
                                 const std::vector<std::vector<uint8_t>> &level_blocks,
                                 const std::vector<uint8_t> &tables = {},
                                 const std::vector<std::vector<uint8_t>> &cluster_blocks = {},
-                                const std::vector<Section> &sections = {});
+                                const std::vector<Section> &sections = {},
+                                const std::vector<uint32_t> *block_order = nullptr);
 /// The same file with `sections` added (replacing any of the same tags): version 4 (the
 /// input may be version 1, 3 or 4) or 5 (a version 5 input). Stages that run after encode() (e.g.
 /// the lossless record, which needs the decoder's numbering) attach their data this way.
