@@ -548,56 +548,76 @@ std::vector<uint8_t> write_lossless_record(const LosslessRecord &r, Mesh &&decod
   return out;
 }
 
-LosslessRecord read_lossless_record(const uint8_t *data, size_t size, const Mesh &decoded,
-                                    int bits) {
-  RangeDecoder rc;
-  RecordModels m;
+namespace {
+
+using IndexPairs = std::vector<std::pair<uint32_t, uint32_t>>;
+
+/// The record's header (the flags byte and the counts), checked against D.
+LosslessCounts read_header(const uint8_t *data, size_t size, const Mesh &decoded, RangeDecoder &rc,
+                           RecordModels &m) {
   const LosslessCounts n = read_counts(data, size, rc, m);
   const uint64_t nv = decoded.vertex_count(), nf = decoded.triangle_count();
-  const uint64_t copies = n.copies, flipped = n.flipped, duplicates = n.duplicated,
-                 degenerate = n.degenerate, extra = n.extra;
-  if (copies >= std::max<uint64_t>(nv, 1) || flipped > nf || duplicates > nf)
+  if (n.copies >= std::max<uint64_t>(nv, 1) || n.flipped > nf || n.duplicated > nf)
     damaged("counts do not fit the decoded mesh");
   if (n.vertices(nv) > 0xFFFFFFFEu || n.faces(nf) > 0xFFFFFFFEu)
     damaged("counts are larger than the record can hold");
-  LosslessRecord r;
-  if (copies) {
-    Candidates cand(decoded);
-    r.copies.reserve(copies);
-    uint64_t gap = get_u(rc, m.copy_gap);
-    for (uint32_t v = 0; v < nv; ++v) {
-      const uint32_t k = cand.of(v);
-      if (k == 0 || r.copies.size() == copies) {
-        cand.add(v);
-        continue;
-      }
-      if (gap > 0) {
-        --gap;
-        cand.add(v);
-        continue;
-      }
-      const uint64_t i = k > 1 ? get_u(rc, m.copy_index) : 0;
-      if (i >= k)
-        damaged("vertex " + std::to_string(v) + " is a copy of a vertex that does not exist");
-      r.copies.push_back({v, cand.nth(v, static_cast<uint32_t>(i))});
-      if (r.copies.size() < copies)
-        gap = get_u(rc, m.copy_gap);
+  return n;
+}
+
+/// The vertex copies: a gap over the vertices whose position repeats a representative's,
+/// then which representative (only when there are several).
+IndexPairs read_copies(RangeDecoder &rc, RecordModels &m, const Mesh &decoded, uint64_t copies) {
+  IndexPairs out;
+  if (copies == 0)
+    return out;
+  const uint64_t nv = decoded.vertex_count();
+  Candidates cand(decoded);
+  out.reserve(copies);
+  uint64_t gap = get_u(rc, m.copy_gap);
+  for (uint32_t v = 0; v < nv; ++v) {
+    const uint32_t k = cand.of(v);
+    if (k == 0 || out.size() == copies) {
+      cand.add(v);
+      continue;
     }
-    if (r.copies.size() != copies)
-      damaged("vertex copies past the last decoded vertex");
+    if (gap > 0) {
+      --gap;
+      cand.add(v);
+      continue;
+    }
+    const uint64_t i = k > 1 ? get_u(rc, m.copy_index) : 0;
+    if (i >= k)
+      damaged("vertex " + std::to_string(v) + " is a copy of a vertex that does not exist");
+    out.push_back({v, cand.nth(v, static_cast<uint32_t>(i))});
+    if (out.size() < copies)
+      gap = get_u(rc, m.copy_gap);
   }
+  if (out.size() != copies)
+    damaged("vertex copies past the last decoded vertex");
+  return out;
+}
+
+/// The flipped faces of D (of `nf`): gaps between their canonical indices.
+std::vector<uint32_t> read_flips(RangeDecoder &rc, RecordModels &m, uint64_t flipped, uint64_t nf) {
+  std::vector<uint32_t> out;
+  out.reserve(flipped);
   uint64_t at = 0;
-  r.flipped.reserve(flipped);
   for (uint64_t i = 0; i < flipped; ++i) {
     at += get_u(rc, m.flip_gap);
     if (at >= nf)
       damaged("flipped face past the last face");
-    r.flipped.push_back(static_cast<uint32_t>(at++));
+    out.push_back(static_cast<uint32_t>(at++));
   }
-  at = 0;
-  r.duplicates.reserve(duplicates);
-  uint64_t copies_of_faces = 0;
-  for (uint64_t i = 0; i < duplicates; ++i) {
+  return out;
+}
+
+/// The duplicated faces of D (of `nf`): per face a gap, then its number of extra copies.
+IndexPairs read_duplicates(RangeDecoder &rc, RecordModels &m, const LosslessCounts &n,
+                           uint64_t nf) {
+  IndexPairs out;
+  out.reserve(n.duplicated);
+  uint64_t at = 0, copies_of_faces = 0;
+  for (uint64_t i = 0; i < n.duplicated; ++i) {
     at += get_u(rc, m.dup_gap);
     const uint64_t k = get_u(rc, m.dup_count) + 1;
     copies_of_faces += k;
@@ -605,23 +625,38 @@ LosslessRecord read_lossless_record(const uint8_t *data, size_t size, const Mesh
       damaged("duplicated face past the last face");
     if (copies_of_faces > n.duplicate_faces)
       damaged("more duplicate faces than counted");
-    r.duplicates.push_back({static_cast<uint32_t>(at++), static_cast<uint32_t>(k)});
+    out.push_back({static_cast<uint32_t>(at++), static_cast<uint32_t>(k)});
   }
   if (copies_of_faces != n.duplicate_faces)
     damaged("fewer duplicate faces than counted");
-  const uint64_t out_vertices = nv - copies + extra;
-  at = 0;
-  r.degenerate.reserve(degenerate);
+  return out;
+}
+
+/// The degenerate faces (a, a, b) over `out_vertices` output vertices: a as a gap, then b
+/// (a bit when b == a).
+std::vector<std::array<uint32_t, 2>> read_degenerate(RangeDecoder &rc, RecordModels &m,
+                                                     uint64_t degenerate, uint64_t out_vertices) {
+  std::vector<std::array<uint32_t, 2>> out;
+  out.reserve(degenerate);
+  uint64_t at = 0;
   for (uint64_t i = 0; i < degenerate; ++i) {
     at += get_u(rc, m.degen_gap);
     const uint64_t b = rc.decode_bit(m.degen_single) ? at : get_u(rc, m.degen_b);
     if (at >= out_vertices || b >= out_vertices)
       damaged("degenerate face uses a vertex past the last one");
-    r.degenerate.push_back({static_cast<uint32_t>(at), static_cast<uint32_t>(b)});
+    out.push_back({static_cast<uint32_t>(at), static_cast<uint32_t>(b)});
   }
+  return out;
+}
+
+/// The extra vertices' quantized positions: per coordinate, a signed difference from the
+/// previous vertex's, on a grid of `bits` bits.
+std::vector<int32_t> read_extra_positions(RangeDecoder &rc, RecordModels &m, uint64_t extra,
+                                          int bits) {
   const int64_t top = (int64_t(1) << bits) - 1;
   int64_t prev[3] = {0, 0, 0};
-  r.extra_q.reserve(3 * extra);
+  std::vector<int32_t> out;
+  out.reserve(3 * extra);
   for (uint64_t i = 0; i < 3 * extra; ++i) {
     const int k = static_cast<int>(i % 3);
     int64_t d = static_cast<int64_t>(get_u(rc, m.extra[k]));
@@ -630,60 +665,81 @@ LosslessRecord read_lossless_record(const uint8_t *data, size_t size, const Mesh
     const int64_t q = prev[k] + d;
     if (q < 0 || q > top)
       damaged("vertex position off the grid");
-    r.extra_q.push_back(static_cast<int32_t>(q));
+    out.push_back(static_cast<int32_t>(q));
     prev[k] = q;
   }
-  if (data[0] & kHasOrder) {
-    // The order is coded against the output's faces: its shape only (the attributes of the
-    // extra vertices come after the order).
-    Mesh shape;
-    shape.positions = decoded.positions;
-    shape.triangles = decoded.triangles;
-    const Mesh mesh = apply_lossless_record(std::move(shape), r, Quantizer());
-    const uint32_t n = static_cast<uint32_t>(mesh.vertex_count());
-    const Neighbours nb(mesh.triangles, n);
-    UnusedSet unused(n);
-    r.order.resize(n);
-    for (uint32_t i = 0, prev = 0; i < n; ++i) {
-      const uint64_t symbol = i > 0 ? get_u(rc, m.order_symbol) : 0;
-      uint32_t o = kNone;
-      if (symbol == 0) {
-        const uint32_t k = get_uniform(rc, unused.left());
-        if (k >= unused.left())
-          damaged("vertex order: rank past the last vertex");
-        o = unused.nth(k);
-      } else {
-        order_candidates(nb, unused, prev, [&](uint32_t w, uint32_t s) {
-          if (s != symbol)
-            return false;
-          o = w;
-          return true;
-        });
-        if (o == kNone)
-          damaged("vertex order: input vertex " + std::to_string(i) + " has no output vertex");
-      }
-      r.order[o] = i;
-      unused.take(o);
-      prev = o;
+  return out;
+}
+
+/// The input vertex numbering, coded against the output's faces (D with `r`, read so far
+/// and without an order, undone): its shape only (the attributes of the extra vertices
+/// come after the order).
+std::vector<uint32_t> read_order(RangeDecoder &rc, RecordModels &m, const Mesh &decoded,
+                                 const LosslessRecord &r) {
+  Mesh shape;
+  shape.positions = decoded.positions;
+  shape.triangles = decoded.triangles;
+  const Mesh mesh = apply_lossless_record(std::move(shape), r, Quantizer());
+  const uint32_t n = static_cast<uint32_t>(mesh.vertex_count());
+  const Neighbours nb(mesh.triangles, n);
+  UnusedSet unused(n);
+  std::vector<uint32_t> order(n);
+  for (uint32_t i = 0, prev = 0; i < n; ++i) {
+    const uint64_t symbol = i > 0 ? get_u(rc, m.order_symbol) : 0;
+    uint32_t o = kNone;
+    if (symbol == 0) {
+      const uint32_t k = get_uniform(rc, unused.left());
+      if (k >= unused.left())
+        damaged("vertex order: rank past the last vertex");
+      o = unused.nth(k);
+    } else {
+      order_candidates(nb, unused, prev, [&](uint32_t w, uint32_t s) {
+        if (s != symbol)
+          return false;
+        o = w;
+        return true;
+      });
+      if (o == kNone)
+        damaged("vertex order: input vertex " + std::to_string(i) + " has no output vertex");
     }
+    order[o] = i;
+    unused.take(o);
+    prev = o;
   }
+  return order;
+}
+
+} // namespace
+
+LosslessRecord read_lossless_record(const uint8_t *data, size_t size, const Mesh &decoded,
+                                    int bits) {
+  RangeDecoder rc;
+  RecordModels m;
+  const LosslessCounts n = read_header(data, size, decoded, rc, m);
+  const uint64_t nv = decoded.vertex_count(), nf = decoded.triangle_count();
+  LosslessRecord r;
+  r.copies = read_copies(rc, m, decoded, n.copies);
+  r.flipped = read_flips(rc, m, n.flipped, nf);
+  r.duplicates = read_duplicates(rc, m, n, nf);
+  r.degenerate = read_degenerate(rc, m, n.degenerate, nv - n.copies + n.extra);
+  r.extra_q = read_extra_positions(rc, m, n.extra, bits);
+  if (data[0] & kHasOrder)
+    r.order = read_order(rc, m, decoded, r);
   if (data[0] & kHasAttributes)
-    r.extra_attributes = read_extra_attributes(rc, extra, size);
+    r.extra_attributes = read_extra_attributes(rc, n.extra, size);
   if (rc.overrun())
     damaged("the data ends too early");
   return r;
 }
 
-Mesh apply_lossless_record(Mesh &&decoded, const LosslessRecord &r, const Quantizer &grid,
-                           std::vector<uint32_t> *source) {
-  // Worked in place on D's own arrays (a full decode hands its mesh over): the output
-  // vertices are D's less the copies, then the extra vertices; the faces D's in canonical
-  // order, written where D's were once bucketed. What can be wrong is checked first: a
-  // damaged record throws with D untouched (skip_damaged keeps it, the cut mesh).
+namespace {
+
+/// Per attribute of D, the extra vertices' values of it (none: a record without
+/// attributes, e.g. written for a mesh that had none); checks that the record fits D.
+std::vector<const VertexAttribute *> check_record_fits(const Mesh &decoded,
+                                                       const LosslessRecord &r) {
   const uint32_t nv = static_cast<uint32_t>(decoded.vertex_count());
   const size_t extra = r.extra_q.size() / 3;
-  // Per attribute of D, the extra vertices' values of it (none: a record without
-  // attributes, e.g. written for a mesh that had none).
   std::vector<const VertexAttribute *> extra_of;
   for (const VertexAttribute &a : decoded.attributes) {
     const VertexAttribute *x = nullptr;
@@ -699,77 +755,121 @@ Mesh apply_lossless_record(Mesh &&decoded, const LosslessRecord &r, const Quanti
   }
   if (!r.order.empty() && r.order.size() != nv - r.copies.size() + extra)
     damaged("the vertex order does not fit the mesh");
-  std::vector<uint32_t> out_of; // D's vertex -> output vertex (when there are copies)
-  if (!r.copies.empty() || source) {
-    out_of.assign(nv, kNone);
-    size_t next_copy = 0;
-    uint32_t next = 0;
-    for (uint32_t v = 0; v < nv; ++v)
-      if (next_copy < r.copies.size() && r.copies[next_copy].first == v)
-        out_of[v] = out_of[r.copies[next_copy++].second];
-      else
-        out_of[v] = next++;
-  }
-  Mesh out;
-  out.positions = std::move(decoded.positions);
-  { // the copies dropped (kept rows move down, in place), the extra vertices appended
-    size_t c = 0, kept = 0;
-    for (uint32_t v = 0; v < nv && !r.copies.empty(); ++v) {
-      if (c < r.copies.size() && r.copies[c].first == v) {
-        ++c;
-        continue;
-      }
-      std::copy(&out.positions[3 * size_t(v)], &out.positions[3 * size_t(v)] + 3,
-                &out.positions[3 * kept++]);
-    }
-    if (!r.copies.empty())
-      out.positions.resize(3 * kept);
-    out.positions.reserve(out.positions.size() + 3 * extra);
-    for (size_t i = 0; i < r.extra_q.size(); ++i)
-      out.positions.push_back(grid.dequantize(static_cast<int>(i % 3), uint32_t(r.extra_q[i])));
-  }
+  return extra_of;
+}
 
-  // Faces: for the i-th face of D in canonical order, its flip and its extra copies.
-  const uint32_t nf = static_cast<uint32_t>(decoded.triangle_count());
-  size_t faces = size_t(nf) + r.degenerate.size();
-  for (const auto &d : r.duplicates)
-    faces += d.second;
-  const auto map = [&](uint32_t v) { return out_of.empty() ? v : out_of[v]; };
-  // Per-corner values follow their faces (D's corner k is the output face's corner k, but
-  // for a flip); a face the record adds back repeating a vertex gets zeros and material 0.
-  const bool uv = !decoded.corner_texcoords.empty(), mat = !decoded.face_materials.empty();
-  if ((uv && decoded.corner_texcoords.size() != 6 * size_t(nf)) ||
-      (mat && decoded.face_materials.size() != nf))
-    throw Error(Error::Kind::Internal, "internal error: the per-corner values do not fit the mesh");
-  if (uv)
-    out.corner_texcoords.assign(6 * faces, 0.0f);
-  if (mat)
-    out.face_materials.assign(faces, 0);
-  size_t flip = 0, dup = 0, at = 0;
-  const auto put = [&](uint32_t i, uint32_t g, uint32_t a, uint32_t b, uint32_t c) {
+/// D's vertex -> output vertex (a copy: its original's); empty when there are no copies
+/// and no `source` to fill.
+std::vector<uint32_t> output_vertex_of(const IndexPairs &copies, uint32_t nv, bool source) {
+  std::vector<uint32_t> out_of;
+  if (copies.empty() && !source)
+    return out_of;
+  out_of.assign(nv, kNone);
+  size_t next_copy = 0;
+  uint32_t next = 0;
+  for (uint32_t v = 0; v < nv; ++v)
+    if (next_copy < copies.size() && copies[next_copy].first == v)
+      out_of[v] = out_of[copies[next_copy++].second];
+    else
+      out_of[v] = next++;
+  return out_of;
+}
+
+/// The output positions, in D's array: the copies dropped (kept rows move down, in place),
+/// the extra vertices appended.
+void output_positions(std::vector<float> &positions, const LosslessRecord &r, const Quantizer &grid,
+                      uint32_t nv) {
+  size_t c = 0, kept = 0;
+  for (uint32_t v = 0; v < nv && !r.copies.empty(); ++v) {
+    if (c < r.copies.size() && r.copies[c].first == v) {
+      ++c;
+      continue;
+    }
+    std::copy(&positions[3 * size_t(v)], &positions[3 * size_t(v)] + 3, &positions[3 * kept++]);
+  }
+  if (!r.copies.empty())
+    positions.resize(3 * kept);
+  positions.reserve(positions.size() + 3 * (r.extra_q.size() / 3));
+  for (size_t i = 0; i < r.extra_q.size(); ++i)
+    positions.push_back(grid.dequantize(static_cast<int>(i % 3), uint32_t(r.extra_q[i])));
+}
+
+/// Writes the output faces of D's faces, met in canonical order: each face with its flip,
+/// its extra copies and its per-corner values (D's corner k is the output face's corner k,
+/// but for a flip); a face the record adds back repeating a vertex gets zeros and
+/// material 0.
+class FaceWriter {
+public:
+  FaceWriter(const Mesh &decoded, const LosslessRecord &r, const std::vector<uint32_t> &out_of,
+             Mesh &out)
+      : decoded_(decoded), r_(r), out_of_(out_of), out_(out),
+        uv_(!decoded.corner_texcoords.empty()), mat_(!decoded.face_materials.empty()) {
+    const uint32_t nf = static_cast<uint32_t>(decoded.triangle_count());
+    faces_ = size_t(nf) + r.degenerate.size();
+    for (const auto &d : r.duplicates)
+      faces_ += d.second;
+    if ((uv_ && decoded.corner_texcoords.size() != 6 * size_t(nf)) ||
+        (mat_ && decoded.face_materials.size() != nf))
+      throw Error(Error::Kind::Internal,
+                  "internal error: the per-corner values do not fit the mesh");
+    if (uv_)
+      out.corner_texcoords.assign(6 * faces_, 0.0f);
+    if (mat_)
+      out.face_materials.assign(faces_, 0);
+  }
+  /// The output's face count.
+  size_t faces() const { return faces_; }
+  /// The i-th face in canonical order, D's face g, as (a, b, c) in D's numbering.
+  void put(uint32_t i, uint32_t g, uint32_t a, uint32_t b, uint32_t c) {
     uint32_t f[3] = {map(a), map(b), map(c)};
     int order[3] = {0, 1, 2};
-    if (flip < r.flipped.size() && r.flipped[flip] == i) {
+    if (flip_ < r_.flipped.size() && r_.flipped[flip_] == i) {
       std::swap(f[1], f[2]);
       std::swap(order[1], order[2]);
-      ++flip;
+      ++flip_;
     }
     uint32_t n = 1;
-    if (dup < r.duplicates.size() && r.duplicates[dup].first == i)
-      n += r.duplicates[dup++].second;
-    for (uint32_t k = 0; k < n; ++k, at += 3) {
-      std::copy(f, f + 3, &out.triangles[at]);
-      if (uv)
+    if (dup_ < r_.duplicates.size() && r_.duplicates[dup_].first == i)
+      n += r_.duplicates[dup_++].second;
+    for (uint32_t k = 0; k < n; ++k, at_ += 3) {
+      std::copy(f, f + 3, &out_.triangles[at_]);
+      if (uv_)
         for (int j = 0; j < 3; ++j) {
-          out.corner_texcoords[2 * (at + j)] =
-              decoded.corner_texcoords[6 * size_t(g) + 2 * order[j]];
-          out.corner_texcoords[2 * (at + j) + 1] =
-              decoded.corner_texcoords[6 * size_t(g) + 2 * order[j] + 1];
+          out_.corner_texcoords[2 * (at_ + j)] =
+              decoded_.corner_texcoords[6 * size_t(g) + 2 * order[j]];
+          out_.corner_texcoords[2 * (at_ + j) + 1] =
+              decoded_.corner_texcoords[6 * size_t(g) + 2 * order[j] + 1];
         }
-      if (mat)
-        out.face_materials[at / 3] = decoded.face_materials[g];
+      if (mat_)
+        out_.face_materials[at_ / 3] = decoded_.face_materials[g];
     }
-  };
+  }
+  /// The degenerate faces, after D's.
+  void put_degenerate() {
+    for (const auto &d : r_.degenerate) {
+      const uint32_t f[3] = {d[0], d[0], d[1]};
+      std::copy(f, f + 3, &out_.triangles[at_]);
+      at_ += 3;
+    }
+  }
+
+private:
+  uint32_t map(uint32_t v) const { return out_of_.empty() ? v : out_of_[v]; }
+  const Mesh &decoded_;
+  const LosslessRecord &r_;
+  const std::vector<uint32_t> &out_of_;
+  Mesh &out_;
+  const bool uv_, mat_;
+  size_t faces_ = 0, flip_ = 0, dup_ = 0, at_ = 0;
+};
+
+/// The output faces: for the i-th face of D in canonical order, its flip and its extra
+/// copies, then the degenerate faces. Ids a mesh's own: D's faces bucketed, then written
+/// in D's triangle array (read no more); else through canonical_face_order.
+void output_faces(Mesh &decoded, const LosslessRecord &r, const std::vector<uint32_t> &out_of,
+                  Mesh &out) {
+  FaceWriter writer(decoded, r, out_of, out);
+  const uint32_t nf = static_cast<uint32_t>(decoded.triangle_count());
   const uint32_t top = decoded.triangles.empty()
                            ? 0
                            : *std::max_element(decoded.triangles.begin(), decoded.triangles.end());
@@ -778,36 +878,38 @@ Mesh apply_lossless_record(Mesh &&decoded, const LosslessRecord &r, const Quanti
     std::vector<Keyed> by;
     canonical_buckets(decoded.triangles, top, end, by);
     out.triangles = std::move(decoded.triangles); // (read no more: `by` holds the faces)
-    out.triangles.resize(3 * faces);
+    out.triangles.resize(3 * writer.faces());
     for (uint32_t k0 = 0, i = 0; i < nf; ++i) {
       while (end[k0] == i)
         ++k0;
       const uint32_t k1 = uint32_t(by[i].key >> 32), k2 = uint32_t(by[i].key);
       const uint32_t s = by[i].id & 3, g = by[i].id >> 2; // D's face g: (k0, k1, k2) rotated back
       if (s == 0)
-        put(i, g, k0, k1, k2);
+        writer.put(i, g, k0, k1, k2);
       else if (s == 1)
-        put(i, g, k2, k0, k1);
+        writer.put(i, g, k2, k0, k1);
       else
-        put(i, g, k1, k2, k0);
+        writer.put(i, g, k1, k2, k0);
     }
   } else {
     const std::vector<uint32_t> order = canonical_face_order(decoded.triangles);
-    out.triangles.resize(3 * faces);
+    out.triangles.resize(3 * writer.faces());
     for (uint32_t i = 0; i < nf; ++i) {
       const uint32_t *t = &decoded.triangles[3 * size_t(order[i])];
-      put(i, order[i], t[0], t[1], t[2]);
+      writer.put(i, order[i], t[0], t[1], t[2]);
     }
   }
-  for (const auto &d : r.degenerate) {
-    const uint32_t f[3] = {d[0], d[0], d[1]};
-    std::copy(f, f + 3, &out.triangles[at]);
-    at += 3;
-  }
+  writer.put_degenerate();
+}
 
-  // Attributes: an output vertex has those of the decoded vertex it comes from (its copies
-  // carry the same values: the cut copies attributes); the extra vertices, those the record
-  // stores (bit for bit).
+/// The textures, materials and vertex attributes (D's `nv` vertices, D's positions moved
+/// out already): an output vertex has those of the decoded vertex it comes from (its copies carry
+/// the same values: the cut copies attributes); the extra vertices, those the record stores (bit
+/// for bit).
+void output_attributes(Mesh &decoded, const LosslessRecord &r,
+                       const std::vector<const VertexAttribute *> &extra_of, uint32_t nv,
+                       Mesh &out) {
+  const size_t extra = r.extra_q.size() / 3;
   out.texture_files = std::move(decoded.texture_files);
   out.materials = std::move(decoded.materials);
   out.texture_images = std::move(decoded.texture_images);
@@ -831,38 +933,65 @@ Mesh apply_lossless_record(Mesh &&decoded, const LosslessRecord &r, const Quanti
     }
     out.attributes.push_back(std::move(b));
   }
+}
 
-  if (!r.order.empty()) {
-    // Output vertex o is input vertex order[o]: renumber (its size checked above).
-    std::vector<float> p(out.positions.size());
-    for (size_t o = 0; o < r.order.size(); ++o)
-      std::copy(&out.positions[3 * o], &out.positions[3 * o] + 3, &p[3 * size_t(r.order[o])]);
-    out.positions.swap(p);
-    for (uint32_t &v : out.triangles)
-      v = r.order[v];
-    for (VertexAttribute &a : out.attributes) {
-      const size_t n = a.components;
-      auto permute = [&](auto &values) {
-        auto moved = values;
-        for (size_t o = 0; o < r.order.size(); ++o)
-          for (size_t k = 0; k < n; ++k)
-            moved[size_t(r.order[o]) * n + k] = values[o * n + k];
-        values.swap(moved);
-      };
-      if (a.kind == AttributeKind::Colour)
-        permute(a.colour);
-      else
-        permute(a.values);
-    }
+/// Output vertex o becomes input vertex order[o]: positions, faces and attributes
+/// renumbered (the order's size is checked by check_record_fits).
+void apply_vertex_order(const std::vector<uint32_t> &order, Mesh &out) {
+  std::vector<float> p(out.positions.size());
+  for (size_t o = 0; o < order.size(); ++o)
+    std::copy(&out.positions[3 * o], &out.positions[3 * o] + 3, &p[3 * size_t(order[o])]);
+  out.positions.swap(p);
+  for (uint32_t &v : out.triangles)
+    v = order[v];
+  for (VertexAttribute &a : out.attributes) {
+    const size_t n = a.components;
+    auto permute = [&](auto &values) {
+      auto moved = values;
+      for (size_t o = 0; o < order.size(); ++o)
+        for (size_t k = 0; k < n; ++k)
+          moved[size_t(order[o]) * n + k] = values[o * n + k];
+      values.swap(moved);
+    };
+    if (a.kind == AttributeKind::Colour)
+      permute(a.colour);
+    else
+      permute(a.values);
   }
-  if (source) {
-    source->assign(out.vertex_count(), kNone);
-    for (uint32_t v = 0; v < nv; ++v) {
-      const uint32_t o = r.order.empty() ? out_of[v] : r.order[out_of[v]];
-      if ((*source)[o] == kNone)
-        (*source)[o] = v;
-    }
+}
+
+/// For each output vertex, the first vertex of D it comes from (kNone: an extra vertex).
+std::vector<uint32_t> source_vertices(const std::vector<uint32_t> &out_of,
+                                      const std::vector<uint32_t> &order, size_t out_vertices) {
+  std::vector<uint32_t> source(out_vertices, kNone);
+  for (uint32_t v = 0; v < out_of.size(); ++v) {
+    const uint32_t o = order.empty() ? out_of[v] : order[out_of[v]];
+    if (source[o] == kNone)
+      source[o] = v;
   }
+  return source;
+}
+
+} // namespace
+
+Mesh apply_lossless_record(Mesh &&decoded, const LosslessRecord &r, const Quantizer &grid,
+                           std::vector<uint32_t> *source) {
+  // Worked in place on D's own arrays (a full decode hands its mesh over): the output
+  // vertices are D's less the copies, then the extra vertices; the faces D's in canonical
+  // order, written where D's were once bucketed. What can be wrong is checked first: a
+  // damaged record throws with D untouched (skip_damaged keeps it, the cut mesh).
+  const std::vector<const VertexAttribute *> extra_of = check_record_fits(decoded, r);
+  const uint32_t nv = static_cast<uint32_t>(decoded.vertex_count());
+  const std::vector<uint32_t> out_of = output_vertex_of(r.copies, nv, source != nullptr);
+  Mesh out;
+  out.positions = std::move(decoded.positions);
+  output_positions(out.positions, r, grid, nv);
+  output_faces(decoded, r, out_of, out);
+  output_attributes(decoded, r, extra_of, nv, out);
+  if (!r.order.empty())
+    apply_vertex_order(r.order, out);
+  if (source)
+    *source = source_vertices(out_of, r.order, out.vertex_count());
   return out;
 }
 
