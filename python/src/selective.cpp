@@ -108,36 +108,18 @@ pomar::ViewCamera view_camera(const py::handle &eye, const std::vector<float> &v
 }
 
 using D = pomar::SelectiveDecoder;
+using DecoderClass = py::class_<Decoder>;
 
-} // namespace
-
-void register_selective_decoder(py::module_ &m) {
-  py::class_<Decoder>(m, "SelectiveDecoder")
-      .def(py::init<const py::handle &, bool, const py::handle &, unsigned>(), py::arg("source"),
-           py::kw_only(), py::arg("skip_damaged") = false, py::arg("memory_limit") = py::none(),
-           py::arg("threads") = 0u)
-      .def_property_readonly("info",
-                             [](Decoder &s) {
-                               pomar::FileInfo i = s.locked([](D &d) { return d.info(); });
-                               return info_dict(i);
-                             })
-      .def_property_readonly(
-          "cluster_count",
-          [](Decoder &s) { return s.locked([](D &d) { return d.cluster_count(); }); })
-      .def_property_readonly(
-          "base_clustered_level",
-          [](Decoder &s) { return s.locked([](D &d) { return d.base_clustered_level(); }); })
-      .def_property_readonly(
-          "finest_level",
-          [](Decoder &s) { return s.locked([](D &d) { return d.finest_level(); }); })
-      .def(
-          "want_cluster",
-          [](Decoder &s, uint32_t cluster, const py::handle &level) {
-            const uint32_t c = s.checked_cluster(cluster);
-            const int l = s.level_or_finest(level);
-            s.locked([&](D &d) { d.want_cluster(c, l); });
-          },
-          py::arg("cluster"), py::arg("level") = py::none())
+/// What to decode: clusters, regions, vertices, faces, a level per cluster.
+void register_wanted(DecoderClass &cls) {
+  cls.def(
+         "want_cluster",
+         [](Decoder &s, uint32_t cluster, const py::handle &level) {
+           const uint32_t c = s.checked_cluster(cluster);
+           const int l = s.level_or_finest(level);
+           s.locked([&](D &d) { d.want_cluster(c, l); });
+         },
+         py::arg("cluster"), py::arg("level") = py::none())
       .def(
           "want_all",
           [](Decoder &s, const py::handle &level) {
@@ -187,21 +169,24 @@ void register_selective_decoder(py::module_ &m) {
             s.locked([&](D &d) { d.set_wanted(levels); });
           },
           py::arg("levels"))
-      .def_property_readonly("wanted",
-                             [](Decoder &s) {
-                               std::vector<int> w = s.locked([](D &d) { return d.wanted(); });
-                               return array_from_vector(std::move(w), 0);
-                             })
-      .def(
-          "want_view",
-          [](Decoder &s, const py::handle &eye, const std::vector<float> &view_proj, float fov_y,
-             float width, float height, float near_distance, float pixel_error) {
-            const pomar::ViewCamera camera =
-                view_camera(eye, view_proj, fov_y, width, height, near_distance);
-            s.locked([&](D &d) { d.want_view(camera, pixel_error); });
-          },
-          py::arg("eye"), py::arg("view_proj"), py::arg("fov_y"), py::arg("width"),
-          py::arg("height"), py::arg("near"), py::arg("pixel_error"))
+      .def_property_readonly("wanted", [](Decoder &s) {
+        std::vector<int> w = s.locked([](D &d) { return d.wanted(); });
+        return array_from_vector(std::move(w), 0);
+      });
+}
+
+/// A camera's view: the levels its pixel error asks for, and the cluster errors behind them.
+void register_view(DecoderClass &cls) {
+  cls.def(
+         "want_view",
+         [](Decoder &s, const py::handle &eye, const std::vector<float> &view_proj, float fov_y,
+            float width, float height, float near_distance, float pixel_error) {
+           const pomar::ViewCamera camera =
+               view_camera(eye, view_proj, fov_y, width, height, near_distance);
+           s.locked([&](D &d) { d.want_view(camera, pixel_error); });
+         },
+         py::arg("eye"), py::arg("view_proj"), py::arg("fov_y"), py::arg("width"),
+         py::arg("height"), py::arg("near"), py::arg("pixel_error"))
       .def(
           "view_levels",
           [](Decoder &s, const py::handle &eye, const std::vector<float> &view_proj, float fov_y,
@@ -222,8 +207,12 @@ void register_selective_decoder(py::module_ &m) {
             const uint32_t c = s.checked_cluster(cluster);
             return s.locked([&](D &d) { return d.cluster_error(c, level); });
           },
-          py::arg("cluster"), py::arg("level"))
-      .def("update", [](Decoder &s) { s.locked([](D &d) { d.update(); }); })
+          py::arg("cluster"), py::arg("level"));
+}
+
+/// The decode and what it gives: the mesh, its clusters and levels, what was read.
+void register_results(DecoderClass &cls) {
+  cls.def("update", [](Decoder &s) { s.locked([](D &d) { d.update(); }); })
       .def_property_readonly("levels",
                              [](Decoder &s) {
                                std::vector<int> l = s.locked([](D &d) { return d.levels(); });
@@ -249,6 +238,32 @@ void register_selective_decoder(py::module_ &m) {
       .def_property_readonly("clusters_decoded", [](Decoder &s) {
         return s.locked([](D &d) { return d.clusters_decoded(); });
       });
+}
+
+} // namespace
+
+void register_selective_decoder(py::module_ &m) {
+  py::class_<Decoder> cls(m, "SelectiveDecoder");
+  cls.def(py::init<const py::handle &, bool, const py::handle &, unsigned>(), py::arg("source"),
+          py::kw_only(), py::arg("skip_damaged") = false, py::arg("memory_limit") = py::none(),
+          py::arg("threads") = 0u)
+      .def_property_readonly("info",
+                             [](Decoder &s) {
+                               pomar::FileInfo i = s.locked([](D &d) { return d.info(); });
+                               return info_dict(i);
+                             })
+      .def_property_readonly(
+          "cluster_count",
+          [](Decoder &s) { return s.locked([](D &d) { return d.cluster_count(); }); })
+      .def_property_readonly(
+          "base_clustered_level",
+          [](Decoder &s) { return s.locked([](D &d) { return d.base_clustered_level(); }); })
+      .def_property_readonly("finest_level", [](Decoder &s) {
+        return s.locked([](D &d) { return d.finest_level(); });
+      });
+  register_wanted(cls);
+  register_view(cls);
+  register_results(cls);
 }
 
 } // namespace pomar_python

@@ -1,7 +1,7 @@
-// The manifold encoder (encode_manifold, called by pomar::encode in
-// lossless/lossless_stage.cpp), as a list of steps: prepare the input (validate, quantize,
-// renumber) -> decimate (section 4) -> base mesh -> global levels (section 5.1) -> clustered levels
-// (section 5.2, encode/clusters.cpp) -> file (format/file_format.cpp) -> report.
+// The manifold encoder (encode_manifold, called by pomar::encode in encode/encode.cpp), as a
+// list of steps: prepare the input (validate, quantize, renumber) -> decimate (section 4) ->
+// base mesh -> global levels (section 5.1) -> clustered levels (section 5.2,
+// encode/clusters.cpp) -> sections -> file (format/file_format.cpp) -> report.
 // The levels are coded by the traversal the decoder runs (encode/encoder_codec.h).
 #include <algorithm>
 #include <chrono>
@@ -212,6 +212,112 @@ std::vector<std::vector<uint8_t>> encode_global_levels(Rebuild &rb, size_t globa
   return blocks;
 }
 
+/// The texture seams of the lossless stage (hook->locked, twin, origin) in the prepared
+/// numbering, for decimation; empty without a seam.
+struct SeamLocks {
+  std::vector<uint8_t> locked;
+  std::vector<uint32_t> twin, origin;
+};
+
+SeamLocks seam_locks(const LosslessHook *hook, const PreparedInput &in) {
+  SeamLocks s;
+  if (!hook || hook->locked.empty())
+    return s;
+  const uint32_t nv = in.vertices;
+  s.locked.resize(nv);
+  s.twin.assign(nv, kNone);
+  s.origin.resize(nv);
+  std::vector<uint32_t> prepared(hook->locked.size(), kNone);
+  for (uint32_t v = 0; v < nv; ++v)
+    prepared[in.to_input[v]] = v;
+  for (uint32_t v = 0; v < nv; ++v) {
+    const uint32_t c = in.to_input[v];
+    s.locked[v] = hook->locked[c];
+    s.origin[v] = hook->origin[c];
+    if (hook->twin[c] != kNone)
+      s.twin[v] = prepared[hook->twin[c]];
+  }
+  return s;
+}
+
+/// The attribute codes of the base mesh's vertices, and the rebuild's attribute state.
+void start_attributes(Rebuild &rb, AttributeTable &attributes, const std::vector<int64_t> &codes) {
+  for (uint32_t v : rb.dec_to_input)
+    attributes.base.insert(attributes.base.end(), codes.begin() + size_t(v) * attributes.codes,
+                           codes.begin() + size_t(v + 1) * attributes.codes);
+  init_attributes(attributes, rb.mesh);
+  plan_wedge_residuals(attributes, rb.mesh); // (the base mesh's connectivity predicts them)
+  rb.attr_codes = &codes;
+  rb.attr_codes_per_vertex = attributes.codes;
+  rb.attr_models = attribute_models(attributes);
+  rb.attr_bits.assign(attributes.codes, 0.0);
+}
+
+FileHeader make_header(const EncodeOptions &options, const PreparedInput &in, const Rebuild &rb) {
+  FileHeader header;
+  // Version 5: patches as placement ranks; else version 1, 3 or 4 (write_file decides).
+  header.version = options.format_version == 5 ? kPatchRankFormatVersion : kFormatVersion;
+  header.grid = in.grid;
+  header.vertices = in.vertices;
+  header.faces = in.faces;
+  header.base_vertices = static_cast<uint32_t>(rb.dec_to_input.size());
+  header.base_faces = rb.mesh.seed_faces;
+  return header;
+}
+
+/// The sections after the levels: attributes (format version 4, "ATTR": descriptors, base
+/// mesh codes, sizes), texture images, the lossless stage's materials and record.
+std::vector<Section> extra_sections(AttributeTable &attributes, const Rebuild &rb,
+                                    const FileHeader &header, std::vector<uint8_t> images,
+                                    const LosslessHook *hook, const PreparedInput &in) {
+  std::vector<Section> sections;
+  if (!attributes.stored.empty() || !attributes.texture_files.empty()) {
+    for (size_t i = 0, k = 0; i < attributes.stored.size(); ++i) {
+      double attr_bits = 0;
+      for (uint32_t c = 0; c < attributes.stored[i].codes(); ++c, ++k)
+        attr_bits += rb.attr_bits[k];
+      attributes.estimated_bytes[i] = static_cast<uint64_t>(attr_bits / 8.0 + 0.5);
+    }
+    sections.push_back(
+        {kAttributeSectionTag, 0, write_attributes(attributes, header.base_vertices)}); // optional
+  }
+  if (!images.empty())
+    sections.push_back({kTextureImagesTag, 0, std::move(images)});
+  if (hook && !hook->materials.empty()) // per-corner values: a reader must turn them back
+    sections.push_back({kMaterialSectionTag, kSectionRequired, hook->materials});
+  if (hook) { // the lossless stage's record, in the decoder's numbering
+    const uint32_t nv = in.vertices;
+    std::vector<uint32_t> decoded_to_cut(nv);
+    for (uint32_t i = 0; i < nv; ++i)
+      decoded_to_cut[i] = in.to_input[rb.dec_to_input[i]];
+    // Required: a reader that ignored it would give the cut mesh for the input.
+    sections.push_back({kLosslessTag, kSectionRequired, hook->record(decoded_to_cut)});
+  }
+  return sections;
+}
+
+/// The report, read from the file just written: a failure here is the encoder's own
+/// inconsistency, never a damaged file.
+void fill_report(const std::vector<uint8_t> &file, const PreparedInput &in, const Rebuild &rb,
+                 size_t input_vertices, EncodeReport &report) {
+  try {
+    const FileLayout layout = read_layout(file.data(), file.size());
+    report.info = file_info(layout, file.size());
+    if (const auto table = load_attribute_table(file.data(), layout))
+      describe_attributes(*table, report.info);
+  } catch (const Error &e) {
+    throw Error(Error::Kind::Internal,
+                std::string("internal encoder error: the file it wrote does not read back (") +
+                    e.what() + ")");
+  }
+  const uint32_t nv = in.vertices;
+  report.input_vertices = input_vertices;
+  report.unreferenced_vertices = input_vertices - nv;
+  report.decoded_to_input.resize(nv);
+  for (uint32_t i = 0; i < nv; ++i)
+    report.decoded_to_input[i] = in.to_input[rb.dec_to_input[i]];
+}
+
 } // namespace
 
 void check_encode_input(const Mesh &mesh, const EncodeOptions &options) {
@@ -243,25 +349,11 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
   auto t1 = std::chrono::steady_clock::now();
   DecimationOptions decimation;
   decimation.threads = resolve_threads(options.threads);
-  std::vector<uint8_t> locked; // texture seams (prepared numbering)
-  std::vector<uint32_t> twin, origin;
+  const SeamLocks seams = seam_locks(hook, in); // texture seams (prepared numbering)
   if (hook && !hook->locked.empty()) {
-    locked.resize(nv);
-    twin.assign(nv, kNone);
-    origin.resize(nv);
-    std::vector<uint32_t> prepared(hook->locked.size(), kNone);
-    for (uint32_t v = 0; v < nv; ++v)
-      prepared[in.to_input[v]] = v;
-    for (uint32_t v = 0; v < nv; ++v) {
-      const uint32_t c = in.to_input[v];
-      locked[v] = hook->locked[c];
-      origin[v] = hook->origin[c];
-      if (hook->twin[c] != kNone)
-        twin[v] = prepared[hook->twin[c]];
-    }
-    decimation.locked = &locked;
-    decimation.twin = &twin;
-    decimation.origin = &origin;
+    decimation.locked = &seams.locked;
+    decimation.twin = &seams.twin;
+    decimation.origin = &seams.origin;
   }
   const Decimation dec = decimate(std::move(in.ct), in.q, decimation, options.progress);
   const double t_decimate = seconds_since(t1);
@@ -270,24 +362,8 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
   Rebuild rb(in.q, dec);
   const BaseMesh base = start_from_base_mesh(rb, nv);
   rb.mesh.reserve_counts(nv, nf); // the splits append without reallocating
-  for (uint32_t v : rb.dec_to_input)
-    attributes.base.insert(attributes.base.end(), codes.begin() + size_t(v) * attributes.codes,
-                           codes.begin() + size_t(v + 1) * attributes.codes);
-  init_attributes(attributes, rb.mesh);
-  plan_wedge_residuals(attributes, rb.mesh); // (the base mesh's connectivity predicts them)
-  rb.attr_codes = &codes;
-  rb.attr_codes_per_vertex = attributes.codes;
-  rb.attr_models = attribute_models(attributes);
-  rb.attr_bits.assign(attributes.codes, 0.0);
-  FileHeader header;
-  // Version 5: patches as placement ranks; else version 1, 3 or 4 (write_file decides).
-  header.version = options.format_version == 5 ? kPatchRankFormatVersion : kFormatVersion;
-  header.grid = in.grid;
-  header.vertices = nv;
-  header.faces = nf;
-  header.base_vertices = static_cast<uint32_t>(rb.dec_to_input.size());
-  header.base_faces = rb.mesh.seed_faces;
-
+  start_attributes(rb, attributes, codes);
+  FileHeader header = make_header(options, in, rb);
   const size_t global = choose_global_levels(dec, header.base_vertices, nv, options);
   SymbolBits bits;
   const std::vector<std::vector<uint8_t>> blocks =
@@ -300,29 +376,8 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
     throw Error(Error::Kind::Internal,
                 "internal encoder error: the refined mesh does not match the input");
 
-  // Attributes (format version 4, "ATTR" section): descriptors, base mesh codes, sizes.
-  std::vector<Section> sections;
-  if (!attributes.stored.empty() || !attributes.texture_files.empty()) {
-    for (size_t i = 0, k = 0; i < attributes.stored.size(); ++i) {
-      double attr_bits = 0;
-      for (uint32_t c = 0; c < attributes.stored[i].codes(); ++c, ++k)
-        attr_bits += rb.attr_bits[k];
-      attributes.estimated_bytes[i] = static_cast<uint64_t>(attr_bits / 8.0 + 0.5);
-    }
-    sections.push_back(
-        {kAttributeSectionTag, 0, write_attributes(attributes, header.base_vertices)}); // optional
-  }
-  if (!images.empty())
-    sections.push_back({kTextureImagesTag, 0, std::move(images)});
-  if (hook && !hook->materials.empty()) // per-corner values: a reader must turn them back
-    sections.push_back({kMaterialSectionTag, kSectionRequired, hook->materials});
-  if (hook) { // the lossless stage's record, in the decoder's numbering
-    std::vector<uint32_t> decoded_to_cut(nv);
-    for (uint32_t i = 0; i < nv; ++i)
-      decoded_to_cut[i] = in.to_input[rb.dec_to_input[i]];
-    // Required: a reader that ignored it would give the cut mesh for the input.
-    sections.push_back({kLosslessTag, kSectionRequired, hook->record(decoded_to_cut)});
-  }
+  std::vector<Section> sections =
+      extra_sections(attributes, rb, header, std::move(images), hook, in);
   // Random access: the blocks in the Morton order of their roots (section BLKO, required:
   // a reader that does not know it would look for the blocks in id order).
   std::vector<uint32_t> block_order;
@@ -340,27 +395,11 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
     file = with_sections(file.data(), file.size(), {{kClusterErrorsTag, 0, std::move(errors)}});
   }
   if (report) {
-    // The report is read from the file just written: a failure here is the encoder's own
-    // inconsistency, never a damaged file.
-    try {
-      const FileLayout layout = read_layout(file.data(), file.size());
-      report->info = file_info(layout, file.size());
-      if (const auto table = load_attribute_table(file.data(), layout))
-        describe_attributes(*table, report->info);
-    } catch (const Error &e) {
-      throw Error(Error::Kind::Internal,
-                  std::string("internal encoder error: the file it wrote does not read back (") +
-                      e.what() + ")");
-    }
-    report->input_vertices = input_vertices;
-    report->unreferenced_vertices = input_vertices - nv;
+    fill_report(file, in, rb, input_vertices, *report);
     report->quantize_seconds = t_quantize;
     report->decimate_seconds = t_decimate;
     report->encode_seconds = seconds_since(t2);
     report->symbol_bits = bits;
-    report->decoded_to_input.resize(nv);
-    for (uint32_t i = 0; i < nv; ++i)
-      report->decoded_to_input[i] = in.to_input[rb.dec_to_input[i]];
   }
   return file;
 }

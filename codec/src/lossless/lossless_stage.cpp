@@ -1,6 +1,6 @@
-// The lossless stage (see lossless_stage.h): pomar::encode() cuts a messy mesh with
-// make_manifold, codes the cut mesh with the manifold encoder and stores what the cut
-// changed; a full decode undoes it.
+// The lossless stage (see lossless_stage.h): the cut of a messy mesh (make_manifold, then
+// its texture seams) that pomar::encode (encode/encode.cpp) codes with the manifold encoder,
+// the record of what the cut changed, and a full decode's undoing of it.
 #include "lossless/lossless_stage.h"
 
 #include <algorithm>
@@ -38,29 +38,6 @@ std::array<uint32_t, 2> degenerate_form(uint32_t x, uint32_t y, uint32_t z) {
   return {z, y}; // z == x: (z, x, y) = (z, z, y)
 }
 
-/// True if every vertex is used by a face (indices out of range are left to the encoder,
-/// which names them).
-bool all_vertices_used(const Mesh &mesh) {
-  const size_t nv = mesh.vertex_count();
-  std::vector<uint8_t> used(nv, 0);
-  for (uint32_t v : mesh.triangles)
-    if (v < nv)
-      used[v] = 1;
-  return std::find(used.begin(), used.end(), 0) == used.end();
-}
-
-/// True when the manifold encoder takes `mesh` as it is: a valid corner table (manifold,
-/// oriented, no face repeating a vertex, no duplicate).
-bool valid_topology(const Mesh &mesh) {
-  try {
-    CornerTable ct;
-    build_corner_table(mesh.triangles.data(), mesh.triangle_count(), mesh.vertex_count(), ct);
-  } catch (const Error &) {
-    return false;
-  }
-  return true;
-}
-
 /// The levels code only vertices a face uses; the record keeps the others' attributes bit
 /// for bit. So that the attribute checks of the coded mesh do not refuse values the levels
 /// never see (an OBJ vertex without a normal, a NaN), such vertices get a neutral value in
@@ -86,6 +63,25 @@ std::string plural(size_t n, const char *one, const char *many) {
 }
 
 } // namespace
+
+bool all_vertices_used(const Mesh &mesh) {
+  const size_t nv = mesh.vertex_count();
+  std::vector<uint8_t> used(nv, 0);
+  for (uint32_t v : mesh.triangles)
+    if (v < nv)
+      used[v] = 1;
+  return std::find(used.begin(), used.end(), 0) == used.end();
+}
+
+bool valid_topology(const Mesh &mesh) {
+  try {
+    CornerTable ct;
+    build_corner_table(mesh.triangles.data(), mesh.triangle_count(), mesh.vertex_count(), ct);
+  } catch (const Error &) {
+    return false;
+  }
+  return true;
+}
 
 std::string LosslessReport::summary() const {
   if (!stored)
@@ -120,22 +116,20 @@ std::string LosslessReport::summary() const {
   return s + " (" + plural(bytes, "byte", "bytes") + ")";
 }
 
-LosslessRecord build_lossless_record(const Mesh &input, const Mesh &cut, const RepairMap &map,
-                                     const std::vector<uint32_t> &decoded_to_cut,
-                                     const Quantizer &grid, bool keep_order, Mesh &decoded,
-                                     std::vector<uint32_t> &output_to_input) {
-  const uint32_t nv = static_cast<uint32_t>(input.vertex_count());
-  const uint32_t nd = static_cast<uint32_t>(decoded_to_cut.size());
-  auto input_of_cut = [&](uint32_t c) { return c < nv ? c : map.copy_of[c - nv]; };
-  LosslessRecord r;
+namespace {
 
-  // Vertices: the first decoded vertex of an input vertex represents it, later ones are
-  // copies; then the input vertices no decoded vertex is.
-  std::vector<uint32_t> first(nv, kNone), input_to_output(nv, kNone);
-  std::vector<uint32_t> cut_to_decoded(cut.vertex_count(), kNone);
+/// The first decoded vertex of an input vertex represents it, later ones are copies (added
+/// to r.copies); numbers the represented input vertices in output order.
+void number_decoded_vertices(const RepairMap &map, uint32_t nv,
+                             const std::vector<uint32_t> &decoded_to_cut, LosslessRecord &r,
+                             std::vector<uint32_t> &input_to_output,
+                             std::vector<uint32_t> &cut_to_decoded,
+                             std::vector<uint32_t> &output_to_input) {
+  const uint32_t nd = static_cast<uint32_t>(decoded_to_cut.size());
+  std::vector<uint32_t> first(nv, kNone);
   output_to_input.clear();
   for (uint32_t d = 0; d < nd; ++d) {
-    const uint32_t c = decoded_to_cut[d], v = input_of_cut(c);
+    const uint32_t c = decoded_to_cut[d], v = c < nv ? c : map.copy_of[c - nv];
     cut_to_decoded[c] = d;
     if (first[v] != kNone) {
       r.copies.push_back({d, first[v]});
@@ -145,8 +139,16 @@ LosslessRecord build_lossless_record(const Mesh &input, const Mesh &cut, const R
     input_to_output[v] = static_cast<uint32_t>(output_to_input.size());
     output_to_input.push_back(v);
   }
-  // The others, sorted by grid position (their output order is free: the deltas from one
-  // to the next are then smaller; keep_order restores the input order anyway).
+}
+
+/// The input vertices no decoded vertex is, sorted by grid position (their output order is
+/// free: the deltas from one to the next are then smaller; keep_order restores the input
+/// order anyway), numbered after the others, with their attributes as the input has them
+/// (the levels never code these vertices).
+void number_extra_vertices(const Mesh &input, const Quantizer &grid, LosslessRecord &r,
+                           std::vector<uint32_t> &input_to_output,
+                           std::vector<uint32_t> &output_to_input) {
+  const uint32_t nv = static_cast<uint32_t>(input.vertex_count());
   std::vector<std::pair<Key, uint32_t>> extra;
   for (uint32_t v = 0; v < nv; ++v)
     if (input_to_output[v] == kNone) {
@@ -161,7 +163,6 @@ LosslessRecord build_lossless_record(const Mesh &input, const Mesh &cut, const R
     output_to_input.push_back(v);
     r.extra_q.insert(r.extra_q.end(), q.begin(), q.end());
   }
-  // Their attributes, as the input has them (the levels never code these vertices).
   if (!extra.empty())
     for (const VertexAttribute &a : input.attributes) {
       VertexAttribute x;
@@ -178,43 +179,15 @@ LosslessRecord build_lossless_record(const Mesh &input, const Mesh &cut, const R
       }
       r.extra_attributes.push_back(std::move(x));
     }
+}
 
-  // D itself (what write_lossless_record reads of it: the positions to place vertex
-  // copies, the faces to apply the record before coding the input's order), and where
-  // each cut face comes in D's canonical order (to name flipped and duplicated faces). A
-  // cut that only left vertices unreferenced needs neither (a scan's stray points).
-  const uint32_t nf = static_cast<uint32_t>(cut.triangle_count());
+/// The removed input faces: repeating a vertex (r.degenerate), or an exact duplicate of a
+/// kept face, the one with the same rotated vertices in input numbering (r.duplicates, by
+/// the kept face's `rank` in D's canonical order).
+void removed_faces(const Mesh &input, const RepairMap &map, uint32_t nf,
+                   const std::vector<uint32_t> &rank, const std::vector<uint32_t> &input_to_output,
+                   LosslessRecord &r) {
   const uint32_t input_faces = static_cast<uint32_t>(input.triangle_count());
-  const bool faces_changed = nf != input_faces || std::find(map.flipped.begin(), map.flipped.end(),
-                                                            1) != map.flipped.end();
-  if (!r.copies.empty() || keep_order) {
-    decoded.positions.resize(3 * size_t(nd));
-    for (uint32_t d = 0; d < nd; ++d)
-      for (int k = 0; k < 3; ++k)
-        decoded.positions[3 * size_t(d) + k] =
-            grid.dequantize(k, grid.quantize(k, cut.positions[3 * size_t(decoded_to_cut[d]) + k]));
-  }
-  if (faces_changed || keep_order) {
-    decoded.triangles.resize(cut.triangles.size());
-    for (size_t c = 0; c < cut.triangles.size(); ++c)
-      decoded.triangles[c] = cut_to_decoded[cut.triangles[c]];
-  }
-  if (!faces_changed) {
-    if (keep_order)
-      r.order = output_to_input;
-    return r;
-  }
-  const std::vector<uint32_t> order = canonical_face_order(decoded.triangles);
-  std::vector<uint32_t> rank(nf);
-  for (uint32_t i = 0; i < nf; ++i)
-    rank[order[i]] = i;
-  for (uint32_t f = 0; f < nf; ++f)
-    if (map.flipped[f])
-      r.flipped.push_back(rank[f]);
-  std::sort(r.flipped.begin(), r.flipped.end());
-
-  // Removed input faces: repeating a vertex, or an exact duplicate of a kept face (the one
-  // with the same rotated vertices in input numbering).
   std::vector<uint8_t> kept(input_faces, 0);
   std::vector<std::pair<Key, uint32_t>> kept_keys(nf);
   for (uint32_t f = 0; f < nf; ++f) {
@@ -243,215 +216,111 @@ LosslessRecord build_lossless_record(const Mesh &input, const Mesh &cut, const R
     if (extra_copies[i])
       r.duplicates.push_back({i, extra_copies[i]});
   std::sort(r.degenerate.begin(), r.degenerate.end());
+}
+
+} // namespace
+
+LosslessRecord build_lossless_record(const Mesh &input, const Mesh &cut, const RepairMap &map,
+                                     const std::vector<uint32_t> &decoded_to_cut,
+                                     const Quantizer &grid, bool keep_order, Mesh &decoded,
+                                     std::vector<uint32_t> &output_to_input) {
+  const uint32_t nv = static_cast<uint32_t>(input.vertex_count());
+  const uint32_t nd = static_cast<uint32_t>(decoded_to_cut.size());
+  LosslessRecord r;
+  std::vector<uint32_t> input_to_output(nv, kNone), cut_to_decoded(cut.vertex_count(), kNone);
+  number_decoded_vertices(map, nv, decoded_to_cut, r, input_to_output, cut_to_decoded,
+                          output_to_input);
+  number_extra_vertices(input, grid, r, input_to_output, output_to_input);
+
+  // D itself (what write_lossless_record reads of it: the positions to place vertex
+  // copies, the faces to apply the record before coding the input's order), and where
+  // each cut face comes in D's canonical order (to name flipped and duplicated faces). A
+  // cut that only left vertices unreferenced needs neither (a scan's stray points).
+  const uint32_t nf = static_cast<uint32_t>(cut.triangle_count());
+  const uint32_t input_faces = static_cast<uint32_t>(input.triangle_count());
+  const bool faces_changed = nf != input_faces || std::find(map.flipped.begin(), map.flipped.end(),
+                                                            1) != map.flipped.end();
+  if (!r.copies.empty() || keep_order) {
+    decoded.positions.resize(3 * size_t(nd));
+    for (uint32_t d = 0; d < nd; ++d)
+      for (int k = 0; k < 3; ++k)
+        decoded.positions[3 * size_t(d) + k] =
+            grid.dequantize(k, grid.quantize(k, cut.positions[3 * size_t(decoded_to_cut[d]) + k]));
+  }
+  if (faces_changed || keep_order) {
+    decoded.triangles.resize(cut.triangles.size());
+    for (size_t c = 0; c < cut.triangles.size(); ++c)
+      decoded.triangles[c] = cut_to_decoded[cut.triangles[c]];
+  }
+  if (faces_changed) {
+    const std::vector<uint32_t> order = canonical_face_order(decoded.triangles);
+    std::vector<uint32_t> rank(nf);
+    for (uint32_t i = 0; i < nf; ++i)
+      rank[order[i]] = i;
+    for (uint32_t f = 0; f < nf; ++f)
+      if (map.flipped[f])
+        r.flipped.push_back(rank[f]);
+    std::sort(r.flipped.begin(), r.flipped.end());
+    removed_faces(input, map, nf, rank, input_to_output, r);
+  }
   if (keep_order)
     r.order = output_to_input;
   return r;
 }
 
-namespace {
-
-/// encode(), given the mesh (`owned`, the same mesh) or not (nullptr): a clean mesh given is
-/// freed once the manifold encoder has quantized it.
-std::vector<uint8_t> encode_any(const Mesh &mesh, const EncodeOptions &options,
-                                EncodeReport *report, Mesh *owned) {
-  bool released = false;
-  std::function<void()> release;
-  if (owned)
-    release = [&] {
-      *owned = Mesh();
-      released = true;
-    };
-  // Per-corner values are coded as the seam cut (lossless/seam_cut.h), whose copies the
-  // record welds back: such a mesh always has a record.
-  const bool corners = has_corner_values(mesh) && options.attributes.keep.texcoords;
-  if (corners)
-    validate_corner_values(mesh, options.attributes.exact);
-  if (options.strict && corners)
-    throw Error(Error::Kind::Usage,
-                "per-corner texture coordinates and face materials are kept with a lossless "
-                "record, which strict mode does not write: encode without strict (--strict), "
-                "or drop the texture coordinates");
-  if (options.strict)
-    return encode_manifold(mesh, options, report, nullptr, release);
-
-  // False once the topology is known to be one the manifold encoder does not take as it is.
-  bool valid = true;
-  if (!options.keep_order && !corners && all_vertices_used(mesh)) {
-    // Most meshes are clean: code them as they are (the file is then byte for byte what
-    // strict gives). The manifold encoder checks the topology early (its corner table),
-    // before it releases the mesh: if the table refuses the mesh (TopologyError), the mesh
-    // is cut; if the encoder refuses it for another reason, the topology is checked here,
-    // and only an invalid one is cut.
-    try {
-      return encode_manifold(mesh, options, report, nullptr, release, false);
-    } catch (const TopologyError &) { // (its corner table refused the mesh)
-      if (released)
-        throw;
-      valid = false;
-    } catch (const Error &) {
-      if (released || mesh.triangles.size() % 3 || valid_topology(mesh))
-        throw; // not a matter of topology: the error stands
-      valid = false;
-    }
-  }
-
-  const size_t nv = mesh.vertex_count();
-  check_encode_input(mesh, options); // unreferenced vertices included
-  Mesh cut;
-  const Mesh *coded = &cut; // what the manifold encoder codes: the cut (the mesh itself if
-                            // no cut and no attribute to neutralise: no copy)
-  RepairMap map;
-  RepairReport repair;
-  SeamCut seams;
-  LosslessHook hook;
-  hook.grid = make_quantizer(mesh.positions.data(), nv, options.bits);
-  LosslessRecord record;
-  Mesh decoded;
-  std::vector<uint32_t> output_to_input;
-  hook.record = [&](const std::vector<uint32_t> &decoded_to_cut) {
-    record = build_lossless_record(mesh, *coded, map, decoded_to_cut, hook.grid, options.keep_order,
-                                   decoded, output_to_input);
-    return write_lossless_record(record, std::move(decoded));
+void start_lossless_cut(const Mesh &mesh, const EncodeOptions &options, LosslessCut &c) {
+  c.hook.grid = make_quantizer(mesh.positions.data(), mesh.vertex_count(), options.bits);
+  const bool keep_order = options.keep_order;
+  c.hook.record = [&mesh, &c, keep_order](const std::vector<uint32_t> &decoded_to_cut) {
+    c.record = build_lossless_record(mesh, *c.coded, c.map, decoded_to_cut, c.hook.grid, keep_order,
+                                     c.decoded, c.output_to_input);
+    return write_lossless_record(c.record, std::move(c.decoded));
   };
-  // The cut (make_manifold) and the record's coding. On a mesh whose topology may be valid
-  // (unreferenced vertices, or the order kept) the cut is first taken to be the mesh itself:
-  // make_manifold leaves such a mesh as it is, and the manifold encoder's corner table says
-  // whether it is (a scan's stray points then cost no topology analysis); if the encoder
-  // refuses it and the topology is the reason, the mesh is cut after all.
-  const auto cut_and_encode = [&](bool cut_needed) {
-    map = RepairMap();
-    repair = RepairReport();
-    decoded = Mesh();
-    coded = &cut;
-    if (cut_needed) {
-      cut = mesh;
-      repair = cut_to_manifold(cut, &map); // checks the indices
-    } else {
-      map.face_origin.resize(mesh.triangle_count());
-      std::iota(map.face_origin.begin(), map.face_origin.end(), 0u);
-      map.flipped.assign(mesh.triangle_count(), 0);
-      if (mesh.attributes.empty())
-        coded = &mesh;
-      else
-        cut = mesh;
-    }
-    hook.locked.clear();
-    hook.twin.clear();
-    hook.origin.clear();
-    hook.materials.clear();
-    if (corners) { // the cut's faces get their corners' values, then it is cut at its seams
-      if (coded != &cut) {
-        cut = mesh;
-        coded = &cut;
-      }
-      corner_values_of_cut(mesh, map, cut);
-      seams = cut_at_seams(cut, map, static_cast<uint32_t>(nv));
-      hook.locked = std::move(seams.locked);
-      hook.twin = std::move(seams.twin);
-      hook.origin = std::move(seams.origin);
-      MaterialTable materials;
-      materials.corner_texcoords = !mesh.corner_texcoords.empty();
-      materials.face_materials = !mesh.face_materials.empty();
-      materials.materials = mesh.materials;
-      hook.materials = write_materials(materials);
-    }
-    if (coded == &cut)
-      usable_attributes_for_unused_vertices(cut);
-    if (coded->triangle_count() == 0)
-      throw Error(Error::Kind::InvalidMesh, "the mesh has no valid triangle: all " +
-                                                std::to_string(mesh.triangle_count()) +
-                                                " faces repeat a vertex");
-    const auto encode_once = [&](const EncodeOptions &o) {
-      if (!cut_needed) // (the topology is not known to be valid: a refusal is not named)
-        return encode_manifold(*coded, o, report, &hook, {}, false);
-      try { // (the encoder's corner table checks the cut, see repair/cut.h)
-        return encode_manifold(cut, o, report, &hook);
-      } catch (const TopologyError &e) {
-        throw still_invalid(e);
-      }
-    };
-    hook.wedge_from_positions = true;
-    std::vector<uint8_t> file = encode_once(options);
-    if (corners && !mesh.corner_texcoords.empty() && !options.attributes.exact) {
-      // The positions predict the (u, v) of charts that map the surface affinely far better
-      // than the neighbours' mean, which does better on charts that do not: both files,
-      // the smaller kept (bench/README.md, "Textured scans"). The cut, the decimation, the
-      // numbering and so the record are the same; only the wedge residuals differ.
-      EncodeReport first;
-      if (report)
-        first = *report;
-      EncodeOptions quiet = options;
-      quiet.progress = nullptr;
-      hook.wedge_from_positions = false;
-      std::vector<uint8_t> mean = encode_once(quiet);
-      if (mean.size() < file.size())
-        file.swap(mean);
-      else if (report)
-        *report = std::move(first);
-    }
-    return file;
-  };
-  std::vector<uint8_t> file;
-  if (valid) {
-    try {
-      file = cut_and_encode(false);
-    } catch (const TopologyError &) {
-      valid = false;
-    } catch (const Error &) {
-      if (mesh.triangles.size() % 3 || valid_topology(mesh))
-        throw; // not a matter of topology: the error stands
-      valid = false;
-    }
-  }
-  if (!valid)
-    file = cut_and_encode(true);
-  if (report) {
-    LosslessReport &l = report->lossless;
-    l = LosslessReport();
-    l.stored = true;
-    l.vertex_copies = record.copies.size();
-    l.vertices_split = repair.vertices_split;
-    l.edges_cut = repair.edges_cut;
-    l.faces_flipped = record.flipped.size();
-    for (const auto &d : record.duplicates)
-      l.duplicate_faces += d.second;
-    l.degenerate_faces = record.degenerate.size();
-    l.unreferenced_vertices = record.extra_q.size() / 3;
-    l.keep_order = options.keep_order;
-    l.seam_edges = seams.seam_edges;
-    l.wedge_copies = seams.wedge_copies;
-    l.bytes = report->info.lossless_bytes;
-    report->info.input_vertices = nv;
-    report->info.input_faces = mesh.triangle_count();
-    report->input_vertices = nv;
-    std::vector<uint8_t> used(nv, 0);
-    for (uint32_t v : mesh.triangles)
-      used[v] = 1;
-    report->unreferenced_vertices =
-        static_cast<size_t>(std::count(used.begin(), used.end(), uint8_t(0)));
-    if (options.keep_order) {
-      report->decoded_to_input.resize(nv);
-      for (uint32_t v = 0; v < nv; ++v)
-        report->decoded_to_input[v] = v;
-    } else {
-      report->decoded_to_input = output_to_input;
-    }
-  }
-  return file;
 }
 
-} // namespace
-
-std::vector<uint8_t> encode(const Mesh &mesh, const EncodeOptions &options, EncodeReport *report) {
-  return encode_any(mesh, options, report, nullptr);
-}
-
-std::vector<uint8_t> encode(Mesh &&mesh, const EncodeOptions &options, EncodeReport *report) {
-  struct LeaveEmpty { // whether encode returns or throws
-    Mesh &mesh;
-    ~LeaveEmpty() { mesh = Mesh(); }
-  } leave_empty{mesh};
-  return encode_any(mesh, options, report, &mesh);
+void cut_for_encoding(const Mesh &mesh, bool cut_needed, bool corners, LosslessCut &c) {
+  c.map = RepairMap();
+  c.repair = RepairReport();
+  c.decoded = Mesh();
+  c.coded = &c.cut;
+  if (cut_needed) {
+    c.cut = mesh;
+    c.repair = cut_to_manifold(c.cut, &c.map); // checks the indices
+  } else {
+    c.map.face_origin.resize(mesh.triangle_count());
+    std::iota(c.map.face_origin.begin(), c.map.face_origin.end(), 0u);
+    c.map.flipped.assign(mesh.triangle_count(), 0);
+    if (mesh.attributes.empty())
+      c.coded = &mesh;
+    else
+      c.cut = mesh;
+  }
+  c.hook.locked.clear();
+  c.hook.twin.clear();
+  c.hook.origin.clear();
+  c.hook.materials.clear();
+  if (corners) { // the cut's faces get their corners' values, then it is cut at its seams
+    if (c.coded != &c.cut) {
+      c.cut = mesh;
+      c.coded = &c.cut;
+    }
+    corner_values_of_cut(mesh, c.map, c.cut);
+    c.seams = cut_at_seams(c.cut, c.map, static_cast<uint32_t>(mesh.vertex_count()));
+    c.hook.locked = std::move(c.seams.locked);
+    c.hook.twin = std::move(c.seams.twin);
+    c.hook.origin = std::move(c.seams.origin);
+    MaterialTable materials;
+    materials.corner_texcoords = !mesh.corner_texcoords.empty();
+    materials.face_materials = !mesh.face_materials.empty();
+    materials.materials = mesh.materials;
+    c.hook.materials = write_materials(materials);
+  }
+  if (c.coded == &c.cut)
+    usable_attributes_for_unused_vertices(c.cut);
+  if (c.coded->triangle_count() == 0)
+    throw Error(Error::Kind::InvalidMesh, "the mesh has no valid triangle: all " +
+                                              std::to_string(mesh.triangle_count()) +
+                                              " faces repeat a vertex");
 }
 
 namespace {

@@ -1,5 +1,6 @@
 // The lossless stage: the codec's first stage on encode (cut the mesh into a manifold,
-// oriented one, remember what changed) and its last on a full decode (undo the cut).
+// oriented one, remember what changed; pomar::encode in encode/encode.cpp runs it) and its
+// last on a full decode (undo the cut).
 // docs/architecture.md, "The lossless stage".
 #pragma once
 
@@ -8,6 +9,7 @@
 #include <vector>
 
 #include "lossless/lossless_record.h"
+#include "lossless/seam_cut.h"
 #include "pomar/pomar.h"
 #include "pomar/repair.h"
 
@@ -60,6 +62,41 @@ LosslessRecord build_lossless_record(const Mesh &input, const Mesh &cut, const R
                                      const std::vector<uint32_t> &decoded_to_cut,
                                      const Quantizer &grid, bool keep_order, Mesh &decoded,
                                      std::vector<uint32_t> &output_to_input);
+
+/// The lossless path of pomar::encode: the mesh the manifold encoder codes (the cut, or the
+/// input itself when nothing is cut nor neutralised), the cut's map and report, the hook,
+/// and the record once the hook has built it. Not copyable: the hook refers to it.
+struct LosslessCut {
+  LosslessCut() = default;
+  LosslessCut(const LosslessCut &) = delete;
+  LosslessCut &operator=(const LosslessCut &) = delete;
+  Mesh cut;
+  const Mesh *coded = &cut;
+  RepairMap map;
+  RepairReport repair;
+  SeamCut seams;
+  LosslessHook hook;
+  LosslessRecord record;
+  Mesh decoded;
+  std::vector<uint32_t> output_to_input; // of the decoded output (build_lossless_record)
+};
+
+/// The hook's grid (every vertex of `mesh`, used or not) and its record callback, which
+/// builds `c.record` for `mesh` (held by the caller until the file is written).
+void start_lossless_cut(const Mesh &mesh, const EncodeOptions &options, LosslessCut &c);
+
+/// The mesh to code: make_manifold's cut (`cut_needed`, which checks the indices) or the
+/// mesh taken as its own cut; with per-corner values (`corners`) the cut is then cut at its
+/// texture seams (lossless/seam_cut.h). Throws InvalidMesh if no triangle is left.
+void cut_for_encoding(const Mesh &mesh, bool cut_needed, bool corners, LosslessCut &c);
+
+/// True if every vertex is used by a face (indices out of range are left to the encoder,
+/// which names them).
+bool all_vertices_used(const Mesh &mesh);
+
+/// True when the manifold encoder takes `mesh` as it is: a valid corner table (manifold,
+/// oriented, no face repeating a vertex, no duplicate).
+bool valid_topology(const Mesh &mesh);
 
 /// inspect(): the input's counts from a lossless record's counts, if the file has one (its
 /// checksum is checked).

@@ -93,54 +93,55 @@ void corner_values_of_cut(const Mesh &input, const RepairMap &map, Mesh &cut) {
   }
 }
 
-SeamCut cut_at_seams(Mesh &mesh, RepairMap &map, uint32_t input_vertices) {
-  const uint32_t nv = static_cast<uint32_t>(mesh.vertex_count());
-  const uint32_t nf = static_cast<uint32_t>(mesh.triangle_count());
-  const uint32_t nc = 3 * nf;
-  const std::vector<uint32_t> &V = mesh.triangles;
-  const bool has_uv = !mesh.corner_texcoords.empty(), has_mat = !mesh.face_materials.empty();
-  // Whether corners a and b (at the same vertex) have the same value, bit for bit.
-  auto same = [&](uint32_t a, uint32_t b) {
-    if (has_uv && std::memcmp(&mesh.corner_texcoords[2 * size_t(a)],
-                              &mesh.corner_texcoords[2 * size_t(b)], 2 * sizeof(float)) != 0)
-      return false;
-    return !has_mat || mesh.face_materials[a / 3] == mesh.face_materials[b / 3];
-  };
+namespace {
 
+uint32_t next_corner(uint32_t c) { return c - c % 3 + (c + 1) % 3; }
+
+/// Whether corners a and b (at the same vertex) have the same value, bit for bit.
+bool same_corner_values(const Mesh &mesh, uint32_t a, uint32_t b) {
+  if (!mesh.corner_texcoords.empty() &&
+      std::memcmp(&mesh.corner_texcoords[2 * size_t(a)], &mesh.corner_texcoords[2 * size_t(b)],
+                  2 * sizeof(float)) != 0)
+    return false;
+  return mesh.face_materials.empty() || mesh.face_materials[a / 3] == mesh.face_materials[b / 3];
+}
+
+/// The wedges: union-find `parent` joins the corners of a vertex that stay together in the
+/// cut. Counts and locks the seam edges' vertices; marks the mesh boundary's vertices.
+void join_wedges(const Mesh &mesh, std::vector<uint32_t> &parent, SeamCut &cut,
+                 std::vector<uint8_t> &seam_edges_at, std::vector<uint8_t> &on_boundary) {
+  const std::vector<uint32_t> &V = mesh.triangles;
+  const uint32_t nc = static_cast<uint32_t>(V.size());
   // The edges, each as (smaller, larger vertex) with the corner that starts it in its face:
   // sorted, the two faces of an interior edge are neighbours (the mesh is manifold).
   std::vector<Keyed> edges(nc);
   for (uint32_t c = 0; c < nc; ++c) {
-    const uint32_t a = V[c], b = V[c - c % 3 + (c + 1) % 3];
+    const uint32_t a = V[c], b = V[next_corner(c)];
     edges[c] = {uint64_t(std::min(a, b)) << 32 | std::max(a, b), c};
   }
   std::sort(edges.begin(), edges.end(), [](const Keyed &x, const Keyed &y) {
     return x.key != y.key ? x.key < y.key : x.id < y.id;
   });
-  std::vector<uint32_t> parent(nc);
+  parent.resize(nc);
   std::iota(parent.begin(), parent.end(), 0u);
-  SeamCut cut;
-  cut.locked.assign(nv, 0);
-  std::vector<uint8_t> seam_edges_at(nv, 0), on_boundary(nv, 0);
-  auto next = [](uint32_t c) { return c - c % 3 + (c + 1) % 3; };
   for (uint32_t i = 0; i < nc; ++i) {
     if (i + 1 == nc || edges[i].key != edges[i + 1].key) { // a boundary edge
-      on_boundary[V[edges[i].id]] = on_boundary[V[next(edges[i].id)]] = 1;
+      on_boundary[V[edges[i].id]] = on_boundary[V[next_corner(edges[i].id)]] = 1;
       continue;
     }
     // Face f has a -> b starting at corner cf, face g has b -> a starting at cg.
     const uint32_t cf = edges[i].id, cg = edges[i + 1].id;
-    const uint32_t f_a = cf, f_b = next(cf), g_b = cg, g_a = next(cg);
+    const uint32_t f_a = cf, f_b = next_corner(cf), g_b = cg, g_a = next_corner(cg);
     // The faces stay neighbours in the cut only if they agree at both ends: a seam edge
     // becomes two boundary edges (joining the corners at the end where they agree would
     // leave the faces sharing a vertex and no edge there: a vertex of two fans).
-    const bool seam = !same(f_a, g_a) || !same(f_b, g_b);
+    const bool seam = !same_corner_values(mesh, f_a, g_a) || !same_corner_values(mesh, f_b, g_b);
     if (!seam) {
       parent[find(parent, f_a)] = find(parent, g_a);
       parent[find(parent, f_b)] = find(parent, g_b);
     } else {
       ++cut.seam_edges;
-      for (uint32_t v : {V[cf], V[next(cf)]}) {
+      for (uint32_t v : {V[cf], V[next_corner(cf)]}) {
         cut.locked[v] = 1;
         seam_edges_at[v] = uint8_t(std::min(255, seam_edges_at[v] + 1));
       }
@@ -148,11 +149,16 @@ SeamCut cut_at_seams(Mesh &mesh, RepairMap &map, uint32_t input_vertices) {
     ++i;
   }
   // Mesh boundary edges are not seams: the wedges they separate are already apart.
+}
 
-  // One vertex per wedge: the wedge of the vertex's first corner keeps it, the others get
-  // copies, numbered in corner order.
+/// One vertex per wedge: the wedge of the vertex's first corner keeps it, the others get
+/// copies, numbered in corner order (cut vertex nv + i copies vertex copy_source[i]).
+/// Returns the cut's triangles.
+std::vector<uint32_t> number_wedges(const std::vector<uint32_t> &V, uint32_t nv,
+                                    std::vector<uint32_t> &parent,
+                                    std::vector<uint32_t> &copy_source) {
+  const uint32_t nc = static_cast<uint32_t>(V.size());
   std::vector<uint32_t> vertex_of_root(nc, kNone), first_root(nv, kNone);
-  std::vector<uint32_t> copy_source; // cut vertex nv + i copies vertex copy_source[i]
   std::vector<uint32_t> triangles(nc);
   for (uint32_t c = 0; c < nc; ++c) {
     const uint32_t r = find(parent, c), v = V[c];
@@ -167,11 +173,12 @@ SeamCut cut_at_seams(Mesh &mesh, RepairMap &map, uint32_t input_vertices) {
     }
     triangles[c] = vertex_of_root[r];
   }
-  cut.wedge_copies = copy_source.size();
-  const uint32_t total = nv + static_cast<uint32_t>(copy_source.size());
+  return triangles;
+}
 
-  // The wedge values of every vertex (a vertex no face uses: zeros).
-  VertexAttribute uv, material;
+/// The wedge values of every vertex of the cut (a vertex no face uses: zeros).
+void wedge_values(const Mesh &mesh, const std::vector<uint32_t> &triangles, uint32_t total,
+                  VertexAttribute &uv, VertexAttribute &material) {
   uv.kind = AttributeKind::TexCoord;
   uv.name = kWedgeTexcoord;
   uv.components = 2;
@@ -180,7 +187,8 @@ SeamCut cut_at_seams(Mesh &mesh, RepairMap &map, uint32_t input_vertices) {
   material.name = kWedgeMaterial;
   material.components = 1;
   material.values.assign(total, 0.0f);
-  for (uint32_t c = 0; c < nc; ++c) {
+  const bool has_uv = !mesh.corner_texcoords.empty(), has_mat = !mesh.face_materials.empty();
+  for (uint32_t c = 0; c < triangles.size(); ++c) {
     const uint32_t w = triangles[c];
     if (has_uv)
       std::memcpy(&uv.values[2 * size_t(w)], &mesh.corner_texcoords[2 * size_t(c)],
@@ -188,9 +196,11 @@ SeamCut cut_at_seams(Mesh &mesh, RepairMap &map, uint32_t input_vertices) {
     if (has_mat)
       material.values[w] = static_cast<float>(mesh.face_materials[c / 3]);
   }
+}
 
-  // The copies: positions and attributes of the vertex they copy.
-  mesh.positions.reserve(3 * size_t(total));
+/// The copies: positions and attributes of the vertex they copy.
+void append_copies(Mesh &mesh, const std::vector<uint32_t> &copy_source) {
+  mesh.positions.reserve(mesh.positions.size() + 3 * copy_source.size());
   for (uint32_t s : copy_source)
     for (int k = 0; k < 3; ++k)
       mesh.positions.push_back(mesh.positions[3 * size_t(s) + k]);
@@ -205,6 +215,14 @@ SeamCut cut_at_seams(Mesh &mesh, RepairMap &map, uint32_t input_vertices) {
           a.values.push_back(a.values[s * n + k]);
     }
   }
+}
+
+/// The copies' locks and origins; a simple seam vertex (one copy, two seam edges, not on the
+/// boundary) and its copy become twins, unlocked.
+void twin_seam_vertices(uint32_t nv, const std::vector<uint32_t> &copy_source,
+                        const std::vector<uint8_t> &seam_edges_at,
+                        const std::vector<uint8_t> &on_boundary, SeamCut &cut) {
+  const uint32_t total = nv + static_cast<uint32_t>(copy_source.size());
   cut.locked.resize(total, 0);
   cut.twin.assign(total, kNone);
   cut.origin.resize(total);
@@ -224,6 +242,26 @@ SeamCut cut_at_seams(Mesh &mesh, RepairMap &map, uint32_t input_vertices) {
       cut.locked[v] = cut.locked[last_copy[v]] = 0;
       cut.twins += 2;
     }
+}
+
+} // namespace
+
+SeamCut cut_at_seams(Mesh &mesh, RepairMap &map, uint32_t input_vertices) {
+  const uint32_t nv = static_cast<uint32_t>(mesh.vertex_count());
+  const bool has_uv = !mesh.corner_texcoords.empty(), has_mat = !mesh.face_materials.empty();
+  SeamCut cut;
+  cut.locked.assign(nv, 0);
+  std::vector<uint8_t> seam_edges_at(nv, 0), on_boundary(nv, 0);
+  std::vector<uint32_t> parent;
+  join_wedges(mesh, parent, cut, seam_edges_at, on_boundary);
+  std::vector<uint32_t> copy_source;
+  std::vector<uint32_t> triangles = number_wedges(mesh.triangles, nv, parent, copy_source);
+  cut.wedge_copies = copy_source.size();
+  const uint32_t total = nv + static_cast<uint32_t>(copy_source.size());
+  VertexAttribute uv, material;
+  wedge_values(mesh, triangles, total, uv, material);
+  append_copies(mesh, copy_source);
+  twin_seam_vertices(nv, copy_source, seam_edges_at, on_boundary, cut);
   // Cut vertex v (v < nv) stands for input vertex v (< input_vertices) or for the copy
   // map.copy_of[v - input_vertices]; so does each of its wedge copies.
   if (map.copy_of.size() + input_vertices != nv)
