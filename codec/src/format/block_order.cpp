@@ -1,5 +1,6 @@
 // The BLKO section; see block_order.h.
 #include "format/block_order.h"
+#include "mesh/morton.h"
 
 #include <algorithm>
 #include <numeric>
@@ -7,17 +8,6 @@
 namespace pomar {
 
 namespace {
-
-/// The low 21 bits of x spread to every third bit.
-uint64_t spread3(uint32_t x) {
-  uint64_t v = x & 0x1FFFFF;
-  v = (v | v << 32) & 0x1F00000000FFFFull;
-  v = (v | v << 16) & 0x1F0000FF0000FFull;
-  v = (v | v << 8) & 0x100F00F00F00F00Full;
-  v = (v | v << 4) & 0x10C30C30C30C30C3ull;
-  v = (v | v << 2) & 0x1249249249249249ull;
-  return v;
-}
 
 constexpr uint8_t kBlockOrderVersion = 1;
 constexpr uint8_t kMortonOfRoots = 1;
@@ -29,9 +19,9 @@ std::vector<uint32_t> morton_block_order(const std::vector<int32_t> &q, uint32_t
   const int shift = std::max(0, bits - 21);
   std::vector<uint64_t> key(clusters);
   for (uint32_t c = 0; c < clusters; ++c)
-    key[c] = spread3(uint32_t(q[3 * size_t(c)]) >> shift) |
-             spread3(uint32_t(q[3 * size_t(c) + 1]) >> shift) << 1 |
-             spread3(uint32_t(q[3 * size_t(c) + 2]) >> shift) << 2;
+    key[c] =
+        morton_key(uint32_t(q[3 * size_t(c)]) >> shift, uint32_t(q[3 * size_t(c) + 1]) >> shift,
+                   uint32_t(q[3 * size_t(c) + 2]) >> shift);
   std::vector<uint32_t> order(clusters);
   std::iota(order.begin(), order.end(), 0u);
   std::sort(order.begin(), order.end(),

@@ -1,25 +1,12 @@
 #include "mesh/reorder.h"
 #include "memory/prefault.h"
 #include "mesh/introsort.h"
+#include "mesh/morton.h"
 #include "mesh/radix_sort.h"
 
 #include <algorithm>
 
 namespace pomar {
-namespace {
-
-/// Spread the low 21 bits of x so that they occupy every third bit.
-uint64_t spread3(uint64_t x) {
-  x &= 0x1FFFFF;
-  x = (x | x << 32) & 0x1F00000000FFFFull;
-  x = (x | x << 16) & 0x1F0000FF0000FFull;
-  x = (x | x << 8) & 0x100F00F00F00F00Full;
-  x = (x | x << 4) & 0x10C30C30C30C30C3ull;
-  x = (x | x << 2) & 0x1249249249249249ull;
-  return x;
-}
-
-} // namespace
 
 std::vector<uint32_t> reorder_vertices(std::vector<int32_t> &q, std::vector<uint32_t> &triangles) {
   const uint32_t nv = static_cast<uint32_t>(q.size() / 3);
@@ -28,7 +15,7 @@ std::vector<uint32_t> reorder_vertices(std::vector<int32_t> &q, std::vector<uint
   for (uint32_t v = 0; v < nv; ++v) {
     const uint64_t x = uint64_t(q[3 * v]) >> 3, y = uint64_t(q[3 * v + 1]) >> 3,
                    z = uint64_t(q[3 * v + 2]) >> 3;
-    key[v] = {spread3(x) | spread3(y) << 1 | spread3(z) << 2, v};
+    key[v] = {morton_key(x, y, z), v};
   }
   sort_by_key(key);
   std::vector<uint32_t> old_to_new = filled_vector<uint32_t>(nv);
