@@ -163,8 +163,8 @@ struct EncodeOptions {
   /// scalars on 16 bits, texture coordinates on 12 bits over their ranges).
   AttributeOptions attributes;
   /// Refuse meshes the codec must cut to code (non-manifold, inconsistently oriented,
-  /// duplicate or degenerate faces) and drop unreferenced vertices, as before format
-  /// version 4. Off: such meshes are cut and the cut is stored (LosslessReport).
+  /// duplicate or degenerate faces) and drop unreferenced vertices: the file then has no
+  /// lossless record. Off: such meshes are cut and the cut is stored (LosslessReport).
   bool strict = false;
   /// Store the input vertex numbering too (messy and clean meshes alike: the file then
   /// carries a lossless record): a full decode gives the vertices back in the input order.

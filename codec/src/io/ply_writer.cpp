@@ -47,7 +47,7 @@ int32_t face_texture_number(const Mesh &mesh, size_t f) {
 /// The binary little-endian body of write_ply_with_attributes: every vertex record (x y z,
 /// then each attribute's components in the header's order) and every face (indices, then
 /// texcoord and texnumber when the mesh has them), written in runs of records into room
-/// made once per run (a byte at a time through std::string::operator+= was 10x slower).
+/// made once per run (a byte at a time through std::string::operator+= is 10x slower).
 void write_binary_body(TextFileWriter &out, const Mesh &mesh) {
   const size_t nv = mesh.vertex_count(), nt = mesh.triangle_count();
   size_t record = 12;

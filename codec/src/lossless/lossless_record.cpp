@@ -55,8 +55,8 @@ uint64_t get_u(RangeDecoder &rc, UintModel &m) {
 
 /// Position groups: group[v] numbers the distinct positions of `mesh` (exact float bits)
 /// in the order of their bits (x, y, z as unsigned words). Two stable radix sorts, by z and
-/// then by (x, y): linear, where a comparison sort of the vertices through their positions
-/// took a twentieth of a messy mesh's decode.
+/// then by (x, y): linear (a comparison sort of the vertices through their positions takes
+/// a twentieth of a messy mesh's decode).
 std::vector<uint32_t> position_groups(const Mesh &mesh) {
   const uint32_t n = static_cast<uint32_t>(mesh.vertex_count());
   const auto word = [&](uint32_t v, int k) {
@@ -343,7 +343,7 @@ std::vector<uint32_t> canonical_face_order(const std::vector<uint32_t> &t) {
   // Each face's vertices rotated to start at the smallest; the faces sorted by that triple,
   // equal triples (duplicate faces) by face index. Ids up to a few times the face count (a
   // mesh's own, every caller's): bucketed by the smallest vertex, the buckets sorted (a
-  // comparison sort of indices through the triples took a sixth of a 35k-vertex decode's
+  // comparison sort of indices through the triples takes a sixth of a 35k-vertex decode's
   // CPU time). Sparse ids (only a test makes them) sort the triples themselves.
   const uint32_t nf = static_cast<uint32_t>(t.size() / 3);
   const uint32_t top = t.empty() ? 0 : *std::max_element(t.begin(), t.end());
