@@ -19,6 +19,16 @@ namespace pomar::tool {
 
 namespace {
 
+/// Writes the decoded mesh and the texture images it embeds beside it, and says what the
+/// output format cannot hold.
+void save_decoded(const DecodeArgs &a, const pomar::Mesh &mesh) {
+  pomar::save_mesh(a.out, mesh, !a.ascii);
+  write_embedded_textures(a.out, mesh, a.quiet);
+  if (!a.quiet)
+    warn_dropped(a.out, pomar::attributes_not_saved(a.out, mesh), "cannot hold",
+                 not_written_hint(a.out));
+}
+
 /// `e` with the .pomar file's name in front of its message, if it does not name it yet.
 pomar::Error naming(const pomar::Error &e, const std::string &path) {
   const std::string what = e.what();
@@ -110,11 +120,7 @@ int run_selective_decode(const DecodeArgs &a) {
   }
   const pomar::Mesh mesh = d.exact_mesh(); // every region at its finest: the input exactly
   const double t_decode = since(t0);
-  pomar::save_mesh(a.out, mesh, !a.ascii);
-  write_embedded_textures(a.out, mesh, a.quiet);
-  if (!a.quiet)
-    warn_dropped(a.out, pomar::attributes_not_saved(a.out, mesh), "cannot hold",
-                 not_written_hint(a.out));
+  save_decoded(a, mesh);
   if (a.stats || !a.quiet) {
     const uint64_t file_size = d.info().total_bytes;
     std::printf("%s: %zu vertices, %zu faces; %u of %u clusters refined (levels %d..%d), %u "
@@ -152,11 +158,7 @@ int run_decode(const DecodeArgs &a) {
     rethrow_with_hint(naming(e, a.in));
   }
   const double t_decode = since(t0);
-  pomar::save_mesh(a.out, mesh, !a.ascii);
-  write_embedded_textures(a.out, mesh, a.quiet);
-  if (!a.quiet)
-    warn_dropped(a.out, pomar::attributes_not_saved(a.out, mesh), "cannot hold",
-                 not_written_hint(a.out));
+  save_decoded(a, mesh);
   if (!a.quiet || a.stats)
     std::printf("%s: %zu vertices, %zu faces (decoded in %.3f s, %zu bytes read)\n", a.out.c_str(),
                 mesh.vertex_count(), mesh.triangle_count(), t_decode, data.size());
