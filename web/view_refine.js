@@ -215,6 +215,18 @@ function backFacing(eye, centre, radius, axis, cosWidth, margin) {
   return angle + Math.acos(Math.min(1, cosWidth)) + margin + Math.asin(radius / distance) < Math.PI / 2;
 }
 
+/** What both error models start from: the face count of a level, the pixels per unit of
+ *  distance, the occlusion buffer of the current mesh (or null) and a copy of the levels. */
+function viewFrame(state, view, occlusion, occlusionWidth) {
+  const { info } = state;
+  return {
+    faces: (l) => (l === 0 ? info.baseFaces : info.levels[l - 1].faces),
+    pixelsPerUnit: view.height / (2 * Math.tan(view.fovY / 2)),
+    buffer: occlusion && state.mesh && view.width ? occlusionBuffer(state.mesh, view, occlusionWidth) : null,
+    wanted: Int32Array.from(state.levels),
+  };
+}
+
 /**
  * @param state {info, levels (Int32Array, current level per cluster), clusterBounds
  *   (Float32Array, BOUNDS_STRIDE per cluster), errorSeen (Map "c:l" -> error, updated
@@ -249,10 +261,7 @@ export function chooseLevels(state, view, {
     detailSeen.set(c, seen);
   }
   const model = { finest, base, errorModel, detailSafety, maxTilt, decay: detailDecay(detailSeen) };
-  const faces = (l) => (l === 0 ? info.baseFaces : info.levels[l - 1].faces);
-  const pixelsPerUnit = view.height / (2 * Math.tan(view.fovY / 2));
-  const buffer = occlusion && state.mesh && view.width ? occlusionBuffer(state.mesh, view, occlusionWidth) : null;
-  const wanted = Int32Array.from(levels);
+  const { faces, pixelsPerUnit, buffer, wanted } = viewFrame(state, view, occlusion, occlusionWidth);
   let triangles = 0;
   for (let c = 0; c < n; ++c) triangles += b[S * c + 7];
   const candidates = [];
@@ -340,10 +349,7 @@ function chooseStored(state, view, { targetPixels, coarsenFraction, triangleBudg
   const n = info.clusters;
   const base = info.baseLevel;
   const finest = info.finestLevel;
-  const faces = (l) => (l === 0 ? info.baseFaces : info.levels[l - 1].faces);
-  const pixelsPerUnit = view.height / (2 * Math.tan(view.fovY / 2));
-  const buffer = occlusion && state.mesh && view.width ? occlusionBuffer(state.mesh, view, occlusionWidth) : null;
-  const wanted = Int32Array.from(levels);
+  const { faces, pixelsPerUnit, buffer, wanted } = viewFrame(state, view, occlusion, occlusionWidth);
   let triangles = 0;
   for (let c = 0; c < n; ++c) triangles += b[S * c + 7];
   const candidates = [];
