@@ -63,13 +63,34 @@ log = fakeServer(true);
 got = await rf.readMany(wanted);
 check(allParts(got.parts) && same(log, [2, 2]), `maxRequestBytes splits requests: ${JSON.stringify(log)}`);
 log = fakeServer(false);
-rf = new RangeFile('http://x/f.pomar', { maxGap: 0 });
+rf = new RangeFile('http://x/f.pomar', { maxGap: 0, requestCost: 0 });
 got = await rf.readMany(wanted);
 check(allParts(got.parts) && same(log, [4, 1, 1, 1, 1]) && rf.multiRange === false && rf.stats.bytesFetched === 670,
   `a server answering several ranges with the whole file: dropped, one range a request: ${JSON.stringify(log)}`);
 log.length = 0;
 got = await rf.readMany(wanted);
 check(allParts(got.parts) && same(log, [1, 1, 1, 1]), 'and no second try');
+// One range a request, planned with the cost of a request: the gaps (850, 1990, 1390 bytes)
+// shorter than requestCost are fetched, the others cost a request each.
+log = fakeServer(false);
+rf = new RangeFile('http://x/f.pomar', { maxGap: 0, requestCost: 1000 });
+got = await rf.readMany(wanted);
+check(allParts(got.parts) && same(log, [4, 1, 1, 1]) && rf.stats.bytesFetched === 50 + 850 + 10 + 600 + 10,
+  `one range a request, requestCost 1000: the 850-byte gap bridged, the others not: ${JSON.stringify(log)} ${rf.stats.bytesFetched}`);
+log = fakeServer(false);
+rf = new RangeFile('http://x/f.pomar', { maxGap: 0 });
+got = await rf.readMany(wanted);
+check(allParts(got.parts) && same(log, [4, 1]) && rf.stats.bytesFetched === 4900 && rf.requestCost === 4096,
+  `one range a request, the default cost (4 KiB): every gap bridged, one request: ${JSON.stringify(log)} ${rf.stats.bytesFetched}`);
+log = fakeServer(false);
+rf = new RangeFile('http://x/f.pomar', { maxGap: 0, maxRanges: 1, requestCost: 1500 });
+got = await rf.readMany(wanted, () => true);
+check(allParts(got.parts) && same(log, [1, 1]) && rf.stats.bytesFetched === 50 + 850 + 10 + 600 + 1390 + 10,
+  `maxRanges 1: planned for one range a request from the start, gaps holding bytes at hand bridged too: ${JSON.stringify(log)}`);
+log = fakeServer(true);
+rf = new RangeFile('http://x/f.pomar', { maxGap: 0, requestCost: 1 << 20 });
+got = await rf.readMany(wanted);
+check(allParts(got.parts) && same(log, [4]) && rf.stats.bytesFetched === 670, 'a multipart server: requestCost does not apply');
 const parts = parseByteranges(new TextEncoder().encode('--B\r\nContent-Range: bytes 5-7/9\r\n\r\nabc\r\n--B--'), 'B');
 check(parts.length === 1 && parts[0].offset === 5 && new TextDecoder().decode(parts[0].bytes) === 'abc', 'a multipart body parsed');
 let message = '';
