@@ -92,7 +92,8 @@ def main():
                   f"{p['bytesFetched']:8d} B {p['triangles']:7d} triangles, max level {p['maxLevel']}, "
                   f"{p['steps']:2d} steps, {p['differing']:6d} pixels differ ({100 * p['differing'] / total:.2f}%), "
                   f"{p['silhouette']} of them on the silhouette; shading: {p['grazingDiffer']} of "
-                  f"{p['grazingPixels']} grazing (|n.l| < 0.5), {p['facingDiffer']} of {p['facingPixels']} facing")
+                  f"{p['grazingPixels']} grazing (|n.l| < 0.5), {p['facingDiffer']} of {p['facingPixels']} facing, "
+                  f"{p['brighter']} drawn brighter")
     return 0
 
 

@@ -223,6 +223,10 @@ def main():
         stop(proc, server)
 
     try:
+        if r.get('firstDraw'):
+            fd = r['firstDraw']
+            print(f"first draw {fd.get('decodeMs', 0):.0f} ms after the worker started, {fd['bytesFetched']} bytes in "
+                  f"{fd['requests']} requests, {fd.get('triangles')} triangles")
         check(r.get('ok'), 'the scripted session ran to the end' + ('' if r.get('ok') else ': ' + str(r.get('exception'))))
         if not r.get('ok'):
             return 1
@@ -263,6 +267,13 @@ def main():
         check(sr['multiRange'] is False and sr['triangles'] == full['triangles'] and sr['minLevel'] == r['info']['finestLevel'],
               f"a server answering several ranges with the whole file: one range a request, same mesh "
               f"({sr['requests']} requests, {sr['bytesFetched']} bytes)")
+        fd, sc = sr['firstDraw'], sr['closeup']
+        check(fd['bytesFetched'] < fd['globalBytes'],
+              f"the first frame is drawn before the global part is in ({fd['bytesFetched']} of {fd['globalBytes']} "
+              f"bytes, {fd['requests']} requests)")
+        check(sc['served'] == sc['requests'] and sc['requests'] <= 60 and sc['maxLevel'] == r['info']['finestLevel'],
+              f"one range a request: the close-up in {sc['requests']} requests (the server answered {sc['served']}; "
+              f"at most 60), {sc['bytesFetched']} bytes, requestCost {sc['requestCost']}")
         # The server's view: the intact file's bytes, each served once.
         served = sorted((e['start'], e['start'] + e['bytes']) for e in log
                         if e['path'] == '/data/model.pomar' and e['status'] == 206)

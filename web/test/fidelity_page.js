@@ -36,6 +36,7 @@ function differing(a, b) {
   let facingPixels = 0;
   let grazingDiffer = 0;
   let facingDiffer = 0;
+  let brighter = 0; // shading pixels drawn brighter than at full resolution
   for (let i = 0; i < a.px.length; i += 4) {
     const d = Math.abs(a.px[i] - b.px[i]) + Math.abs(a.px[i + 1] - b.px[i + 1]) + Math.abs(a.px[i + 2] - b.px[i + 2]);
     const surface = !background(a.px, i);
@@ -46,9 +47,10 @@ function differing(a, b) {
       if (surface === background(b.px, i)) ++silhouette;
       else if (steep) ++grazingDiffer;
       else if (surface) ++facingDiffer;
+      if (surface && surface !== background(b.px, i) && b.px[i] > a.px[i]) ++brighter;
     }
   }
-  return { n, silhouette, grazingPixels, facingPixels, grazingDiffer, facingDiffer };
+  return { n, silhouette, grazingPixels, facingPixels, grazingDiffer, facingDiffer, brighter };
 }
 async function post(name, body) {
   await fetch('/report/' + name, { method: 'POST', body });

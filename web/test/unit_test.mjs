@@ -226,4 +226,23 @@ check(same(Array.from(conv.next(Int32Array.of(2, 2, 4), B, view)), [2, 3, 4]),
   'only the clusters flipping back are damped');
 check(same(Array.from(conv.next(A, B, lookAlongMinusZ([0, 0, 1]))), [1, 2, 5]), 'another camera starts afresh');
 
+// ---- the stored error model's facet size (maxEdgePixels): the near cluster's stored error
+// projects to 0.005 px, its longest edge (0.02 at distance 1, 500 px a unit) to 10 px.
+const storedInfo = { ...info, clusterErrors: new Float32Array(3 * 3).fill(1e-5) };
+const facets = [[-0.1, -0.1, -1.1], [0.1, 0.1, -1], 0.02, 10];
+const storedState = () => ({ info: storedInfo, levels: Int32Array.of(2, 2, 2),
+  clusterBounds: bounds([facets, far, behind]), errorSeen: new Map() });
+choice = chooseLevels(storedState(), view, { targetPixels: 3, occlusion: false, maxEdgePixels: Infinity });
+check(choice.levels[0] === 2, `stored errors under the target, no facet bound: kept coarse (${choice.levels})`);
+choice = chooseLevels(storedState(), view, { targetPixels: 3, occlusion: false });
+check(choice.levels[0] === 3 && choice.levels[1] === 2,
+  `facets over 8 px (the default) refined to the level whose extrapolated edge (10 / sqrt 2 px) is under it; far kept: ${choice.levels}`);
+choice = chooseLevels(storedState(), view, { targetPixels: 3, occlusion: false, maxEdgePixels: 4 });
+check(choice.levels[0] === 5, `maxEdgePixels 4: refined to level 5 (edge 10 / sqrt 4 = 5 px at level 4): ${choice.levels}`);
+state = { ...storedState(), levels: Int32Array.of(3, 2, 2) };
+choice = chooseLevels(state, view, { targetPixels: 3, occlusion: false, maxEdgePixels: 30 });
+check(choice.levels[0] === 2, `coarsened when the coarser level's facets are under half the bound: ${choice.levels}`);
+choice = chooseLevels(state, view, { targetPixels: 3, occlusion: false, maxEdgePixels: 12 });
+check(choice.levels[0] === 3, `kept when they would be over half of it: ${choice.levels}`);
+
 result.done('unit tests');
