@@ -102,7 +102,8 @@ export class PomarStream {
       }
     };
     show(have);
-    const split = layout.levelStart > have && layout.attrStart === 0;
+    // (Sections of a few bytes, such as BLKO's, are not worth a request of their own.)
+    const split = layout.levelStart > have + 64 && layout.attrStart === 0;
     if (!split) {
       const rest = await file.read(have, layout.globalBytes - have);
       all.set(rest, have);
