@@ -13,7 +13,9 @@ a fresh stream, the view refined until stable, and counts the pixels of the 800x
 buffer that differ (|dR|+|dG|+|dB| > 32, the browser test's metric). Prints one line per
 view and policy: bytes fetched (% of the file), triangles, finest level used, steps,
 differing pixels, and how many of those are covered by the surface in one image only (the
-silhouette moved; the others differ by their shading). See web/README.md, "View-dependent refinement".
+silhouette moved; the others differ by their shading), and the shading ones split by the
+reference's brightness: where the surface is seen at a grazing angle (|n.l| < 0.5 with the
+viewer's headlight) or facing the eye. See web/README.md, "View-dependent refinement".
 """
 import argparse
 import json
@@ -89,7 +91,9 @@ def main():
             print(f"  {json.dumps(p['settings']):60s} {100 * p['bytesFetched'] / v['fileBytes']:6.2f}% "
                   f"{p['bytesFetched']:8d} B {p['triangles']:7d} triangles, max level {p['maxLevel']}, "
                   f"{p['steps']:2d} steps, {p['differing']:6d} pixels differ ({100 * p['differing'] / total:.2f}%), "
-                  f"{p['silhouette']} of them on the silhouette")
+                  f"{p['silhouette']} of them on the silhouette; shading: {p['grazingDiffer']} of "
+                  f"{p['grazingPixels']} grazing (|n.l| < 0.5), {p['facingDiffer']} of {p['facingPixels']} facing, "
+                  f"{p['brighter']} drawn brighter")
     return 0
 
 

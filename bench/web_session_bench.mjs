@@ -28,7 +28,9 @@ for (let k = 1; k < args.length; k += 2) {
 const settings = { targetPixels: Number(opt('target', 3)) };
 const M = await loadModuleInNode();
 const blob = new Blob([readFileSync(file)]);
-const stream = await new PomarStream(M, new RangeFile(blob, options), options).open();
+let firstDraw = null;
+const stream = await new PomarStream(M, new RangeFile(blob, options), options)
+  .open((m, stats) => { firstDraw ??= { ...stats, level: m.level }; });
 let mesh = stream.decoder.mesh();
 const errorSeen = new Map();
 const detailSeen = new Map();
@@ -55,6 +57,9 @@ async function settle(camera) {
   }
 }
 console.log(`${file}: ${info.fileBytes} bytes, ${info.clusters} clusters, options ${JSON.stringify(options)}`);
+if (firstDraw)
+  console.log(`first draw   ${firstDraw.requests} requests ${firstDraw.bytesFetched} B ` +
+    `(${(100 * firstDraw.bytesFetched / info.fileBytes).toFixed(2)}%), global level ${firstDraw.level}`);
 line('open');
 const camera = orbitCamera();
 frameMesh(camera, mesh.positions);

@@ -3,13 +3,17 @@
 // with the file as a Blob: the same requests the browser would make, counted.
 //
 //   node bench/web_view_bench.mjs FILE.pomar [--closeup 0.1] [--target 3] [--size 800x457]
-//        [--clusters 1000,2000] [--maxGap B] [--wholeBlockBytes B] [--estimateMargin F]
+//        [--clusters 1000,2000] [--maxGap B] [--maxRanges N] [--requestCost B] [--firstRequestBytes B]
+//        [--wholeBlockBytes B] [--estimateMargin F]
 //        [--backface] [--no-occlusion] [--errorModel auto|stored|edge|measured [--detailSafety K] [--maxTilt T]]
 //
 // Reports, each from a fresh stream: the base clustered mesh (open), the overview (whole
 // model framed as the viewer frames it, refined to `target` pixels), a close-up (the
 // surface point facing the camera seen from `closeup` x the model's size, as
-// web/test/page_test.js does) and single clusters raised to the finest level. Percentages
+// web/test/page_test.js does) and single clusters raised to the finest level; first the
+// bytes at the first draw (the base mesh and global levels drawn while the global part
+// arrives, pomar_stream.js readGlobal). --maxRanges 1: a server answering one range a
+// request (every range its own request, planned with --requestCost). Percentages
 // are of the file size; "requests" counts Range requests (a server answering several ranges
 // in one request assumed), "ranges" the byte ranges they asked for. See web/README.md for the table.
 // DEBUG=1 also prints, per refinement step, the clusters refined, coarsened, hidden
@@ -36,7 +40,7 @@ if (!file) {
 }
 const [width, height] = opt('size', '800x457').split('x').map(Number);
 const fetchOptions = { maxGap: 128 }; // pomar.js's default
-for (const name of ['maxGap', 'maxRanges', 'wholeBlockBytes', 'estimateMargin', 'estimateSlack'])
+for (const name of ['maxGap', 'maxRanges', 'requestCost', 'firstRequestBytes', 'wholeBlockBytes', 'estimateMargin', 'estimateSlack'])
   if (opt(name) !== undefined) fetchOptions[name] = Number(opt(name));
 const settings = { targetPixels: Number(opt('target', 3)), backface: args.includes('--backface'),
   occlusion: !args.includes('--no-occlusion'), errorModel: opt('errorModel', 'auto') };
@@ -44,8 +48,11 @@ for (const name of ['detailSafety', 'maxTilt']) if (opt(name) !== undefined) set
 const M = await loadModuleInNode();
 const blob = new Blob([readFileSync(file)]);
 
+let firstDraw = null; // the file's stats at the first mesh drawn (a preview, or the opened mesh)
 async function fresh() {
-  const stream = await new PomarStream(M, new RangeFile(blob, fetchOptions), fetchOptions).open();
+  firstDraw = null;
+  const stream = await new PomarStream(M, new RangeFile(blob, fetchOptions), fetchOptions)
+    .open((mesh, stats) => { firstDraw ??= { ...stats, level: mesh.level, triangles: mesh.triangles.length / 3 }; });
   return { stream, mesh: stream.decoder.mesh(), errorSeen: new Map(), detailSeen: new Map() };
 }
 const pct = (s, b) => `${(100 * b / s.file.size).toFixed(2)}%`;
@@ -83,6 +90,9 @@ console.log(`${file}: ${info.vertices} vertices, ${info.fileBytes} bytes, ${info
   `${settings.occlusion}, error model ${settings.errorModel}` +
   `${settings.errorModel === 'measured' ? ` (detailSafety ${settings.detailSafety ?? 1}, maxTilt ${settings.maxTilt ?? 'none'})` : ''}, ` +
   `fetch ${JSON.stringify(fetchOptions)}`);
+if (firstDraw)
+  console.log(`${'first draw'.padEnd(22)} ${pct(s.stream, firstDraw.bytesFetched).padStart(7)} ${String(firstDraw.bytesFetched).padStart(8)} B ` +
+    `${String(firstDraw.requests).padStart(5)} requests, global level ${firstDraw.level}, ${firstDraw.triangles} triangles (before the global part is in)`);
 line('open (base mesh)', s);
 if (info.clusters) {
   const camera = orbitCamera();

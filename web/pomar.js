@@ -19,15 +19,20 @@
 // the promises with an Error whose message says what happened; damaged cluster blocks are
 // skipped (as `pomar decode --skip-damaged` does) and reported through `onWarning`.
 import { chooseLevels, Convergence, sameLevels } from './view_refine.js';
+import { DEFAULT_REQUEST_COST } from './range_fetch.js';
 
 /**
  * @param source URL of a .pomar file, or a File/Blob (e.g. dropped on the page)
- * @param options {onMesh(mesh, model), onWarning(message), onError(message),
+ * @param options {onMesh(mesh, model), onPreview(mesh, stats) (first frames while the
+ *   global part arrives: the base mesh and the global levels at hand, positions and
+ *   triangles only; model.firstDraw keeps the stats of the first), onWarning(message), onError(message),
  *   maxInFlight = 4, maxGap = 128 bytes (ranges this close are fetched in one request;
  *   what lies between is kept: a wider gap costs more bytes than the request it saves,
  *   see web/README.md), maxRanges = 100 (ranges in one request: `Range: bytes=a-b,c-d,...`
  *   answered multipart/byteranges; a server that answers otherwise gets one range a
- *   request), maxRequestBytes = 1 MiB, memoryBudget = 256 MiB (block bytes
+ *   request), requestCost = 4 KiB (a server answering one range a request: gaps between
+ *   the ranges of a step shorter than this are fetched rather than paying another
+ *   request; range_fetch.js), maxRequestBytes = 1 MiB, memoryBudget = 256 MiB (block bytes
  *   held; over it the worker rebuilds its decoder with only the blocks in use),
  *   firstRequestBytes = 16 KiB, tolerant = false (true: fetch whole blocks from the start;
  *   see pomar_stream.js), keepSeams = false (true: a textured file's mesh stays cut at its
@@ -41,7 +46,9 @@ export function open(source, options = {}) {
 
 export class PomarModel {
   constructor(options) {
-    this.options = { memoryBudget: 256 << 20, maxGap: 128, maxRanges: 100, maxRequestBytes: 1 << 20, maxInFlight: 4, ...options };
+    this.options = { memoryBudget: 256 << 20, maxGap: 128, maxRanges: 100, maxRequestBytes: 1 << 20, maxInFlight: 4,
+      requestCost: DEFAULT_REQUEST_COST, ...options };
+    this.firstDraw = null; // stats (bytesFetched, requests, decodeMs) of the first mesh drawn
     this.worker = new Worker(new URL('./pomar_worker.js', import.meta.url), { type: 'module' });
     this.info = null;
     this.mesh = null;
@@ -60,12 +67,19 @@ export class PomarModel {
   start(source) {
     return new Promise((resolve, reject) => {
       this.waiters.push({ id: 0, resolve, reject });
-      const { onMesh, onWarning, onError, ...plain } = this.options;
+      const { onMesh, onPreview, onWarning, onError, ...plain } = this.options;
       this.worker.postMessage({ type: 'open', source, options: plain });
     });
   }
 
   receive(msg) {
+    if (msg.type === 'preview') {
+      // A first frame from the global levels at hand (positions and triangles only).
+      if (!this.firstDraw) this.firstDraw = { ...msg.stats };
+      if (this.options.onPreview) this.options.onPreview(msg.mesh, msg.stats);
+      return;
+    }
+    if (!this.firstDraw && msg.type === 'opened') this.firstDraw = { ...msg.stats };
     if (msg.type === 'warning') {
       if (this.options.onWarning) this.options.onWarning(msg.message);
       return;

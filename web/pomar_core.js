@@ -41,6 +41,37 @@ export function globalBytes(M, prefix, fileSize) {
   return n;
 }
 
+/** Where the pieces of the global part lie, from the file's first bytes `prefix` (null
+ *  while they do not hold the whole header): {headerBytes, baseEnd, attrStart, attrEnd
+ *  (0 0: no ATTR section), levelEnds (end of each global level's bytes), levelStart (level
+ *  1), tablesOffset (model tables; a progressive file: the end of its levels), globalBytes}. */
+export function layoutOf(M, prefix, fileSize) {
+  const ptr = withBytes(M, prefix, (p) => M._pw_layout(p, prefix.length, fileSize));
+  if (!ptr) return null;
+  const head = new Float64Array(M.HEAPF64.buffer, ptr, 5);
+  const g = head[4];
+  const d = new Float64Array(M.HEAPF64.buffer, ptr, 5 + g + 3).slice();
+  return { headerBytes: d[0], baseEnd: d[1], attrStart: d[2], attrEnd: d[3], levelEnds: Array.from(d.subarray(5, 5 + g)),
+    levelStart: d[5 + g], tablesOffset: d[6 + g], globalBytes: d[7 + g] };
+}
+
+/** The mesh of a first frame: the base mesh and global levels 1..`levels`, decoded from
+ *  `bytes` (the file's first bytes; only the header, the base mesh, the ATTR section if
+ *  any and those levels need to be there: layoutOf). {positions, triangles, level}. */
+export function previewMesh(M, bytes, fileSize, levels) {
+  const level = withBytes(M, bytes, (p) => M._pw_preview(p, bytes.length, fileSize, levels));
+  if (level < 0) throw new PomarError(lastError(M));
+  const nv = M._pw_preview_vertex_count();
+  const nt = M._pw_preview_triangle_count();
+  const mesh = {
+    positions: new Float32Array(M.HEAPF32.buffer, M._pw_preview_positions(), 3 * nv).slice(),
+    triangles: new Uint32Array(M.HEAPU32.buffer, M._pw_preview_triangles(), 3 * nt).slice(),
+    level,
+  };
+  M._pw_preview_release();
+  return mesh;
+}
+
 export class Decoder {
   /** Decode the base clustered mesh from the file's first bytes (>= globalBytes).
    *  `tolerant`: skip damaged or missing cluster blocks (and read every block whole);

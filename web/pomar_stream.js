@@ -11,7 +11,7 @@
 // clustered level, nothing fetched) and the level map decoded again. Damage (a block that
 // fails its check or does not decode, a truncated file, a failed fetch) switches the stream
 // to tolerant mode for good: whole blocks, damaged ones skipped as --skip-damaged does.
-import { Decoder, PomarError, globalBytes } from './pomar_core.js';
+import { Decoder, PomarError, globalBytes, layoutOf, previewMesh } from './pomar_core.js';
 
 function concat(a, b) {
   const out = new Uint8Array(a.length + b.length);
@@ -34,12 +34,23 @@ export class PomarStream {
     this.warnings = [];
   }
 
-  async open() {
+  /** Read the global part and decode the base clustered mesh. `onPreview(mesh, stats)`,
+   *  when given, gets the first frames while the global part is still arriving: the base
+   *  mesh and the global levels at hand once the first request is in, the last global level
+   *  once the levels are in (previewMesh: positions and triangles). */
+  async open(onPreview = null) {
     const file = this.file;
     let prefix = await file.read(0, this.options.firstRequestBytes || 16384);
     if (prefix.length === 0) throw new PomarError(`${file.name} is empty`);
-    for (let need; (need = globalBytes(this.M, prefix, file.size)) > prefix.length;)
-      prefix = concat(prefix, await file.read(prefix.length, need - prefix.length));
+    for (let need; (need = globalBytes(this.M, prefix, file.size)) > prefix.length;) {
+      const layout = layoutOf(this.M, prefix, file.size); // null: the header is not all in yet
+      if (!layout || !onPreview) {
+        prefix = concat(prefix, await file.read(prefix.length, need - prefix.length));
+        continue;
+      }
+      prefix = await this.readGlobal(prefix, layout, onPreview);
+      break;
+    }
     this.prefix = prefix;
     try {
       this.decoder = new Decoder(this.M, prefix, file.size, this.tolerant);
@@ -60,6 +71,54 @@ export class PomarStream {
     this.levels = new Int32Array(n).fill(this.info.baseLevel);
     this.absorb([{ offset: 0, bytes: prefix }]).forEach((c) => this.put(c));
     return this;
+  }
+
+  /** The rest of the global part after its first bytes `prefix`, drawing as it comes: the
+   *  base mesh (fetched first if the first request did not hold it) with the global levels
+   *  at hand, then, in a file whose sections (stored errors, attributes) lie between the
+   *  base mesh and the levels, the levels, model tables and cluster index in one request
+   *  while the sections come in another, so the last global level is drawn before the
+   *  sections are in. */
+  async readGlobal(prefix, layout, onPreview) {
+    const file = this.file;
+    const all = new Uint8Array(layout.globalBytes);
+    all.set(prefix);
+    let have = prefix.length;
+    if (layout.baseEnd > have) {
+      all.set(await file.read(have, layout.baseEnd - have), have);
+      have = layout.baseEnd;
+    }
+    const show = (upto) => {
+      // The levels decodable from the bytes [0, upto) and [levelStart, upto).
+      const attr = layout.attrEnd <= upto || layout.attrEnd === 0;
+      let levels = 0;
+      while (attr && levels < layout.levelEnds.length && layout.levelEnds[levels] <= upto) ++levels;
+      try {
+        const mesh = previewMesh(this.M, all.subarray(0, levels ? layout.levelEnds[levels - 1] : layout.baseEnd), file.size, levels);
+        onPreview(mesh, { ...this.file.stats, fileBytes: file.size });
+      } catch (e) {
+        // A damaged base mesh or level: the decoder opened next names it.
+        if (!(e instanceof PomarError)) throw e;
+      }
+    };
+    show(have);
+    // (Sections of a few bytes, such as BLKO's, are not worth a request of their own.)
+    const split = layout.levelStart > have + 64 && layout.attrStart === 0;
+    if (!split) {
+      const rest = await file.read(have, layout.globalBytes - have);
+      all.set(rest, have);
+      return all.subarray(0, have + rest.length); // (shorter: a truncated file)
+    }
+    // The sections between the base mesh and the levels (stored errors) in parallel.
+    const pending = file.read(have, layout.levelStart - have);
+    pending.catch(() => {}); // (a failure is thrown below, once the levels are awaited)
+    const levels = await file.read(layout.levelStart, layout.globalBytes - layout.levelStart);
+    all.set(levels, layout.levelStart);
+    if (levels.length === layout.globalBytes - layout.levelStart) show(layout.globalBytes);
+    const sections = await pending;
+    all.set(sections, have);
+    if (sections.length < layout.levelStart - have) return all.subarray(0, have + sections.length);
+    return all.subarray(0, layout.levelStart + levels.length);
   }
 
   get baseLevels() {

@@ -2,7 +2,8 @@
 // meshes (transferred typed arrays) and messages back.
 //
 // in:  {type:'open', source (URL or File), options}, {type:'want', id, levels}, {type:'close'}
-// out: {type:'opened'|'mesh', id, info, mesh, levels, stats}, {type:'warning', message},
+// out: {type:'preview', mesh, stats} (first frames while the global part arrives),
+//      {type:'opened'|'mesh', id, info, mesh, levels, stats}, {type:'warning', message},
 //      {type:'error', id, message}
 import { loadModule } from './pomar_core.js';
 import { PomarStream } from './pomar_stream.js';
@@ -60,7 +61,12 @@ self.onmessage = async (event) => {
       const t0 = performance.now();
       const M = await loadModule();
       keepSeams = !!(msg.options && msg.options.keepSeams);
-      stream = await new PomarStream(M, new RangeFile(msg.source, msg.options), msg.options).open();
+      // First frames before the global part is in: the base mesh and the global levels
+      // (positions and triangles; the page draws them until the base clustered mesh comes).
+      const preview = (mesh, stats) => self.postMessage({ type: 'preview', mesh, stats: { ...stats,
+        vertices: mesh.positions.length / 3, triangles: mesh.triangles.length / 3, decodeMs: performance.now() - t0 } },
+      [mesh.positions.buffer, mesh.triangles.buffer]);
+      stream = await new PomarStream(M, new RangeFile(msg.source, msg.options), msg.options).open(preview);
       post('opened', 0, { decodeMs: performance.now() - t0 });
     } catch (e) {
       self.postMessage({ type: 'error', id: 0, fatal: true, message: e.message || String(e) });

@@ -1,10 +1,23 @@
 // Byte ranges of a remote file (HTTP Range requests) or of a local File/Blob: adjacent
 // ranges are coalesced into one range, up to `maxRanges` ranges go in one request
-// (`Range: bytes=a-b,c-d`, answered multipart/byteranges; one range a request from servers
-// that do not answer so), at most `maxInFlight` requests run at once, and every failure is
-// an Error whose message names the URL and the problem.
+// (`Range: bytes=a-b,c-d`, answered multipart/byteranges), at most `maxInFlight` requests
+// run at once, and every failure is an Error whose message names the URL and the problem.
+//
+// Range planning. A server that answers several ranges in one request (nginx, Apache) gets
+// the ranges of a step closer than `maxGap` joined and the rest batched. A server that
+// answers one range a request (Amazon S3, most CDNs) makes every range a request: there
+// the ranges of a step are planned with a cost model, each request costing
+// `requestCost` bytes on top of the bytes it brings, so a gap is bridged exactly when it
+// is shorter than `requestCost` (the cost is a sum over gaps: each gap is bridged or not
+// on its own, and this rule gives the cheapest plan). In a file with a BLKO section the
+// blocks lie in the Morton order of their clusters, so the blocks of one region are one
+// run of the file and the plan reads it in a few requests.
 
 export class RangeError_ extends Error {}
+
+/** The cost of one request in bytes (range planning for servers that answer one range a
+ *  request; web/README.md "Requests" has the trade-off it makes). */
+export const DEFAULT_REQUEST_COST = 4096;
 
 /** Coalesce byte ranges [{key, offset, size}] (any order) into requests
  *  [{offset, size, parts}] of adjacent ranges (gap <= maxGap bytes, at most maxBytes each
@@ -64,11 +77,13 @@ export function parseByteranges(body, boundary, name = 'the file') {
 
 export class RangeFile {
   /** `source`: a URL (string) or a File/Blob. */
-  constructor(source, { maxInFlight = 4, maxGap = 0, maxRequestBytes = 1 << 20, maxRanges = 100 } = {}) {
+  constructor(source, { maxInFlight = 4, maxGap = 0, maxRequestBytes = 1 << 20, maxRanges = 100,
+    requestCost = DEFAULT_REQUEST_COST } = {}) {
     this.source = source;
     this.name = typeof source === 'string' ? source : source.name || 'local file';
     this.maxInFlight = maxInFlight;
     this.maxGap = maxGap;
+    this.requestCost = requestCost;
     this.maxRequestBytes = maxRequestBytes;
     this.maxRanges = maxRanges;
     // Does the server answer several ranges in one request? null: not asked yet (the
@@ -233,11 +248,27 @@ export class RangeFile {
     return out;
   }
 
-  /** Fetch ranges [{key, offset, size}], coalesced and batched, at most maxInFlight
-   *  requests at once. Returns {parts: Map key -> Uint8Array (shorter than asked at the end
-   *  of a truncated file) or Error (that request failed), chunks: [{offset, bytes}] (every
-   *  range received, gaps between coalesced ranges included)}. */
-  async readMany(ranges, skipGap = undefined) {
+  /** The requests [{offset, size, parts}] for `ranges`, clipped to the file: for a server
+   *  answering several ranges a request, gaps up to maxGap bridged except those holding
+   *  bytes at hand (`skipGap`); one range a request (`oneRange`), gaps shorter than
+   *  requestCost bridged, whatever they hold (a request costs more than those bytes). */
+  plan(ranges, oneRange, skipGap) {
+    const gap = oneRange ? Math.max(this.maxGap, this.requestCost) : this.maxGap;
+    const requests = [];
+    for (const req of coalesce(ranges, gap, this.maxRequestBytes, oneRange ? () => false : skipGap)) {
+      if (this.size >= 0) req.size = Math.max(0, Math.min(this.size, req.offset + req.size) - req.offset);
+      requests.push(req);
+    }
+    return requests;
+  }
+
+  /** Fetch ranges [{key, offset, size}], planned (plan) and batched, at most maxInFlight
+   *  requests at once. The first request of several ranges probes the server; when it
+   *  answers one range a request, what that request asked for and everything after is
+   *  planned again for one range a request. Returns {parts: Map key -> Uint8Array (shorter
+   *  than asked at the end of a truncated file) or Error (that request failed), chunks:
+   *  [{offset, bytes}] (every range received, bridged gaps included)}. */
+  async readMany(ranges, skipGap = () => false) {
     const parts = new Map();
     const chunks = [];
     const fill = (req, chunk) => {
@@ -250,38 +281,53 @@ export class RangeFile {
         parts.set(p.key, chunk.bytes.subarray(a, Math.min(chunk.bytes.length, a + p.size)));
       }
     };
+    const one = async (req) => {
+      if (req.size <= 0) {
+        fill(req, { offset: req.offset, bytes: new Uint8Array(0) });
+        return;
+      }
+      let chunk;
+      try {
+        chunk = { offset: req.offset, bytes: await this.read(req.offset, req.size) };
+      } catch (e) {
+        fill(req, e);
+        return;
+      }
+      chunks.push(chunk);
+      fill(req, chunk);
+    };
+    const oneByOne = (list) => Promise.all(this.plan(list, true, skipGap).map(one));
+    if (this.multiRange === false) {
+      await oneByOne(ranges);
+      return { parts, chunks };
+    }
+    const covers = (c, req) => c.offset <= req.offset && c.offset + c.bytes.length >= req.offset + req.size;
+    const again = []; // ranges of batches the server answered otherwise: one range a request
     const requests = [];
-    for (const req of coalesce(ranges, this.maxGap, this.maxRequestBytes, skipGap)) {
-      if (this.size >= 0) req.size = Math.max(0, Math.min(this.size, req.offset + req.size) - req.offset);
+    for (const req of this.plan(ranges, false, skipGap)) {
       if (req.size > 0) requests.push(req);
       else fill(req, { offset: req.offset, bytes: new Uint8Array(0) });
     }
-    const covers = (c, req) => c.offset <= req.offset && c.offset + c.bytes.length >= req.offset + req.size;
     await Promise.all(this.batches(requests).map(async (batch) => {
-      let got = [];
-      if (batch.length > 1) {
-        try {
-          got = await this.readRanges(batch);
-        } catch (e) {
-          batch.forEach((req) => fill(req, e));
-          return;
-        }
-        chunks.push(...got);
+      if (batch.length === 1) {
+        await one(batch[0]);
+        return;
       }
-      await Promise.all(batch.map(async (req) => {
-        let chunk = got.find((c) => covers(c, req));
-        if (!chunk) {
-          try {
-            chunk = { offset: req.offset, bytes: await this.read(req.offset, req.size) };
-          } catch (e) {
-            fill(req, e);
-            return;
-          }
-          chunks.push(chunk);
-        }
-        fill(req, chunk);
-      }));
+      let got;
+      try {
+        got = await this.readRanges(batch);
+      } catch (e) {
+        batch.forEach((req) => fill(req, e));
+        return;
+      }
+      chunks.push(...got);
+      for (const req of batch) {
+        const chunk = got.find((c) => covers(c, req));
+        if (chunk) fill(req, chunk);
+        else again.push(...req.parts);
+      }
     }));
+    if (again.length) await oneByOne(again);
     return { parts, chunks };
   }
 }

@@ -2,7 +2,10 @@
 //
 // A file with a CERR section stores an error bound per cluster and level: errorModel 'auto'
 // (the default) then uses it (chooseStored: every level's error known, straight to the
-// coarsest level within the target). Without one, the error of a cluster at
+// coarsest level within the target whose facets are at most `maxEdgePixels` on screen: the
+// viewer shades flat facets, and a coarse facet within the geometric bound still tilts
+// against the finer ones, which changes its colour wherever it covers several pixels).
+// Without one, the error of a cluster at
 // its current level is bounded from what is decoded: the longest edge between two of its
 // vertices (`clusterBounds[8c+6]`, computed in WebAssembly from the current mesh; a cluster
 // that is a single vertex, as at the base clustered level, takes its incident edges). The
@@ -239,6 +242,7 @@ function viewFrame(state, view, occlusion, occlusionWidth) {
 export function chooseLevels(state, view, {
   targetPixels = 3, coarsenFraction = 0.5, triangleBudget = 2e6, backface = false, backfaceMargin = 0.3,
   occlusion = true, occlusionWidth = 128, errorModel = 'auto', detailSafety = 1, maxTilt = Infinity,
+  maxEdgePixels = 8,
 } = {}) {
   const { info, levels, clusterBounds: b, errorSeen } = state;
   const S = BOUNDS_STRIDE;
@@ -248,7 +252,10 @@ export function chooseLevels(state, view, {
   const stored = info.clusterErrors;
   if (errorModel === 'auto') errorModel = stored ? 'stored' : 'edge';
   if (errorModel === 'stored' && !stored) errorModel = 'edge';
-  if (errorModel === 'stored') return chooseStored(state, view, { targetPixels, coarsenFraction, triangleBudget, occlusion, occlusionWidth });
+  if (errorModel === 'stored') {
+    return chooseStored(state, view, { targetPixels, coarsenFraction, triangleBudget, occlusion, occlusionWidth,
+      maxEdgePixels });
+  }
   // The detail measured per cluster and level, kept for the decay (state.detailSeen, made
   // here when the caller keeps none).
   const detailSeen = state.detailSeen ?? (state.detailSeen = new Map());
@@ -341,9 +348,12 @@ export function storedError(info, c, l) {
 /** chooseLevels with the file's stored errors (errorModel 'stored'): every level's error is
  *  known, so each cluster in view goes straight to the coarsest level whose error, projected
  *  at the distance to its box (grown by its error at the current level), is within the
- *  target, and coarsens straight to the coarsest under `coarsenFraction` of it; outside the
- *  frustum: the base level; occluded: one level coarser per step. */
-function chooseStored(state, view, { targetPixels, coarsenFraction, triangleBudget, occlusion, occlusionWidth }) {
+ *  target and whose longest edge (the current one, extrapolated with the level table's face
+ *  counts) is within `maxEdgePixels`, and coarsens straight to the coarsest under
+ *  `coarsenFraction` of both; outside the frustum: the base level; occluded: one level
+ *  coarser per step. */
+function chooseStored(state, view, { targetPixels, coarsenFraction, triangleBudget, occlusion, occlusionWidth,
+  maxEdgePixels }) {
   const { info, levels, clusterBounds: b } = state;
   const S = BOUNDS_STRIDE;
   const n = info.clusters;
@@ -375,13 +385,17 @@ function chooseStored(state, view, { targetPixels, coarsenFraction, triangleBudg
       continue;
     }
     const toPixels = pixelsPerUnit / Math.max(view.near, distanceToBox(view.eye, lo, hi));
+    // The facets' size on screen (maxEdgePixels): the longest edge of the current level,
+    // extrapolated to level k with the level table's face counts.
+    const edgePixels = (k) => b[S * c + 6] * toPixels * Math.sqrt(faces(l) / faces(k));
     let to = base;
-    while (to < finest && storedError(info, c, to) * toPixels > targetPixels) ++to;
+    while (to < finest && (storedError(info, c, to) * toPixels > targetPixels || edgePixels(to) > maxEdgePixels)) ++to;
     if (to > l) {
       candidates.push({ c, to, pixels: storedError(info, c, l) * toPixels });
     } else if (to < l) {
       let down = l;
-      while (down > base && storedError(info, c, down - 1) * toPixels < coarsenFraction * targetPixels) --down;
+      while (down > base && storedError(info, c, down - 1) * toPixels < coarsenFraction * targetPixels &&
+        edgePixels(down - 1) < coarsenFraction * maxEdgePixels) --down;
       if (down < l) {
         wanted[c] = down;
         ++coarsen;

@@ -419,10 +419,21 @@ async function openSource(source, extraOptions = {}) {
   $('textures').textContent = '';
   upload({ positions: new Float32Array(0), triangles: new Uint32Array(0), vertexCluster: new Uint32Array(0), vertexLevel: new Uint32Array(0), colour: null, texcoords: null });
   frame(null);
+  let previewed = false;
   const m = await open(source, {
     keepSeams: true, // a textured mesh: one texture coordinate per vertex at full resolution too
     ...extraOptions,
     onMesh: (mesh, m) => onMesh(mesh, m),
+    // The base mesh and global levels while the global part arrives: drawn plain.
+    onPreview: (mesh, stats) => {
+      if (!previewed) frameMesh(camera, mesh.positions, canvas.clientWidth / Math.max(1, canvas.clientHeight));
+      previewed = true;
+      const nv = mesh.positions.length / 3;
+      upload({ ...mesh, vertexCluster: new Uint32Array(nv), vertexLevel: new Uint32Array(nv), colour: null, texcoords: null });
+      frame(null);
+      $('stats').textContent = `fetched ${(stats.bytesFetched / 1024).toFixed(1)} KiB of ${(stats.fileBytes / 1024).toFixed(1)} KiB ` +
+        `in ${stats.requests} requests: global level ${mesh.level}, ${stats.triangles} triangles`;
+    },
     onWarning: (message) => { $('warning').textContent = 'warning: ' + message; },
   });
   model = m;

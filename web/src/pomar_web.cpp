@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "attributes/attribute_section.h"
+#include "decode/global_levels.h"
 #include "format/file_format.h"
 #include "pomar/pomar.h"
 #include "pomar/random_access.h"
@@ -199,6 +201,9 @@ void per_vertex_texcoords(Handle &h) {
     h.texcoords = std::move(uv);
 }
 
+/// The mesh of pw_preview, kept for JavaScript to copy out of the heap.
+pomar::Mesh g_preview;
+
 } // namespace
 
 extern "C" {
@@ -230,6 +235,87 @@ EMSCRIPTEN_KEEPALIVE double pw_global_bytes(const uint8_t *data, size_t n, doubl
   });
   return out;
 }
+
+/// Where the pieces of the global part lie, from the header alone (`n` >= the header size
+/// pw_global_bytes asks for first): [header bytes, end of the base mesh, start and end of
+/// the ATTR section (0 0: none), global levels G, then G values: the end of each global
+/// level's bytes, then the start of level 1, the start of the model tables (clustered; else
+/// the end of the last level) and the global part's size]. Null on a damaged header.
+EMSCRIPTEN_KEEPALIVE const double *pw_layout(const uint8_t *data, size_t n, double file_size) {
+  static std::vector<double> out;
+  const int status = guarded([&] {
+    const uint64_t size = static_cast<uint64_t>(file_size);
+    const size_t hsize = pomar::header_size(data, n);
+    if (n < hsize)
+      throw pomar::Error("the header needs " + std::to_string(hsize) + " bytes");
+    const pomar::FileLayout layout = pomar::read_layout(data, hsize, size, true);
+    const pomar::FileHeader &h = layout.header;
+    const size_t global = h.clustered() ? h.global_levels : h.levels.size();
+    out = {double(layout.header_bytes), double(layout.base_offset + h.base_bytes), 0, 0,
+           double(global)};
+    const int attr = pomar::find_section(layout, pomar::section_tag("ATTR"));
+    if (attr >= 0) {
+      out[2] = double(layout.section_offset[attr]);
+      out[3] = double(layout.section_offset[attr] + h.sections[attr].bytes);
+    }
+    for (size_t i = 0; i < global; ++i)
+      out.push_back(double(layout.level_offset[i] + h.levels[i].connectivity_bytes +
+                           h.levels[i].geometry_bytes));
+    out.push_back(double(global ? layout.level_offset[0] : layout.global_bytes));
+    out.push_back(double(h.clustered() ? layout.tables_offset : layout.global_bytes));
+    out.push_back(double(std::min<uint64_t>(layout.global_bytes, size)));
+    return 0;
+  });
+  return status < 0 ? nullptr : out.data();
+}
+
+/// The mesh a first frame can show before the global part is complete: the base mesh and
+/// global levels 1..`levels` (a progressive file's levels). `data` holds the file's first
+/// `n` bytes, of which only the header, the base mesh, the ATTR section (when the file has
+/// one and `levels` > 0) and those levels need to be there (pw_layout says where; other
+/// bytes may be zeros). Positions and triangles only (pw_preview_*). Returns the levels
+/// decoded, -1 on error (pw_last_error).
+EMSCRIPTEN_KEEPALIVE int pw_preview(const uint8_t *data, size_t n, double file_size, int levels) {
+  int decoded = -1;
+  guarded([&] {
+    const uint64_t size = static_cast<uint64_t>(file_size);
+    const size_t hsize = pomar::header_size(data, n);
+    if (n < hsize)
+      throw pomar::Error("the header needs " + std::to_string(hsize) + " bytes");
+    const pomar::FileLayout layout = pomar::read_layout(data, hsize, size, true);
+    const pomar::FileHeader &h = layout.header;
+    const size_t global = h.clustered() ? h.global_levels : h.levels.size();
+    const size_t upto = std::min<size_t>(global, size_t(std::max(0, levels)));
+    if (layout.base_offset + h.base_bytes > n ||
+        (upto && layout.level_offset[upto - 1] + h.levels[upto - 1].connectivity_bytes +
+                         h.levels[upto - 1].geometry_bytes >
+                     n))
+      throw pomar::Error("the first frame needs the base mesh and its levels");
+    pomar::LevelMesh lm = pomar::base_level_mesh(data, layout);
+    pomar::Models models;
+    if (upto) {
+      if (const auto attributes = pomar::load_attribute_table(data, layout)) {
+        pomar::init_attributes(*attributes, lm, pomar::AttributeMask::none()); // read past
+        models.attr = pomar::attribute_models(*attributes);
+      }
+    }
+    decoded = int(pomar::decode_global_levels(data, layout, 0, upto, lm, models, {}));
+    g_preview = pomar::to_mesh(std::move(lm), h.grid);
+    return 0;
+  });
+  return decoded;
+}
+EMSCRIPTEN_KEEPALIVE int pw_preview_vertex_count() { return int(g_preview.vertex_count()); }
+EMSCRIPTEN_KEEPALIVE int pw_preview_triangle_count() {
+  return int(g_preview.triangle_count());
+}
+EMSCRIPTEN_KEEPALIVE const float *pw_preview_positions() {
+  return g_preview.positions.data();
+}
+EMSCRIPTEN_KEEPALIVE const uint32_t *pw_preview_triangles() {
+  return g_preview.triangles.data();
+}
+EMSCRIPTEN_KEEPALIVE void pw_preview_release() { g_preview = pomar::Mesh(); }
 
 /// Decode the base clustered mesh from the file's first `n` bytes (at least
 /// pw_global_bytes) of `file_size`. `tolerant`: damaged or missing cluster blocks are

@@ -24,17 +24,33 @@ function pixels() {
 const background = (px, i) => Math.abs(px[i] - 32) + Math.abs(px[i + 1] - 36) + Math.abs(px[i + 2] - 42) <= 12;
 /** Pixels that differ, and of those the ones where the surface covers one image only (the
  *  silhouette moved: geometry; the others differ by their shading). */
+/** Plain grey (viewer.js: 0.82 x (0.25 + 0.75 |n.l|) in red) seen at a grazing angle:
+ *  |n.l| under 0.5, i.e. the surface turned more than 60 degrees from the eye. */
+const grazing = (px, i) => (px[i] / 255 / 0.82 - 0.25) / 0.75 < 0.5;
 function differing(a, b) {
   let n = 0;
   let silhouette = 0;
+  // Of the surface pixels (in the reference `a`), how many face the eye at a grazing angle,
+  // and how many of those and of the others differ by their shading.
+  let grazingPixels = 0;
+  let facingPixels = 0;
+  let grazingDiffer = 0;
+  let facingDiffer = 0;
+  let brighter = 0; // shading pixels drawn brighter than at full resolution
   for (let i = 0; i < a.px.length; i += 4) {
     const d = Math.abs(a.px[i] - b.px[i]) + Math.abs(a.px[i + 1] - b.px[i + 1]) + Math.abs(a.px[i + 2] - b.px[i + 2]);
+    const surface = !background(a.px, i);
+    const steep = surface && grazing(a.px, i);
+    if (surface) steep ? ++grazingPixels : ++facingPixels;
     if (d > PIXEL_THRESHOLD) {
       ++n;
-      if (background(a.px, i) !== background(b.px, i)) ++silhouette;
+      if (surface === background(b.px, i)) ++silhouette;
+      else if (steep) ++grazingDiffer;
+      else if (surface) ++facingDiffer;
+      if (surface && surface !== background(b.px, i) && b.px[i] > a.px[i]) ++brighter;
     }
   }
-  return { n, silhouette };
+  return { n, silhouette, grazingPixels, facingPixels, grazingDiffer, facingDiffer, brighter };
 }
 async function post(name, body) {
   await fetch('/report/' + name, { method: 'POST', body });
@@ -80,7 +96,7 @@ export async function run(v) {
         const got = pixels();
         await save(`${name.replace(':', '_')}_${policies.indexOf(settings)}`);
         entry.policies.push({ settings, steps, bytesFetched: model.stats.bytesFetched, triangles: model.stats.triangles,
-          maxLevel: Math.max(...model.levels), ...(({ n, silhouette }) => ({ differing: n, silhouette }))(differing(reference, got)) });
+          maxLevel: Math.max(...model.levels), ...(({ n, ...rest }) => ({ differing: n, ...rest }))(differing(reference, got)) });
       }
       result.views.push(entry);
     }

@@ -291,6 +291,7 @@ export async function run(v) {
     const fetchOptions = params.has('maxGap') ? { maxGap: Number(params.get('maxGap')) } : {};
     const model = await within(30000, v.openSource(params.get('file'), fetchOptions), 'open');
     result.firstFrameMs = performance.now() - t0;
+    result.firstDraw = model.firstDraw; // (a first frame before the global part, or the opened mesh)
     result.up = v.camera.up;
     result.material = $('colour').value;
     result.info = { clusters: model.info.clusters, baseLevel: model.info.baseLevel, finestLevel: model.info.finestLevel,
@@ -345,11 +346,21 @@ export async function run(v) {
     // A server that answers a request for several ranges with the whole file (as Amazon
     // S3 does): the answer is dropped, then one range a request; same mesh. (Two clusters
     // first: their neighbours' block prefixes leave holes for full resolution to fill.)
-    const single = await within(20000, v.openSource(params.get('singleRange')), 'single-range server');
+    // Opened with a first request of 2 KiB: the first frame is drawn before the global part
+    // is in. Then the close-up, its requests counted by the server (one range each).
+    const served = async () => (await (await fetch('/log')).json()).filter((e) => e.path.startsWith('/single-range/')).length;
+    const single = await within(20000, v.openSource(params.get('singleRange'), { firstRequestBytes: 2048 }), 'single-range server');
+    const firstDraw = { ...single.firstDraw, globalBytes: single.info.globalBytes };
+    closeUp(v.camera, single.mesh.positions, closeup);
+    const servedBefore = await served();
+    const singleRequestsBefore = single.stats.requests;
+    await settle(v, 'single-range close-up');
+    const singleCloseup = { requests: single.stats.requests - singleRequestsBefore, served: (await served()) - servedBefore,
+      bytesFetched: single.stats.bytesFetched, maxLevel: Math.max(...single.levels), requestCost: single.options.requestCost };
     await within(30000, single.want({ cluster: 0, level: single.info.finestLevel }), 'single-range server');
     await within(30000, single.want({ cluster: single.info.clusters >> 1, level: single.info.finestLevel }), 'single-range server');
     await within(30000, single.want({ all: single.info.finestLevel }), 'single-range server');
-    result.singleRange = snapshot(single, -1, { multiRange: single.stats.multiRange });
+    result.singleRange = snapshot(single, -1, { multiRange: single.stats.multiRange, firstDraw, closeup: singleCloseup });
     note('single-range server', JSON.stringify(result.singleRange));
 
     // Error cases: each must show a message in the page, never hang.

@@ -63,13 +63,34 @@ log = fakeServer(true);
 got = await rf.readMany(wanted);
 check(allParts(got.parts) && same(log, [2, 2]), `maxRequestBytes splits requests: ${JSON.stringify(log)}`);
 log = fakeServer(false);
-rf = new RangeFile('http://x/f.pomar', { maxGap: 0 });
+rf = new RangeFile('http://x/f.pomar', { maxGap: 0, requestCost: 0 });
 got = await rf.readMany(wanted);
 check(allParts(got.parts) && same(log, [4, 1, 1, 1, 1]) && rf.multiRange === false && rf.stats.bytesFetched === 670,
   `a server answering several ranges with the whole file: dropped, one range a request: ${JSON.stringify(log)}`);
 log.length = 0;
 got = await rf.readMany(wanted);
 check(allParts(got.parts) && same(log, [1, 1, 1, 1]), 'and no second try');
+// One range a request, planned with the cost of a request: the gaps (850, 1990, 1390 bytes)
+// shorter than requestCost are fetched, the others cost a request each.
+log = fakeServer(false);
+rf = new RangeFile('http://x/f.pomar', { maxGap: 0, requestCost: 1000 });
+got = await rf.readMany(wanted);
+check(allParts(got.parts) && same(log, [4, 1, 1, 1]) && rf.stats.bytesFetched === 50 + 850 + 10 + 600 + 10,
+  `one range a request, requestCost 1000: the 850-byte gap bridged, the others not: ${JSON.stringify(log)} ${rf.stats.bytesFetched}`);
+log = fakeServer(false);
+rf = new RangeFile('http://x/f.pomar', { maxGap: 0 });
+got = await rf.readMany(wanted);
+check(allParts(got.parts) && same(log, [4, 1]) && rf.stats.bytesFetched === 4900 && rf.requestCost === 4096,
+  `one range a request, the default cost (4 KiB): every gap bridged, one request: ${JSON.stringify(log)} ${rf.stats.bytesFetched}`);
+log = fakeServer(false);
+rf = new RangeFile('http://x/f.pomar', { maxGap: 0, maxRanges: 1, requestCost: 1500 });
+got = await rf.readMany(wanted, () => true);
+check(allParts(got.parts) && same(log, [1, 1]) && rf.stats.bytesFetched === 50 + 850 + 10 + 600 + 1390 + 10,
+  `maxRanges 1: planned for one range a request from the start, gaps holding bytes at hand bridged too: ${JSON.stringify(log)}`);
+log = fakeServer(true);
+rf = new RangeFile('http://x/f.pomar', { maxGap: 0, requestCost: 1 << 20 });
+got = await rf.readMany(wanted);
+check(allParts(got.parts) && same(log, [4]) && rf.stats.bytesFetched === 670, 'a multipart server: requestCost does not apply');
 const parts = parseByteranges(new TextEncoder().encode('--B\r\nContent-Range: bytes 5-7/9\r\n\r\nabc\r\n--B--'), 'B');
 check(parts.length === 1 && parts[0].offset === 5 && new TextDecoder().decode(parts[0].bytes) === 'abc', 'a multipart body parsed');
 let message = '';
@@ -204,5 +225,24 @@ check(conv.next(A, B, view) === null, 'back to a map it had: damped, nothing new
 check(same(Array.from(conv.next(Int32Array.of(2, 2, 4), B, view)), [2, 3, 4]),
   'only the clusters flipping back are damped');
 check(same(Array.from(conv.next(A, B, lookAlongMinusZ([0, 0, 1]))), [1, 2, 5]), 'another camera starts afresh');
+
+// ---- the stored error model's facet size (maxEdgePixels): the near cluster's stored error
+// projects to 0.005 px, its longest edge (0.02 at distance 1, 500 px a unit) to 10 px.
+const storedInfo = { ...info, clusterErrors: new Float32Array(3 * 3).fill(1e-5) };
+const facets = [[-0.1, -0.1, -1.1], [0.1, 0.1, -1], 0.02, 10];
+const storedState = () => ({ info: storedInfo, levels: Int32Array.of(2, 2, 2),
+  clusterBounds: bounds([facets, far, behind]), errorSeen: new Map() });
+choice = chooseLevels(storedState(), view, { targetPixels: 3, occlusion: false, maxEdgePixels: Infinity });
+check(choice.levels[0] === 2, `stored errors under the target, no facet bound: kept coarse (${choice.levels})`);
+choice = chooseLevels(storedState(), view, { targetPixels: 3, occlusion: false });
+check(choice.levels[0] === 3 && choice.levels[1] === 2,
+  `facets over 8 px (the default) refined to the level whose extrapolated edge (10 / sqrt 2 px) is under it; far kept: ${choice.levels}`);
+choice = chooseLevels(storedState(), view, { targetPixels: 3, occlusion: false, maxEdgePixels: 4 });
+check(choice.levels[0] === 5, `maxEdgePixels 4: refined to level 5 (edge 10 / sqrt 4 = 5 px at level 4): ${choice.levels}`);
+state = { ...storedState(), levels: Int32Array.of(3, 2, 2) };
+choice = chooseLevels(state, view, { targetPixels: 3, occlusion: false, maxEdgePixels: 30 });
+check(choice.levels[0] === 2, `coarsened when the coarser level's facets are under half the bound: ${choice.levels}`);
+choice = chooseLevels(state, view, { targetPixels: 3, occlusion: false, maxEdgePixels: 12 });
+check(choice.levels[0] === 3, `kept when they would be over half of it: ${choice.levels}`);
 
 result.done('unit tests');

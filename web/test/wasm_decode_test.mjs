@@ -14,7 +14,7 @@ import { execFileSync } from 'node:child_process';
 import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { PomarError } from '../pomar_core.js';
+import { PomarError, layoutOf } from '../pomar_core.js';
 import { PomarStream } from '../pomar_stream.js';
 import { RangeFile } from '../range_fetch.js';
 import { checker, loadModuleInNode } from './node_support.mjs';
@@ -143,6 +143,35 @@ for (const file of files) {
   const probe = await open(bytes);
   const info = probe.info;
   probe.close();
+
+  // First frames (pomar_stream.js readGlobal): a first request that ends after the base
+  // mesh, or after half the global levels when they follow it, draws the base mesh and the
+  // levels at hand before the global part is in; a file whose sections (stored errors) lie
+  // between the base mesh and the levels draws the last global level once the levels are
+  // in. Each drawn mesh is the native decode of its level (positions and triangles).
+  const layout = layoutOf(M, bytes, bytes.length);
+  const half = layout.levelEnds[Math.floor(layout.levelEnds.length / 2)];
+  for (const first of [layout.baseEnd + 1, ...(half && layout.levelStart < layout.baseEnd + 64 ? [half + 1] : [])]) {
+    if (first >= info.globalBytes) continue;
+    const previews = [];
+    const stream = await new PomarStream(M, new RangeFile(new Blob([bytes]), {}), { firstRequestBytes: first })
+      .open((mesh, stats) => previews.push({ mesh, bytes: stats.bytesFetched }));
+    check(previews.length > 0 && previews[0].bytes < info.globalBytes,
+      `first request of ${first} bytes: a first frame at ${previews[0]?.bytes} bytes, before the global part (${info.globalBytes}) is in`);
+    const sections = layout.levelStart > layout.baseEnd + 64 && layout.attrStart === 0;
+    const last = previews[previews.length - 1]?.mesh;
+    check(!sections || last?.level === layout.levelEnds.length,
+      `a file with sections before its levels: the last global level drawn before the sections (${last?.level})`);
+    for (const { mesh } of previews) {
+      // (A progressive file's finest level is the encoded mesh, before its lossless record.)
+      if (!info.clusters && mesh.level === info.finestLevel) continue;
+      const want = native(file, ['--level', `${mesh.level}`]);
+      compare(mesh, { ...want, colour: new Uint8Array(0) }, `first frame (first request ${first} bytes): global level ${mesh.level}`);
+    }
+    compare(stream.decoder.mesh(), native(file, ['--level', `${info.clusters ? info.baseLevel : 0}`, ...(info.clusters ? ['--cluster', '0:0'] : [])]),
+      'opened after the first frames');
+    stream.close();
+  }
   if (info.clusters > 0) {
     const base = info.baseLevel;
     const finest = info.finestLevel;
