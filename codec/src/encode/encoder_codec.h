@@ -316,16 +316,24 @@ template <class Codec> void take_wedge_costs(Rebuild &rb, Codec &codec) {
 }
 
 /// Before refinement level `level`: the wedge texture coordinate's predictor for it in
-/// `rb.mesh.wedge_uv_positions`: the first level (or one after a level without splits)
-/// takes the base mesh's, every other the predictor whose residuals on the level before
-/// cost less (take_wedge_costs; a tie: the mean).
+/// `rb.mesh.wedge_uv_positions`: the first level takes the base mesh's, every other the
+/// predictor of the level before, or the other one if its residuals on the level before
+/// (take_wedge_costs) cost more than kSwitchBits less.
 inline void choose_wedge_predictor(Rebuild &rb, uint32_t level) {
   if (!rb.wedge_choice)
     return;
   std::vector<uint8_t> &p = rb.mesh.wedge_uv_positions;
   p.resize(size_t(level) + 1, 0);
-  p[level] = level == 1 || rb.wedge_tally.empty() ? rb.wedge_first
-                                                  : rb.wedge_tally.bits(1) < rb.wedge_tally.bits(0);
+  // A level keeps the predictor of the level before unless the other saves more than a
+  // switch costs in the level's frozen tables (kSwitchBits, a rough figure: the tables are
+  // coded against the level before's, and the bits of their classes are what change).
+  constexpr double kSwitchBits = 128;
+  const bool before = level == 1 ? rb.wedge_first : p[level - 1] != 0;
+  const double mean = rb.wedge_tally.bits(0), positions = rb.wedge_tally.bits(1);
+  p[level] = before;
+  if (level > 1 && !rb.wedge_tally.empty() &&
+      (before ? mean + kSwitchBits < positions : positions + kSwitchBits < mean))
+    p[level] = !before;
   rb.wedge_tally.clear();
 }
 
