@@ -171,10 +171,22 @@ StoredAttribute wedge_descriptor(const std::vector<uint8_t> &file) {
   return StoredAttribute();
 }
 
+/// How many of the file's refinement levels predict the wedge texture coordinate from the
+/// positions (the descriptor's positions flag: all of them; else its level mask).
+size_t levels_from_positions(const std::vector<uint8_t> &file) {
+  const StoredAttribute s = wedge_descriptor(file);
+  const FileInfo info = inspect(file.data(), file.size());
+  if (s.from_positions)
+    return info.levels.size();
+  EXPECT_LE(s.level_positions.size(), info.levels.size());
+  return size_t(std::count(s.level_positions.begin(), s.level_positions.end(), uint8_t(1)));
+}
+
 // The wedge texture coordinates are predicted from the positions where the charts map the
 // surface affinely (the cube map's projections) and by the neighbours' mean where they do
-// not (the same mesh, each wedge moved at random by up to 40 grid steps): the encoder keeps
-// the smaller file, and either way the corners come back.
+// not (the same mesh, each wedge moved at random by up to 40 grid steps): the encoder
+// chooses level by level, from its estimates of both on the level before, and either way
+// the corners come back.
 TEST(TextureSeams, WedgePredictionFollowsTheCharts) {
   const Mesh m = cube_mapped(gen::noisy_sphere(3000, 3, 0.05));
   Mesh jittered = m;
@@ -192,10 +204,56 @@ TEST(TextureSeams, WedgePredictionFollowsTheCharts) {
   }
   const Coded affine = encode_textured(m, true), noisy = encode_textured(jittered, true);
   EXPECT_EQ(affine.report.lossless.wedge_copies, noisy.report.lossless.wedge_copies);
-  EXPECT_TRUE(wedge_descriptor(affine.file).from_positions);
-  EXPECT_FALSE(wedge_descriptor(noisy.file).from_positions);
+  const size_t levels = inspect(affine.file.data(), affine.file.size()).levels.size();
+  EXPECT_GT(levels, 5u);
+  EXPECT_GE(levels_from_positions(affine.file), levels - 1); // (the first: the base mesh's)
+  // (The jittered wedges leave residuals of about the jitter either way: the estimates
+  // choose level by level, and the corners come back whichever they take.)
   expect_corners_kept(affine, decode(affine.file.data(), affine.file.size()), false);
   expect_corners_kept(noisy, decode(noisy.file.data(), noisy.file.size()), false);
+}
+
+// The ATTR section's level mask (version 4): which levels predict the wedge texture
+// coordinate from the positions, a bit a level over two bytes here; a bit past the level
+// count, or the mask with the every-level positions flag, is a damaged section.
+TEST(TextureSeams, LevelMaskOfTheWedgePredictor) {
+  AttributeTable t;
+  StoredAttribute s;
+  s.kind = AttributeKind::TexCoord;
+  s.name = kWedgeTexcoord;
+  s.components = 2;
+  s.bits = 12;
+  s.lo = {0.f, 0.f};
+  s.hi = {1.f, 1.f};
+  s.level_positions = {1, 0, 0, 1, 1, 0, 0, 0, 1, 0};
+  t.stored.push_back(s);
+  t.estimated_bytes = {0};
+  t.codes = 2;
+  t.wedge_uv = 0;
+  const std::vector<uint8_t> body = write_attributes(t, 0);
+  EXPECT_EQ(body[0], kAttributeSectionLevelsVersion);
+  const AttributeTable back = read_attributes(body.data(), body.size(), 0);
+  ASSERT_EQ(back.stored.size(), 1u);
+  EXPECT_EQ(back.stored[0].level_positions, s.level_positions);
+  EXPECT_FALSE(back.stored[0].from_positions);
+  // version, count; kind, components, bits, flags, name length, name; 2 x (lo, hi); mask
+  const size_t mask = 2 + 5 + s.name.size() + 16;
+  ASSERT_EQ(body[mask] | body[mask + 1] << 8, 10);
+  EXPECT_EQ(body[mask + 2], 0x19); // levels 1, 4, 5
+  EXPECT_EQ(body[mask + 3], 0x01); // level 9
+  std::vector<uint8_t> past = body;
+  past[mask + 3] |= 0x04; // level 11 of 10
+  try {
+    read_attributes(past.data(), past.size(), 0);
+    ADD_FAILURE() << "a mask bit past the level count was taken";
+  } catch (const Error &e) {
+    EXPECT_EQ(e.kind(), Error::Kind::DamagedFile);
+    EXPECT_NE(std::string(e.what()).find("level mask past its level count"), std::string::npos)
+        << e.what();
+  }
+  std::vector<uint8_t> both = body;
+  both[2 + 3] |= 2; // the descriptor's flags: the every-level positions flag as well
+  EXPECT_THROW(read_attributes(both.data(), both.size(), 0), Error);
 }
 
 TEST(TextureSeams, EveryLevelIsClosedAndInItsCharts) {

@@ -560,6 +560,15 @@ EMSCRIPTEN_KEEPALIVE const float *pw_texcoords(Handle *h) {
   return h->texcoords.empty() ? nullptr : h->texcoords.data();
 }
 EMSCRIPTEN_KEEPALIVE int pw_texcoord_conflicts(Handle *h) { return int(h->texcoord_conflicts); }
+/// The extracted mesh's texture coordinates per corner (6 floats per triangle: u, v of its
+/// corners in order), as `pomar decode` writes them (PLY face `texcoord`), or null when the
+/// mesh has none; valid until the next pw_extract.
+EMSCRIPTEN_KEEPALIVE const float *pw_corner_texcoords(Handle *h) {
+  return h->mesh.corner_texcoords.size() == 2 * h->mesh.triangles.size() &&
+                 !h->mesh.corner_texcoords.empty()
+             ? h->mesh.corner_texcoords.data()
+             : nullptr;
+}
 /// The extracted mesh's material per triangle (index into the materials), or null.
 EMSCRIPTEN_KEEPALIVE const uint32_t *pw_face_materials(Handle *h) {
   return h->mesh.face_materials.size() == h->mesh.triangle_count() &&

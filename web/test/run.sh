@@ -4,7 +4,9 @@
 #     from npm into web/dist/ for the page);
 #  2. encodes samples/bunny.ply three ways and a coloured mesh (web/test/coloured_mesh.py)
 #     with the native tool and checks that the WASM decoder decodes them bit for bit like
-#     the native one (colours too), and that damaged/truncated copies give messages
+#     the native one (colours too; and the per-corner texture coordinates and texture numbers
+#     of the textured cube, samples/textured_sphere.obj and, when ../shared/data is there,
+#     its textured bunny scan), and that damaged/truncated copies give messages
 #     (web/test/wasm_decode_test.mjs, Node.js);
 #  3. streams one of them from Debian's nginx and Apache through the client's own transport
 #     (multipart/byteranges answers) and checks the meshes against the local file's
@@ -37,6 +39,14 @@ python3 "$REPO/web/test/coloured_mesh.py" "$samples/coloured_zup.ply"
 "$TOOL" encode "$samples/coloured_zup.ply" "$samples/coloured_zup.pomar" -q
 python3 "$REPO/web/test/textured_mesh.py" "$samples/textured"
 "$TOOL" encode "$samples/textured/textured.obj" "$samples/textured/textured.pomar" -q
+"$TOOL" encode "$REPO/samples/textured_sphere.obj" "$samples/textured_sphere.pomar" -q
+# A textured scan (charts that the positions map far from affinely), when the shared data is there.
+scan="$REPO/../shared/data/meshlab_bunny10k_textured.obj"
+textured_scan=()
+if [ -f "$scan" ]; then
+  "$TOOL" encode "$scan" "$samples/bunny_textured.pomar" -q
+  textured_scan=("$samples/bunny_textured.pomar")
+fi
 node "$REPO/web/test/unit_test.mjs"
 echo "web tests: texture coordinates and materials (node web/test/texture_test.mjs)"
 node "$REPO/web/test/texture_test.mjs" "$samples/textured/textured.pomar"
@@ -53,6 +63,9 @@ fi
 echo "web tests: WASM decode = native decode (node web/test/wasm_decode_test.mjs)"
 node "$REPO/web/test/wasm_decode_test.mjs" "$TOOL" "$samples/bunny.pomar" "$samples/bunny_c5.pomar" \
   "$samples/bunny_progressive.pomar" "$samples/coloured_zup.pomar" "${view_files[@]}"
+echo "web tests: WASM decode = native decode of textured files, every corner's (u, v) (node web/test/wasm_decode_test.mjs --textured)"
+node "$REPO/web/test/wasm_decode_test.mjs" --textured "$TOOL" "$samples/textured/textured.pomar" \
+  "$samples/textured_sphere.pomar" ${textured_scan[@]+"${textured_scan[@]}"}
 if [ -x "$RA_BENCH" ]; then
   echo "web tests: view selection in WASM = native (node web/test/view_test.mjs)"
   node "$REPO/web/test/view_test.mjs" "$RA_BENCH" "$samples/bunny_view.pomar" \

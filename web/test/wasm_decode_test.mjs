@@ -1,15 +1,22 @@
 // WASM decode = native decode, bit for bit; damaged and truncated inputs give messages.
 //
-//   node web/test/wasm_decode_test.mjs POMAR_TOOL FILE.pomar [FILE.pomar ...]
+//   node web/test/wasm_decode_test.mjs [--textured] POMAR_TOOL FILE.pomar [FILE.pomar ...]
 //
 // For each file, the native tool (`pomar decode`) writes binary PLYs of: the base clustered
 // mesh, a selective decode (two clusters refined, their neighbours by the level map rule)
 // and the full resolution; the WebAssembly decoder (web/pomar_core.js, the worker's own
 // code) decodes the same requests, in an order that exercises refinement on top of a
 // decoded state and coarsening, and every position (as bits), index and colour byte (a
-// file with per-vertex colour: the mesh's `colour`, drawn by the viewer) must match. Then
+// file with per-vertex colour: the mesh's `colour`, drawn by the viewer) must match; so must,
+// in a textured file, every corner's texture coordinate (as bits: the PLY's face `texcoord`
+// against the decoder's corners, and the viewer's per-vertex `texcoords` where the mesh has
+// them) and every face's texture number (`texnumber`). Then
 // truncated copies and copies with flipped bytes must open and decode or fail with a
-// pomar message, never trap.
+// pomar message, never trap. With --textured, every file must have per-corner texture
+// coordinates (so that their comparison is not vacuous), and the checks that a selective
+// request reads only some blocks and that short estimates are retried are left out: the
+// clusters of copies along a seam are decoded to one level together (the decoder's cluster
+// links), which on a small textured file can bring in every block.
 import { execFileSync } from 'node:child_process';
 import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
@@ -19,9 +26,11 @@ import { PomarStream } from '../pomar_stream.js';
 import { RangeFile } from '../range_fetch.js';
 import { checker, loadModuleInNode } from './node_support.mjs';
 
-const [tool, ...files] = process.argv.slice(2);
+const args = process.argv.slice(2);
+const textured = args[0] === '--textured';
+const [tool, ...files] = textured ? args.slice(1) : args;
 if (!tool || files.length === 0) {
-  console.error('usage: node wasm_decode_test.mjs POMAR_TOOL FILE.pomar...');
+  console.error('usage: node wasm_decode_test.mjs [--textured] POMAR_TOOL FILE.pomar...');
   process.exit(2);
 }
 const M = await loadModuleInNode();
@@ -55,25 +64,41 @@ function readPly(path) {
     }
   };
   let at = end;
-  const out = { positionBits: [], triangles: [], colour: [] };
+  const out = { positionBits: [], triangles: [], colour: [], cornerUvBits: [], texnumber: [] };
   for (const el of elements) {
     for (let i = 0; i < el.count; ++i) {
       for (const p of el.props) {
         if (p[0] === 'list') {
           const n = get(p[1], at);
           at += size[p[1]];
-          if (el.name === 'face' && n !== 3) throw new Error('non-triangle face');
-          for (let k = 0; k < n; ++k, at += size[p[2]]) out.triangles.push(get(p[2], at));
+          if (el.name === 'face' && p[3] === 'vertex_indices' && n !== 3) throw new Error('non-triangle face');
+          if (el.name === 'face' && p[3] === 'texcoord' && n !== 6) throw new Error('a face with ' + n + ' texcoords');
+          const into = el.name === 'face' && p[3] === 'texcoord' ? out.cornerUvBits : out.triangles;
+          for (let k = 0; k < n; ++k, at += size[p[2]]) into.push(get(p[2], at));
         } else {
           if (el.name === 'vertex' && 'xyz'.includes(p[1])) out.positionBits.push(get(p[0], at));
           if (el.name === 'vertex' && ['red', 'green', 'blue', 'alpha'].includes(p[1])) out.colour.push(get(p[0], at));
+          if (el.name === 'face' && p[1] === 'texnumber') out.texnumber.push(get(p[0], at));
           at += size[p[0]];
         }
       }
     }
   }
   return { positionBits: Uint32Array.from(out.positionBits), triangles: Uint32Array.from(out.triangles),
-    colour: Uint8Array.from(out.colour) };
+    colour: Uint8Array.from(out.colour), cornerUvBits: Uint32Array.from(out.cornerUvBits),
+    texnumber: Int32Array.from(out.texnumber) };
+}
+
+/** The decoder's current mesh (the viewer's `mesh()`), with the texture coordinates of its
+ *  corners as bits (6 per triangle; empty without any) and each face's texture number (the
+ *  texture of its material, -1 for none; empty without materials), as the native PLY has
+ *  them. */
+function meshOf(decoder) {
+  const m = decoder.mesh();
+  const ptr = M._pw_corner_texcoords(decoder.h);
+  m.cornerUvBits = ptr ? new Uint32Array(M.HEAPU32.buffer, ptr, 2 * m.triangles.length).slice() : new Uint32Array(0);
+  m.texnumber = m.faceMaterials ? Int32Array.from(m.faceMaterials, (f) => m.materials[f].texture) : new Int32Array(0);
+  return m;
 }
 
 function native(file, args) {
@@ -96,9 +121,26 @@ function compare(wasmMesh, nativeMesh, what) {
   check(sameArrays(wasmMesh.triangles, nativeMesh.triangles), `${what}: triangles differ`);
   const colour = wasmMesh.colour ? wasmMesh.colour.values : new Uint8Array(0);
   check(sameArrays(colour, nativeMesh.colour), `${what}: colours differ (${colour.length} bytes in WASM, ${nativeMesh.colour.length} native)`);
+  const uv = wasmMesh.cornerUvBits;
+  check(uv.length === nativeMesh.cornerUvBits.length,
+    `${what}: ${uv.length / 2} corner texture coordinates in WASM, ${nativeMesh.cornerUvBits.length / 2} native`);
+  let uvDiffer = 0;
+  for (let i = 0; i < Math.min(uv.length, nativeMesh.cornerUvBits.length); ++i) if (uv[i] !== nativeMesh.cornerUvBits[i]) ++uvDiffer;
+  check(uvDiffer === 0, `${what}: ${uvDiffer} of ${uv.length} corner texture coordinates differ`);
+  check(sameArrays(wasmMesh.texnumber, nativeMesh.texnumber), `${what}: face texture numbers differ`);
+  if (wasmMesh.texcoords) { // the viewer's per-vertex values: those of the vertex's corners
+    const vertexBits = new Uint32Array(wasmMesh.texcoords.buffer, wasmMesh.texcoords.byteOffset, wasmMesh.texcoords.length);
+    let off = 0;
+    for (let c = 0; c < wasmMesh.triangles.length && c < uv.length / 2; ++c) {
+      const v = wasmMesh.triangles[c];
+      if (vertexBits[2 * v] !== uv[2 * c] || vertexBits[2 * v + 1] !== uv[2 * c + 1]) ++off;
+    }
+    check(off === 0, `${what}: ${off} corners whose vertex's texture coordinate is not the corner's`);
+  }
   if (result.failures === 0) {
     console.log(`  ${what}: ${bits.length / 3} vertices, ${wasmMesh.triangles.length / 3} faces` +
-      `${colour.length ? `, ${colour.length} colour bytes` : ''} identical`);
+      `${colour.length ? `, ${colour.length} colour bytes` : ''}` +
+      `${uv.length ? `, ${uv.length / 2} corner texture coordinates` : ''} identical`);
   }
 }
 
@@ -119,14 +161,28 @@ function canonical(m) {
     positionBits.set(bits.subarray(3 * v, 3 * v + 3), 3 * r);
     colour.set(colourIn.subarray(per * v, per * v + per), per * r);
   });
+  // A face: its three vertices from the lowest, then its corners' (u, v) bits in the same
+  // rotation and its texture number (so faces on the same vertices sort by them too).
+  const uv = m.cornerUvBits;
+  const tex = m.texnumber;
   const faces = [];
   for (let f = 0; f < m.triangles.length; f += 3) {
     const t = [rank[m.triangles[f]], rank[m.triangles[f + 1]], rank[m.triangles[f + 2]]];
     const k = t.indexOf(Math.min(...t));
-    faces.push([t[k], t[(k + 1) % 3], t[(k + 2) % 3]]);
+    const face = [t[k], t[(k + 1) % 3], t[(k + 2) % 3]];
+    if (uv.length) for (let j = 0; j < 3; ++j) face.push(uv[2 * (f + (k + j) % 3)], uv[2 * (f + (k + j) % 3) + 1]);
+    if (tex.length) face.push(tex[f / 3]);
+    faces.push(face);
   }
-  faces.sort((x, y) => x[0] - y[0] || x[1] - y[1] || x[2] - y[2]);
-  return { positions: new Float32Array(positionBits.buffer), positionBits, triangles: Uint32Array.from(faces.flat()),
+  faces.sort((x, y) => {
+    for (let j = 0; j < x.length; ++j) if (x[j] !== y[j]) return x[j] - y[j];
+    return 0;
+  });
+  const width = 3 + (uv.length ? 6 : 0);
+  return { positions: new Float32Array(positionBits.buffer), positionBits, triangles: Uint32Array.from(faces.map((x) => x.slice(0, 3)).flat()),
+    cornerUvBits: Uint32Array.from(faces.map((x) => x.slice(3, width)).flat()),
+    texnumber: Int32Array.from(tex.length ? faces.map((x) => x[width]) : []),
+    texcoords: null, // (per vertex: not kept in canonical order; the corners are)
     // The colour as it came: bytes (a native PLY) or pomar_core.js's {components, values}.
     colour: m.positionBits ? colour : per ? { components: per, values: colour } : null };
 }
@@ -181,34 +237,35 @@ for (const file of files) {
     selective[a] = Math.min(finest, base + 4);
     selective[b] = Math.min(finest, base + 2);
     const nativeBase = native(file, ['--level', `${base}`, '--cluster', '0:0']);
+    if (textured) check(nativeBase.cornerUvBits.length > 0, `${file}: per-corner texture coordinates (--textured)`);
     const nativeSelective = native(file, ['--cluster', `${a}:${selective[a]}`, '--cluster', `${b}:${selective[b]}`]);
     const nativeFull = native(file, ['--level', `${finest}`, '--cluster', '0']);
     const fetched = {};
     for (const tolerant of [false, true]) {
       const mode = tolerant ? 'tolerant (whole blocks)' : 'block prefixes';
       const s = await open(bytes, tolerant);
-      compare(s.decoder.mesh(), nativeBase, `${mode}: base clustered mesh`);
+      compare(meshOf(s.decoder), nativeBase, `${mode}: base clustered mesh`);
       await s.want(selective);
-      compare(s.decoder.mesh(), nativeSelective, `${mode}: clusters ${a}:${selective[a]} and ${b}:${selective[b]}`);
+      compare(meshOf(s.decoder), nativeSelective, `${mode}: clusters ${a}:${selective[a]} and ${b}:${selective[b]}`);
       fetched[mode] = s.stats().bytesFetched;
       console.log(`  ${mode}: the selective request fetched ${fetched[mode]} of ${bytes.length} bytes ` +
         `(${s.stats().blocksHeld} blocks, ${s.retries} short estimates)`);
-      check(s.decoder.info.blocksRead < info.clusters, `${mode}: a selective decode reads some blocks`);
+      if (!textured) check(s.decoder.info.blocksRead < info.clusters, `${mode}: a selective decode reads some blocks`);
       // Refining on top of a decoded state numbers the new vertices in decoding order: the
       // same mesh as a fresh decode, up to vertex numbering.
       await s.want(new Array(info.clusters).fill(finest));
-      compare(canonical(s.decoder.mesh()), canonical(nativeFull), `${mode}: full resolution refined from the selective state (canonical order)`);
+      compare(canonical(meshOf(s.decoder)), canonical(nativeFull), `${mode}: full resolution refined from the selective state (canonical order)`);
       check(s.stats().bytesFetched === bytes.length, `${mode}: every byte fetched once (${s.stats().bytesFetched} of ${bytes.length})`);
       check(s.decoder.info.blocksRead === info.clusters, `${mode}: every block read (${s.decoder.info.blocksRead} of ${info.clusters})`);
       // Coarsening decodes again from the base clustered mesh, in a fresh decode's order.
       await s.want(selective);
-      compare(s.decoder.mesh(), nativeSelective, `${mode}: coarsened back to the selective request`);
+      compare(meshOf(s.decoder), nativeSelective, `${mode}: coarsened back to the selective request`);
       check(s.stats().bytesFetched === bytes.length, `${mode}: coarsening fetches nothing`);
       check(s.decoder.damaged().count === 0 && s.tolerant === tolerant, `${mode}: an intact file reports no damage`);
       s.close();
       const fresh = await open(bytes, tolerant);
       await fresh.want(new Array(info.clusters).fill(finest));
-      compare(fresh.decoder.mesh(), nativeFull, `${mode}: full resolution`);
+      compare(meshOf(fresh.decoder), nativeFull, `${mode}: full resolution`);
       fresh.close();
     }
     check(fetched['block prefixes'] <= fetched['tolerant (whole blocks)'], 'block prefixes fetch no more than whole blocks');
@@ -216,22 +273,22 @@ for (const file of files) {
     const short = await open(bytes, false, { estimateMargin: 0.2 });
     const middle = new Array(info.clusters).fill(Math.min(finest - 1, base + 6));
     await short.want(selective);
-    compare(short.decoder.mesh(), nativeSelective, 'short estimates: selective request');
+    compare(meshOf(short.decoder), nativeSelective, 'short estimates: selective request');
     await short.want(middle);
-    compare(canonical(short.decoder.mesh()), canonical(native(file, ['--level', `${middle[0]}`, '--cluster', '0:0'])),
+    compare(canonical(meshOf(short.decoder)), canonical(native(file, ['--level', `${middle[0]}`, '--cluster', '0:0'])),
       `short estimates: every cluster at level ${middle[0]} (canonical order)`);
-    check(short.retries > 0 && !short.tolerant && short.decoder.damaged().count === 0,
+    check((textured || short.retries > 0) && !short.tolerant && short.decoder.damaged().count === 0,
       `short estimates are retried (${short.retries} retries), not taken for damage`);
     console.log(`  short estimates: ${short.retries} retries, results identical`);
     short.close();
   } else {
     const s = await open(bytes);
-    compare(s.decoder.mesh(), native(file, ['--level', '0']), 'base mesh');
+    compare(meshOf(s.decoder), native(file, ['--level', '0']), 'base mesh');
     const mid = Math.min(10, info.finestLevel);
     await s.want([mid]);
-    compare(s.decoder.mesh(), native(file, ['--level', `${mid}`]), `level ${mid}`);
+    compare(meshOf(s.decoder), native(file, ['--level', `${mid}`]), `level ${mid}`);
     await s.want([info.finestLevel]);
-    compare(s.decoder.mesh(), native(file, []), 'full resolution');
+    compare(meshOf(s.decoder), native(file, []), 'full resolution');
     s.close();
   }
 
@@ -245,7 +302,7 @@ for (const file of files) {
       s = await open(damaged);
       const top = s.info.clusters > 0 ? new Array(s.info.clusters).fill(s.info.finestLevel) : [s.info.finestLevel];
       await s.want(top);
-      const m = s.decoder.mesh();
+      const m = meshOf(s.decoder);
       check(m.triangles.every((v) => v < m.positions.length / 3), `${what}: index out of range`);
       if (s.decoder.damaged().count > 0) ++skipped;
       else ++decoded;

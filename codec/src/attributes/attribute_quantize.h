@@ -30,9 +30,12 @@ struct StoredAttribute {
   /// decoded as exactly (0, 0, 0)). Without it the codes stay on the grid.
   bool zero_normals = false;
   /// The seam cut's wedge texture coordinate (quantized): predicted from the positions
-  /// (attributes/wedge_prediction.h) instead of by its neighbours' mean, in the levels and
-  /// in the base mesh.
+  /// (attributes/wedge_prediction.h) instead of by its neighbours' mean, in every level
+  /// (ATTR version 3) and in the base mesh.
   bool from_positions = false, base_from_positions = false;
+  /// Or, per refinement level l = 1, 2, ... (index l - 1; ATTR version 4): 1 if level l
+  /// predicts it from the positions (levels past the end: by the mean).
+  std::vector<uint8_t> level_positions;
   /// Integer codes per vertex.
   uint32_t codes() const { return kind == AttributeKind::Normal && bits ? 2 : components; }
   /// Largest error of a decoded value (degrees for normals, absolute otherwise).

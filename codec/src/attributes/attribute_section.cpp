@@ -25,10 +25,11 @@ template <class Coder> void code_base(Coder &&code_one, uint32_t count, uint32_t
       code_one(v, k);
 }
 
-/// The flags byte of a descriptor (ATTR section versions 2 and 3).
+/// The flags byte of a descriptor (ATTR section versions 2 to 4).
 constexpr uint8_t kZeroNormalsFlag = 1; // a quantized normal attribute with zero-length normals
-// The wedge texcoord predicted from the positions (version 3): in the levels, in the base mesh.
-constexpr uint8_t kPositionsFlag = 2, kBasePositionsFlag = 4;
+// The wedge texcoord predicted from the positions (version 3): in the levels, in the base mesh;
+// (version 4) in the levels its mask names.
+constexpr uint8_t kPositionsFlag = 2, kBasePositionsFlag = 4, kLevelPositionsFlag = 8;
 bool is_wedge_grid(const StoredAttribute &s) {
   return s.kind == AttributeKind::TexCoord && s.bits && s.name == kWedgeTexcoord;
 }
@@ -36,11 +37,15 @@ bool positions_predict(const StoredAttribute &s) { return is_wedge_grid(s) && s.
 bool base_positions_predict(const StoredAttribute &s) {
   return is_wedge_grid(s) && s.base_from_positions;
 }
+bool level_positions_predict(const StoredAttribute &s) {
+  return is_wedge_grid(s) && !s.level_positions.empty();
+}
 uint8_t descriptor_flags(const StoredAttribute &s) {
   return uint8_t(
       (s.kind == AttributeKind::Normal && s.bits && s.zero_normals ? kZeroNormalsFlag : 0) |
       (positions_predict(s) ? kPositionsFlag : 0) |
-      (base_positions_predict(s) ? kBasePositionsFlag : 0));
+      (base_positions_predict(s) ? kBasePositionsFlag : 0) |
+      (level_positions_predict(s) ? kLevelPositionsFlag : 0));
 }
 
 /// kind, name, components, bits and bound of a stored attribute into a VertexAttribute or
@@ -181,8 +186,31 @@ void plan_wedge_residuals(AttributeTable &t, const LevelMesh &base) {
     }
 }
 
-AttributeTable plan_attributes(const Mesh &mesh, const AttributeOptions &options,
-                               bool wedge_from_positions) {
+bool has_wedge_grid(const AttributeTable &table) {
+  for (const StoredAttribute &s : table.stored)
+    if (is_wedge_grid(s))
+      return true;
+  return false;
+}
+
+bool base_wedge_from_positions(const AttributeTable &table) { return wedge_positions(table, true); }
+
+void set_wedge_levels(AttributeTable &table, const std::vector<uint8_t> &positions) {
+  // Every level from the positions: the positions flag (version 3); none: no flag; a mix:
+  // the level mask (version 4).
+  const auto first = positions.begin() + std::min<size_t>(1, positions.size());
+  const size_t ones = size_t(std::count(first, positions.end(), uint8_t(1)));
+  const size_t levels = size_t(positions.end() - first);
+  for (StoredAttribute &s : table.stored)
+    if (is_wedge_grid(s)) {
+      s.from_positions = ones > 0 && ones == levels;
+      s.level_positions.clear();
+      if (ones > 0 && ones < levels)
+        s.level_positions.assign(first, positions.end());
+    }
+}
+
+AttributeTable plan_attributes(const Mesh &mesh, const AttributeOptions &options) {
   AttributeTable t;
   for (const VertexAttribute &a : mesh.attributes)
     if (keeps_attribute(a.name, a.kind, options.keep)) {
@@ -197,8 +225,7 @@ AttributeTable plan_attributes(const Mesh &mesh, const AttributeOptions &options
       } else {
         t.stored.push_back(describe(a, options));
         // (plan_wedge_residuals keeps the base mesh's prediction from the positions only
-        // if it codes smaller)
-        t.stored.back().from_positions = wedge_from_positions && a.name == kWedgeTexcoord;
+        // if it codes smaller; the levels' are set after them, set_wedge_levels)
         t.stored.back().base_from_positions = a.name == kWedgeTexcoord;
       }
       t.codes += t.stored.back().codes();
@@ -267,7 +294,16 @@ void init_attributes(const AttributeTable &table, LevelMesh &lm, const Attribute
   lm.attr_hi.clear();
   lm.normal_code = -1;
   lm.wedge_uv_code = table.wedge_uv;
-  lm.wedge_uv_positions = wedge_positions(table);
+  lm.wedge_uv_positions.clear();
+  if (wedge_positions(table)) // (version 3: every level)
+    lm.wedge_uv_positions.assign(1, 1);
+  for (const StoredAttribute &s : table.stored)
+    if (level_positions_predict(s)) { // level l at index l, then the mean past the last
+      lm.wedge_uv_positions.assign(1, 0);
+      lm.wedge_uv_positions.insert(lm.wedge_uv_positions.end(), s.level_positions.begin(),
+                                   s.level_positions.end());
+      lm.wedge_uv_positions.push_back(0);
+    }
   lm.normal_zero = false;
   for (const StoredAttribute &s : table.stored) {
     if (s.kind == AttributeKind::Normal && s.bits && lm.normal_code < 0) {
@@ -306,15 +342,18 @@ std::vector<uint8_t> write_attributes(const AttributeTable &t, uint32_t base_ver
   ByteWriter w(out);
   // Version 1 unless a descriptor needs its flags byte (version 2): files whose attributes
   // use no flag stay readable by readers of version 1.
-  // Version 3 only when the wedge texture coordinate is predicted from the positions.
-  bool flags = false, positions = false;
+  // Version 3 only when the wedge texture coordinate is predicted from the positions,
+  // version 4 only when it says so level by level.
+  bool flags = false, positions = false, levels = false;
   for (const StoredAttribute &s : t.stored) {
     flags |= descriptor_flags(s) != 0;
     positions |= positions_predict(s) || base_positions_predict(s);
+    levels |= level_positions_predict(s);
   }
-  w.u8(positions ? kAttributeSectionPositionsVersion
-       : flags   ? kAttributeSectionFlagsVersion
-                 : kAttributeSectionVersion);
+  w.u8(levels      ? kAttributeSectionLevelsVersion
+       : positions ? kAttributeSectionPositionsVersion
+       : flags     ? kAttributeSectionFlagsVersion
+                   : kAttributeSectionVersion);
   w.u8(static_cast<uint8_t>(t.stored.size()));
   for (size_t i = 0; i < t.stored.size(); ++i) {
     const StoredAttribute &s = t.stored[i];
@@ -328,6 +367,17 @@ std::vector<uint8_t> write_attributes(const AttributeTable &t, uint32_t base_ver
     for (size_t k = 0; k < s.lo.size(); ++k) {
       w.f32(s.lo[k]);
       w.f32(s.hi[k]);
+    }
+    if (level_positions_predict(s)) { // u16 level count, then a bit per level
+      if (s.level_positions.size() > 0xFFFF)
+        throw Error(Error::Kind::Internal, "internal encoder error: more than 65535 levels");
+      w.u16(static_cast<uint16_t>(s.level_positions.size()));
+      for (size_t l = 0; l < s.level_positions.size(); l += 8) {
+        uint8_t byte = 0;
+        for (size_t b = 0; b < 8 && l + b < s.level_positions.size(); ++b)
+          byte = uint8_t(byte | (s.level_positions[l + b] ? 1u << b : 0u));
+        w.u8(byte);
+      }
     }
     w.u32(static_cast<uint32_t>(t.estimated_bytes[i]));
     w.u32(static_cast<uint32_t>(t.estimated_bytes[i] >> 32));
@@ -362,11 +412,10 @@ AttributeTable read_attributes(const uint8_t *data, size_t size, uint32_t base_v
   ByteReader r(data, size, "damaged .pomar file: ATTR section");
   AttributeTable t;
   const uint8_t version = r.u8();
-  if (version != kAttributeSectionVersion && version != kAttributeSectionFlagsVersion &&
-      version != kAttributeSectionPositionsVersion)
+  if (version < kAttributeSectionVersion || version > kAttributeSectionLevelsVersion)
     throw Error(Error::Kind::Unsupported, "ATTR section version " + std::to_string(version) +
                                               " is not supported (this pomar reads versions 1 "
-                                              "to 3)");
+                                              "to 4)");
   const uint32_t count = r.u8();
   auto read_string = [&](size_t len) {
     std::string s;
@@ -384,9 +433,13 @@ AttributeTable read_attributes(const uint8_t *data, size_t size, uint32_t base_v
     s.bits = r.u8();
     const uint8_t flags = version != kAttributeSectionVersion ? r.u8() : 0;
     s.zero_normals = flags & kZeroNormalsFlag;
-    s.from_positions = version == kAttributeSectionPositionsVersion && (flags & kPositionsFlag);
-    s.base_from_positions =
-        version == kAttributeSectionPositionsVersion && (flags & kBasePositionsFlag);
+    const bool positions_flags = version >= kAttributeSectionPositionsVersion;
+    s.from_positions = positions_flags && (flags & kPositionsFlag);
+    s.base_from_positions = positions_flags && (flags & kBasePositionsFlag);
+    const bool level_flag =
+        version >= kAttributeSectionLevelsVersion && (flags & kLevelPositionsFlag);
+    if (level_flag)
+      s.level_positions.assign(1, 0); // (read below: the mask follows the ranges)
     s.name = read_string(r.u8());
     const uint32_t want = s.kind == AttributeKind::Normal     ? 3
                           : s.kind == AttributeKind::TexCoord ? 2
@@ -398,13 +451,28 @@ AttributeTable read_attributes(const uint8_t *data, size_t size, uint32_t base_v
                              : s.bits <= 24;
     if (s.components != want || want < 1 || want > 4 ||
         (s.kind == AttributeKind::Colour && want < 3) || !bits_ok || s.name.empty() ||
-        flags != descriptor_flags(s))
+        flags != descriptor_flags(s) || (s.from_positions && level_flag))
       damaged("attribute '" + s.name + "' has an invalid descriptor");
     if (s.bits && s.kind != AttributeKind::Normal)
       for (uint32_t k = 0; k < s.components; ++k) {
         s.lo.push_back(r.f32());
         s.hi.push_back(r.f32());
       }
+    if (level_flag) {
+      const uint32_t levels = r.u16();
+      if (levels == 0)
+        damaged("attribute '" + s.name + "' predicts no level from the positions");
+      s.level_positions.assign(levels, 0);
+      for (uint32_t l = 0; l < levels; l += 8) {
+        const uint8_t byte = r.u8();
+        for (uint32_t b = 0; b < 8; ++b)
+          if (byte >> b & 1) {
+            if (l + b >= levels)
+              damaged("attribute '" + s.name + "' has a level mask past its level count");
+            s.level_positions[l + b] = 1;
+          }
+      }
+    }
     const uint64_t low = r.u32();
     t.estimated_bytes.push_back(low | uint64_t(r.u32()) << 32);
     t.codes += s.codes();

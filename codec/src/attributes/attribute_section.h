@@ -30,6 +30,9 @@ constexpr uint8_t kAttributeSectionFlagsVersion = 2;
 /// The version whose descriptors may also have the positions flag (the wedge texture
 /// coordinate predicted from the positions; written only when it is set).
 constexpr uint8_t kAttributeSectionPositionsVersion = 3;
+/// The version whose wedge texture coordinate may say per level whether it is predicted from
+/// the positions (the "level positions" flag; written only when a level does).
+constexpr uint8_t kAttributeSectionLevelsVersion = 4;
 
 /// The attributes of a file: descriptors, texture files and the codes of the base mesh.
 struct AttributeTable {
@@ -56,12 +59,19 @@ struct AttributeTable {
 void plan_wedge_residuals(AttributeTable &table, const LevelMesh &base);
 
 /// The encoder's side: what is kept of `mesh`'s attributes and how (empty table: nothing).
-/// Throws pomar::Error if they need more than kMaxAttributeCodes codes per vertex.
-/// `wedge_from_positions`: the seam cut's wedge texture coordinate, if quantized, is
-/// predicted in the levels from the positions (attributes/wedge_prediction.h), else by its
-/// neighbours' mean (in the base mesh: whichever codes smaller, plan_wedge_residuals).
-AttributeTable plan_attributes(const Mesh &mesh, const AttributeOptions &options,
-                               bool wedge_from_positions = true);
+/// Throws pomar::Error if they need more than kMaxAttributeCodes codes per vertex. The seam
+/// cut's wedge texture coordinate, if quantized, is predicted in the base mesh from the
+/// positions or by its neighbours' mean, whichever codes smaller (plan_wedge_residuals); in
+/// the levels as the encoder chooses level by level (set_wedge_levels).
+AttributeTable plan_attributes(const Mesh &mesh, const AttributeOptions &options);
+/// Whether the table has a quantized wedge texture coordinate (whose predictor the encoder
+/// chooses), and whether its base mesh codes are predicted from the positions.
+bool has_wedge_grid(const AttributeTable &table);
+bool base_wedge_from_positions(const AttributeTable &table);
+/// The encoder's side, after the levels: which refinement levels predicted the wedge
+/// texture coordinate from the positions (`positions[l]` for level l; index 0 unused): the
+/// descriptor's positions flag when all did, its level mask when some did.
+void set_wedge_levels(AttributeTable &table, const std::vector<uint8_t> &positions);
 /// Codes of every vertex, in the order of `to_input` (to_input[i] = the mesh's vertex).
 std::vector<int64_t> attribute_codes(const Mesh &mesh, const AttributeTable &table,
                                      const AttributeOptions &options,

@@ -68,14 +68,11 @@ private:
   double weight_ = 0.0;
 };
 
-/// The prediction of split vertex x's wedge texture coordinate (`pred`: the vertex's first
-/// code) from v_to's patch faces (v_to, n_i, n_i+1) of `ring` (v_to's ring as the level
-/// sees it), which the split gives to x. False (pred untouched) if the file does not
-/// predict so (LevelMesh::wedge_uv_positions) or the patch faces have no area.
+/// The prediction of split vertex x's wedge texture coordinate (`pred`: its two codes) from
+/// v_to's patch faces (v_to, n_i, n_i+1) of `ring` (v_to's ring as the level sees it), which
+/// the split gives to x. False (pred untouched) if the patch faces have no area.
 inline bool predict_wedge_from_positions(const LevelMesh &mesh, uint32_t v_to, const Ring &ring,
                                          const PatchRange &p, const int32_t x[3], int64_t *pred) {
-  if (!mesh.wedge_uv_positions)
-    return false;
   const uint32_t n = mesh.attr_codes, k = uint32_t(mesh.wedge_uv_code), m = ring.size();
   const auto uv = [&](uint32_t v) { return &mesh.attr[size_t(v) * n + k]; };
   const auto at = [&](uint32_t v) { return &mesh.q[3 * size_t(v)]; };
@@ -86,7 +83,7 @@ inline bool predict_wedge_from_positions(const LevelMesh &mesh, uint32_t v_to, c
   }
   const int64_t lo[2] = {mesh.attr_lo[k], mesh.attr_lo[k + 1]};
   const int64_t hi[2] = {mesh.attr_hi[k], mesh.attr_hi[k + 1]};
-  return w.get(lo, hi, pred + k);
+  return w.get(lo, hi, pred);
 }
 
 } // namespace pomar

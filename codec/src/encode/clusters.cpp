@@ -163,6 +163,7 @@ ClusteredLevels encode_clustered_levels(Rebuild &rb, size_t global, FileHeader &
   for (size_t r = global; r < L; ++r) {
     const uint32_t level = static_cast<uint32_t>(r + 1);
     Models &models = level_models[r - global];
+    choose_wedge_predictor(rb, level);
     codec.begin_level(rb.collapses(level), &models);
     const uint32_t older_than = lm.vertex_count(); // levels are encoded in order
     const ModelSlots slots(models);
@@ -182,6 +183,7 @@ ClusteredLevels encode_clustered_levels(Rebuild &rb, size_t global, FileHeader &
       }
     }
     codec.end_level();
+    take_wedge_costs(rb, codec);
     add_level_entry(header, lm, 0, 0);
     if (threaded) {
       freezer.freeze(models, slots, parallel.counts());

@@ -52,40 +52,20 @@ bool encode_as_it_is(const Mesh &mesh, const EncodeOptions &options, EncodeRepor
   return false;
 }
 
-/// The cut (cut_for_encoding) coded with its record. With per-corner texture coordinates
-/// (not exact), coded twice: the positions predict the (u, v) of charts that map the surface
-/// affinely far better than the neighbours' mean, which does better on charts that do not;
-/// the smaller file is kept (bench/README.md, "Textured scans"). The cut, the decimation, the
-/// numbering and so the record are the same; only the wedge residuals differ.
+/// The cut (cut_for_encoding) coded with its record. (Per-corner texture coordinates: the
+/// encoder chooses their predictor level by level, encode/encoder_codec.h
+/// choose_wedge_predictor.)
 std::vector<uint8_t> encode_cut(const Mesh &mesh, const EncodeOptions &options,
                                 EncodeReport *report, bool cut_needed, bool corners,
                                 LosslessCut &c) {
   cut_for_encoding(mesh, cut_needed, corners, c);
-  const auto encode_once = [&](const EncodeOptions &o) {
-    if (!cut_needed) // (the topology is not known to be valid: a refusal is not named)
-      return encode_manifold(*c.coded, o, report, &c.hook, {}, false);
-    try { // (the encoder's corner table checks the cut, see repair/cut.h)
-      return encode_manifold(c.cut, o, report, &c.hook);
-    } catch (const TopologyError &e) {
-      throw still_invalid(e);
-    }
-  };
-  c.hook.wedge_from_positions = true;
-  std::vector<uint8_t> file = encode_once(options);
-  if (corners && !mesh.corner_texcoords.empty() && !options.attributes.exact) {
-    EncodeReport first;
-    if (report)
-      first = *report;
-    EncodeOptions quiet = options;
-    quiet.progress = nullptr;
-    c.hook.wedge_from_positions = false;
-    std::vector<uint8_t> mean = encode_once(quiet);
-    if (mean.size() < file.size())
-      file.swap(mean);
-    else if (report)
-      *report = std::move(first);
+  if (!cut_needed) // (the topology is not known to be valid: a refusal is not named)
+    return encode_manifold(*c.coded, options, report, &c.hook, {}, false);
+  try { // (the encoder's corner table checks the cut, see repair/cut.h)
+    return encode_manifold(c.cut, options, report, &c.hook);
+  } catch (const TopologyError &e) {
+    throw still_invalid(e);
   }
-  return file;
 }
 
 /// The cut and the record's coding. On a mesh whose topology may be valid (`valid`:

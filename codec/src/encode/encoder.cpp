@@ -193,10 +193,12 @@ std::vector<std::vector<uint8_t>> encode_global_levels(Rebuild &rb, size_t globa
     const uint32_t level = static_cast<uint32_t>(r + 1);
     std::vector<uint8_t> conn, geom;
     RangeEncoder conn_rc(&conn), geom_rc(&geom);
+    choose_wedge_predictor(rb, level);
     codec.begin_level(rb.collapses(level), &models);
     codec.set_sinks(&conn_rc, &geom_rc);
     rb.step.global_level(rb.mesh, codec, level);
     codec.end_level();
+    take_wedge_costs(rb, codec);
     conn_rc.finish();
     geom_rc.finish();
     add_level_entry(header, rb.mesh, static_cast<uint32_t>(conn.size()),
@@ -251,6 +253,8 @@ void start_attributes(Rebuild &rb, AttributeTable &attributes, const std::vector
   rb.attr_codes_per_vertex = attributes.codes;
   rb.attr_models = attribute_models(attributes);
   rb.attr_bits.assign(attributes.codes, 0.0);
+  rb.wedge_choice = has_wedge_grid(attributes);
+  rb.wedge_first = base_wedge_from_positions(attributes);
 }
 
 FileHeader make_header(const EncodeOptions &options, const PreparedInput &in, const Rebuild &rb) {
@@ -271,6 +275,7 @@ std::vector<Section> extra_sections(AttributeTable &attributes, const Rebuild &r
                                     const FileHeader &header, std::vector<uint8_t> images,
                                     const LosslessHook *hook, const PreparedInput &in) {
   std::vector<Section> sections;
+  set_wedge_levels(attributes, rb.mesh.wedge_uv_positions);
   if (!attributes.stored.empty() || !attributes.texture_files.empty()) {
     for (size_t i = 0, k = 0; i < attributes.stored.size(); ++i) {
       double attr_bits = 0;
@@ -334,8 +339,7 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
   const double t_quantize = seconds_since(t0);
   // Attributes: codes of every vertex (prepared numbering); the base mesh's go to the ATTR
   // section, the others are coded with their positions by the level steps.
-  AttributeTable attributes =
-      plan_attributes(mesh, options.attributes, !hook || hook->wedge_from_positions);
+  AttributeTable attributes = plan_attributes(mesh, options.attributes);
   const std::vector<int64_t> codes =
       attributes.codes ? attribute_codes(mesh, attributes, options.attributes, in.to_input)
                        : std::vector<int64_t>();

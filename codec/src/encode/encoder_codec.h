@@ -6,6 +6,8 @@
 // the answers.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -18,6 +20,56 @@
 #include "refine/level_step.h"
 
 namespace pomar {
+
+/// The residuals the two predictors of the wedge texture coordinate (0: the mean, 1: from
+/// the positions) would leave on a level, tallied as put_signed codes them
+/// (entropy/models.h): the bit length n of each code's residual, in the context the
+/// attribute models give it (the u code: one; the v code: the u residual's bit length),
+/// then n bits (sign, top and lower bits). bits() is the empirical code length of each:
+/// integer counts, the same for any thread count.
+struct WedgeTally {
+  static constexpr int kContexts = 1 + kAttributeContexts, kClasses = 65;
+  uint32_t classes[2][kContexts][kClasses] = {};
+  uint64_t raw[2] = {0, 0};
+
+  void add(int predictor, int64_t ru, int64_t rv) {
+    const int nu = bit_length(uint64_t(ru < 0 ? -ru : ru));
+    const int nv = bit_length(uint64_t(rv < 0 ? -rv : rv));
+    ++classes[predictor][0][nu];
+    ++classes[predictor][1 + std::min(nu, kAttributeContexts - 1)][nv];
+    raw[predictor] += uint64_t(nu + nv);
+  }
+  void add(const WedgeTally &o) {
+    for (int i = 0; i < 2; ++i) {
+      raw[i] += o.raw[i];
+      for (int c = 0; c < kContexts; ++c)
+        for (int n = 0; n < kClasses; ++n)
+          classes[i][c][n] += o.classes[i][c][n];
+    }
+  }
+  void clear() { *this = WedgeTally(); }
+  bool empty() const { return raw[0] == 0 && raw[1] == 0 && classes[0][0][0] == 0; }
+  double bits(int predictor) const {
+    // Each context's classes as an adaptive model would code them, learning as it goes
+    // (Krichevsky-Trofimov: a class seen h times of t costs log2((t + K/2) / (h + 1/2)));
+    // the total depends on the counts alone, not on their order. A class seen once costs far
+    // more than its empirical share: what the level's frozen table pays to hold it.
+    constexpr double a = 0.5, k = 32;
+    double nats = 0;
+    for (int c = 0; c < kContexts; ++c) {
+      uint64_t total = 0;
+      for (int n = 0; n < kClasses; ++n) {
+        const uint32_t h = classes[predictor][c][n];
+        total += h;
+        if (h)
+          nats -= std::lgamma(double(h) + a) - std::lgamma(a);
+      }
+      if (total)
+        nats += std::lgamma(double(total) + k * a) - std::lgamma(k * a);
+    }
+    return double(raw[predictor]) + nats / std::log(2.0);
+  }
+};
 
 /// The traversal policy of the encoder: it knows every collapse of the level. `Sink` is a
 /// RangeEncoder (global levels) or a RecorderStream (clustered levels, coded later).
@@ -75,6 +127,8 @@ public:
   void add_emitted(EncoderCodec &worker) {
     emitted_ += worker.emitted_;
     worker.emitted_ = 0;
+    wedge_tally.add(worker.wedge_tally);
+    worker.wedge_tally.clear();
   }
 
   int split_flag(uint32_t v, int context) {
@@ -177,6 +231,16 @@ public:
       }
     }
   }
+  /// The residuals the split vertex's wedge texture coordinate (its `codes`) would leave
+  /// predicted by the mean (both[0..1]) and from the positions (both[2..3]), whichever the
+  /// level uses, tallied in wedge_tally.
+  void weigh_wedge(const LevelMesh &mesh, const int64_t *codes, const int64_t *both) {
+    const uint32_t k = uint32_t(mesh.wedge_uv_code);
+    for (int i = 0; i < 2; ++i)
+      wedge_tally.add(i, codes[k] - both[2 * i], codes[k + 1] - both[2 * i + 1]);
+  }
+  WedgeTally wedge_tally;
+
   /// Attribute codes of every input vertex (encoder numbering), `n` per vertex.
   void set_attribute_codes(const std::vector<int64_t> *codes, uint32_t n) {
     attr_codes_ = codes;
@@ -231,6 +295,11 @@ struct Rebuild {
   uint32_t attr_codes_per_vertex = 0;
   std::vector<AttributeCodeModels> attr_models; // fresh models for one level set
   std::vector<double> attr_bits;
+  // The quantized wedge texture coordinate's predictor, chosen level by level
+  // (choose_wedge_predictor): the first level takes the base mesh's (`wedge_first`), every
+  // other the one whose residuals on the level before (wedge_tally) cost less.
+  bool wedge_choice = false, wedge_first = false;
+  WedgeTally wedge_tally;
 
   size_t levels() const { return dec.levels.size(); }
   /// The collapses that refinement level `level` (1 = first above the base) undoes.
@@ -238,6 +307,35 @@ struct Rebuild {
     return dec.levels[dec.levels.size() - level];
   }
 };
+
+/// After a level: the estimates `codec` gathered on it (EncoderCodec::weigh_wedge), handed
+/// over to `rb` for the next level's choice.
+template <class Codec> void take_wedge_costs(Rebuild &rb, Codec &codec) {
+  rb.wedge_tally.add(codec.wedge_tally);
+  codec.wedge_tally.clear();
+}
+
+/// Before refinement level `level`: the wedge texture coordinate's predictor for it in
+/// `rb.mesh.wedge_uv_positions`: the first level takes the base mesh's, every other the
+/// predictor of the level before, or the other one if its residuals on the level before
+/// (take_wedge_costs) cost more than kSwitchBits less.
+inline void choose_wedge_predictor(Rebuild &rb, uint32_t level) {
+  if (!rb.wedge_choice)
+    return;
+  std::vector<uint8_t> &p = rb.mesh.wedge_uv_positions;
+  p.resize(size_t(level) + 1, 0);
+  // A level keeps the predictor of the level before unless the other saves more than a
+  // switch costs in the level's frozen tables (kSwitchBits, a rough figure: the tables are
+  // coded against the level before's, and the bits of their classes are what change).
+  constexpr double kSwitchBits = 128;
+  const bool before = level == 1 ? rb.wedge_first : p[level - 1] != 0;
+  const double mean = rb.wedge_tally.bits(0), positions = rb.wedge_tally.bits(1);
+  p[level] = before;
+  if (level > 1 && !rb.wedge_tally.empty() &&
+      (before ? mean + kSwitchBits < positions : positions + kSwitchBits < mean))
+    p[level] = !before;
+  rb.wedge_tally.clear();
+}
 
 /// Append the level table entry of the level just encoded (the mesh's counts after it).
 inline void add_level_entry(FileHeader &header, const LevelMesh &mesh, uint32_t conn_bytes,

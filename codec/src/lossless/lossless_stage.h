@@ -33,9 +33,6 @@ struct LosslessHook {
   std::vector<uint32_t> twin, origin;
   /// The body of the required MATL section (materials of per-corner values), or empty.
   std::vector<uint8_t> materials;
-  /// Whether the wedge texture coordinate (if quantized) is predicted from the positions
-  /// (attributes/wedge_prediction.h) or by its neighbours' mean.
-  bool wedge_from_positions = true;
 };
 
 /// The codec proper (codec/src/encode/encoder.cpp): a manifold, oriented mesh; unreferenced

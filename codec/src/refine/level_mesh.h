@@ -38,11 +38,17 @@ struct LevelMesh {
   uint32_t attr_skipped = 0;
   int normal_code = -1;   // first code of a quantized normal attribute (-1: none)
   int wedge_uv_code = -1; // first code of the seam cut's wedge texcoord (-1: none)
-  bool wedge_uv_positions =
-      false;                // it is predicted from the positions (attributes/wedge_prediction.h)
+  // Per refinement level (the index; past the end: the last entry), whether it is
+  // predicted from the positions there (attributes/wedge_prediction.h); empty: nowhere.
+  std::vector<uint8_t> wedge_uv_positions;
   int normal_bits = 0;      // its octahedral bits
   bool normal_zero = false; // its codes may be the zero-length normal's (octahedral_zero_code)
   uint32_t vertex_count() const { return ct.vertex_count(); }
+  bool wedge_from_positions(uint32_t level) const {
+    return !wedge_uv_positions.empty() &&
+           wedge_uv_positions[level < wedge_uv_positions.size() ? level
+                                                                : wedge_uv_positions.size() - 1];
+  }
   uint32_t level_of(uint32_t v) const { return lineage[v].level; }
   uint32_t cluster_of(uint32_t v) const { return lineage[v].cluster; }
   uint64_t key(uint32_t v) const { return (uint64_t(lineage[v].cluster) << 32) | lineage[v].local; }

@@ -137,25 +137,44 @@ inline void get_view_ring(const LevelMesh &mesh, uint32_t v, const LevelView &le
 /// if v_to's normal is zero-length. The seam cut's wedge texture coordinate (files with a
 /// MATL section) is predicted by the mean of the codes of v_from's neighbours to be (v_to
 /// and the patch ring, all in v_from's chart: the cut separates the charts), rounded half
-/// away from zero, or, in files that say so, from the positions (predict_wedge_from_positions).
-inline void predict_attributes(const LevelMesh &mesh, uint32_t v_to, const Ring &ring,
-                               const PatchRange &p, const int32_t position[3], int64_t *pred) {
+/// away from zero, or, at the levels where the file says so, from the positions
+/// (predict_wedge_from_positions; the mean where the patch faces have no area). `both`
+/// (the encoder's, to choose the next level's predictor): the wedge's prediction by the mean
+/// (both[0..1]) and from the positions (both[2..3]).
+inline void predict_attributes(const LevelMesh &mesh, uint32_t level, uint32_t v_to,
+                               const Ring &ring, const PatchRange &p, const int32_t position[3],
+                               int64_t *pred, int64_t *both = nullptr) {
   const uint32_t n = mesh.attr_codes;
   std::copy(&mesh.attr[size_t(v_to) * n], &mesh.attr[size_t(v_to) * n] + n, pred);
-  if (mesh.wedge_uv_code >= 0 && ring.size() > 0 &&
-      !predict_wedge_from_positions(mesh, v_to, ring, p, position, pred)) {
+  if (mesh.wedge_uv_code >= 0 && ring.size() > 0) {
     const uint32_t k = uint32_t(mesh.wedge_uv_code), m = ring.size();
-    int64_t su = pred[k], sv = pred[k + 1], count = 1;
-    for (uint32_t t = 0, i = p.first_face; t <= p.faces; ++t, i = (i + 1) % m, ++count) {
-      const int64_t *c = &mesh.attr[size_t(ring.neighbour[i]) * n + k];
-      su += c[0];
-      sv += c[1];
+    const bool positions = both || mesh.wedge_from_positions(level);
+    int64_t by_positions[2];
+    const bool got =
+        positions && predict_wedge_from_positions(mesh, v_to, ring, p, position, by_positions);
+    int64_t by_mean[2] = {pred[k], pred[k + 1]};
+    if (!got || both) {
+      int64_t su = pred[k], sv = pred[k + 1], count = 1;
+      for (uint32_t t = 0, i = p.first_face; t <= p.faces; ++t, i = (i + 1) % m, ++count) {
+        const int64_t *c = &mesh.attr[size_t(ring.neighbour[i]) * n + k];
+        su += c[0];
+        sv += c[1];
+      }
+      const auto mean = [count](int64_t x) {
+        return (x >= 0 ? x + count / 2 : x - count / 2) / count;
+      };
+      by_mean[0] = mean(su);
+      by_mean[1] = mean(sv);
     }
-    const auto mean = [count](int64_t x) {
-      return (x >= 0 ? x + count / 2 : x - count / 2) / count;
-    };
-    pred[k] = mean(su);
-    pred[k + 1] = mean(sv);
+    const bool use_positions = got && mesh.wedge_from_positions(level);
+    pred[k] = use_positions ? by_positions[0] : by_mean[0];
+    pred[k + 1] = use_positions ? by_positions[1] : by_mean[1];
+    if (both) {
+      both[0] = by_mean[0];
+      both[1] = by_mean[1];
+      both[2] = got ? by_positions[0] : by_mean[0];
+      both[3] = got ? by_positions[1] : by_mean[1];
+    }
   }
   if (mesh.normal_code < 0)
     return;
@@ -197,6 +216,14 @@ inline void predict_attributes(const LevelMesh &mesh, uint32_t v_to, const Ring 
 constexpr const char *kSharedFace = "two vertex splits of one level share a face";
 
 /// Whether a Codec can read past attribute codes (the decoder's skip_attributes).
+/// Whether a Codec weighs the two wedge predictors at every split (the encoder's
+/// weigh_wedge: it chooses each level's from the one before).
+template <class Codec, class = void> struct WeighsWedges : std::false_type {};
+template <class Codec>
+struct WeighsWedges<Codec, std::void_t<decltype(std::declval<Codec &>().weigh_wedge(
+                               std::declval<const LevelMesh &>(), nullptr, nullptr))>>
+    : std::true_type {};
+
 template <class Codec, class = void> struct SkipsAttributes : std::false_type {};
 template <class Codec>
 struct SkipsAttributes<Codec, std::void_t<decltype(std::declval<Codec &>().skip_attributes(0u))>>
@@ -286,8 +313,17 @@ void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v,
   codec.geometry(v, prediction, ps.position);
   if (mesh.attr_codes) {
     int64_t pred[kMaxAttributeCodes], codes[kMaxAttributeCodes];
-    predict_attributes(mesh, v, ring, p, ps.position, pred);
-    codec.attributes(mesh, pred, codes);
+    if constexpr (WeighsWedges<Codec>::value) {
+      int64_t both[4];
+      predict_attributes(mesh, level, v, ring, p, ps.position, pred,
+                         mesh.wedge_uv_code >= 0 ? both : nullptr);
+      codec.attributes(mesh, pred, codes);
+      if (mesh.wedge_uv_code >= 0 && ring.size() > 0)
+        codec.weigh_wedge(mesh, codes, both);
+    } else {
+      predict_attributes(mesh, level, v, ring, p, ps.position, pred);
+      codec.attributes(mesh, pred, codes);
+    }
     splits.attr.insert(splits.attr.end(), codes, codes + mesh.attr_codes);
   } else if constexpr (SkipsAttributes<Codec>::value) {
     if (mesh.attr_skipped)
