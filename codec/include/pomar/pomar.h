@@ -181,6 +181,14 @@ struct EncodeOptions {
   /// optional), measured by decoding the file level by level,
   /// for view-dependent decoding (SelectiveDecoder::want_view). Off by default.
   bool cluster_errors = false;
+  /// Measurement of the tiers of docs/format.md ("Version 5", part 1; pomar_ra_bench tiers,
+  /// not a tool option): decimate the rounds down to the clusters' count in tiers of
+  /// `tier_rounds` rounds, each on a grid of cells holding about `tier_cell_vertices`
+  /// vertices at the tier's start, collapsing only inside a cell, the cells' border
+  /// vertices locked. The file is an ordinary file (the levels are just collapses).
+  /// 0 = off (the default).
+  uint32_t tier_rounds = 0;
+  uint32_t tier_cell_vertices = 1024;
 };
 
 /// What the codec stored to give a mesh back exactly although it had to cut it (the
@@ -300,6 +308,22 @@ struct EncodeReport {
   /// decoded vertex i (in a full decode) is input vertex decoded_to_input[i].
   std::vector<uint32_t> decoded_to_input;
   LosslessReport lossless; ///< what was stored to undo the cut
+  /// Clustered files: for cluster c (block c) and clustered level j (level
+  /// global_levels + 1 + j), cluster_level_ends[c * clustered levels + j] is the size its
+  /// block had once the range coder had coded that level (the prefix holding levels
+  /// 0..j, up to the coder's few pending bytes).
+  std::vector<uint32_t> cluster_level_ends;
+  /// With EncodeOptions::tier_rounds: the tiers, finest first. Levels are refinement
+  /// levels (the tier refines levels first_level .. first_level + levels - 1); cells are
+  /// cubes of side 2^cell_bits grid units, shifted by half a side when `shifted`;
+  /// longest_edge (grid units) is the mesh's longest edge after the tier's levels.
+  struct Tier {
+    int first_level = 0, levels = 0, cell_bits = 0;
+    bool shifted = false;
+    uint32_t vertices = 0, cells = 0, border = 0; ///< after the tier's levels
+    double longest_edge = 0;
+  };
+  std::vector<Tier> tiers;
 };
 
 /// Encode a triangle mesh. The codec codes manifold, consistently oriented meshes: any other

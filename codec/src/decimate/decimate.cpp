@@ -131,6 +131,9 @@ public:
   void gather() { gather_positions(); }
 
   Ring from_;
+  /// Per vertex, during a tier's rounds: 1 = a border vertex of the tier (never v_from,
+  /// never v_to); null outside tiers.
+  const uint8_t *tier_lock = nullptr;
   std::vector<Candidate> found; // scratch of the parallel evaluation (Decimator::candidates)
 
 private:
@@ -170,6 +173,12 @@ public:
 
   /// Run one level; returns its collapses.
   std::vector<Collapse> run_level(std::vector<uint32_t> &alive);
+  /// The border vertices of the current tier (per vertex, 1 = locked), or null: no tier.
+  void set_tier_lock(const uint8_t *lock) {
+    for (Evaluator &e : eval_)
+      e.tier_lock = lock;
+    twin_eval_.tier_lock = lock;
+  }
 
 private:
   std::vector<Candidate> candidates(const std::vector<uint32_t> &alive);
@@ -197,6 +206,8 @@ bool Evaluator::allowed_direction(uint32_t i) const {
   const uint32_t m = from_.size();
   if (m < 3)
     return false; // v_from would leave no face behind
+  if (tier_lock && tier_lock[from_.neighbour[i]])
+    return false; // v_to on the border of its tier's cell
   return from_.closed || i == 0 || i == m - 1;
 }
 
@@ -366,6 +377,8 @@ void Evaluator::normals_before() {
 // tried smallest first, picking the smallest left each time: usually the first or second
 // one is admissible, so this is cheaper than sorting them.
 bool Evaluator::best_option(Candidate &out) {
+  if (tier_lock && tier_lock[v_from_])
+    return false; // on the border of its tier's cell
   collect_options();
   while (!options_.empty()) {
     auto best = std::min_element(options_.begin(), options_.end());
@@ -507,7 +520,7 @@ std::vector<Collapse> Decimator::run_level(std::vector<uint32_t> &alive) {
     if (dirty_[c.v_from] == level_stamp_ || target_mark_[c.v_to] == level_stamp_)
       continue;
     const uint32_t twin = opt_.twin ? (*opt_.twin)[c.v_from] : kNone;
-    if (twin != kNone && dirty_[twin] == level_stamp_)
+    if (twin != kNone && (dirty_[twin] == level_stamp_ || (e.tier_lock && e.tier_lock[twin])))
       continue;
     e.load(c.v_from);
     const int i = from_.index_of(c.v_to);
@@ -532,7 +545,74 @@ std::vector<Collapse> Decimator::run_level(std::vector<uint32_t> &alive) {
   return done;
 }
 
+/// The packed cell coordinates of q for cells of side 2^k, shifted by `shift` units.
+inline uint64_t cell_key(const int32_t *q, int k, int32_t shift) {
+  const auto axis = [&](int a) { return uint64_t(uint32_t(q[a] + shift) >> k) & 0x1FFFFF; };
+  return axis(0) << 42 | axis(1) << 21 | axis(2);
+}
+
+/// Starts tier number `index` at decimation round `round` on the current mesh: chooses the
+/// cell side (the k whose occupied cells hold, on average, closest in ratio to the wanted
+/// number of vertices), marks the border vertices in `lock` and measures the longest edge.
+DecimationTier start_tier(const CornerTable &ct, const std::vector<int32_t> &q,
+                          const DecimationTiers &opt, uint32_t index, uint32_t round,
+                          std::vector<uint8_t> &lock) {
+  DecimationTier t;
+  t.first_round = round;
+  t.shifted = index % 2 == 1;
+  std::vector<uint32_t> live;
+  for (uint32_t v = 0; v < ct.vertex_count(); ++v)
+    if (ct.VC[v] != kNone)
+      live.push_back(v);
+  t.vertices = static_cast<uint32_t>(live.size());
+  std::vector<uint64_t> keys(live.size());
+  double best_err = 0;
+  for (int k = 1; k <= opt.bits; ++k) {
+    const int32_t shift = t.shifted ? int32_t(1) << (k - 1) : 0;
+    for (size_t i = 0; i < live.size(); ++i)
+      keys[i] = cell_key(&q[3 * size_t(live[i])], k, shift);
+    std::sort(keys.begin(), keys.end());
+    const size_t cells = size_t(std::unique(keys.begin(), keys.end()) - keys.begin());
+    const double err =
+        std::fabs(std::log(double(live.size()) / double(cells) / double(opt.cell_vertices)));
+    if (k == 1 || err < best_err) {
+      best_err = err;
+      t.cell_bits = k;
+      t.cells = static_cast<uint32_t>(cells);
+    }
+  }
+  const int32_t shift = t.shifted ? int32_t(1) << (t.cell_bits - 1) : 0;
+  std::vector<uint64_t> key(ct.vertex_count());
+  for (uint32_t v : live)
+    key[v] = cell_key(&q[3 * size_t(v)], t.cell_bits, shift);
+  lock.assign(ct.vertex_count(), 0);
+  double longest2 = 0;
+  for (uint32_t f = 0; f < ct.face_count(); ++f) {
+    if (ct.V[3 * f] == kNone)
+      continue;
+    for (uint32_t j = 0; j < 3; ++j) {
+      const uint32_t a = ct.V[3 * f + j], b = ct.V[3 * f + (j + 1) % 3];
+      if (key[a] != key[b])
+        lock[a] = lock[b] = 1;
+      double d2 = 0;
+      for (int x = 0; x < 3; ++x) {
+        const double d = double(q[3 * size_t(a) + x]) - double(q[3 * size_t(b) + x]);
+        d2 += d * d;
+      }
+      longest2 = std::max(longest2, d2);
+    }
+  }
+  t.longest_edge = std::sqrt(longest2);
+  for (uint32_t v : live)
+    t.border += lock[v];
+  return t;
+}
+
 } // namespace
+
+uint64_t tier_cell(const DecimationTier &t, const int32_t *q) {
+  return cell_key(q, t.cell_bits, t.shifted ? int32_t(1) << (t.cell_bits - 1) : 0);
+}
 
 Decimation decimate(CornerTable ct, const std::vector<int32_t> &q, const DecimationOptions &options,
                     const Progress &progress) {
@@ -543,18 +623,54 @@ Decimation decimate(CornerTable ct, const std::vector<int32_t> &q, const Decimat
       alive.push_back(v); // (the candidates v_from: a locked vertex is never one)
   const double initial = static_cast<double>(alive.size());
   Decimator d(ct, q, options);
+  // Tiers: a new one every `rounds` rounds while the mesh has more than until_vertices
+  // vertices. A round of a tier that removes nothing or too little ends the tier (its cells
+  // are used up, not the mesh); one that does so as the first of its tier ends the
+  // decimation, as without tiers.
+  std::vector<uint8_t> tier_lock;
+  size_t live = 0;
+  for (uint32_t v = 0; v < ct.vertex_count(); ++v)
+    live += ct.VC[v] != kNone;
+  bool tiered = options.tiers && options.tiers->rounds > 0;
+  bool tier_ended = true;
   while (result.levels.size() < options.max_levels) {
     const size_t before = alive.size();
+    if (tiered && (tier_ended || result.tiers.back().rounds == options.tiers->rounds)) {
+      tier_ended = false;
+      if (live > options.tiers->until_vertices) {
+        result.tiers.push_back(start_tier(ct, q, *options.tiers,
+                                          static_cast<uint32_t>(result.tiers.size()),
+                                          static_cast<uint32_t>(result.levels.size()), tier_lock));
+        d.set_tier_lock(tier_lock.data());
+      } else {
+        tiered = false;
+        d.set_tier_lock(nullptr);
+      }
+    }
     std::vector<Collapse> level = d.run_level(alive);
-    if (level.empty())
+    const bool small =
+        level.empty() || double(level.size()) < options.min_level_fraction * double(before);
+    const bool end_tier = tiered && small && result.tiers.back().rounds > 0;
+    if (end_tier) {
+      tier_ended = true; // (an empty round is dropped; a small one is kept)
+      if (level.empty())
+        continue;
+    }
+    if (level.empty()) {
+      if (tiered)
+        result.tiers.pop_back();
       break;
+    }
+    if (tiered)
+      ++result.tiers.back().rounds;
+    live -= level.size();
     level.shrink_to_fit(); // kept to the end of the encode: without push_back's slack
     result.levels.push_back(std::move(level));
     if (progress)
       progress(std::min(1.0, std::log(initial / double(alive.size())) /
                                  std::max(1.0, std::log(initial / 16.0))),
                "decimate");
-    if (double(result.levels.back().size()) < options.min_level_fraction * double(before))
+    if (small && !end_tier)
       break;
   }
   for (uint32_t f = 0; f < ct.face_count(); ++f)

@@ -149,6 +149,7 @@ ClusteredLevels encode_clustered_levels(Rebuild &rb, size_t global, FileHeader &
   // ever held (the finest level's are the most), not every clustered level's.
   ClusteredLevels out;
   out.blocks.resize(clusters);
+  out.level_ends.resize(size_t(clusters) * (L - global));
   std::vector<RangeEncoder> block_coders;
   block_coders.reserve(clusters);
   for (uint32_t c = 0; c < clusters; ++c)
@@ -207,6 +208,9 @@ ClusteredLevels encode_clustered_levels(Rebuild &rb, size_t global, FileHeader &
       for (uint32_t c = 0; c < clusters; ++c)
         code_recording(recordings[c], slots, block_coders[c]);
     }
+    for (uint32_t c = 0; c < clusters; ++c)
+      out.level_ends[size_t(c) * (L - global) + (r - global)] =
+          static_cast<uint32_t>(out.blocks[c].size());
     for (SymbolRecorder &recording : recordings)
       recording.events.clear(); // keeps its capacity for the next, larger level
     if (progress)
@@ -214,6 +218,8 @@ ClusteredLevels encode_clustered_levels(Rebuild &rb, size_t global, FileHeader &
   }
   for (RangeEncoder &rc : block_coders)
     rc.finish();
+  for (uint32_t c = 0; c < clusters; ++c)
+    out.level_ends[size_t(c + 1) * (L - global) - 1] = static_cast<uint32_t>(out.blocks[c].size());
   out.tables = write_tables(level_models);
   uint64_t cluster_bytes = 0;
   for (const auto &b : out.blocks)

@@ -19,6 +19,9 @@ size_t choose_global_levels(const Decimation &dec, uint32_t base_vertices, uint3
 struct ClusteredLevels {
   std::vector<uint8_t> tables;
   std::vector<std::vector<uint8_t>> blocks;
+  /// Per cluster c and clustered level j: blocks[c]'s size once level j was coded, at
+  /// [c * levels + j] (the last level's: the finished block's size).
+  std::vector<uint32_t> level_ends;
 };
 
 /// Encode refinement levels global+1 .. last of `rebuild` (which holds the base clustered

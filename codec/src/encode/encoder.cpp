@@ -359,6 +359,15 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
     decimation.twin = &seams.twin;
     decimation.origin = &seams.origin;
   }
+  DecimationTiers tiers; // (measurement only: EncodeOptions::tier_rounds)
+  if (options.tier_rounds > 0 && !options.progressive) {
+    tiers.rounds = options.tier_rounds;
+    tiers.cell_vertices = std::max(1u, options.tier_cell_vertices);
+    tiers.until_vertices = static_cast<uint32_t>(
+        options.clusters ? options.clusters : options.cluster_ratio * double(nv));
+    tiers.bits = in.grid.bits;
+    decimation.tiers = &tiers;
+  }
   const Decimation dec = decimate(std::move(in.ct), in.q, decimation, options.progress);
   const double t_decimate = seconds_since(t1);
 
@@ -404,6 +413,20 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
     report->decimate_seconds = t_decimate;
     report->encode_seconds = seconds_since(t2);
     report->symbol_bits = bits;
+    report->cluster_level_ends = std::move(clustered.level_ends);
+    const int L = static_cast<int>(dec.levels.size());
+    for (const DecimationTier &t : dec.tiers) {
+      EncodeReport::Tier r;
+      r.levels = static_cast<int>(t.rounds);
+      r.first_level = L - static_cast<int>(t.first_round + t.rounds) + 1;
+      r.cell_bits = t.cell_bits;
+      r.shifted = t.shifted;
+      r.vertices = t.vertices;
+      r.cells = t.cells;
+      r.border = t.border;
+      r.longest_edge = t.longest_edge;
+      report->tiers.push_back(r);
+    }
   }
   return file;
 }
