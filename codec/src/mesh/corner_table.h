@@ -38,7 +38,9 @@ struct CornerTable {
     return o == kNone ? kNone : prev(o);
   }
   /// Start fetching corner c's entries of V and O into the cache (nothing for kNone).
-  void prefetch(uint32_t c) const {
+  /// Always inlined, like every function whose only effect is a prefetch: GCC counts a
+  /// prefetch as no side effect, finds such a function const and deletes its calls.
+  [[gnu::always_inline]] void prefetch(uint32_t c) const {
     if (c != kNone) {
       __builtin_prefetch(&V[c]);
       __builtin_prefetch(&O[c]);
