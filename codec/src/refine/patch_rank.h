@@ -42,9 +42,8 @@ inline constexpr Log2Table kLog2Table{};
 inline int32_t log2_q8(uint64_t x) {
   if (x == 0)
     return 0;
-  const int n = 63 - __builtin_clzll(x);
-  const uint32_t top = n >= 8 ? uint32_t(x >> (n - 8)) : uint32_t(x << (8 - n));
-  return n * 256 + kLog2Table.q8[top & 255];
+  const int z = __builtin_clzll(x); // x << z: the top bit at 63, then the 8 bits below it
+  return (63 - z) * 256 + kLog2Table.q8[(x << z) >> 55 & 255];
 }
 
 /// The placements of a patch of `faces` (= s_l + s_r) in a ring of m neighbours, as the
