@@ -2,6 +2,7 @@
 // both ways, and every placement naming a valid patch with its v_ref inside.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <random>
@@ -103,6 +104,50 @@ TEST(PatchRank, EveryPlacementIsAValidPatchAroundItsVRef) {
         }
       }
     }
+}
+
+TEST(PatchRank, ScoresFollowTheirDefinitionOnRandomRings) {
+  // Every placement in order of il, scored from the logs of its interior spokes (smallest,
+  // then sum; a one-face patch: its two sides), whatever the loop that computes them.
+  std::mt19937 rng(5);
+  PatchPlacements p;
+  for (int round = 0; round < 20; ++round)
+    for (bool closed : {true, false})
+      for (uint32_t m = 2; m <= 20; ++m) {
+        const Ring ring = make_ring(m, closed);
+        std::vector<Spoke> spokes(m);
+        for (Spoke &s : spokes) // ties, zero and long spokes
+          s.len2 = rng() % 4 == 0 ? int64_t(rng() % 3) : int64_t(rng()) * int64_t(rng() % 1000);
+        const auto lg = [&](int32_t i) {
+          return int64_t(log2_q8(uint64_t(spokes[uint32_t(i) % m].len2)));
+        };
+        for (uint32_t faces = 1; faces + (closed ? 1 : 0) <= m; ++faces) {
+          SCOPED_TRACE(std::to_string(m) + (closed ? " closed, " : " open, ") +
+                       std::to_string(faces) + " faces");
+          score_placements(ring, spokes.data(), faces, p);
+          uint32_t k = 0;
+          for (int32_t il = closed ? 0 : -1;
+               closed ? il < int32_t(m) : il + int32_t(faces) <= int32_t(m); ++il) {
+            if (!closed && !open_placement_valid(il, faces, m))
+              continue;
+            const int32_t ir = il + int32_t(faces);
+            int64_t score = lg(il) + lg(ir);
+            if (faces > 1) {
+              int64_t least = lg(il + 1), sum = 0;
+              for (int32_t t = il + 1; t < ir; ++t) {
+                least = std::min(least, lg(t));
+                sum += lg(t);
+              }
+              score = least * (int64_t(1) << 32) + sum;
+            }
+            ASSERT_LT(k, p.count);
+            EXPECT_EQ(p.il[k], il);
+            EXPECT_EQ(p.score[k], score) << "il " << il;
+            ++k;
+          }
+          EXPECT_EQ(p.count, k);
+        }
+      }
 }
 
 TEST(PatchRank, LongerInteriorSpokesRankFirst) {

@@ -38,7 +38,9 @@ struct CornerTable {
     return o == kNone ? kNone : prev(o);
   }
   /// Start fetching corner c's entries of V and O into the cache (nothing for kNone).
-  void prefetch(uint32_t c) const {
+  /// Always inlined, like every function whose only effect is a prefetch: GCC counts a
+  /// prefetch as no side effect, finds such a function const and deletes its calls.
+  [[gnu::always_inline]] void prefetch(uint32_t c) const {
     if (c != kNone) {
       __builtin_prefetch(&V[c]);
       __builtin_prefetch(&O[c]);
@@ -120,9 +122,12 @@ struct Ring {
 /// left out. Returns false if the walk ran into the fan's boundary: the ring is whole
 /// only if `first` was the fan's clockwise end.
 template <class Name>
-bool walk_fan(const CornerTable &ct, uint32_t first, const Name &name, Ring &ring) {
-  const uint32_t *V = ct.V.data(), *O = ct.O.data(); // (locals: the stores below are
-  uint32_t *corner = ring.corner.grow_to(32);        //  uint32_t too and could alias)
+bool walk_fan(const CornerTable &ct, uint32_t first, const Name &name_of, Ring &ring) {
+  // (Locals, the naming function's copy too: the stores below are uint32_t and could
+  // alias what the caller holds, which would then be read again at every face.)
+  const Name name = name_of;
+  const uint32_t *V = ct.V.data(), *O = ct.O.data();
+  uint32_t *corner = ring.corner.grow_to(32);
   uint32_t *neighbour = ring.neighbour.grow_to(ring.corner.capacity() + 1);
   const uint32_t room = static_cast<uint32_t>(ring.corner.capacity());
   uint32_t before = name(V[CornerTable::next(first)]);
@@ -140,7 +145,11 @@ bool walk_fan(const CornerTable &ct, uint32_t first, const Name &name, Ring &rin
     }
     // The face beyond edge (a, b) is in the fans of a and b, which a breadth-first walk
     // visits soon: fetch it now.
-    ct.prefetch(O[c]);
+    const uint32_t across = O[c]; // (ct.prefetch, on the local arrays)
+    if (across != kNone) {
+      __builtin_prefetch(V + across);
+      __builtin_prefetch(O + across);
+    }
     const uint32_t after = name(b);
     if (after != before) {
       corner[kept++] = c;

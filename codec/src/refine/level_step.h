@@ -223,8 +223,9 @@ private:
   /// Applying the splits is memory bound (with threads, another core traversed their
   /// faces): fetch the first face of the split 4 ahead, and 2 ahead the faces the split
   /// reads next from there, the second of its range and the one across its left edge.
-  static void prefetch_split(const CornerTable &ct, const SplitList &splits, uint32_t i,
-                             uint32_t n) {
+  /// (Always inlined: see CornerTable::prefetch.)
+  [[gnu::always_inline]] static void prefetch_split(const CornerTable &ct, const SplitList &splits,
+                                                    uint32_t i, uint32_t n) {
     if (i + 4 < n)
       ct.prefetch(splits.split[i + 4].op.first_corner);
     if (i + 2 < n) {

@@ -368,8 +368,10 @@ uint32_t queue_neighbours(TraversalScratch &s, uint32_t v, uint32_t from, const 
 /// the queue, the corners of its first face 8 places ahead, and 4 places ahead the two
 /// faces next to that one in its fan (their O entries have arrived by then). (A further
 /// stage, the next face on either side 2 places ahead, gained nothing: walk_fan has
-/// fetched most of those as the faces beyond an earlier fan.)
-inline void prefetch_ahead(const LevelMesh &mesh, const TraversalScratch &s, size_t head) {
+/// fetched most of those as the faces beyond an earlier fan.) Always inlined (see
+/// CornerTable::prefetch).
+[[gnu::always_inline]] inline void prefetch_ahead(const LevelMesh &mesh, const TraversalScratch &s,
+                                                  size_t head) {
   const CornerTable &ct = mesh.ct;
   const size_t n = s.queue.size();
   if (head + 4 < n) {

@@ -42,9 +42,8 @@ inline constexpr Log2Table kLog2Table{};
 inline int32_t log2_q8(uint64_t x) {
   if (x == 0)
     return 0;
-  const int n = 63 - __builtin_clzll(x);
-  const uint32_t top = n >= 8 ? uint32_t(x >> (n - 8)) : uint32_t(x << (8 - n));
-  return n * 256 + kLog2Table.q8[top & 255];
+  const int z = __builtin_clzll(x); // x << z: the top bit at 63, then the 8 bits below it
+  return (63 - z) * 256 + kLog2Table.q8[(x << z) >> 55 & 255];
 }
 
 /// The placements of a patch of `faces` (= s_l + s_r) in a ring of m neighbours, as the
@@ -87,34 +86,48 @@ inline void score_placements(const Ring &ring, const Spoke *spokes, uint32_t fac
   int32_t *lg = out.log.data();
   for (uint32_t i = 0; i < m; ++i)
     lg[i] = lg[i + m] = log2_q8(uint64_t(spokes[i].len2));
+  // The placements are one run of il: closed fans 0..m-1; open fans -1..m-T less the
+  // invalid ones, which are only at the ends (a one-face patch needs both sides).
+  int32_t lo = 0, hi = int32_t(m) - 1;
+  if (!ring.closed) {
+    lo = -1;
+    hi = int32_t(m) - int32_t(faces);
+    while (lo <= hi && !open_placement_valid(lo, faces, m))
+      ++lo;
+    while (hi >= lo && !open_placement_valid(hi, faces, m))
+      --hi;
+  }
+  const uint32_t n = hi >= lo ? uint32_t(hi - lo + 1) : 0;
   int64_t *score = out.score.data();
   int32_t *first = out.il.data();
-  uint32_t n = 0;
-  const auto add = [&](int32_t il) {
-    const int32_t ir = il + int32_t(faces);
-    int64_t sc;
-    if (faces == 1) { // both sides exist (a valid one-face placement)
-      sc = int64_t(lg[il]) + lg[ir];
-    } else {
-      const int32_t *x = lg + (il + 1); // interior spokes il+1 .. ir-1 (open fans: inside 0..m-1)
-      int64_t sum = 0;
-      int32_t least = x[0];
-      for (uint32_t t = 0; t + 1 < faces; ++t) {
-        sum += x[t];
-        least = x[t] < least ? x[t] : least;
-      }
-      sc = int64_t(least) * (int64_t(1) << 32) + sum;
+  for (uint32_t k = 0; k < n; ++k)
+    first[k] = lo + int32_t(k);
+  // One loop per window size (the interior spokes il+1 .. il+T-1; open fans: inside
+  // 0..m-1): T = 2 and 3 are most splits.
+  const int32_t *x = lg + (lo + 1); // placement k's first interior spoke is x[k]
+  constexpr int64_t kHigh = int64_t(1) << 32;
+  if (faces == 1) { // both sides exist (a valid one-face placement)
+    for (uint32_t k = 0; k < n; ++k)
+      score[k] = int64_t(x[int32_t(k) - 1]) + x[k];
+  } else if (faces == 2) {
+    for (uint32_t k = 0; k < n; ++k)
+      score[k] = int64_t(x[k]) * kHigh + x[k];
+  } else if (faces == 3) {
+    for (uint32_t k = 0; k < n; ++k) {
+      const int32_t a = x[k], b = x[k + 1];
+      score[k] = int64_t(a < b ? a : b) * kHigh + (int64_t(a) + b);
     }
-    first[n] = il;
-    score[n++] = sc;
-  };
-  if (ring.closed) {
-    for (uint32_t il = 0; il < m; ++il)
-      add(int32_t(il));
   } else {
-    for (int32_t il = -1; il + int32_t(faces) <= int32_t(m); ++il)
-      if (open_placement_valid(il, faces, m))
-        add(il);
+    for (uint32_t k = 0; k < n; ++k) {
+      const int32_t *w = x + k;
+      int64_t sum = 0;
+      int32_t least = w[0];
+      for (uint32_t t = 0; t + 1 < faces; ++t) {
+        sum += w[t];
+        least = w[t] < least ? w[t] : least;
+      }
+      score[k] = int64_t(least) * kHigh + sum;
+    }
   }
   out.count = n;
 }
@@ -177,17 +190,15 @@ void patch_symbols(const Ring &ring, const Spoke *spokes, int32_t il, uint32_t f
   j = kNone;
   const int32_t ir = il + int32_t(faces);
   if (ring.closed) {
-    for (uint32_t t = 1; t < faces; ++t) {
-      const uint32_t i = (uint32_t(il) + t) % m;
+    // (il < m and faces < m: each index wraps at most once, by a subtraction)
+    const uint32_t l = uint32_t(il), r = uint32_t(ir) >= m ? uint32_t(ir) - m : uint32_t(ir);
+    for (uint32_t t = 1, i = l + 1 == m ? 0 : l + 1; t < faces; ++t, i = i + 1 == m ? 0 : i + 1)
       if (j == kNone || better(i, j))
         j = i;
-    }
-    if (j == kNone) {
-      const uint32_t l = uint32_t(il), r = uint32_t(ir) % m;
+    if (j == kNone)
       j = better(r, l) ? r : l;
-    }
-    s.s_l = (j + m - uint32_t(il)) % m;
-    s.s_r = (uint32_t(ir) % m + m - j) % m;
+    s.s_l = j >= l ? j - l : j + m - l;
+    s.s_r = r >= j ? r - j : r + m - j;
   } else {
     for (int32_t i = il + 1; i < ir; ++i)
       if (i >= 0 && i < int32_t(m) && (j == kNone || better(uint32_t(i), j)))
