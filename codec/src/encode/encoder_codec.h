@@ -138,6 +138,7 @@ public:
     return k;
   }
 
+  const NormalPredictor &normal_predictor() const { return m_->normal; }
   void geometry(uint32_t v_to, const Prediction &p, int32_t position[3]) {
     (void)v_to;
     const uint32_t v_from = (*level_)[current_].v_from;
@@ -231,6 +232,10 @@ struct Rebuild {
   uint32_t attr_codes_per_vertex = 0;
   std::vector<AttributeCodeModels> attr_models; // fresh models for one level set
   std::vector<double> attr_bits;
+  // Format version 5: fit each level's normal predictor (encode/fit_prediction.h) before it
+  // is coded; normal[l - 1] is level l's (the GEOP section).
+  bool fit_normal = false;
+  std::vector<NormalPredictor> normal;
 
   size_t levels() const { return dec.levels.size(); }
   /// The collapses that refinement level `level` (1 = first above the base) undoes.
