@@ -31,6 +31,8 @@ struct ScriptedCodec {
     s.s_r = 0;
   }
   const LevelMesh *mesh = nullptr;
+  const NormalPredictor &normal_predictor() const { return normal; }
+  NormalPredictor normal; // (the curvature term)
   void geometry(uint32_t v_to, const Prediction &, int32_t position[3]) {
     for (int k = 0; k < 3; ++k)
       position[k] = mesh->q[3 * v_to + k];

@@ -56,6 +56,7 @@ public:
     return placement_of_rank(p, r);
   }
 
+  const NormalPredictor &normal_predictor() const { return m_->normal; }
   void geometry(uint32_t, const Prediction &p, int32_t position[3]) {
     int64_t r[3];
     r[0] = get_residual(*geom_, m_->geom, 0, p.context) + p.offset[0];

@@ -6,6 +6,7 @@
 
 #include "decode/damage.h"
 #include "decode/decoder_codec.h"
+#include "format/geometry_prediction.h"
 #include "geometry/quantize.h"
 #include "refine/level_step.h"
 
@@ -57,6 +58,7 @@ size_t decode_global_levels(const uint8_t *data, const FileLayout &layout, size_
                             std::vector<DamagedBlock> *damaged) {
   const FileHeader &h = layout.header;
   models.conn.patch_rank = h.ranks_patches(); // (the models' set of a file's version)
+  const std::vector<NormalPredictor> normal = load_geometry_prediction(data, layout);
   DecoderCodec codec(h.grid.bits);
   LevelStep step;
   RangeDecoder conn, geom;
@@ -67,6 +69,7 @@ size_t decode_global_levels(const uint8_t *data, const FileLayout &layout, size_
       const uint8_t *p = data + layout.level_offset[i];
       conn.reset(p, e.connectivity_bytes);
       geom.reset(p + e.connectivity_bytes, e.geometry_bytes);
+      models.normal = normal[i];
       codec.set(&models, &conn, &geom, static_cast<uint32_t>(i + 1));
       step.global_level(lm, codec, static_cast<uint32_t>(i + 1), [&](const StepCounts &n) {
         if (conn.overrun() || geom.overrun())

@@ -21,6 +21,7 @@
 #include "format/block_order.h"
 #include "format/cluster_errors.h"
 #include "format/file_format.h"
+#include "format/geometry_prediction.h"
 #include "geometry/quantize.h"
 #include "lossless/lossless_stage.h"
 #include "parallel/thread_pool.h"
@@ -369,6 +370,9 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   s.level_models =
       read_tables(s.global.data() + s.layout.tables_offset, h.tables_bytes,
                   h.levels.size() - h.global_levels, h.ranks_patches(), s.global_models.attr);
+  const std::vector<NormalPredictor> normal = load_geometry_prediction(s.global.data(), s.layout);
+  for (size_t k = 0; k < s.level_models.size(); ++k) // (each clustered level's predictor)
+    s.level_models[k].normal = normal[h.global_levels + k];
   s.index = read_cluster_index(s.global.data() + s.layout.index_offset, s.layout);
   s.info.cluster_block_bytes = s.index.size;
   decode_global_levels(s.global.data(), s.layout, 0, h.global_levels, s.mesh, s.global_models, {});

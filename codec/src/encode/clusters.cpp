@@ -7,7 +7,9 @@
 #include <functional>
 #include <memory>
 
+#include "encode/fit_prediction.h"
 #include "entropy/static_tables.h"
+#include "format/geometry_prediction.h"
 #include "parallel/thread_pool.h"
 
 namespace pomar {
@@ -165,6 +167,9 @@ ClusteredLevels encode_clustered_levels(Rebuild &rb, size_t global, FileHeader &
     const uint32_t level = static_cast<uint32_t>(r + 1);
     Models &models = level_models[r - global];
     choose_wedge_predictor(rb, level);
+    if (rb.fit_normal)
+      rb.normal[r] = fit_normal_predictor(rb, level, true, needs_geometry_prediction(rb.normal));
+    models.normal = rb.normal[r];
     codec.begin_level(rb.collapses(level), &models);
     const uint32_t older_than = lm.vertex_count(); // levels are encoded in order
     const ModelSlots slots(models);

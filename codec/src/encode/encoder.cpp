@@ -16,10 +16,12 @@
 #include "encode/cluster_error_measure.h"
 #include "encode/clusters.h"
 #include "encode/encoder_codec.h"
+#include "encode/fit_prediction.h"
 #include "entropy/models.h"
 #include "format/block_order.h"
 #include "format/cluster_errors.h"
 #include "format/file_format.h"
+#include "format/geometry_prediction.h"
 #include "geometry/quantize.h"
 #include "lossless/lossless_stage.h"
 #include "memory/prefault.h"
@@ -194,6 +196,9 @@ std::vector<std::vector<uint8_t>> encode_global_levels(Rebuild &rb, size_t globa
     std::vector<uint8_t> conn, geom;
     RangeEncoder conn_rc(&conn), geom_rc(&geom);
     choose_wedge_predictor(rb, level);
+    if (rb.fit_normal)
+      rb.normal[r] = fit_normal_predictor(rb, level, false, needs_geometry_prediction(rb.normal));
+    models.normal = rb.normal[r];
     codec.begin_level(rb.collapses(level), &models);
     codec.set_sinks(&conn_rc, &geom_rc);
     rb.step.global_level(rb.mesh, codec, level);
@@ -377,6 +382,8 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
   rb.mesh.reserve_counts(nv, nf); // the splits append without reallocating
   start_attributes(rb, attributes, codes);
   FileHeader header = make_header(options, in, rb);
+  rb.fit_normal = header.ranks_patches(); // (version 5)
+  rb.normal.assign(rb.levels(), NormalPredictor{});
   const size_t global = choose_global_levels(dec, header.base_vertices, nv, options);
   SymbolBits bits;
   const std::vector<std::vector<uint8_t>> blocks =
@@ -391,6 +398,11 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
 
   std::vector<Section> sections =
       extra_sections(attributes, rb, header, std::move(images), hook, in);
+  // Levels with a linear normal predictor (section GEOP, required: a reader that ignored it
+  // would predict those levels' positions with the curvature term).
+  if (needs_geometry_prediction(rb.normal))
+    sections.push_back(
+        {kGeometryPredictionTag, kSectionRequired, write_geometry_prediction(rb.normal)});
   // Random access: the blocks in the Morton order of their roots (section BLKO, required:
   // a reader that does not know it would look for the blocks in id order).
   std::vector<uint32_t> block_order;

@@ -192,6 +192,7 @@ public:
     return k;
   }
 
+  const NormalPredictor &normal_predictor() const { return m_->normal; }
   void geometry(uint32_t v_to, const Prediction &p, int32_t position[3]) {
     (void)v_to;
     const uint32_t v_from = (*level_)[current_].v_from;
@@ -300,6 +301,10 @@ struct Rebuild {
   // other the one whose residuals on the level before (wedge_tally) cost less.
   bool wedge_choice = false, wedge_first = false;
   WedgeTally wedge_tally;
+  // Format version 5: fit each level's normal predictor (encode/fit_prediction.h) before it
+  // is coded; normal[l - 1] is level l's (the GEOP section).
+  bool fit_normal = false;
+  std::vector<NormalPredictor> normal;
 
   size_t levels() const { return dec.levels.size(); }
   /// The collapses that refinement level `level` (1 = first above the base) undoes.

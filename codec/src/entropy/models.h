@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "entropy/range_coder.h"
+#include "geometry/normal_predictor.h"
 
 namespace pomar {
 
@@ -91,6 +92,9 @@ struct AttributeCodeModels {
 struct Models {
   ConnectivityModels conn;
   GeometryModels geom;
+  /// The level's normal predictor (section GEOP; not a probability model: the static
+  /// tables do not hold it, for_each_model does not visit it).
+  NormalPredictor normal;
   /// One per attribute code of a vertex (empty for files without attributes).
   std::vector<AttributeCodeModels> attr;
 };

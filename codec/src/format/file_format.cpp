@@ -336,8 +336,8 @@ uint32_t read_fixed_header(ByteReader &r, FileHeader &h) {
   return levels;
 }
 
-/// The header's size (fixed part, level table, cluster header, the section table of versions 4 and 5,
-/// checksum) into L.header_bytes, and its checksum checked; returns the section count.
+/// The header's size (fixed part, level table, cluster header, the section table of versions 4 and
+/// 5, checksum) into L.header_bytes, and its checksum checked; returns the section count.
 uint32_t check_header_bytes(const uint8_t *data, size_t size, uint32_t levels, FileLayout &L) {
   const FileHeader &h = L.header;
   const bool v4 = h.version >= kSectionsFormatVersion; // (4 and 5: a section table)
@@ -669,9 +669,9 @@ const uint8_t *section_body(const uint8_t *data, const FileLayout &L, size_t i) 
 
 const std::vector<uint32_t> &known_sections() {
   // The sections this build's decoders honour.
-  static const std::vector<uint32_t> known = {section_tag("ATTR"), kLosslessTag,
-                                              section_tag("MATL"), section_tag("TEXI"),
-                                              section_tag("CERR"), section_tag("BLKO")};
+  static const std::vector<uint32_t> known = {
+      section_tag("ATTR"), kLosslessTag,        section_tag("MATL"), section_tag("TEXI"),
+      section_tag("CERR"), section_tag("BLKO"), section_tag("GEOP")};
   return known;
 }
 

@@ -20,6 +20,7 @@
 //   uint32_t patch_faces(uint32_t v, const Ring& ring);  // version 5: s_l + s_r
 //   uint32_t patch_placement(const Ring& ring, uint32_t faces,
 //                            const PatchPlacements& p);  // the patch's placement (index in p)
+//   const NormalPredictor& normal_predictor();  // the level's (geometry/predict.h)
 //   void geometry(uint32_t v_to, const Prediction& prediction, int32_t position[3]);
 //                                     // prediction: geometry/predict.h
 //   void attributes(const LevelMesh& mesh, const int64_t* prediction, int64_t* codes); // if any
@@ -309,7 +310,7 @@ void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v,
   PendingSplit ps;
   ps.op = {v, ring.corner[p.first_face], p.faces, p.il != kNone, p.ir != kNone};
   Prediction prediction;
-  predict(&mesh.q[3 * size_t(v)], ring, s.spokes.data(), p, prediction);
+  predict(&mesh.q[3 * size_t(v)], ring, s.spokes.data(), p, codec.normal_predictor(), prediction);
   codec.geometry(v, prediction, ps.position);
   if (mesh.attr_codes) {
     int64_t pred[kMaxAttributeCodes], codes[kMaxAttributeCodes];
