@@ -1,6 +1,7 @@
 // pomar decode: a whole file or a level (pomar::decode), or regions (a SelectiveDecoder on
 // the file); damaged blocks skipped on request and reported (exit 4).
 #include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <memory>
 
@@ -133,6 +134,42 @@ int run_selective_decode(const DecodeArgs &a) {
   return report_damage(d.damaged(), a.out);
 }
 
+/// A full decode to binary PLY can be written region by region when it does not fit.
+bool can_decode_bounded(const DecodeArgs &a) {
+  if (a.selective() || a.level >= 0 || a.skip_damaged || a.ascii)
+    return false;
+  std::string ext = a.out.size() >= 4 ? a.out.substr(a.out.size() - 4) : "";
+  for (char &c : ext)
+    c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".ply";
+}
+
+/// The decode that did not fit (`refused`), region by region within the limit.
+int run_bounded_decode(const DecodeArgs &a, uint64_t memory_limit, const pomar::Error &refused) {
+  const auto t0 = Clock::now();
+  pomar::BoundedDecodeOptions options;
+  options.memory_limit = memory_limit;
+  options.threads = a.threads;
+  options.progress = terminal_progress(a.quiet);
+  pomar::BoundedDecodeReport report;
+  try {
+    report = pomar::decode_to_ply_bounded(a.in, a.out, options);
+  } catch (const pomar::Error &e) {
+    if (e.kind() == pomar::Error::Kind::Unsupported) // say what did not fit first
+      throw pomar::Error(pomar::Error::Kind::MemoryLimit,
+                         refused.what() + std::string("; ") + e.what());
+    rethrow_with_hint(naming(e, a.in));
+  }
+  if (!a.quiet || a.stats)
+    std::printf("%s: %lu vertices, %lu faces (decoded in %u regions within %s, the largest "
+                "estimated at %s, in %.3f s)\n",
+                a.out.c_str(), static_cast<unsigned long>(report.vertices),
+                static_cast<unsigned long>(report.faces), report.regions,
+                pomar::format_memory_size(memory_limit).c_str(),
+                pomar::format_memory_size(report.largest_region).c_str(), since(t0));
+  return 0;
+}
+
 } // namespace
 
 int run_decode(const DecodeArgs &a) {
@@ -141,7 +178,7 @@ int run_decode(const DecodeArgs &a) {
     return run_selective_decode(a);
   const uint64_t memory_limit = pomar::parse_memory_size(a.max_memory);
   const auto t0 = Clock::now();
-  const std::vector<uint8_t> data = pomar::read_file(a.in);
+  std::vector<uint8_t> data = pomar::read_file(a.in);
   pomar::DecodeOptions options;
   options.level = a.level;
   options.skip_damaged = a.skip_damaged;
@@ -155,7 +192,17 @@ int run_decode(const DecodeArgs &a) {
   try {
     mesh = pomar::decode(data.data(), data.size(), options, &report);
   } catch (const pomar::Error &e) {
-    rethrow_with_hint(naming(e, a.in));
+    if (e.kind() == pomar::Error::Kind::MemoryLimit && !can_decode_bounded(a) && !a.selective() &&
+        a.level < 0 && !a.skip_damaged) {
+      pomar::Error hinted(e.kind(), naming(e, a.in).what() +
+                                        std::string(" (to a binary .ply, a full decode is "
+                                                    "written region by region within the limit)"));
+      throw hinted;
+    }
+    if (e.kind() != pomar::Error::Kind::MemoryLimit || !can_decode_bounded(a))
+      rethrow_with_hint(naming(e, a.in));
+    data = {}; // (the bounded decode reads the file region by region)
+    return run_bounded_decode(a, memory_limit, naming(e, a.in));
   }
   const double t_decode = since(t0);
   save_decoded(a, mesh);

@@ -157,7 +157,11 @@ CLI::App *add_decode_command(CLI::App &app, DecodeArgs &a) {
                   "SIZE of memory, checked from its header (with --cluster/--sphere/--box: the "
                   "base clustered mesh, then the clusters asked for, estimated from the level "
                   "table): as for encode, e.g. 512M, 2G, 'none'; default 'auto' = the memory "
-                  "available")
+                  "available. A full decode to a binary .ply that would not fit is written "
+                  "region by region within SIZE instead (the same file, byte for byte; slower: "
+                  "each region is decoded twice, with the clusters its level map needs around "
+                  "it; random-access files without attributes or a lossless record); exit 7 "
+                  "then names the least SIZE that works")
       ->type_name("SIZE")
       ->capture_default_str();
   return dec;

@@ -603,6 +603,37 @@ expect_rc 0
 expect_file "$WORK/mem/out.ply"
 rm -f "$WORK/mem/out.ply"
 
+section "decode --max-memory below a whole decode: written region by region, the same file"
+# The bunny without its unreferenced vertices (--strict: no lossless record). A whole decode
+# needs about 12.2 MiB on one thread; 12M holds a few regions at a time.
+run encode --strict "$SAMPLES/bunny.ply" "$WORK/mem/strict.pomar" -q
+expect_rc 0
+run decode "$WORK/mem/strict.pomar" "$WORK/mem/whole.ply" -q
+expect_rc 0
+run decode "$WORK/mem/strict.pomar" "$WORK/mem/regions.ply" --max-memory 12M --threads 1
+expect_rc 0
+expect_contains "$OUT" "34834 vertices, 69451 faces (decoded in" "stdout"
+expect_contains "$OUT" "regions within 12.0 MiB" "stdout"
+cmp -s "$WORK/mem/whole.ply" "$WORK/mem/regions.ply" || fail "the region-by-region PLY differs from the whole decode's"
+pass
+run decode "$WORK/mem/strict.pomar" "$WORK/mem/regions.obj" --max-memory 12M --threads 1
+expect_rc 7
+expect_one_line_error
+expect_contains "$ERR" "(to a binary .ply, a full decode is written region by region within the limit)" "stderr"
+expect_no_file "$WORK/mem/regions.obj"
+run decode "$WORK/mem/strict.pomar" "$WORK/mem/small.ply" --max-memory 9M --threads 1
+expect_rc 7
+expect_one_line_error
+expect_contains "$ERR" "in bounded memory: its smallest region" "stderr"
+expect_contains "$ERR" "the limit is 9.0 MiB" "stderr"
+expect_no_file "$WORK/mem/small.ply"
+run decode "$WORK/mem/bunny.pomar" "$WORK/mem/small.ply" --max-memory 14M --threads 1
+expect_rc 7
+expect_one_line_error
+expect_contains "$ERR" "cannot be decoded in bounded memory: it carries a lossless record" "stderr"
+expect_no_file "$WORK/mem/small.ply"
+expect_dir_only "$WORK/mem" bunny.pomar strict.pomar whole.ply regions.ply
+
 section "decode --sphere/--cluster --max-memory: the region asked for is checked too"
 # 16M holds the base clustered mesh (14.0 MiB on two threads) and one cluster's
 # neighbourhood, not the whole mesh at full resolution (21.5 MiB).

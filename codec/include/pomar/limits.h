@@ -154,4 +154,11 @@ void check_level_map_memory(const FileInfo &info, const std::vector<int> &levels
                             uint64_t held, uint64_t limit,
                             const AttributeMask &keep = AttributeMask(), unsigned threads = 1);
 
+/// The bytes check_level_map_memory compares with the limit (and, if asked, the map's
+/// estimated vertex and face counts).
+uint64_t level_map_memory_estimate(const FileInfo &info, const std::vector<int> &levels,
+                                   int base_level, const AttributeMask &keep = AttributeMask(),
+                                   unsigned threads = 1, uint64_t *vertices = nullptr,
+                                   uint64_t *faces = nullptr);
+
 } // namespace pomar

@@ -113,6 +113,33 @@ Mesh load_mesh(const std::string &path, LoadReport *report = nullptr,
 /// without white space.
 void save_mesh(const std::string &path, const Mesh &mesh, bool binary = true);
 
+/// decode_to_ply_bounded's settings.
+struct BoundedDecodeOptions {
+  /// The bytes the decode may use at its peak (0: what is available, pomar/limits.h).
+  uint64_t memory_limit = 0;
+  unsigned threads = 0;                  ///< as SelectiveOptions::threads
+  uint32_t min_parallel_vertices = 4096; ///< as SelectiveOptions::min_parallel_vertices
+  Progress progress;                     ///< stages "count" and "write", per region
+};
+
+struct BoundedDecodeReport {
+  uint64_t vertices = 0, faces = 0;
+  uint32_t regions = 0;        ///< regions decoded (each twice: counted, then written)
+  uint64_t largest_region = 0; ///< estimated peak of the largest region, tables included
+};
+
+/// A full decode of the .pomar file `in` written to the binary PLY `out` without holding
+/// the whole mesh: the clusters are decoded in regions (runs of the Morton order of their
+/// roots) whose level maps fit `memory_limit`, each region twice (once to count what each
+/// cluster adds in each level, once to write its vertices and faces at the numbers a full
+/// decode gives them). The file is byte for byte save_mesh(out, decode(in)). Random-access
+/// files without attributes or a lossless record only (pomar::Error Kind::Unsupported
+/// otherwise, saying why); Kind::MemoryLimit when one cluster with its neighbours at full
+/// resolution does not fit (naming the memory it needs); Kind::Io when the disk cannot hold
+/// the output (checked first). Written atomically like save_mesh.
+BoundedDecodeReport decode_to_ply_bounded(const std::string &in, const std::string &out,
+                                          const BoundedDecodeOptions &options = {});
+
 /// What save_mesh(path, mesh) cannot write of the mesh's attributes in `path`'s format, one
 /// entry per kind ("scalars 'quality', 'confidence'", "texture coordinates", "alpha of the
 /// colours", ...); empty when it writes them all. For a warning naming what is not written.

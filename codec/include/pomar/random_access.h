@@ -94,6 +94,8 @@ struct SelectiveOptions {
   /// thread: on small levels the parallel phases cost more than they save. 0: every level
   /// on the threads. The mesh does not depend on it.
   uint32_t min_parallel_vertices = 4096;
+  /// Keep SelectiveDecoder::numbered_levels() (24 bytes per cluster level decoded).
+  bool record_numbering = false;
 };
 
 /// A camera for view-dependent decoding, as the web client describes it (camera.js viewOf):
@@ -212,6 +214,18 @@ public:
   /// Per vertex of mesh(): its cluster and the level that created it.
   std::vector<uint32_t> vertex_cluster() const;
   std::vector<uint32_t> vertex_level() const;
+  /// Where the cluster levels decoded on top of the base clustered mesh were numbered, in
+  /// the order they were applied (level by level, clusters in id order inside a level):
+  /// cluster `cluster`'s data of `level` created the vertices first_vertex ..
+  /// first_vertex + vertices - 1 and the faces first_face .. first_face + faces - 1 of
+  /// mesh(), in the order a full decode creates them (a full decode numbers them from the
+  /// counts of the clusters before it in that level instead). Kept with
+  /// SelectiveOptions::record_numbering only; empty for progressive files, and again once
+  /// the decoder goes back to the base clustered mesh.
+  struct NumberedLevel {
+    uint32_t cluster, level, first_vertex, vertices, first_face, faces;
+  };
+  const std::vector<NumberedLevel> &numbered_levels() const;
 
   // ----- statistics -----
   uint64_t bytes_read() const;       ///< everything read from the source so far

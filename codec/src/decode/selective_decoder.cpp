@@ -62,6 +62,8 @@ struct SelectiveDecoder::State {
   };
   std::vector<Cluster> clusters;
   std::vector<int> wanted, levels;
+  bool record_numbering = false;
+  std::vector<SelectiveDecoder::NumberedLevel> numbered; // (SelectiveDecoder::numbered_levels)
 
   // Damaged blocks (skip_damaged): cap[c] = the finest level cluster c may reach.
   bool skip_damaged = false;
@@ -111,6 +113,7 @@ struct SelectiveDecoder::State {
 
 void SelectiveDecoder::State::reset_to_snapshot() {
   mesh = snapshot;
+  numbered.clear();
   for (Cluster &k : clusters) {
     k.level = global_levels;
     k.next_local = 1;
@@ -153,9 +156,13 @@ struct StreamCheck {
 void SelectiveDecoder::State::decode_cluster_level(uint32_t c, int level, uint32_t older_than) {
   Cluster &k = clusters[c];
   DecoderCodec codec = cluster_codec(c, level);
+  const uint32_t v0 = mesh.vertex_count(), f0 = mesh.ct.face_count();
   steps[0].cluster_level(mesh, codec, {c, static_cast<uint32_t>(level), older_than}, k.next_local,
                          StreamCheck{k.stream.decoder(), codec});
   k.level = level;
+  if (record_numbering)
+    numbered.push_back({c, static_cast<uint32_t>(level), v0, mesh.vertex_count() - v0, f0,
+                        mesh.ct.face_count() - f0});
 }
 
 /// The data of `level` of the clusters `refine` (increasing), on the pool's threads, a
@@ -212,6 +219,10 @@ void SelectiveDecoder::State::decode_level_parallel(const std::vector<uint32_t> 
       return false;
     }
     first_new[i % window] = {vertices, faces};
+    if (record_numbering)
+      numbered.push_back({c, l, static_cast<uint32_t>(vertices),
+                          static_cast<uint32_t>(in.adds.vertices), static_cast<uint32_t>(faces),
+                          static_cast<uint32_t>(in.adds.faces)});
     vertices += in.adds.vertices;
     faces += in.adds.faces;
     return true;
@@ -315,6 +326,7 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   s.threads = decode_threads(options.threads);
   s.min_parallel_vertices = options.min_parallel_vertices;
   s.memory_limit = options.memory_limit;
+  s.record_numbering = options.record_numbering;
   s.attribute_mask = options.attributes;
   const uint64_t file_size = s.source->size();
   // Header: the fixed part, then as much more as header_size() asks for (version 4 needs
@@ -779,6 +791,10 @@ std::vector<uint32_t> SelectiveDecoder::vertex_cluster() const {
     for (uint32_t v = 0; v < out.size(); ++v)
       out[v] = s_->mesh.cluster_of(v);
   return out;
+}
+
+const std::vector<SelectiveDecoder::NumberedLevel> &SelectiveDecoder::numbered_levels() const {
+  return s_->numbered;
 }
 
 std::vector<uint32_t> SelectiveDecoder::vertex_level() const {

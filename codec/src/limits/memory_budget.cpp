@@ -113,20 +113,19 @@ constexpr uint64_t kThreadPerFace = 5;
 // Per-vertex attributes (bench/README.md, "Memory", attributes): encoding, what tori (F =
 // 2V, binary PLY) with colour, normal, quality and UV (8 codes), colour (3) or quality (1)
 // peak above the same torus without attributes (the encoder frees its input once
-// quantized): 226-243 B/vertex (8 codes), 74-93 (3), 31-41 (1) at 300k and 1M vertices (100k: 262, 94, 40). 16 + 34 B per code: each part 0.62-0.85 of its
-// estimate at 300k and 1M, each whole peak 0.71-0.80 of the PLY row plus the part.
-// Decoding: 81 B/vertex (8 codes, 27 bytes of values) and 12 B/vertex (1 code, 4 bytes): the
-// codes (8 B each) plus the values, plus slack.
-// The lossless stage (bench/README.md, "Memory"): noisy spheres of 300k and 1M vertices
-// with 10% of their faces duplicated, shuffled, and 5% more vertices no face uses (cut and
-// recorded) peak at 131 and 361 MiB to encode where the load check's PLY row (input
-// counts) says 94.5 and 287.4, and at 46 and 136 MiB to decode where the clustered row says
-// 53.4 and 145.4. The terms: 88 bytes per face on top to encode (the encoder's check: the
-// cut mesh's faces), 128 with --keep-order (checked at load: the file's faces), two
-// threads' part included, and 32 bytes per vertex and 28 per face to undo the record at
-// full resolution. A --keep-order encode of a messy mesh pays the cut's copy and the
-// order's work together; of a clean one (no copy of the mesh or the input), 107 and 336
-// MiB on the spheres (decodes 57 and 172), 0.65 of the sums
+// quantized): 226-243 B/vertex (8 codes), 74-93 (3), 31-41 (1) at 300k and 1M vertices (100k: 262,
+// 94, 40). 16 + 34 B per code: each part 0.62-0.85 of its estimate at 300k and 1M, each whole peak
+// 0.71-0.80 of the PLY row plus the part. Decoding: 81 B/vertex (8 codes, 27 bytes of values) and
+// 12 B/vertex (1 code, 4 bytes): the codes (8 B each) plus the values, plus slack. The lossless
+// stage (bench/README.md, "Memory"): noisy spheres of 300k and 1M vertices with 10% of their faces
+// duplicated, shuffled, and 5% more vertices no face uses (cut and recorded) peak at 131 and 361
+// MiB to encode where the load check's PLY row (input counts) says 94.5 and 287.4, and at 46 and
+// 136 MiB to decode where the clustered row says 53.4 and 145.4. The terms: 88 bytes per face on
+// top to encode (the encoder's check: the cut mesh's faces), 128 with --keep-order (checked at
+// load: the file's faces), two threads' part included, and 32 bytes per vertex and 28 per face to
+// undo the record at full resolution. A --keep-order encode of a messy mesh pays the cut's copy and
+// the order's work together; of a clean one (no copy of the mesh or the input), 107 and 336 MiB on
+// the spheres (decodes 57 and 172), 0.65 of the sums
 // (MemoryEstimate.LosslessStageIsAboveTheMeasuredPeaks).
 constexpr uint64_t kLosslessEncodePerFace = 88;
 constexpr uint64_t kLosslessKeepOrderEncodePerFace = 128;
@@ -461,8 +460,7 @@ void check_encode_memory(uint64_t vertices, uint64_t faces, uint64_t limit, uint
   check_memory("encode", vertices, faces, needed, held, limit);
 }
 
-uint64_t decode_thread_memory(uint64_t /*vertices: no per-vertex part*/,
-                              uint64_t faces) {
+uint64_t decode_thread_memory(uint64_t /*vertices: no per-vertex part*/, uint64_t faces) {
   return add_mul(kThreadFixed, faces, kThreadPerFace);
 }
 
@@ -499,11 +497,15 @@ void check_decode_memory(const FileInfo &info, int level, uint64_t limit, const 
   check_memory("decode", v, f, decode_needs(info, v, f, full, keep, threads), 0, limit);
 }
 
-void check_level_map_memory(const FileInfo &info, const std::vector<int> &levels, int base_level,
-                            uint64_t held, uint64_t limit, const AttributeMask &keep,
-                            unsigned threads) {
+namespace {
+struct MapNeeds {
+  uint64_t vertices = 0, faces = 0, bytes = 0;
+};
+MapNeeds level_map_needs(const FileInfo &info, const std::vector<int> &levels, int base_level,
+                         const AttributeMask &keep, unsigned threads) {
+  MapNeeds out;
   if (levels.empty())
-    return;
+    return out;
   const auto [lo, hi] = std::minmax_element(levels.begin(), levels.end());
   auto [v, f] = counts_at(info, *hi); // a whole-mesh level: exact
   if (*lo != *hi) {
@@ -519,8 +521,31 @@ void check_level_map_memory(const FileInfo &info, const std::vector<int> &levels
     f = std::min(f, base_f + uint64_t(std::ceil(1.3 * grow_f / n)));
   }
   const bool full = static_cast<size_t>(*lo) >= info.levels.size();
-  check_memory("refine the clusters asked for to about", v, f,
-               decode_needs(info, v, f, full, keep, threads), held, limit);
+  out.vertices = v;
+  out.faces = f;
+  out.bytes = decode_needs(info, v, f, full, keep, threads);
+  return out;
+}
+} // namespace
+
+uint64_t level_map_memory_estimate(const FileInfo &info, const std::vector<int> &levels,
+                                   int base_level, const AttributeMask &keep, unsigned threads,
+                                   uint64_t *vertices, uint64_t *faces) {
+  const MapNeeds n = level_map_needs(info, levels, base_level, keep, threads);
+  if (vertices)
+    *vertices = n.vertices;
+  if (faces)
+    *faces = n.faces;
+  return n.bytes;
+}
+
+void check_level_map_memory(const FileInfo &info, const std::vector<int> &levels, int base_level,
+                            uint64_t held, uint64_t limit, const AttributeMask &keep,
+                            unsigned threads) {
+  if (levels.empty())
+    return;
+  const MapNeeds n = level_map_needs(info, levels, base_level, keep, threads);
+  check_memory("refine the clusters asked for to about", n.vertices, n.faces, n.bytes, held, limit);
 }
 
 } // namespace pomar
