@@ -18,6 +18,7 @@
 #include "decode/level_map.h"
 #include "decode/level_schedule.h"
 #include "entropy/static_tables.h"
+#include "format/block_checks.h"
 #include "format/block_order.h"
 #include "format/cluster_errors.h"
 #include "format/file_format.h"
@@ -370,6 +371,7 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
       read_tables(s.global.data() + s.layout.tables_offset, h.tables_bytes,
                   h.levels.size() - h.global_levels, h.ranks_patches(), s.global_models.attr);
   s.index = read_cluster_index(s.global.data() + s.layout.index_offset, s.layout);
+  load_block_checks(s.global.data(), s.layout, s.index);
   s.info.cluster_block_bytes = s.index.size;
   decode_global_levels(s.global.data(), s.layout, 0, h.global_levels, s.mesh, s.global_models, {});
   const uint32_t n = h.clusters;
@@ -384,7 +386,7 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   s.clusters.resize(n);
   for (uint32_t c = 0; c < n; ++c) {
     s.clusters[c].stream.init(s.source.get(), c, s.index.offset[c], s.index.size[c],
-                              s.index.check[c], &s.reads);
+                              s.index.check[c], s.index.check_mask, &s.reads);
     s.clusters[c].level = s.global_levels;
   }
   s.wanted.assign(n, s.global_levels);

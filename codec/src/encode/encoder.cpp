@@ -17,6 +17,7 @@
 #include "encode/clusters.h"
 #include "encode/encoder_codec.h"
 #include "entropy/models.h"
+#include "format/block_checks.h"
 #include "format/block_order.h"
 #include "format/cluster_errors.h"
 #include "format/file_format.h"
@@ -378,6 +379,9 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
 
   std::vector<Section> sections =
       extra_sections(attributes, rb, header, std::move(images), hook, in);
+  // Random access, version 5: each block's whole XXH32 (section BCHK, optional).
+  if (header.clustered() && header.ranks_patches())
+    sections.push_back({kBlockChecksTag, 0, write_block_checks(clustered.blocks)});
   // Random access: the blocks in the Morton order of their roots (section BLKO, required:
   // a reader that does not know it would look for the blocks in id order).
   std::vector<uint32_t> block_order;
