@@ -34,9 +34,13 @@ FileInfo inspect(const uint8_t *data, size_t size) {
     const ClusterIndex index = read_cluster_index(data + layout.index_offset, layout);
     info.cluster_block_bytes = index.size;
   }
-  if (const auto table = load_attribute_table(data, layout, false)) { // (no codes kept)
+  const auto table = load_attribute_table(data, layout, false); // (no codes kept)
+  const size_t textures = table ? table->texture_files.size() : 0;
+  // The materials, as every decode reads them (a damaged MATL section fails here too).
+  load_material_table(data, layout, textures);
+  if (table) {
     describe_attributes(*table, info);
-    info.embedded_texture_bytes = texture_image_sizes(data, layout, table->texture_files.size());
+    info.embedded_texture_bytes = texture_image_sizes(data, layout, textures);
   }
   return info;
 }
