@@ -8,6 +8,9 @@
 # more memory), and a decode that runs out of memory exits 7.
 # Usage: hostile_info_test.sh POMAR POMAR_HOSTILE_FILES SAMPLES_DIR
 set -u
+# About 10 s of CPU; each command is capped at 120 s of CPU time (ulimit -t, which the
+# machine's load does not stretch; ctest's TIMEOUT is a backstop for a hang).
+ulimit -t 120
 POMAR=$1
 CRAFT=$2
 SAMPLES=$3
