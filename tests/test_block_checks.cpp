@@ -197,6 +197,17 @@ TEST(BlockChecks, ADamagedSectionIsNamed) {
     }
   }
   EXPECT_THROW(check_blocks(file.data(), file.size()), Error);
+  EXPECT_THROW(inspect(file.data(), file.size()), Error); // pomar info: exit 4
+  // A flipped byte, the section's checksum left as it was: named too.
+  std::vector<uint8_t> flipped = e.file;
+  flipped[e.layout.section_offset[size_t(i)] + 7] ^= 0x10;
+  try {
+    inspect(flipped.data(), flipped.size());
+    ADD_FAILURE() << "inspect accepted a damaged BCHK section";
+  } catch (const Error &err) {
+    EXPECT_NE(std::string(err.what()).find("BCHK"), std::string::npos) << err.what();
+  }
+  EXPECT_THROW(open(flipped, true), Error);
 }
 
 } // namespace

@@ -31,7 +31,8 @@ FileInfo inspect(const uint8_t *data, size_t size) {
   if (layout.header.clustered()) {
     check_block(data + layout.tables_offset, layout.header.tables_bytes,
                 layout.header.tables_checksum, "static model tables");
-    const ClusterIndex index = read_cluster_index(data + layout.index_offset, layout);
+    ClusterIndex index = read_cluster_index(data + layout.index_offset, layout);
+    load_block_checks(data, layout, index); // (read at open by every decode)
     info.cluster_block_bytes = index.size;
   }
   const auto table = load_attribute_table(data, layout, false); // (no codes kept)
