@@ -128,11 +128,13 @@ std::vector<Case> crafted(const std::vector<uint8_t> &clustered,
     put_le(b, kFixedHeaderBytes + 4, 2 * f, 4);
     add("zero_base_1mb", b);
   }
-  {
-    // A structurally valid base mesh as large as its block allows: separate triangles, every
-    // vertex at one position (the deltas cost almost nothing), with four colour codes and a
-    // scalar per vertex (all zero, almost free too) in its ATTR section: a header, a base mesh
-    // and a section that agree, each decoded whole by info.
+  // A structurally valid base mesh as large as its block allows: separate triangles, every
+  // vertex at one position (the deltas cost almost nothing), with four colour codes and a
+  // scalar per vertex (all zero, almost free too) in its ATTR section: a header, a base mesh
+  // and a section that agree, each decoded whole by info. The same with a wedge texture
+  // coordinate ("pomar:corner texcoord", the seam cut's, predicted from the base mesh's
+  // neighbours) instead: info --check builds that base mesh to resolve it.
+  for (const bool wedges : {false, true}) {
     const uint32_t f = 1'000'000, v = 3 * f;
     BaseMesh base;
     base.q.assign(size_t(v) * 3, 0);
@@ -142,17 +144,26 @@ std::vector<Case> crafted(const std::vector<uint8_t> &clustered,
     Mesh m;
     m.positions.assign(size_t(v) * 3, 0.0f);
     m.triangles = base.triangles;
-    VertexAttribute colour;
-    colour.kind = AttributeKind::Colour;
-    colour.name = "colour";
-    colour.components = 4;
-    colour.colour.assign(size_t(v) * 4, 0);
-    m.attributes.push_back(colour);
-    VertexAttribute quality;
-    quality.kind = AttributeKind::Scalar;
-    quality.name = "quality";
-    quality.values.assign(v, 0.0f);
-    m.attributes.push_back(quality);
+    if (wedges) {
+      VertexAttribute uv;
+      uv.kind = AttributeKind::TexCoord;
+      uv.name = "pomar:corner texcoord";
+      uv.components = 2;
+      uv.values.assign(size_t(v) * 2, 0.0f);
+      m.attributes.push_back(uv);
+    } else {
+      VertexAttribute colour;
+      colour.kind = AttributeKind::Colour;
+      colour.name = "colour";
+      colour.components = 4;
+      colour.colour.assign(size_t(v) * 4, 0);
+      m.attributes.push_back(colour);
+      VertexAttribute quality;
+      quality.kind = AttributeKind::Scalar;
+      quality.name = "quality";
+      quality.values.assign(v, 0.0f);
+      m.attributes.push_back(quality);
+    }
     AttributeTable table = plan_attributes(m, AttributeOptions());
     std::vector<uint32_t> order(v);
     for (uint32_t i = 0; i < v; ++i)
@@ -168,7 +179,7 @@ std::vector<Case> crafted(const std::vector<uint8_t> &clustered,
     h.levels.push_back({2 * v, 2 * f, 0, 0, 0});
     std::vector<uint8_t> b =
         write_file(h, block, {{}}, {}, {}, {{kAttributeSectionTag, 0, write_attributes(table, v)}});
-    add("big_base_attributes", b);
+    add(wedges ? "big_base_wedges" : "big_base_attributes", b);
   }
   // Section tables: the count at its limit (64, the entries read from the bytes after
   // the header) and beyond it; a section claiming far more bytes than the file has.

@@ -7,6 +7,9 @@
 #    next: sampling noise; overall at least 100x from level 0 to the full mesh);
 # 3. a .pomar of another mesh is rejected with a clear message and a non-zero exit.
 set -u
+# About 7 s of CPU, most of it pomar_rd's distances; bounded by CPU time (ulimit -t), which
+# the machine's load does not stretch; ctest's TIMEOUT is a backstop for a hang.
+ulimit -t 120
 RD=$1 CLI=$2 GEN=$3 SAMPLES=$4
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT

@@ -7,6 +7,7 @@ import warnings
 import subprocess
 import sys
 import threading
+import time
 
 import numpy as np
 import pytest
@@ -323,7 +324,11 @@ def test_a_damaged_attr_section_is_a_damaged_file(tmp_path):
 def test_gil_released_during_encode_and_decode():
     """Another Python thread runs while encode/decode work. With a 0.5 s switch interval a
     thread holding the GIL keeps it through a call shorter than that (these take a few
-    ms), so the counter could not move during the call if the GIL were held."""
+    ms), so the counter could not move during the call if the GIL were held. The counter
+    gives the GIL up after every tick (time.sleep(0) releases it): the calls take it back
+    for each progress report (to look for Ctrl-C), and a counter that held it would make
+    each of those wait for the switch interval, about two minutes in all; a call that held
+    the GIL still stops the counter, which then waits for the GIL through the whole call."""
     vertices, faces = torus(100, 50)
     ticks = 0
     stop = threading.Event()
@@ -332,6 +337,7 @@ def test_gil_released_during_encode_and_decode():
         nonlocal ticks
         while not stop.is_set():
             ticks += 1
+            time.sleep(0)
 
     moved = []
 

@@ -5,8 +5,12 @@
 #
 # Registered in ctest as "cli_end_to_end" (tests/CMakeLists.txt). Each check is an explicit assertion:
 # the first failing one prints what failed (with the command's stderr) and exits 1.
-# Needs bash, coreutils and python3 (for JSON parsing). Runs in a few seconds.
+# Needs bash, coreutils and python3 (for JSON parsing). About 15 s of CPU; on a loaded
+# machine the wall-clock time is several times that, so what bounds a runaway command is
+# its CPU time: at most 120 s each (ulimit -t, which load does not stretch; ctest's TIMEOUT
+# is a backstop for a command that hangs without using the CPU).
 set -euo pipefail
+ulimit -t 120
 
 if [ $# -ne 2 ]; then
   echo "usage: $0 POMAR_EXECUTABLE SAMPLES_DIR" >&2

@@ -159,7 +159,10 @@ for s in ATTR MATL TEXI LSLS; do
   expect 4 "checksum mismatch in section '$s'" info --check "flip_$s.pomar"
   expect 4 "checksum mismatch in section '$s'" verify textured_sphere.obj "flip_$s.pomar"
 done
-expect 4 "checksum mismatch in section 'ATTR'" info flip_ATTR.pomar
+for s in ATTR MATL TEXI; do # plain info reads the sections a decode needs first, too
+  expect 4 "checksum mismatch in section '$s'" info "flip_$s.pomar"
+  expect 4 "$s section is truncated" info "cut_$s.pomar"
+done
 expect 4 "checksum mismatch in section 'ATTR'" decode flip_ATTR.pomar x.obj --cluster 0
 expect 4 "checksum mismatch in section 'ATTR'" decode flip_ATTR.pomar x.obj --skip-damaged
 rm -f no_record.obj
@@ -227,6 +230,7 @@ expect 8 "'MATX'" decode unknown_section.pomar x.obj --cluster 0
 for s in ATTR MATL TEXI; do
   expect 8 "$s section version 99" decode "v99_$s.pomar" x.obj
   expect 8 "$s section version 99" info --check "v99_$s.pomar"
+  expect 8 "$s section version 99" info "v99_$s.pomar"
 done
 
 echo "$checks checks, $failures failed"

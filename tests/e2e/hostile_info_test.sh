@@ -8,6 +8,9 @@
 # more memory), and a decode that runs out of memory exits 7.
 # Usage: hostile_info_test.sh POMAR POMAR_HOSTILE_FILES SAMPLES_DIR
 set -u
+# About 10 s of CPU; each command is capped at 120 s of CPU time (ulimit -t, which the
+# machine's load does not stretch; ctest's TIMEOUT is a backstop for a hang).
+ulimit -t 120
 POMAR=$1
 CRAFT=$2
 SAMPLES=$3
@@ -36,7 +39,10 @@ print(r.returncode, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)' "$T
 # what the header claims, which only a decode finds): info describes them and
 # info --check finds every checksum right (exit 0). A misaligned cluster index is
 # consistent too, but its blocks fail their checks: info --check lists them (exit 4).
-consistent=" huge_counts big_base_attributes shifted_index "
+consistent=" huge_counts big_base_attributes big_base_wedges shifted_index "
+# Checked apart (below): info --check builds the base mesh of a file with wedge texture
+# coordinates to resolve them, so it needs what a decode of the base mesh needs.
+base_decoded=" big_base_wedges "
 blocks_fail=" shifted_index "
 checked=0
 for name in $names; do
@@ -44,6 +50,7 @@ for name in $names; do
   size=$(stat -c %s "$f")
   [ "$size" -lt 1000000 ] || fail "$name: $size bytes, not under 1 MB"
   for args in "" "--json" "--check"; do
+    case "$args$base_decoded" in "--check"*" $name "*) continue ;; esac
     want=4
     case $consistent in *" $name "*) want=0 ;; esac
     case "$args$blocks_fail" in "--check"*" $name "*) want=4 ;; esac
@@ -65,6 +72,22 @@ for name in $names; do
   esac
   echo "ok: decode $name: exit $status, peak RSS $rss KiB"
 done
+# info --check of a base mesh of 3 million vertices with wedge texture coordinates (878 KB):
+# its peak stays under the memory check's estimate for decoding the base mesh, and an
+# address space below that estimate is refused before the base mesh is built (exit 7).
+f="$TMP/crafted/big_base_wedges.pomar"
+status=$( (ulimit -v 200000; "$POMAR" info --check "$f" >/dev/null 2>"$TMP/err"); echo $?)
+[ "$status" = 7 ] || fail "info --check big_base_wedges under 200 MB: exit $status, expected 7: $(cat "$TMP/err")"
+grep -q "^pomar: error: not enough memory to decode 3,000,000 vertices" "$TMP/err" ||
+  fail "info --check big_base_wedges under 200 MB: $(cat "$TMP/err")"
+need=$(sed -n 's/.*needs about \([0-9.]*\) MiB.*/\1/p' "$TMP/err")
+[ -n "$need" ] || fail "info --check big_base_wedges: no estimate in MiB: $(cat "$TMP/err")"
+read -r status rss < <(probe "$POMAR" info "$f" --check)
+[ "$status" = 0 ] || fail "pomar info --check big_base_wedges: exit $status: $(cat "$TMP/err")"
+python3 -c 'import sys; sys.exit(0 if float(sys.argv[1]) <= float(sys.argv[2]) * 1024 else 1)' "$rss" "$need" ||
+  fail "pomar info --check big_base_wedges: peak RSS $rss KiB over the estimate of $need MiB"
+echo "ok: info --check big_base_wedges: refused under 200 MB (needs about $need MiB), else exit 0 with peak RSS $rss KiB"
+
 # Memory running out (no check, a 400 MB address space) is the memory kind's status, 7,
 # never 1: the base mesh of big_base_attributes needs more.
 status=$( (ulimit -v 400000; "$POMAR" decode "$TMP/crafted/big_base_attributes.pomar" "$TMP/out.ply" \

@@ -335,6 +335,26 @@ TEST_F(PomarPluginTest, OpenErrors) {
   QFile::remove(path("cut.pomar"));
 }
 
+// The warning names the file as it is, whatever it holds: "%1" and "%2" in a path are no
+// places for arguments.
+TEST_F(PomarPluginTest, DamageWarningKeepsThePathAsItIs) {
+  std::vector<uint8_t> cut(clustered_->begin(), clustered_->begin() + clustered_->size() / 2);
+  const QString name = path("cut %2 %1 %3.pomar");
+  writeBytes(name, cut);
+  g_warnings.clear();
+  ASSERT_TRUE(openAt(name, 0, 0, true)) << plugin()->errorMsg().toStdString();
+  pomar::DecodeOptions o;
+  o.skip_damaged = true;
+  pomar::DecodeReport report;
+  pomar::decode(cut.data(), cut.size(), o, &report);
+  ASSERT_FALSE(report.damaged.empty());
+  const QString expected = QFileInfo(name).absoluteFilePath() + ": " +
+                           QString::number(report.damaged.size()) + " damaged block(s) skipped";
+  EXPECT_TRUE(g_warnings.join("\n").contains(expected))
+      << "expected: " << expected.toStdString() << "\ngot: " << g_warnings.join("\n").toStdString();
+  QFile::remove(name);
+}
+
 // ---------------------------------------------------------------- save
 
 TEST_F(PomarPluginTest, SaveWithDefaultsEqualsTheLibrary) {

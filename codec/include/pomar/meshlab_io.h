@@ -161,10 +161,11 @@ inline int fillLayer(MeshModel &m, const DecodedFile &file, const QString &path,
 
 /// The warning about the blocks "Skip damaged blocks" skipped.
 inline QString damageWarning(const QString &path, const std::vector<pomar::DamagedBlock> &damaged) {
+  // One arg() call for all three: a chained arg() would read a "%2" in the path (or in the
+  // damage text) as a place for the next argument.
   return QString("%1: %2 damaged block(s) skipped, the mesh is coarser there:\n%3")
-      .arg(path)
-      .arg(damaged.size())
-      .arg(QString::fromStdString(pomar::describe_damage(damaged)));
+      .arg(path, QString::number(damaged.size()),
+           QString::fromStdString(pomar::describe_damage(damaged)));
 }
 
 /// The log line of a successful open.

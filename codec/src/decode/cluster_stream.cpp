@@ -9,12 +9,13 @@
 namespace pomar {
 
 void ClusterStream::init(ByteSource *source, uint32_t id, uint64_t offset, uint32_t size,
-                         uint8_t check, ReadStats *stats) {
+                         uint32_t check, uint32_t mask, ReadStats *stats) {
   source_ = source;
   id_ = id;
   offset_ = offset;
   size_ = size;
   check_ = check;
+  mask_ = mask;
   stats_ = stats;
 }
 
@@ -43,7 +44,7 @@ bool ClusterStream::load(size_t upto) {
   }
   loaded_ = upto;
   if (loaded_ == block_.size() && !checked_) {
-    failed_ = !passes_block_check(block_.data(), loaded_, check_);
+    failed_ = !passes_block_check(block_.data(), loaded_, check_, mask_);
     checked_ = !failed_;
   }
   return !failed_;

@@ -27,9 +27,10 @@ class ClusterStream : public StreamRefill {
 public:
   static constexpr size_t kChunk = 4; // bytes per on-demand read of a cluster block
 
-  /// Cluster `id`'s block: `size` bytes at `offset` of `source`, with its 8-bit check.
-  void init(ByteSource *source, uint32_t id, uint64_t offset, uint32_t size, uint8_t check,
-            ReadStats *stats);
+  /// Cluster `id`'s block: `size` bytes at `offset` of `source`, with its check (the bits
+  /// `mask` of its XXH32: ClusterIndex).
+  void init(ByteSource *source, uint32_t id, uint64_t offset, uint32_t size, uint32_t check,
+            uint32_t mask, ReadStats *stats);
   /// (Re)start the stream from its first byte; `whole` reads the block at once (it will be
   /// decoded to the end, or its check must pass first), otherwise bytes are read as the
   /// decoder needs them. Throws if the file ends before the block (truncated file).
@@ -38,7 +39,7 @@ public:
   /// holds it. Returns why start(true) would fail (empty: it would not).
   std::string problem();
   RangeDecoder &decoder() { return rc_; }
-  /// The block passed its 8-bit check (it has been read whole).
+  /// The block passed its check (it has been read whole).
   bool checked() const { return checked_; }
   /// The block, if it has been read whole (else null).
   const std::vector<uint8_t> *whole_block() const { return loaded_ == size_ ? &block_ : nullptr; }
@@ -54,7 +55,7 @@ private:
   ReadStats *stats_ = nullptr;
   uint32_t id_ = 0, size_ = 0;
   uint64_t offset_ = 0;
-  uint8_t check_ = 0;
+  uint32_t check_ = 0, mask_ = 0xFF;
   std::vector<uint8_t> block_; // sized to the whole block; [0, loaded_) read so far
   size_t loaded_ = 0;
   bool checked_ = false;

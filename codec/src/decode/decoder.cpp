@@ -12,6 +12,7 @@
 #include "decode/decoder_codec.h"
 #include "decode/global_levels.h"
 #include "entropy/models.h"
+#include "format/block_checks.h"
 #include "format/block_order.h"
 #include "format/cluster_errors.h"
 #include "format/file_format.h"
@@ -30,12 +31,17 @@ FileInfo inspect(const uint8_t *data, size_t size) {
   if (layout.header.clustered()) {
     check_block(data + layout.tables_offset, layout.header.tables_bytes,
                 layout.header.tables_checksum, "static model tables");
-    const ClusterIndex index = read_cluster_index(data + layout.index_offset, layout);
+    ClusterIndex index = read_cluster_index(data + layout.index_offset, layout);
+    load_block_checks(data, layout, index); // (read at open by every decode)
     info.cluster_block_bytes = index.size;
   }
-  if (const auto table = load_attribute_table(data, layout, false)) { // (no codes kept)
+  const auto table = load_attribute_table(data, layout, false); // (no codes kept)
+  const size_t textures = table ? table->texture_files.size() : 0;
+  // The materials, as every decode reads them (a damaged MATL section fails here too).
+  load_material_table(data, layout, textures);
+  if (table) {
     describe_attributes(*table, info);
-    info.embedded_texture_bytes = texture_image_sizes(data, layout, table->texture_files.size());
+    info.embedded_texture_bytes = texture_image_sizes(data, layout, textures);
   }
   return info;
 }
@@ -140,6 +146,7 @@ std::vector<DamagedBlock> check_blocks(const uint8_t *data, size_t size) {
   check_block(data + layout.tables_offset, h.tables_bytes, h.tables_checksum,
               "static model tables");
   ClusterIndex index = read_cluster_index(data + layout.index_offset, layout);
+  load_block_checks(data, layout, index);
   if (has_block_order(data, layout)) { // the blocks lie in the Morton order of their roots
     LevelMesh lm = base_level_mesh(data, layout);
     Models models;
@@ -157,7 +164,8 @@ std::vector<DamagedBlock> check_blocks(const uint8_t *data, size_t size) {
     const char *problem = nullptr;
     if (index.offset[c] + index.size[c] > size)
       problem = "missing: the file ends before this block (truncated file)";
-    else if (!passes_block_check(data + index.offset[c], index.size[c], index.check[c]))
+    else if (!passes_block_check(data + index.offset[c], index.size[c], index.check[c],
+                                 index.check_mask))
       problem = "checksum mismatch";
     if (problem)
       damaged.push_back(damaged_cluster(c,

@@ -18,6 +18,7 @@
 #include "decode/level_map.h"
 #include "decode/level_schedule.h"
 #include "entropy/static_tables.h"
+#include "format/block_checks.h"
 #include "format/block_order.h"
 #include "format/cluster_errors.h"
 #include "format/file_format.h"
@@ -386,6 +387,7 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   for (size_t k = 0; k < s.level_models.size(); ++k) // (each clustered level's predictor)
     s.level_models[k].normal = normal[h.global_levels + k];
   s.index = read_cluster_index(s.global.data() + s.layout.index_offset, s.layout);
+  load_block_checks(s.global.data(), s.layout, s.index);
   s.info.cluster_block_bytes = s.index.size;
   decode_global_levels(s.global.data(), s.layout, 0, h.global_levels, s.mesh, s.global_models, {});
   const uint32_t n = h.clusters;
@@ -400,7 +402,7 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   s.clusters.resize(n);
   for (uint32_t c = 0; c < n; ++c) {
     s.clusters[c].stream.init(s.source.get(), c, s.index.offset[c], s.index.size[c],
-                              s.index.check[c], &s.reads);
+                              s.index.check[c], s.index.check_mask, &s.reads);
     s.clusters[c].level = s.global_levels;
   }
   s.wanted.assign(n, s.global_levels);

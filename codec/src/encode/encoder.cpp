@@ -18,6 +18,7 @@
 #include "encode/encoder_codec.h"
 #include "encode/fit_prediction.h"
 #include "entropy/models.h"
+#include "format/block_checks.h"
 #include "format/block_order.h"
 #include "format/cluster_errors.h"
 #include "format/file_format.h"
@@ -403,6 +404,9 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
   if (needs_geometry_prediction(rb.normal))
     sections.push_back(
         {kGeometryPredictionTag, kSectionRequired, write_geometry_prediction(rb.normal)});
+  // Random access, version 5: each block's whole XXH32 (section BCHK, optional).
+  if (header.clustered() && header.ranks_patches())
+    sections.push_back({kBlockChecksTag, 0, write_block_checks(clustered.blocks)});
   // Random access: the blocks in the Morton order of their roots (section BLKO, required:
   // a reader that does not know it would look for the blocks in id order).
   std::vector<uint32_t> block_order;

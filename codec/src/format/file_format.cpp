@@ -114,7 +114,7 @@ std::vector<uint8_t> pack_cluster_index(const ClusterIndex &index) {
       else
         rc.encode_bypass(uint32_t(bit), 1);
     }
-    rc.encode_bypass(index.check[c], 8);
+    rc.encode_bypass(index.check[c] & 0xFF, 8);
   }
   rc.finish();
   return out;
@@ -671,7 +671,7 @@ const std::vector<uint32_t> &known_sections() {
   // The sections this build's decoders honour.
   static const std::vector<uint32_t> known = {
       section_tag("ATTR"), kLosslessTag,        section_tag("MATL"), section_tag("TEXI"),
-      section_tag("CERR"), section_tag("BLKO"), section_tag("GEOP")};
+      section_tag("CERR"), section_tag("BLKO"), section_tag("GEOP"), section_tag("BCHK")};
   return known;
 }
 

@@ -92,11 +92,14 @@ struct FileHeader {
   bool ranks_patches() const { return version >= kPatchRankFormatVersion; }
 };
 
-/// Where each cluster's block is, and its 8-bit check (low byte of its XXH32).
+/// Where each cluster's block is, and its check: the low byte of its XXH32 from the index,
+/// all 32 bits once a BCHK section completes it (format/block_checks.h); `check_mask` says
+/// which bits hold.
 struct ClusterIndex {
   std::vector<uint64_t> offset; // absolute file offsets
   std::vector<uint32_t> size;
-  std::vector<uint8_t> check;
+  std::vector<uint32_t> check;
+  uint32_t check_mask = 0xFF;
 };
 
 /// The base mesh: quantized positions and triangles (range coded, see pack_base_mesh).
@@ -118,9 +121,11 @@ struct FileLayout {
 };
 
 uint32_t checksum(const uint8_t *data, size_t size);
-/// A cluster block against its 8-bit check from the index (the low byte of its XXH32).
-inline bool passes_block_check(const uint8_t *block, size_t size, uint8_t check) {
-  return (checksum(block, size) & 0xFF) == check;
+/// A cluster block against its check: the bits of `mask` of its XXH32 (the index's low
+/// byte, or all 32 with a BCHK section).
+inline bool passes_block_check(const uint8_t *block, size_t size, uint32_t check,
+                               uint32_t mask = 0xFF) {
+  return ((checksum(block, size) ^ check) & mask) == 0;
 }
 /// XXH32 (seed 0) of the concatenation of `blocks`, as checksum() of the whole would give.
 uint32_t checksum(const std::vector<const std::vector<uint8_t> *> &blocks);
