@@ -173,14 +173,14 @@ struct EncodeOptions {
   /// vertex smaller), or 4: the layout of versions 1, 3 and 4 (readers that predate
   /// version 5 read it).
   int format_version = 5;
-  /// Random-access files: store the cluster blocks in the Morton order of the clusters'
-  /// roots (section BLKO, required), so that the blocks of
-  /// one region lie together in the file. Off by default.
-  bool spatial_layout = false;
-  /// Random-access files: store a geometric error per cluster and level (section CERR,
-  /// optional), measured by decoding the file level by level,
-  /// for view-dependent decoding (SelectiveDecoder::want_view). Off by default.
-  bool cluster_errors = false;
+  /// Random-access files of version 5: store the cluster blocks in the Morton order of the
+  /// clusters' roots (section BLKO, required), so that the blocks of one region lie
+  /// together in the file. Off: the blocks in cluster id order. On by default.
+  bool spatial_layout = true;
+  /// Random-access files of version 5: store a geometric error per cluster and level
+  /// (section CERR, optional; about 3% of the file), bounded while the clustered levels are
+  /// coded, for view-dependent decoding (SelectiveDecoder::want_view). On by default.
+  bool cluster_errors = true;
 };
 
 /// What the codec stored to give a mesh back exactly although it had to cut it (the
