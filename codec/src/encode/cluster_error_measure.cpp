@@ -149,11 +149,19 @@ void ClusterErrorMeasure::measure_cluster(const Rebuild &rb, uint32_t level, uin
   for (; i < end && created_[i] <= level; ++i) // present from this level on: decoder ids
     id_[i] = rb.input_to_dec[id_[i]];
   first_future_[c] = i;
-  for (; i < end; ++i) {
+  const uint32_t first = i;
+  for (; i < end; ++i) { // the ancestors first (entry order: a parent's before its children)
     const uint32_t p = parent_[i];
-    const uint32_t a = created_[p] <= level ? id_[p] : ancestor_[p];
-    ancestor_[i] = a;
-    raise_to_fan_distance(mesh, a, at(q_, i), worst);
+    ancestor_[i] = created_[p] <= level ? id_[p] : ancestor_[p];
+  }
+  constexpr uint32_t kAhead = 8; // the fans read next are fetched meanwhile
+  for (i = first; i < end; ++i) {
+    if (i + kAhead < end) {
+      const uint32_t b = ancestor_[i + kAhead];
+      __builtin_prefetch(&mesh.ct.VC[b]);
+      __builtin_prefetch(&mesh.q[3 * size_t(b)]);
+    }
+    raise_to_fan_distance(mesh, ancestor_[i], at(q_, i), worst);
   }
 }
 
