@@ -380,7 +380,8 @@ int run_view(int argc, char **argv) {
 }
 
 /// `encode MESH OUT.pomar [RATIO]`: a random-access file with a stored error per cluster and
-/// level (CERR) and its blocks in spatial order (BLKO), as the view benches and tests use.
+/// level (CERR) and its blocks in spatial order (BLKO), as the view benches and tests use
+/// (what `pomar encode` writes by default, with RATIO as --cluster-ratio).
 int run_encode(int argc, char **argv) {
   if (argc < 4)
     usage("encode needs MESH OUT.pomar [RATIO]");

@@ -12,6 +12,7 @@
 #include "mesh/corner_table.h"
 #include "pomar/pomar.h"
 #include "pomar/random_access.h"
+#include "support/block_layout.h"
 #include "support/hostile_files.h"
 #include "support/mesh_compare.h"
 #include "support/mesh_gen.h"
@@ -24,17 +25,24 @@ using test::canonical;
 struct Encoded {
   std::vector<uint8_t> file;
   FileInfo info;
+  test::BlockLayout blocks; // where each cluster's block lies (any block order)
 };
+
+Encoded described(std::vector<uint8_t> file) {
+  Encoded e;
+  e.file = std::move(file);
+  e.info = inspect(e.file.data(), e.file.size());
+  if (e.info.clustered())
+    e.blocks = test::block_layout(e.file);
+  return e;
+}
 
 Encoded encode_with(const Mesh &m, double ratio, bool progressive = false, int format_version = 5) {
   EncodeOptions o;
   o.cluster_ratio = ratio;
   o.progressive = progressive;
   o.format_version = format_version;
-  Encoded e;
-  e.file = encode(m, o);
-  e.info = inspect(e.file.data(), e.file.size());
-  return e;
+  return described(encode(m, o));
 }
 
 const Encoded &sphere() {
@@ -54,12 +62,7 @@ const Encoded &pieces() { // several connected components: several cluster graph
   return e;
 }
 
-uint64_t block_offset(const Encoded &e, uint32_t cluster) {
-  uint64_t at = e.info.global_bytes;
-  for (uint32_t c = 0; c < cluster; ++c)
-    at += e.info.cluster_block_bytes[c];
-  return at;
-}
+uint64_t block_offset(const Encoded &e, uint32_t cluster) { return e.blocks.offset[cluster]; }
 
 /// Clusters with a block long enough to damage, spread over the file.
 std::vector<uint32_t> damageable(const Encoded &e, size_t count) {
@@ -214,13 +217,10 @@ TEST(DamagedBlocks, SeveralDamagedClusters) {
 TEST(DamagedBlocks, TruncatedManyClusterFileDecodesInOneRound) {
   EncodeOptions eo;
   eo.clusters = 5000;
-  Encoded e;
-  e.file = encode(gen::icosphere(6), eo);
-  e.info = inspect(e.file.data(), e.file.size());
+  const Encoded e = described(encode(gen::icosphere(6), eo));
   ASSERT_GT(e.info.clusters, 4000u);
-  for (const double kept : {0.4, 0.6}) {
-    const size_t keep = size_t(double(e.file.size()) * kept);
-    ASSERT_GT(keep, e.info.global_bytes);
+  for (const double kept : {0.4, 0.6}) { // of the cluster data
+    const size_t keep = size_t(e.info.global_bytes + double(e.info.cluster_bytes) * kept);
     const std::vector<uint8_t> file(e.file.begin(), e.file.begin() + long(keep));
     std::vector<uint32_t> missing;
     for (uint32_t c = 0; c < e.info.clusters; ++c)
@@ -261,7 +261,7 @@ TEST(DamagedBlocks, TruncatedManyClusterFileDecodesInOneRound) {
 // Blocks that pass their 8-bit check and are damaged cost at most one more round, however
 // many there are and at whatever level they fail: 24 blocks each with a byte flipped so that
 // the check still passes (most then fail while they are decoded, at different levels), and
-// a cluster index with one size changed (cluster k's block one byte longer, the last one
+// a cluster index with one size changed (the k-th block in the file one byte longer, the last one
 // byte shorter, every checksum right: every block after k is read one byte off, about 255 in
 // 256 of them fail their check and are capped before the decode, the others hold wrong data
 // that may decode), whole and cut at 80%. Rounds, not time: whatever the thread count, the
@@ -274,9 +274,7 @@ TEST(DamagedBlocks, DamagedBlocksPastTheirCheckCostOneRound) {
   EncodeOptions eo;
   eo.clusters = 5000;
   eo.format_version = 4; // (8-bit checks only: a BCHK section catches all of these)
-  Encoded e;
-  e.file = encode(gen::icosphere(6), eo);
-  e.info = inspect(e.file.data(), e.file.size());
+  const Encoded e = described(encode(gen::icosphere(6), eo));
   const uint32_t n = e.info.clusters;
   ASSERT_GT(n, 4000u);
   const FileLayout L = read_layout(e.file.data(), e.file.size());
@@ -291,7 +289,7 @@ TEST(DamagedBlocks, DamagedBlocksPastTheirCheckCostOneRound) {
     std::vector<uint8_t> file = e.file;
     uint32_t flipped = 0;
     for (uint32_t i = 0; i < n && flipped < 24; i += n / 24) {
-      const uint64_t at = index.offset[i], size = index.size[i];
+      const uint64_t at = e.blocks.offset[i], size = index.size[i];
       if (size < 8)
         continue;
       for (uint32_t k = 0; k < 4096; ++k) {
@@ -309,10 +307,10 @@ TEST(DamagedBlocks, DamagedBlocksPastTheirCheckCostOneRound) {
     file.resize(file.size() * 8 / 10);
     cases.push_back({"24 blocks damaged past their check, cut at 80%", file});
   }
-  for (const uint32_t k : {5u, n / 2, n - 40}) {
+  for (const uint32_t k : {5u, n / 2, n - 40}) { // the k-th block in file order
     ClusterIndex shifted = index;
-    ++shifted.size[k];
-    --shifted.size[n - 1];
+    ++shifted.size[e.blocks.order[k]];
+    --shifted.size[e.blocks.order[n - 1]];
     cases.push_back({"misaligned after cluster " + std::to_string(k),
                      hostile::with_cluster_index(e.file, shifted)});
     if (k == n / 2) {
@@ -418,7 +416,7 @@ TEST(DamagedBlocks, StructuralDamagePastTheEightBitCheck) {
   }();
   int located = 0, unlocated = 0, misplaced = 0, tried = 0;
   for (uint32_t c : damageable(e, 40)) {
-    const uint64_t at = index.offset[c], n = index.size[c];
+    const uint64_t at = e.blocks.offset[c], n = index.size[c];
     for (uint32_t k = 0; k < 4096 && tried < 24; ++k) {
       std::vector<uint8_t> file = with_flipped_byte(e.file, at + k % n, uint8_t(1 + k / n));
       if ((checksum(file.data() + at, n) & 0xFF) != index.check[c])

@@ -1,7 +1,9 @@
 // Format version 4: sections in the global part (docs/format.md, "Version 4: sections").
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <memory>
+#include <string>
 
 #include "format/file_format.h"
 #include "pomar/limits.h"
@@ -11,12 +13,17 @@
 namespace pomar {
 namespace {
 
+/// A file of `m` whose only sections are those the tests add: version 5 random-access
+/// files otherwise carry BLKO and CERR (FormatSections.Version5RandomAccessFilesHaveTheir
+/// SectionsByDefault).
 std::vector<uint8_t> file_of(const Mesh &m, bool progressive, int format_version = 5) {
   EncodeOptions o;
   o.progressive = progressive;
   o.clusters = progressive ? 0 : 8;
   o.memory_limit = kNoMemoryLimit;
   o.format_version = format_version;
+  o.spatial_layout = false;
+  o.cluster_errors = false;
   return encode(m, o);
 }
 
@@ -59,6 +66,37 @@ TEST(FormatSections, Version5FilesHaveASectionTableAndKeepTheirVersion) {
     EXPECT_EQ(g.size(), f.size() + kSectionEntryBytes + 3);
     EXPECT_EQ(decode(g.data(), g.size()).triangles, decode(f.data(), f.size()).triangles);
   }
+}
+
+TEST(FormatSections, Version5RandomAccessFilesHaveTheirSectionsByDefault) {
+  EncodeOptions o;
+  o.clusters = 8;
+  const Mesh m = gen::icosphere(2);
+  const std::vector<uint8_t> f = encode(m, o);
+  const FileInfo info = inspect(f.data(), f.size());
+  ASSERT_EQ(info.version, 5u);
+  ASSERT_EQ(info.sections.size(), 2u);
+  std::vector<std::string> names{info.sections[0].name, info.sections[1].name};
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"BLKO", "CERR"}));
+  for (const FileInfo::Section &s : info.sections)
+    EXPECT_EQ(s.required, s.name == "BLKO");
+  // Off, one by one; the mesh is the same.
+  for (const bool errors : {false, true}) {
+    o.cluster_errors = errors;
+    o.spatial_layout = !errors;
+    const std::vector<uint8_t> g = encode(m, o);
+    const FileInfo gi = inspect(g.data(), g.size());
+    ASSERT_EQ(gi.sections.size(), 1u);
+    EXPECT_EQ(gi.sections[0].name, errors ? "CERR" : "BLKO");
+    EXPECT_EQ(decode(g.data(), g.size()).triangles, decode(f.data(), f.size()).triangles);
+  }
+  // Format version 4 writes neither (its readers would refuse BLKO): version 3, no table.
+  o.cluster_errors = o.spatial_layout = true;
+  o.format_version = 4;
+  const std::vector<uint8_t> v4 = encode(m, o);
+  EXPECT_EQ(inspect(v4.data(), v4.size()).version, 3u);
+  EXPECT_TRUE(inspect(v4.data(), v4.size()).sections.empty());
 }
 
 TEST(FormatSections, TheEncoderRefusesAnUnknownFormatVersion) {

@@ -340,12 +340,13 @@ TEST(Lossless, CoarserLevelsAndSelectiveDecodesShowTheCutMesh) {
 TEST(Lossless, DamagedRecordIsAnErrorNotAWrongMesh) {
   const std::vector<uint8_t> file = encode(messy_sphere(2));
   const FileLayout layout = read_layout(file.data(), file.size());
-  ASSERT_EQ(find_section(layout, kLosslessTag), 0); // (then the blocks' checks, BCHK)
-  const SectionEntry &s = layout.header.sections[0];
+  const int li = find_section(layout, kLosslessTag); // (beside the BLKO and CERR sections)
+  ASSERT_GE(li, 0);
+  const SectionEntry &s = layout.header.sections[size_t(li)];
   EXPECT_EQ(s.flags, kSectionRequired);
   for (uint64_t i = 0; i < s.bytes; ++i) {
     std::vector<uint8_t> copy = file;
-    copy[layout.section_offset[0] + i] ^= 0x20;
+    copy[layout.section_offset[size_t(li)] + i] ^= 0x20;
     EXPECT_THROW(decode(copy.data(), copy.size()), Error) << "byte " << i;
   }
 }
@@ -358,7 +359,9 @@ TEST(Lossless, SkipDamagedGivesTheCutMeshWhenTheRecordIsDamaged) {
     EncodeReport er;
     std::vector<uint8_t> file = encode(m, o, &er);
     const FileLayout layout = read_layout(file.data(), file.size());
-    file[layout.section_offset[0] + 1] ^= 0x40;
+    const int li = find_section(layout, kLosslessTag);
+    ASSERT_GE(li, 0);
+    file[layout.section_offset[size_t(li)] + 1] ^= 0x40;
     DecodeOptions d;
     d.skip_damaged = true;
     DecodeReport r;

@@ -18,6 +18,8 @@ struct EncodeArgs {
   double cluster_ratio = 0.01;
   bool progressive = false, quiet = false, repair = false, strict = false, keep_order = false;
   bool embed_textures = false, force = false;
+  bool no_stored_errors = false;
+  std::string block_order = "spatial";
   std::string max_memory = "auto";
   unsigned threads = 0;
   pomar::AttributeOptions attributes;

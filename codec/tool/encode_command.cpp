@@ -58,6 +58,8 @@ int run_encode(const EncodeArgs &a) {
   opt.attributes.keep = parse_drop(a.drop);
   opt.strict = a.strict;
   opt.keep_order = a.keep_order;
+  opt.cluster_errors = !a.no_stored_errors;
+  opt.spatial_layout = a.block_order == "spatial";
   pomar::EncodeReport r;
   const auto t1 = Clock::now();
   std::vector<uint8_t> file;

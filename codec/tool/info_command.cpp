@@ -15,6 +15,20 @@ namespace pomar::tool {
 
 namespace {
 
+bool has_section(const pomar::FileInfo &i, const char *name) {
+  return std::any_of(i.sections.begin(), i.sections.end(),
+                     [&](const pomar::FileInfo::Section &s) { return s.name == name; });
+}
+
+/// What a section the tool knows holds, for the text listing ("" otherwise).
+const char *section_meaning(const std::string &name) {
+  if (name == "CERR")
+    return ": stored errors, a bound per cluster and level for view-dependent decoding";
+  if (name == "BLKO")
+    return ": cluster blocks in spatial (Morton) order";
+  return "";
+}
+
 nlohmann::json info_json(const pomar::FileInfo &i) {
   nlohmann::json j;
   j["version"] = i.version;
@@ -58,6 +72,10 @@ nlohmann::json info_json(const pomar::FileInfo &i) {
                         {"bpv", bpv(sec.bytes, i.vertices)},
                         {"required", sec.required}});
   j["sections"] = sections;
+  if (i.clustered()) {
+    j["stored_errors"] = has_section(i, "CERR");
+    j["block_order"] = has_section(i, "BLKO") ? "spatial" : "id";
+  }
   j["header_bytes"] = i.header_bytes;
   j["base_bytes"] = i.base_bytes;
   j["total_bytes"] = i.total_bytes;
@@ -140,11 +158,17 @@ int print_info(const std::string &in, bool json) {
       std::printf("  %u clusters, block bytes min %u, median %u, max %u (pomar info --json lists "
                   "them all)\n",
                   i.clusters, sizes.front(), sizes[sizes.size() / 2], sizes.back());
+    std::printf("  blocks in %s; %s\n",
+                has_section(i, "BLKO") ? "spatial (Morton) order" : "cluster id order",
+                has_section(i, "CERR")
+                    ? "stored errors per cluster and level"
+                    : "no stored errors (views estimate them from edge lengths)");
   }
   for (const pomar::FileInfo::Section &sec : i.sections)
-    std::printf("  section %s: %lu bytes = %.2f bits/vertex%s\n",
+    std::printf("  section %s: %lu bytes = %.2f bits/vertex%s%s\n",
                 pomar::printable(sec.name).c_str(), static_cast<unsigned long>(sec.bytes),
-                bpv(sec.bytes, i.vertices), sec.required ? " (required)" : "");
+                bpv(sec.bytes, i.vertices), sec.required ? " (required)" : "",
+                section_meaning(sec.name));
   if (i.lossless_bytes)
     std::printf("  lossless record (section LSLS): a full decode gives back the input's %lu "
                 "vertices and %lu faces exactly (levels and regions show the coded, cut mesh)\n",

@@ -2,7 +2,7 @@
 // arguments, options and help) and main(), which runs the command and maps a pomar::Error
 // to the exit status (exit_codes.h).
 //   pomar encode IN OUT.pomar [--bits N] [--progressive] [--strict | --repair] [--keep-order]
-//                [--max-memory SIZE]
+//                [--no-stored-errors] [--block-order spatial|id] [--max-memory SIZE]
 //   pomar decode IN.pomar OUT [--level L] [--cluster/--sphere/--box ...] [--skip-damaged]
 //                [--max-memory SIZE]
 //   pomar info IN.pomar [--json | --check]
@@ -45,6 +45,16 @@ CLI::App *add_encode_command(CLI::App &app, EncodeArgs &a) {
       ->capture_default_str();
   enc->add_flag("--progressive", a.progressive,
                 "Pure progressive mode: global levels only, no random access (a little smaller)");
+  enc->add_flag("--no-stored-errors", a.no_stored_errors,
+                "Random access: leave out the geometric error stored per cluster and level (about "
+                "3% of the file); view-dependent decoding (the web viewer) then estimates the "
+                "errors from edge lengths");
+  enc->add_option("--block-order", a.block_order,
+                  "Random access: how the cluster blocks are laid out in the file: spatial (the "
+                  "Morton order of the clusters, so that the blocks of one region lie together: "
+                  "fewer, longer byte ranges to fetch) or id (cluster id order)")
+      ->check(CLI::IsMember({"spatial", "id"}))
+      ->capture_default_str();
   enc->add_option("--threads", a.threads,
                   "Threads for decimation (0 = every core this process may use); the output is the "
                   "same for any number")

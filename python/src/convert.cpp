@@ -389,6 +389,16 @@ py::dict info_dict(const pomar::FileInfo &i) {
     sections.append(entry);
   }
   d["sections"] = sections;
+  if (i.clustered()) { // (as pomar info --json)
+    const auto has = [&](const char *name) {
+      for (const pomar::FileInfo::Section &section : i.sections)
+        if (section.name == name)
+          return true;
+      return false;
+    };
+    d["stored_errors"] = has("CERR");
+    d["block_order"] = has("BLKO") ? "spatial" : "id";
+  }
   d["lossless_bytes"] = i.lossless_bytes;
   d["lossless_bits_per_vertex"] = bpv(i.lossless_bytes);
   d["input_vertices"] = i.input_vertices;

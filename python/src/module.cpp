@@ -41,7 +41,7 @@ py::bytes encode(const py::handle &vertices, const py::handle &faces, int bits, 
                  double cluster_ratio, bool progressive, const py::handle &max_memory,
                  const py::handle &progress, const py::dict &attributes, int normal_bits,
                  int scalar_bits, int texcoord_bits, bool exact_attributes, bool strict,
-                 bool keep_order, unsigned threads) {
+                 bool keep_order, unsigned threads, bool stored_errors, bool spatial_blocks) {
   check_bits("bits", bits, 4, 24);
   check_bits("normal_bits", normal_bits, 4, 16);
   check_bits("scalar_bits", scalar_bits, 1, 24);
@@ -59,6 +59,8 @@ py::bytes encode(const py::handle &vertices, const py::handle &faces, int bits, 
   options.strict = strict;
   options.keep_order = keep_order;
   options.threads = threads;
+  options.cluster_errors = stored_errors;
+  options.spatial_layout = spatial_blocks;
   options.memory_limit = memory_limit(max_memory);
   options.progress = python_progress(progress);
   std::vector<uint8_t> file;
@@ -152,7 +154,8 @@ PYBIND11_MODULE(_pomar, m) {
         py::arg("clusters"), py::arg("cluster_ratio"), py::arg("progressive"),
         py::arg("memory_limit"), py::arg("progress"), py::arg("attributes"), py::arg("normal_bits"),
         py::arg("scalar_bits"), py::arg("texcoord_bits"), py::arg("exact_attributes"),
-        py::arg("strict"), py::arg("keep_order"), py::arg("threads"));
+        py::arg("strict"), py::arg("keep_order"), py::arg("threads"), py::arg("stored_errors"),
+        py::arg("spatial_blocks"));
   m.def("decode", &decode, py::arg("data"), py::arg("level"), py::arg("skip_damaged"),
         py::arg("memory_limit"), py::arg("progress"), py::arg("attributes"), py::arg("threads"));
   m.def("info", &info, py::arg("data"));

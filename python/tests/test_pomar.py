@@ -969,18 +969,28 @@ def _view_levels_in_python(d, eye, view_proj, fov_y, height, near, pixels):
     return out
 
 
+def test_stored_errors_and_block_order_are_options():
+    vertices, faces = torus(60, 30)
+    def names(data):
+        return sorted(s["name"] for s in pomar.info(data)["sections"])
+    assert names(pomar.encode(vertices, faces)) == ["BLKO", "CERR"]
+    assert names(pomar.encode(vertices, faces, stored_errors=False)) == ["BLKO"]
+    assert names(pomar.encode(vertices, faces, block_order="id")) == ["CERR"]
+    plain = pomar.encode(vertices, faces, stored_errors=False, block_order="id")
+    assert names(plain) == []
+    assert np.array_equal(pomar.decode(plain).faces, pomar.decode(pomar.encode(vertices, faces)).faces)
+    with pytest.raises(ValueError):
+        pomar.encode(vertices, faces, block_order="morton")
+
+
 def test_want_view_uses_the_stored_errors(tmp_path):
     vertices, faces = torus(120, 60)
-    # A file with stored errors (CERR): written by `pomar_ra_bench encode`, beside the tool.
-    tool = os.environ.get("POMAR_TOOL", "")
-    bench = os.path.join(os.path.dirname(tool), "..", "bench", "pomar_ra_bench")
-    if not os.path.exists(bench):
-        pytest.skip("no pomar_ra_bench beside POMAR_TOOL")
-    pomar.write(str(tmp_path / "torus.ply"), pomar.Mesh(vertices, faces))
-    subprocess.check_call([bench, "encode", str(tmp_path / "torus.ply"),
-                           str(tmp_path / "torus.pomar"), "0.03"], stdout=subprocess.DEVNULL)
-    d = pomar.SelectiveDecoder(str(tmp_path / "torus.pomar"))
-    assert not pomar.SelectiveDecoder(pomar.encode(vertices, faces)).has_cluster_errors
+    # Files store the errors (CERR) by default; stored_errors=False leaves them out.
+    data = pomar.encode(vertices, faces, cluster_ratio=0.03)
+    d = pomar.SelectiveDecoder(data)
+    without = pomar.encode(vertices, faces, cluster_ratio=0.03, stored_errors=False)
+    assert not pomar.SelectiveDecoder(without).has_cluster_errors
+    assert len(without) < len(data)
     assert d.has_cluster_errors
     base, finest = d.base_clustered_level, d.finest_level
     assert d.cluster_error(0, finest) == 0

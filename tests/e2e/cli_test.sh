@@ -326,6 +326,33 @@ sys.exit(1 if bad else 0)
 PY
 pass
 
+section "stored errors and the spatial block order by default; --no-stored-errors, --block-order id"
+run encode "$WORK/nm/clean.ply" "$WORK/nm/layout_default.pomar"
+expect_rc 0
+run info "$WORK/nm/layout_default.pomar"
+expect_contains "$OUT" "blocks in spatial (Morton) order; stored errors per cluster and level" "pomar info"
+expect_contains "$OUT" "section CERR:" "pomar info"
+expect_contains "$OUT" "section BLKO:" "pomar info"
+run info "$WORK/nm/layout_default.pomar" --json
+expect_contains "$OUT" '"stored_errors": true' "pomar info --json"
+expect_contains "$OUT" '"block_order": "spatial"' "pomar info --json"
+run encode "$WORK/nm/clean.ply" "$WORK/nm/layout_plain.pomar" --no-stored-errors --block-order id
+expect_rc 0
+run info "$WORK/nm/layout_plain.pomar"
+expect_contains "$OUT" "blocks in cluster id order; no stored errors" "pomar info"
+case "$OUT" in *"section CERR"*|*"section BLKO"*) fail "--no-stored-errors --block-order id wrote a CERR or BLKO section" ;; esac
+pass
+[ "$(stat -c %s "$WORK/nm/layout_plain.pomar")" -lt "$(stat -c %s "$WORK/nm/layout_default.pomar")" ] \
+  || fail "the file without stored errors is not smaller"
+pass
+run verify "$WORK/nm/clean.ply" "$WORK/nm/layout_plain.pomar"
+expect_rc 0
+run verify "$WORK/nm/clean.ply" "$WORK/nm/layout_default.pomar"
+expect_rc 0
+run encode "$WORK/nm/clean.ply" "$WORK/nm/layout_bad.pomar" --block-order morton
+expect_nonzero
+expect_no_file "$WORK/nm/layout_bad.pomar"
+
 section "encode --repair cuts the non-manifold input and reports every change"
 mkdir "$WORK/repair"
 run encode "$NONMANIFOLD" "$WORK/repair/out.pomar" --repair
@@ -958,7 +985,7 @@ help_mentions() { # help_mentions SUBCOMMAND OPTION...
   for opt in "$@"; do expect_contains "$OUT" "$opt" "pomar $sub --help"; done
 }
 help_mentions encode --bits --progressive --clusters --cluster-ratio --repair --strict --keep-order --quiet --max-memory 512M input output \
-  --drop --normal-bits --scalar-bits --texcoord-bits --exact-attributes --embed-textures --force
+  --no-stored-errors --block-order spatial --drop --normal-bits --scalar-bits --texcoord-bits --exact-attributes --embed-textures --force
 help_mentions decode --level --cluster --sphere --box --stats --ascii --quiet --skip-damaged --max-memory input output \
   --no-attributes
 help_mentions info --json --check input

@@ -229,7 +229,11 @@ def main():
         touch('touchStart', [(0, box)])
         touch('touchEnd', [])
         refined = settled('refinement on')
-        check(refined['maxLevel'] > first['maxLevel'] and refined['bytesFetched'] > first['bytesFetched'],
+        # (the file stores its errors: at the phone's overview the base clustered mesh may
+        # already be within the pixel budget, so the tap need not refine; the pinch below must)
+        on = page('Runtime.evaluate', {'expression': "document.getElementById('refine').checked",
+                                       'returnByValue': True})['result']['value']
+        check(on and refined['maxLevel'] >= first['maxLevel'] and refined['bytesFetched'] >= first['bytesFetched'],
               f"a tap turns refinement on: levels {refined['minLevel']}..{refined['maxLevel']}, {refined['triangles']} "
               f"triangles, {refined['bytesFetched']} bytes")
 
@@ -254,9 +258,11 @@ def main():
               f"{pinch['finestClusters']} clusters at the finest level, {pinch['bytesFetched']} bytes in "
               f"{pinch['requests']} requests, camera distance {orbit['distance']:.4g} -> {pinch['distance']:.4g}")
         check(pinch['distance'] < orbit['distance'] / 2, 'a two-finger pinch zooms in')
-        check(pinch['finestClusters'] > orbit['finestClusters'] and pinch['bytesFetched'] >= orbit['bytesFetched'],
-              f"the pinch refined: {orbit['finestClusters']} -> {pinch['finestClusters']} clusters at the finest level "
-              f"({pinch['bytesFetched'] - orbit['bytesFetched']} more bytes)")
+        check((pinch['finestClusters'] > orbit['finestClusters'] or pinch['maxLevel'] > orbit['maxLevel'])
+              and pinch['triangles'] > orbit['triangles'] and pinch['bytesFetched'] > orbit['bytesFetched'],
+              f"the pinch refined: levels up to {orbit['maxLevel']} -> {pinch['maxLevel']}, {orbit['finestClusters']} -> "
+              f"{pinch['finestClusters']} clusters at the finest level, {orbit['triangles']} -> {pinch['triangles']} "
+              f"triangles ({pinch['bytesFetched'] - orbit['bytesFetched']} more bytes)")
         check(pinch['covered'] > first['covered'], 'the model fills more of the screen')
 
         # Two fingers moving together: pan (the target follows their midpoint).

@@ -68,8 +68,9 @@ node "$REPO/web/test/wasm_decode_test.mjs" --textured "$TOOL" "$samples/textured
   "$samples/textured_sphere.pomar" ${textured_scan[@]+"${textured_scan[@]}"}
 if [ -x "$RA_BENCH" ]; then
   echo "web tests: view selection in WASM = native (node web/test/view_test.mjs)"
+  "$TOOL" encode "$REPO/samples/bunny.ply" "$samples/bunny_edges.pomar" --no-stored-errors -q
   node "$REPO/web/test/view_test.mjs" "$RA_BENCH" "$samples/bunny_view.pomar" \
-    "$samples/bunny_view_c5.pomar" "$samples/bunny.pomar"
+    "$samples/bunny_view_c5.pomar" "$samples/bunny.pomar" "$samples/bunny_edges.pomar"
 else
   echo "web tests: view selection SKIPPED: no $RA_BENCH"
 fi

@@ -173,20 +173,24 @@ struct EncodeOptions {
   /// vertex smaller), or 4: the layout of versions 1, 3 and 4 (readers that predate
   /// version 5 read it).
   int format_version = 5;
-  /// Random-access files: store the cluster blocks in the Morton order of the clusters'
-  /// roots (section BLKO, required), so that the blocks of
-  /// one region lie together in the file. Off by default.
-  bool spatial_layout = false;
-  /// Random-access files: store a geometric error per cluster and level (section CERR,
-  /// optional), measured by decoding the file level by level,
-  /// for view-dependent decoding (SelectiveDecoder::want_view). Off by default.
-  bool cluster_errors = false;
-  /// Measurement of the tiers of docs/format.md ("Version 5", part 1; pomar_ra_bench tiers,
-  /// not a tool option): decimate the rounds down to the clusters' count in tiers of
-  /// `tier_rounds` rounds, each on a grid of cells holding about `tier_cell_vertices`
-  /// vertices at the tier's start, collapsing only inside a cell, the cells' border
-  /// vertices locked. The file is an ordinary file (the levels are just collapses).
-  /// 0 = off (the default).
+  /// Random-access files of version 5: store the cluster blocks in the Morton order of the
+  /// clusters' roots (section BLKO, required), so that the blocks of one region lie
+  /// together in the file. Off: the blocks in cluster id order. On by default.
+  bool spatial_layout = true;
+  /// Random-access files of version 5: store a geometric error per cluster and level
+  /// (section CERR, optional; about 3% of the file), bounded while the clustered levels are
+  /// coded, for view-dependent decoding (SelectiveDecoder::want_view). On by default.
+  bool cluster_errors = true;
+  /// Random-access files of version 5: store the whole 32-bit checksum of every cluster
+  /// block (section BCHK, optional; 3 bytes per cluster), so that a damaged block is found
+  /// by a region decode or `--skip-damaged` however its data decodes. On by default.
+  bool block_checks = true;
+  /// Measurement of a layout of tiers (bench/README.md, "Tiers of clustered levels: measured
+  /// cost"; pomar_ra_bench tiers, not a tool option): decimate the rounds down to the
+  /// clusters' count in tiers of `tier_rounds` rounds, each on a grid of cells holding about
+  /// `tier_cell_vertices` vertices at the tier's start, collapsing only inside a cell, the
+  /// cells' border vertices locked. The file is an ordinary file (the levels are just
+  /// collapses). 0 = off (the default).
   uint32_t tier_rounds = 0;
   uint32_t tier_cell_vertices = 1024;
 };

@@ -5,8 +5,7 @@
 #include <cmath>
 
 #include "format/cluster_errors.h"
-#include "pomar/limits.h"
-#include "pomar/random_access.h"
+#include "parallel/thread_pool.h"
 
 namespace pomar {
 
@@ -20,6 +19,11 @@ V3 operator+(V3 a, V3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
 V3 operator*(double s, V3 a) { return {s * a.x, s * a.y, s * a.z}; }
 double dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 double norm2(V3 a) { return dot(a, a); }
+
+V3 at(const std::vector<int32_t> &q, uint32_t v) {
+  const int32_t *p = q.data() + 3 * size_t(v);
+  return {double(p[0]), double(p[1]), double(p[2])};
+}
 
 /// Squared distance from p to the triangle abc (the closest point by its Voronoi region).
 double distance2_to_triangle(V3 p, V3 a, V3 b, V3 c) {
@@ -51,102 +55,143 @@ double distance2_to_triangle(V3 p, V3 a, V3 b, V3 c) {
   return norm2(p - (a + v * ab + w * ac));
 }
 
-/// CSR lists of `items` grouped by key (keys < groups).
-void group(const std::vector<uint32_t> &key, uint32_t begin, uint32_t end, uint32_t groups,
-           std::vector<uint32_t> &start, std::vector<uint32_t> &list) {
-  start.assign(groups + 1, 0);
-  for (uint32_t v = begin; v < end; ++v)
-    ++start[key[v] + 1];
-  for (uint32_t g = 0; g < groups; ++g)
-    start[g + 1] += start[g];
-  list.resize(end - begin);
-  std::vector<uint32_t> at(start.begin(), start.end() - 1);
-  for (uint32_t v = begin; v < end; ++v)
-    list[at[key[v]]++] = v;
+/// Raise `worst` to the squared distance from p to the faces around vertex a of `mesh`
+/// if it is larger. The distance is only computed as far as it can raise it: a face (or
+/// a itself, a corner of each) within `worst` of p settles that it cannot.
+void raise_to_fan_distance(const LevelMesh &mesh, uint32_t a, V3 p, double &worst) {
+  const V3 pa = p - at(mesh.q, a);
+  double best = norm2(pa);
+  if (best <= worst)
+    return;
+  const CornerTable &ct = mesh.ct;
+  const uint32_t first = ct.VC[a];
+  const auto face = [&](uint32_t c) {
+    const double d = distance2_to_triangle(p, at(mesh.q, a), at(mesh.q, ct.V[CornerTable::next(c)]),
+                                           at(mesh.q, ct.V[CornerTable::prev(c)]));
+    best = std::min(best, d);
+    return d <= worst;
+  };
+  if (first != kNone) {
+    uint32_t c = first;
+    do {
+      if (face(c))
+        return;
+      c = ct.swing_ccw(c);
+    } while (c != kNone && c != first);
+    if (c == kNone) // an open fan: the faces clockwise of the first
+      for (c = ct.swing_cw(first); c != kNone; c = ct.swing_cw(c))
+        if (face(c))
+          return;
+  }
+  worst = best;
 }
+
+constexpr uint32_t kClustersPerItem = 64; // on the threads
 
 } // namespace
 
-std::vector<uint8_t> measure_cluster_errors(const std::vector<uint8_t> &file, unsigned threads) {
-  SelectiveOptions options;
-  options.attributes = AttributeMask::none();
-  options.memory_limit = kNoMemoryLimit;
-  options.threads = threads;
-  SelectiveDecoder d(std::make_unique<MemorySource>(file.data(), file.size()), options);
-  const uint32_t clusters = d.cluster_count();
-  const int base = d.base_clustered_level(), finest = d.finest_level();
-  const uint32_t levels = uint32_t(finest - base);
-  // The faces of every stored level (the mesh decoded uniformly to it); the positions are
-  // those of the full decode (a vertex keeps its position from the level that creates it).
-  std::vector<std::vector<uint32_t>> faces(levels);
-  std::vector<uint32_t> vertices(levels);
-  for (int l = base; l <= finest; ++l) {
-    if (l > base) {
-      d.want_all(l);
-      d.update();
-    }
-    if (l < finest) {
-      Mesh m = d.mesh();
-      vertices[size_t(l - base)] = static_cast<uint32_t>(m.vertex_count());
-      faces[size_t(l - base)] = std::move(m.triangles);
-    }
+ClusterErrorMeasure::ClusterErrorMeasure(const Rebuild &rb, size_t global, const Quantizer &grid)
+    : global_(static_cast<uint32_t>(global)), clusters_(rb.mesh.vertex_count()),
+      step_(grid.step()) {
+  // The decoder's positions are the grid's rounded to floats: each coordinate within half
+  // a float ulp of the grid position, so a point within sqrt(3) 2^-24 M of it (M: the
+  // largest magnitude on the grid), and a distance from a point to a triangle within twice
+  // that.
+  double m = 0;
+  for (int k = 0; k < 3; ++k)
+    m = std::max({m, std::fabs(double(grid.origin[k])),
+                  std::fabs(double(grid.origin[k]) + double(grid.extent))});
+  margin_ = 2.0 * std::sqrt(3.0) * std::ldexp(m, -24);
+  // The cluster of every vertex the clustered levels create (its v_to's), then the entries
+  // grouped by cluster, each cluster's in creation order.
+  const size_t nv = rb.q.size() / 3;
+  std::vector<uint32_t> cluster(nv, kNone), entry(nv, kNone);
+  std::vector<uint32_t> count(clusters_ + 1, 0);
+  for (uint32_t c = 0; c < clusters_; ++c) {
+    cluster[rb.dec_to_input[c]] = c;
+    ++count[c + 1];
   }
-  const Mesh full = d.mesh();
-  const std::vector<uint32_t> cluster = d.vertex_cluster();
-  const uint32_t nv = static_cast<uint32_t>(full.vertex_count());
-  const auto at = [&](uint32_t v) {
-    const float *p = full.positions.data() + 3 * size_t(v);
-    return V3{p[0], p[1], p[2]};
+  for (size_t r = global + 1; r <= rb.levels(); ++r)
+    for (const Collapse &s : rb.collapses(r)) {
+      cluster[s.v_from] = cluster[s.v_to];
+      ++count[cluster[s.v_from] + 1];
+    }
+  for (uint32_t c = 0; c < clusters_; ++c)
+    count[c + 1] += count[c];
+  start_ = count;
+  first_future_.assign(start_.begin(), start_.end() - 1);
+  const size_t n = start_.back();
+  created_.resize(n);
+  parent_.resize(n);
+  id_.resize(n);
+  ancestor_.assign(n, kNone);
+  q_.resize(3 * n);
+  const auto put = [&](uint32_t v, uint32_t level, uint32_t parent) {
+    const uint32_t i = count[cluster[v]]++;
+    entry[v] = i;
+    created_[i] = static_cast<uint16_t>(level);
+    parent_[i] = parent == kNone ? kNone : entry[parent];
+    id_[i] = v;
+    std::copy_n(&rb.q[3 * size_t(v)], 3, &q_[3 * size_t(i)]);
   };
-  std::vector<double> error(size_t(levels) * clusters, 0);
-  std::vector<uint32_t> fan_start, fan, present_start, present, future_start, future;
-  for (uint32_t k = 0; k < levels; ++k) {
-    const std::vector<uint32_t> &t = faces[k];
-    const uint32_t n = vertices[k];
-    // The faces around each vertex of level l.
-    fan_start.assign(n + 1, 0);
-    for (uint32_t v : t)
-      ++fan_start[v + 1];
-    for (uint32_t v = 0; v < n; ++v)
-      fan_start[v + 1] += fan_start[v];
-    fan.resize(t.size());
-    {
-      std::vector<uint32_t> put(fan_start.begin(), fan_start.end() - 1);
-      for (size_t i = 0; i < t.size(); ++i)
-        fan[put[t[i]]++] = static_cast<uint32_t>(i / 3);
-    }
-    group(cluster, 0, n, clusters, present_start, present);
-    group(cluster, n, nv, clusters, future_start, future);
-    for (uint32_t c = 0; c < clusters; ++c) {
-      double worst = 0;
-      for (uint32_t i = future_start[c]; i < future_start[c + 1]; ++i) {
-        const V3 p = at(future[i]);
-        uint32_t nearest = UINT32_MAX;
-        double best = INFINITY;
-        for (uint32_t j = present_start[c]; j < present_start[c + 1]; ++j) {
-          const double d2 = norm2(p - at(present[j]));
-          if (d2 < best) {
-            best = d2;
-            nearest = present[j];
-          }
-        }
-        if (nearest == UINT32_MAX)
-          continue; // (every cluster holds its root)
-        for (uint32_t j = fan_start[nearest]; j < fan_start[nearest + 1]; ++j) {
-          const uint32_t *f = t.data() + 3 * size_t(fan[j]);
-          best = std::min(best, distance2_to_triangle(p, at(f[0]), at(f[1]), at(f[2])));
-        }
-        worst = std::max(worst, best);
-      }
-      error[size_t(k) * clusters + c] = std::sqrt(worst);
-    }
+  for (uint32_t c = 0; c < clusters_; ++c)
+    put(rb.dec_to_input[c], uint32_t(global), kNone);
+  for (size_t r = global + 1; r <= rb.levels(); ++r)
+    for (const Collapse &s : rb.collapses(r))
+      put(s.v_from, uint32_t(r), s.v_to);
+}
+
+void ClusterErrorMeasure::measure_cluster(const Rebuild &rb, uint32_t level, uint32_t c,
+                                          double &worst) {
+  const LevelMesh &mesh = rb.mesh;
+  uint32_t i = first_future_[c];
+  const uint32_t end = start_[c + 1];
+  for (; i < end && created_[i] <= level; ++i) // present from this level on: decoder ids
+    id_[i] = rb.input_to_dec[id_[i]];
+  first_future_[c] = i;
+  const uint32_t first = i;
+  for (; i < end; ++i) { // the ancestors first (entry order: a parent's before its children)
+    const uint32_t p = parent_[i];
+    ancestor_[i] = created_[p] <= level ? id_[p] : ancestor_[p];
   }
+  constexpr uint32_t kAhead = 8; // the fans read next are fetched meanwhile
+  for (i = first; i < end; ++i) {
+    if (i + kAhead < end) {
+      const uint32_t b = ancestor_[i + kAhead];
+      __builtin_prefetch(&mesh.ct.VC[b]);
+      __builtin_prefetch(&mesh.q[3 * size_t(b)]);
+    }
+    raise_to_fan_distance(mesh, ancestor_[i], at(q_, i), worst);
+  }
+}
+
+void ClusterErrorMeasure::measure(const Rebuild &rb, ThreadPool *pool) {
+  const uint32_t level = global_ + measured_++;
+  std::vector<double> worst(clusters_, -1.0); // -1: no vertex of the cluster is missing
+  const auto clusters = [&](uint32_t begin, uint32_t end) {
+    for (uint32_t c = begin; c < end; ++c)
+      measure_cluster(rb, level, c, worst[c]);
+  };
+  const uint32_t items = (clusters_ + kClustersPerItem - 1) / kClustersPerItem;
+  if (pool && items > 1)
+    pool->run(items, [&](size_t i, unsigned) {
+      const uint32_t begin = uint32_t(i) * kClustersPerItem;
+      clusters(begin, std::min(clusters_, begin + kClustersPerItem));
+    });
+  else
+    clusters(0, clusters_);
+  for (uint32_t c = 0; c < clusters_; ++c)
+    error_.push_back(worst[c] < 0 ? 0.0 : std::sqrt(worst[c]) * step_ * (1 + 1e-9) + margin_);
+}
+std::vector<uint8_t> ClusterErrorMeasure::section() const {
+  std::vector<double> error = error_;
+  const uint32_t levels = measured_;
   // A coarser level never promises less than a finer one.
   for (uint32_t k = levels; k-- > 1;)
-    for (uint32_t c = 0; c < clusters; ++c)
-      error[size_t(k - 1) * clusters + c] =
-          std::max(error[size_t(k - 1) * clusters + c], error[size_t(k) * clusters + c]);
-  return write_cluster_errors(quantize_cluster_errors(uint32_t(base), clusters, error));
+    for (uint32_t c = 0; c < clusters_; ++c)
+      error[size_t(k - 1) * clusters_ + c] =
+          std::max(error[size_t(k - 1) * clusters_ + c], error[size_t(k) * clusters_ + c]);
+  return write_cluster_errors(quantize_cluster_errors(global_, clusters_, error));
 }
 
 } // namespace pomar

@@ -58,6 +58,7 @@ public:
     counts_.resize(pool_->size());
   }
   bool on() const { return pool_ != nullptr; }
+  ThreadPool *pool() const { return pool_.get(); }
 
   /// Record every cluster's splits of `where.level` (where.cluster is ignored), and count
   /// the symbols recorded (counts()).
@@ -132,7 +133,7 @@ private:
 
 ClusteredLevels encode_clustered_levels(Rebuild &rb, size_t global, FileHeader &header,
                                         unsigned threads, uint32_t min_parallel_vertices,
-                                        const Progress &progress) {
+                                        const Progress &progress, ClusterErrorMeasure *errors) {
   const size_t L = rb.levels();
   LevelMesh &lm = rb.mesh;
   header.flags |= kFlagClustered;
@@ -165,6 +166,8 @@ ClusteredLevels encode_clustered_levels(Rebuild &rb, size_t global, FileHeader &
   ParallelClusters parallel(rb, clusters, threads);
   for (size_t r = global; r < L; ++r) {
     const uint32_t level = static_cast<uint32_t>(r + 1);
+    if (errors) // (the mesh holds level r)
+      errors->measure(rb, parallel.pool());
     Models &models = level_models[r - global];
     choose_wedge_predictor(rb, level);
     if (rb.fit_normal)

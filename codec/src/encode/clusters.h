@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "encode/cluster_error_measure.h"
 #include "encode/encoder_codec.h"
 #include "pomar/pomar.h"
 
@@ -31,8 +32,11 @@ struct ClusteredLevels {
 /// The clusters of a level are recorded on `threads` threads (1: one after the other),
 /// those of a level started on fewer than `min_parallel_vertices` vertices on the calling
 /// thread; the file does not depend on either.
+/// With `errors`, the stored error of each level is bounded before the level above it is
+/// coded (the mesh is then the one a decoder holds at that level).
 ClusteredLevels encode_clustered_levels(Rebuild &rebuild, size_t global, FileHeader &header,
                                         unsigned threads, uint32_t min_parallel_vertices,
-                                        const Progress &progress);
+                                        const Progress &progress,
+                                        ClusterErrorMeasure *errors = nullptr);
 
 } // namespace pomar

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <optional>
 #include <string>
 
 #include "attributes/attribute_section.h"
@@ -390,9 +391,14 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
   const std::vector<std::vector<uint8_t>> blocks =
       encode_global_levels(rb, global, header, bits, options.progress);
   ClusteredLevels clustered;
-  if (global < rb.levels())
+  std::optional<ClusterErrorMeasure> errors; // (section CERR, bounded level by level)
+  if (global < rb.levels()) {
+    if (options.cluster_errors && options.format_version >= 5)
+      errors.emplace(rb, global, in.grid);
     clustered = encode_clustered_levels(rb, global, header, decode_threads(options.threads),
-                                        options.min_parallel_vertices, options.progress);
+                                        options.min_parallel_vertices, options.progress,
+                                        errors ? &*errors : nullptr);
+  }
   if (rb.mesh.vertex_count() != nv || rb.mesh.ct.face_count() != nf)
     throw Error(Error::Kind::Internal,
                 "internal encoder error: the refined mesh does not match the input");
@@ -405,24 +411,22 @@ std::vector<uint8_t> encode_manifold(const Mesh &mesh, const EncodeOptions &opti
     sections.push_back(
         {kGeometryPredictionTag, kSectionRequired, write_geometry_prediction(rb.normal)});
   // Random access, version 5: each block's whole XXH32 (section BCHK, optional).
-  if (header.clustered() && header.ranks_patches())
+  if (header.clustered() && header.ranks_patches() && options.block_checks)
     sections.push_back({kBlockChecksTag, 0, write_block_checks(clustered.blocks)});
   // Random access: the blocks in the Morton order of their roots (section BLKO, required:
-  // a reader that does not know it would look for the blocks in id order).
+  // a reader that does not know it would look for the blocks in id order). Both it and
+  // CERR are version 5's: format_version 4 writes the files of the readers before it.
   std::vector<uint32_t> block_order;
-  if (header.clustered() && options.spatial_layout) {
+  if (header.clustered() && options.spatial_layout && options.format_version >= 5) {
     block_order =
         morton_block_order(rb.mesh.q, static_cast<uint32_t>(clustered.blocks.size()), in.grid.bits);
     sections.push_back({kBlockOrderTag, kSectionRequired, write_block_order()});
   }
+  if (errors) // the error per cluster and level (section CERR, optional)
+    sections.push_back({kClusterErrorsTag, 0, errors->section()});
   std::vector<uint8_t> file =
       write_file(header, pack_base_mesh(base, in.grid.bits), blocks, clustered.tables,
                  clustered.blocks, sections, block_order.empty() ? nullptr : &block_order);
-  // The error per cluster and level (section CERR, optional), measured on the file itself.
-  if (header.clustered() && options.cluster_errors) {
-    std::vector<uint8_t> errors = measure_cluster_errors(file, decode_threads(options.threads));
-    file = with_sections(file.data(), file.size(), {{kClusterErrorsTag, 0, std::move(errors)}});
-  }
   if (report) {
     fill_report(file, in, rb, input_vertices, *report);
     report->quantize_seconds = t_quantize;
