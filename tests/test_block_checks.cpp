@@ -7,9 +7,11 @@
 #include <string>
 
 #include "format/block_checks.h"
+#include "format/block_order.h"
 #include "format/file_format.h"
 #include "pomar/pomar.h"
 #include "pomar/random_access.h"
+#include "support/block_layout.h"
 #include "support/hostile_files.h"
 #include "support/mesh_compare.h"
 #include "support/mesh_gen.h"
@@ -25,10 +27,13 @@ struct Encoded {
   ClusterIndex index; // with the section's checks, as a decoder reads them
 };
 
-Encoded encode_sphere(int format_version) {
+Encoded encode_sphere(int format_version, bool spatial_layout = false) {
   EncodeOptions o;
   o.cluster_ratio = 0.02;
   o.format_version = format_version;
+  // Blocks in cluster id order, so that a misaligned index shifts every block after the
+  // damage (the default spatial order is checked by the first test).
+  o.spatial_layout = spatial_layout;
   Encoded e;
   e.file = encode(gen::icosphere(5), o);
   e.layout = read_layout(e.file.data(), e.file.size());
@@ -80,6 +85,15 @@ TEST(BlockChecks, VersionFiveFilesHoldTheWholeChecksumOfEveryBlock) {
   EXPECT_EQ(e.index.check_mask, 0xFFFFFFFFu);
   for (uint32_t c = 0; c < n; ++c)
     EXPECT_EQ(e.index.check[c], checksum(e.file.data() + e.index.offset[c], e.index.size[c]));
+  // The same with the blocks in the spatial order (BLKO, the default): the checks stay in
+  // cluster id order, each the whole XXH32 of its cluster's block wherever it lies.
+  const Encoded spatial = encode_sphere(5, true);
+  ASSERT_GE(find_section(spatial.layout, kBlockOrderTag), 0);
+  const test::BlockLayout blocks = test::block_layout(spatial.file);
+  EXPECT_NE(blocks.order.front(), 0u);
+  for (uint32_t c = 0; c < spatial.layout.header.clusters; ++c)
+    EXPECT_EQ(spatial.index.check[c],
+              checksum(spatial.file.data() + blocks.offset[c], blocks.size[c]));
   // Format version 4 writes no such section: its blocks keep their 8-bit checks.
   const Encoded v4 = encode_sphere(4);
   EXPECT_EQ(find_section(v4.layout, kBlockChecksTag), -1);

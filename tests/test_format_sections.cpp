@@ -75,13 +75,16 @@ TEST(FormatSections, Version5RandomAccessFilesHaveTheirSectionsByDefault) {
   const std::vector<uint8_t> f = encode(m, o);
   const FileInfo info = inspect(f.data(), f.size());
   ASSERT_EQ(info.version, 5u);
-  ASSERT_EQ(info.sections.size(), 2u);
-  std::vector<std::string> names{info.sections[0].name, info.sections[1].name};
+  ASSERT_EQ(info.sections.size(), 3u);
+  std::vector<std::string> names;
+  for (const FileInfo::Section &s : info.sections)
+    names.push_back(s.name);
   std::sort(names.begin(), names.end());
-  EXPECT_EQ(names, (std::vector<std::string>{"BLKO", "CERR"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"BCHK", "BLKO", "CERR"}));
   for (const FileInfo::Section &s : info.sections)
     EXPECT_EQ(s.required, s.name == "BLKO");
   // Off, one by one; the mesh is the same.
+  o.block_checks = false;
   for (const bool errors : {false, true}) {
     o.cluster_errors = errors;
     o.spatial_layout = !errors;
@@ -91,7 +94,13 @@ TEST(FormatSections, Version5RandomAccessFilesHaveTheirSectionsByDefault) {
     EXPECT_EQ(gi.sections[0].name, errors ? "CERR" : "BLKO");
     EXPECT_EQ(decode(g.data(), g.size()).triangles, decode(f.data(), f.size()).triangles);
   }
-  // Format version 4 writes neither (its readers would refuse BLKO): version 3, no table.
+  o.cluster_errors = o.spatial_layout = false;
+  o.block_checks = true;
+  const std::vector<uint8_t> checks_only = encode(m, o);
+  const FileInfo ci = inspect(checks_only.data(), checks_only.size());
+  ASSERT_EQ(ci.sections.size(), 1u);
+  EXPECT_EQ(ci.sections[0].name, "BCHK");
+  // Format version 4 writes none (its readers would refuse BLKO): version 3, no table.
   o.cluster_errors = o.spatial_layout = true;
   o.format_version = 4;
   const std::vector<uint8_t> v4 = encode(m, o);

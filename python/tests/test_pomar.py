@@ -971,8 +971,9 @@ def _view_levels_in_python(d, eye, view_proj, fov_y, height, near, pixels):
 
 def test_stored_errors_and_block_order_are_options():
     vertices, faces = torus(60, 30)
-    def names(data):
-        return sorted(s["name"] for s in pomar.info(data)["sections"])
+    def names(data):  # besides the blocks' 32-bit checks and the normal predictor
+        return sorted(s["name"] for s in pomar.info(data)["sections"]
+                      if s["name"] not in ("BCHK", "GEOP"))
     assert names(pomar.encode(vertices, faces)) == ["BLKO", "CERR"]
     assert names(pomar.encode(vertices, faces, stored_errors=False)) == ["BLKO"]
     assert names(pomar.encode(vertices, faces, block_order="id")) == ["CERR"]
