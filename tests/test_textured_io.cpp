@@ -488,7 +488,8 @@ TEST_F(TexturedIo, WedgesPredictedEitherWayDecode) {
   const std::vector<uint8_t> new_file = encode(m);
   ASSERT_FALSE(old_file.empty());
   EXPECT_LT(attribute_section_version(old_file), 3);
-  { // the same layout as the old file (no stored errors, blocks in id order, no 32-bit block checks): no larger
+  { // the same layout as the old file (no stored errors, blocks in id order, no 32-bit block
+    // checks): no larger
     EncodeOptions o;
     o.cluster_errors = false;
     o.spatial_layout = false;

@@ -43,8 +43,8 @@ export function globalBytes(M, prefix, fileSize) {
 
 /** Where the pieces of the global part lie, from the file's first bytes `prefix` (null
  *  while they do not hold the whole header): {headerBytes, baseEnd, attrStart, attrEnd
- *  (0 0: no ATTR section), levelEnds (end of each global level's bytes), levelStart (level
- *  1), tablesOffset (model tables; a progressive file: the end of its levels), globalBytes}. */
+ *  (the span of the sections the levels need, ATTR and GEOP; 0 0: none), levelEnds (end
+ *  of each global level's bytes), levelStart (level 1), tablesOffset (model tables; a progressive file: the end of its levels), globalBytes}. */
 export function layoutOf(M, prefix, fileSize) {
   const ptr = withBytes(M, prefix, (p) => M._pw_layout(p, prefix.length, fileSize));
   if (!ptr) return null;
@@ -56,8 +56,8 @@ export function layoutOf(M, prefix, fileSize) {
 }
 
 /** The mesh of a first frame: the base mesh and global levels 1..`levels`, decoded from
- *  `bytes` (the file's first bytes; only the header, the base mesh, the ATTR section if
- *  any and those levels need to be there: layoutOf). {positions, triangles, level}. */
+ *  `bytes` (the file's first bytes; only the header, the base mesh, the ATTR and GEOP
+ *  sections if any and those levels need to be there: layoutOf). {positions, triangles, level}. */
 export function previewMesh(M, bytes, fileSize, levels) {
   const level = withBytes(M, bytes, (p) => M._pw_preview(p, bytes.length, fileSize, levels));
   if (level < 0) throw new PomarError(lastError(M));

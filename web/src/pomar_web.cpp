@@ -238,9 +238,10 @@ EMSCRIPTEN_KEEPALIVE double pw_global_bytes(const uint8_t *data, size_t n, doubl
 
 /// Where the pieces of the global part lie, from the header alone (`n` >= the header size
 /// pw_global_bytes asks for first): [header bytes, end of the base mesh, start and end of
-/// the ATTR section (0 0: none), global levels G, then G values: the end of each global
-/// level's bytes, then the start of level 1, the start of the model tables (clustered; else
-/// the end of the last level) and the global part's size]. Null on a damaged header.
+/// the span of the sections the global levels need, ATTR and GEOP (0 0: none), global
+/// levels G, then G values: the end of each global level's bytes, then the start of level 1, the
+/// start of the model tables (clustered; else the end of the last level) and the global part's
+/// size]. Null on a damaged header.
 EMSCRIPTEN_KEEPALIVE const double *pw_layout(const uint8_t *data, size_t n, double file_size) {
   static std::vector<double> out;
   const int status = guarded([&] {
@@ -253,10 +254,16 @@ EMSCRIPTEN_KEEPALIVE const double *pw_layout(const uint8_t *data, size_t n, doub
     const size_t global = h.clustered() ? h.global_levels : h.levels.size();
     out = {double(layout.header_bytes), double(layout.base_offset + h.base_bytes), 0, 0,
            double(global)};
-    const int attr = pomar::find_section(layout, pomar::section_tag("ATTR"));
-    if (attr >= 0) {
-      out[2] = double(layout.section_offset[attr]);
-      out[3] = double(layout.section_offset[attr] + h.sections[attr].bytes);
+    // The sections the global levels need (ATTR, GEOP): one span from the first's start to
+    // the last's end.
+    for (const uint32_t tag : {pomar::section_tag("ATTR"), pomar::section_tag("GEOP")}) {
+      const int i = pomar::find_section(layout, tag);
+      if (i < 0)
+        continue;
+      const double start = double(layout.section_offset[i]),
+                   end = double(layout.section_offset[i] + h.sections[i].bytes);
+      out[2] = out[3] == 0 ? start : std::min(out[2], start);
+      out[3] = std::max(out[3], end);
     }
     for (size_t i = 0; i < global; ++i)
       out.push_back(double(layout.level_offset[i] + h.levels[i].connectivity_bytes +
@@ -271,8 +278,8 @@ EMSCRIPTEN_KEEPALIVE const double *pw_layout(const uint8_t *data, size_t n, doub
 
 /// The mesh a first frame can show before the global part is complete: the base mesh and
 /// global levels 1..`levels` (a progressive file's levels). `data` holds the file's first
-/// `n` bytes, of which only the header, the base mesh, the ATTR section (when the file has
-/// one and `levels` > 0) and those levels need to be there (pw_layout says where; other
+/// `n` bytes, of which only the header, the base mesh, the ATTR and GEOP sections (when the
+/// file has them and `levels` > 0) and those levels need to be there (pw_layout says where; other
 /// bytes may be zeros). Positions and triangles only (pw_preview_*). Returns the levels
 /// decoded, -1 on error (pw_last_error).
 EMSCRIPTEN_KEEPALIVE int pw_preview(const uint8_t *data, size_t n, double file_size, int levels) {
@@ -299,22 +306,17 @@ EMSCRIPTEN_KEEPALIVE int pw_preview(const uint8_t *data, size_t n, double file_s
         models.attr = pomar::attribute_models(*attributes);
       }
     }
-    decoded = int(pomar::decode_global_levels(data, layout, 0, upto, lm, models, {}));
+    // (No level: the sections the levels need may not be in yet.)
+    decoded = upto ? int(pomar::decode_global_levels(data, layout, 0, upto, lm, models, {})) : 0;
     g_preview = pomar::to_mesh(std::move(lm), h.grid);
     return 0;
   });
   return decoded;
 }
 EMSCRIPTEN_KEEPALIVE int pw_preview_vertex_count() { return int(g_preview.vertex_count()); }
-EMSCRIPTEN_KEEPALIVE int pw_preview_triangle_count() {
-  return int(g_preview.triangle_count());
-}
-EMSCRIPTEN_KEEPALIVE const float *pw_preview_positions() {
-  return g_preview.positions.data();
-}
-EMSCRIPTEN_KEEPALIVE const uint32_t *pw_preview_triangles() {
-  return g_preview.triangles.data();
-}
+EMSCRIPTEN_KEEPALIVE int pw_preview_triangle_count() { return int(g_preview.triangle_count()); }
+EMSCRIPTEN_KEEPALIVE const float *pw_preview_positions() { return g_preview.positions.data(); }
+EMSCRIPTEN_KEEPALIVE const uint32_t *pw_preview_triangles() { return g_preview.triangles.data(); }
 EMSCRIPTEN_KEEPALIVE void pw_preview_release() { g_preview = pomar::Mesh(); }
 
 /// Decode the base clustered mesh from the file's first `n` bytes (at least
