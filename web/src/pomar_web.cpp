@@ -204,6 +204,15 @@ void per_vertex_texcoords(Handle &h) {
 /// The mesh of pw_preview, kept for JavaScript to copy out of the heap.
 pomar::Mesh g_preview;
 
+/// The layout of a file of `file_size` bytes from its first `n` bytes, which must hold its
+/// header (pw_global_bytes says how many).
+pomar::FileLayout header_layout(const uint8_t *data, size_t n, double file_size) {
+  const size_t hsize = pomar::header_size(data, n);
+  if (n < hsize)
+    throw pomar::Error("the header needs " + std::to_string(hsize) + " bytes");
+  return pomar::read_layout(data, hsize, static_cast<uint64_t>(file_size), true);
+}
+
 } // namespace
 
 extern "C" {
@@ -245,11 +254,7 @@ EMSCRIPTEN_KEEPALIVE double pw_global_bytes(const uint8_t *data, size_t n, doubl
 EMSCRIPTEN_KEEPALIVE const double *pw_layout(const uint8_t *data, size_t n, double file_size) {
   static std::vector<double> out;
   const int status = guarded([&] {
-    const uint64_t size = static_cast<uint64_t>(file_size);
-    const size_t hsize = pomar::header_size(data, n);
-    if (n < hsize)
-      throw pomar::Error("the header needs " + std::to_string(hsize) + " bytes");
-    const pomar::FileLayout layout = pomar::read_layout(data, hsize, size, true);
+    const pomar::FileLayout layout = header_layout(data, n, file_size);
     const pomar::FileHeader &h = layout.header;
     const size_t global = h.clustered() ? h.global_levels : h.levels.size();
     out = {double(layout.header_bytes), double(layout.base_offset + h.base_bytes), 0, 0,
@@ -270,7 +275,8 @@ EMSCRIPTEN_KEEPALIVE const double *pw_layout(const uint8_t *data, size_t n, doub
                            h.levels[i].geometry_bytes));
     out.push_back(double(global ? layout.level_offset[0] : layout.global_bytes));
     out.push_back(double(h.clustered() ? layout.tables_offset : layout.global_bytes));
-    out.push_back(double(std::min<uint64_t>(layout.global_bytes, size)));
+    out.push_back(
+        double(std::min<uint64_t>(layout.global_bytes, static_cast<uint64_t>(file_size))));
     return 0;
   });
   return status < 0 ? nullptr : out.data();
@@ -285,11 +291,7 @@ EMSCRIPTEN_KEEPALIVE const double *pw_layout(const uint8_t *data, size_t n, doub
 EMSCRIPTEN_KEEPALIVE int pw_preview(const uint8_t *data, size_t n, double file_size, int levels) {
   int decoded = -1;
   guarded([&] {
-    const uint64_t size = static_cast<uint64_t>(file_size);
-    const size_t hsize = pomar::header_size(data, n);
-    if (n < hsize)
-      throw pomar::Error("the header needs " + std::to_string(hsize) + " bytes");
-    const pomar::FileLayout layout = pomar::read_layout(data, hsize, size, true);
+    const pomar::FileLayout layout = header_layout(data, n, file_size);
     const pomar::FileHeader &h = layout.header;
     const size_t global = h.clustered() ? h.global_levels : h.levels.size();
     const size_t upto = std::min<size_t>(global, size_t(std::max(0, levels)));

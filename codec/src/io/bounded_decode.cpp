@@ -19,6 +19,7 @@
 //           PLY's fixed-size records.
 // The file is that of save_mesh(out, decode(in)) byte for byte.
 #include "io/io_common.h"
+#include "mesh/morton.h"
 #include "parallel/thread_pool.h"
 
 #include "pomar/limits.h"
@@ -54,16 +55,6 @@ uint64_t vertices_after(const FileInfo &info, int level) {
 }
 uint64_t faces_after(const FileInfo &info, int level) {
   return level == 0 ? info.base_faces : info.levels[size_t(level) - 1].faces;
-}
-
-uint64_t spread_bits(uint64_t x) { // 21 bits -> every third bit
-  x &= 0x1fffff;
-  x = (x | x << 32) & 0x1f00000000ffffull;
-  x = (x | x << 16) & 0x1f0000ff0000ffull;
-  x = (x | x << 8) & 0x100f00f00f00f00full;
-  x = (x | x << 4) & 0x10c30c30c30c30c3ull;
-  x = (x | x << 2) & 0x1249249249249249ull;
-  return x;
 }
 
 /// What the file needs that a bounded decode cannot give: an empty string if none.
@@ -134,7 +125,7 @@ Plan make_plan(const std::string &in, unsigned threads) {
     for (int k = 0; k < 3; ++k) {
       const double side = std::max(1e-30, double(hi[k]) - double(lo[k]));
       const double t = (double(base.positions[3 * c + k]) - lo[k]) / side;
-      code |= spread_bits(static_cast<uint64_t>(std::clamp(t, 0.0, 1.0) * 2097151.0)) << k;
+      code |= spread3(static_cast<uint64_t>(std::clamp(t, 0.0, 1.0) * 2097151.0)) << k;
     }
     keyed[c] = {code, c};
   }
