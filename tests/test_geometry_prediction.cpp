@@ -13,24 +13,15 @@
 #include "pomar/pomar.h"
 #include "pomar/random_access.h"
 #include "support/mesh_compare.h"
+#include "support/stored_files.h"
 
 namespace pomar {
 namespace {
 
 namespace fs = std::filesystem;
-const fs::path kLegacy = fs::path(POMAR_SOURCE_DIR) / "tests" / "data" / "legacy";
-
-std::vector<uint8_t> read_bytes(const fs::path &p) {
-  std::ifstream in(p, std::ios::binary);
-  return std::vector<uint8_t>(std::istreambuf_iterator<char>(in), {});
-}
-
-Mesh on_grid(Mesh m, const Quantizer &grid) {
-  for (size_t i = 0; i < m.vertex_count(); ++i)
-    for (int k = 0; k < 3; ++k)
-      m.positions[3 * i + k] = grid.dequantize(k, grid.quantize(k, m.positions[3 * i + k]));
-  return m;
-}
+using test::on_grid;
+using test::read_bytes;
+const fs::path &kLegacy = test::kLegacyDir;
 
 bool has_section(const FileInfo &info, const std::string &name, bool required) {
   for (const auto &s : info.sections)

@@ -21,6 +21,7 @@
 #include "pomar/random_access.h"
 #include "support/mesh_attributes.h"
 #include "support/mesh_gen.h"
+#include "support/stored_files.h"
 
 namespace pomar {
 namespace {
@@ -159,22 +160,10 @@ TEST(TextureSeams, CornersAndMaterialsAreKept) {
     }
 }
 
-/// The descriptor of a file's wedge texture coordinate (its ATTR section).
-StoredAttribute wedge_descriptor(const std::vector<uint8_t> &file) {
-  const FileLayout layout = read_layout(file.data(), file.size(), file.size());
-  const std::unique_ptr<AttributeTable> table = load_attribute_table(file.data(), layout);
-  if (table)
-    for (const StoredAttribute &s : table->stored)
-      if (s.name == kWedgeTexcoord)
-        return s;
-  ADD_FAILURE() << "the file has no wedge texture coordinate";
-  return StoredAttribute();
-}
-
 /// How many of the file's refinement levels predict the wedge texture coordinate from the
 /// positions (the descriptor's positions flag: all of them; else its level mask).
 size_t levels_from_positions(const std::vector<uint8_t> &file) {
-  const StoredAttribute s = wedge_descriptor(file);
+  const StoredAttribute s = test::wedge_descriptor(file);
   const FileInfo info = inspect(file.data(), file.size());
   if (s.from_positions)
     return info.levels.size();

@@ -28,6 +28,7 @@
 #include "attributes/attribute_section.h"
 #include "format/file_format.h"
 #include "lossless/seam_cut.h"
+#include "support/stored_files.h"
 #include "support/temp_dir.h"
 
 namespace pomar {
@@ -213,11 +214,7 @@ void expect_codec_round_trips(const Mesh &m,
     o.attributes.exact = exact;
     const std::vector<uint8_t> file = encode(m, o);
     const FileInfo info = inspect(file.data(), file.size());
-    Mesh ref = m;
-    for (size_t i = 0; i < ref.positions.size(); ++i) {
-      const int axis = int(i % 3);
-      ref.positions[i] = info.grid.dequantize(axis, info.grid.quantize(axis, ref.positions[i]));
-    }
+    Mesh ref = test::on_grid(m, info.grid);
     const Mesh out = decode(file.data(), file.size());
     EXPECT_EQ(out.vertex_count(), m.vertex_count());
     EXPECT_EQ(out.materials.size(), m.materials.size());
@@ -499,11 +496,7 @@ TEST_F(TexturedIo, WedgesPredictedEitherWayDecode) {
   for (const std::vector<uint8_t> *file : {&old_file, &new_file}) {
     SCOPED_TRACE(file == &old_file ? "file of tests/data" : "file of this encoder");
     const FileInfo info = inspect(file->data(), file->size());
-    Mesh ref = m;
-    for (size_t i = 0; i < ref.positions.size(); ++i) {
-      const int axis = int(i % 3);
-      ref.positions[i] = info.grid.dequantize(axis, info.grid.quantize(axis, ref.positions[i]));
-    }
+    Mesh ref = test::on_grid(m, info.grid);
     const Mesh out = decode(file->data(), file->size());
     ASSERT_EQ(out.corner_texcoords.size(), m.corner_texcoords.size());
     EXPECT_GT(out.corner_texcoord_bound, 0.0);
@@ -511,26 +504,10 @@ TEST_F(TexturedIo, WedgesPredictedEitherWayDecode) {
   }
 }
 
-/// The wedge texture coordinate's descriptor in a file's ATTR section.
-StoredAttribute wedge_of(const std::vector<uint8_t> &file) {
-  const FileLayout layout = read_layout(file.data(), file.size(), file.size());
-  const std::unique_ptr<AttributeTable> table = load_attribute_table(file.data(), layout);
-  if (table)
-    for (const StoredAttribute &s : table->stored)
-      if (s.name == kWedgeTexcoord)
-        return s;
-  ADD_FAILURE() << "no wedge texture coordinate";
-  return StoredAttribute();
-}
-
 /// A full decode of `file` (made from `m`): every face back, its corners within the bound.
 void expect_decodes_to(const Mesh &m, const std::vector<uint8_t> &file) {
   const FileInfo info = inspect(file.data(), file.size());
-  Mesh ref = m;
-  for (size_t i = 0; i < ref.positions.size(); ++i) {
-    const int axis = int(i % 3);
-    ref.positions[i] = info.grid.dequantize(axis, info.grid.quantize(axis, ref.positions[i]));
-  }
+  Mesh ref = test::on_grid(m, info.grid);
   const Mesh out = decode(file.data(), file.size());
   ASSERT_EQ(out.corner_texcoords.size(), m.corner_texcoords.size());
   EXPECT_GT(out.corner_texcoord_bound, 0.0);
@@ -548,8 +525,8 @@ TEST_F(TexturedIo, WedgesPredictedFromThePositionsInEveryLevelDecode) {
   const std::vector<uint8_t> old_file(old_text.begin(), old_text.end());
   ASSERT_FALSE(old_file.empty());
   EXPECT_EQ(attribute_section_version(old_file), 3);
-  EXPECT_TRUE(wedge_of(old_file).from_positions);
-  EXPECT_TRUE(wedge_of(old_file).level_positions.empty());
+  EXPECT_TRUE(test::wedge_descriptor(old_file).from_positions);
+  EXPECT_TRUE(test::wedge_descriptor(old_file).level_positions.empty());
   {
     SCOPED_TRACE("file of tests/data");
     expect_decodes_to(m, old_file);
@@ -601,7 +578,7 @@ TEST_F(TexturedIo, RealObjBunny10kWedgePredictorPerLevel) {
   o.block_checks = false;
   const std::vector<uint8_t> coded = encode(m, o);
   EXPECT_EQ(attribute_section_version(coded), 4);
-  const StoredAttribute s = wedge_of(coded);
+  const StoredAttribute s = test::wedge_descriptor(coded);
   EXPECT_FALSE(s.from_positions);
   const size_t from_positions =
       size_t(std::count(s.level_positions.begin(), s.level_positions.end(), uint8_t(1)));
