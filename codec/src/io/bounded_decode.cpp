@@ -253,10 +253,7 @@ struct LevelTable {
 class RecordFile {
 public:
   RecordFile(const std::string &out, uint64_t vertices, uint64_t faces) : out_(out), tmp_(out) {
-    header_ = "ply\nformat binary_little_endian 1.0\ncomment VCGLIB generated\nelement vertex " +
-              io::num(vertices) +
-              "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
-              io::num(faces) + "\nproperty list uchar int vertex_indices\nend_header\n";
+    header_ = io::binary_ply_header(vertices, faces);
     faces_at_ = header_.size() + 12 * vertices;
     size_ = faces_at_ + 13 * faces;
     const size_t slash = out.find_last_of('/');

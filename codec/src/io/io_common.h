@@ -296,7 +296,7 @@ private:
   std::string target_;
   TempFile tmp_;
   int fd_ = -1;
-  uint64_t written_ = 0; // bytes written so far
+  uint64_t written_ = 0;  // bytes written so far
   bool in_place_ = false; // the target is not a regular file: written directly
 };
 
@@ -436,6 +436,9 @@ void write_ply_ascii(TextFileWriter &out, const Mesh &mesh);
 /// the tests compare with and the path on big-endian hosts).
 void save_ply_binary(const std::string &path, const Mesh &mesh);
 void save_ply_binary_vcg(const std::string &path, const Mesh &mesh);
+/// The header of the binary PLY files save_ply_binary writes (vcglib's, for float x, y, z
+/// and triangles): `vertices` records of 12 bytes follow it, then `faces` of 13.
+std::string binary_ply_header(uint64_t vertices, uint64_t faces);
 /// A PLY file (ASCII or binary little-endian) with the mesh's attributes as vertex
 /// properties (red green blue [alpha] uchar, nx ny nz, texture_u texture_v, one float per
 /// scalar by its name), "comment TextureFile" lines and, as MeshLab writes them, the

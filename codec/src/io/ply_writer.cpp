@@ -202,18 +202,19 @@ void write_ply_with_attributes(TextFileWriter &out, const Mesh &mesh, bool binar
   }
 }
 
+std::string binary_ply_header(uint64_t vertices, uint64_t faces) {
+  return "ply\nformat binary_little_endian 1.0\ncomment VCGLIB generated\nelement vertex " +
+         num(vertices) + "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
+         num(faces) + "\nproperty list uchar int vertex_indices\nend_header\n";
+}
+
 void save_ply_binary(const std::string &path, const Mesh &mesh) {
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
   // The bytes vcglib's exporter writes for our mesh type (same header, float xyz, a uchar
   // count and three ints per face), written from the flat arrays in large chunks instead
   // of through a vcglib copy and one fwrite per value.
   const uint64_t nv = mesh.vertex_count(), nf = mesh.triangle_count();
-  const std::string header = "ply\nformat binary_little_endian 1.0\ncomment VCGLIB generated\n"
-                             "element vertex " +
-                             num(nv) +
-                             "\nproperty float x\nproperty float y\nproperty float z\n"
-                             "element face " +
-                             num(nf) + "\nproperty list uchar int vertex_indices\nend_header\n";
+  const std::string header = binary_ply_header(nv, nf);
   ChunkedFileWriter out(path, header.size() + 12 * nv + 13 * nf);
   out.put(header.data(), header.size());
   out.put(mesh.positions.data(), 12 * nv);
