@@ -16,7 +16,17 @@ A second table breaks pomar's cost down (bytes with minus bytes without, from `p
 --json`): the base mesh block, the ATTR section (the base mesh's attribute codes), the
 encoder's estimate of the wedge texture coordinates in the levels and cluster blocks,
 the rest of the levels and blocks (the copies' positions and connectivity, the blocks'
-own ends), the cluster index, the model tables, the MATL and LSLS sections and the header.
+own ends), the cluster index, the model tables, the MATL and LSLS sections, the sections
+that grow with the cluster count (CERR stored errors, BCHK block checks) and the header
+(with any other section).
+A third table says why the base mesh is large: the input's seam vertices that may
+collapse (twins: two wedges, two seam edges, off the boundary) and the locked ones (the
+others: where three or more charts meet, or a seam meets the boundary), and the base mesh
+with texture coordinates (`pomar decode --level 0` to OBJ): its vertices (one a cluster),
+their distinct positions, its charts (connected sets of faces of the cut) and how many of
+them are one triangle, and its vertices in one face only (a copy whose side of the seam
+is one face: decimation keeps it, and its twin with it, since a collapse must leave a
+face to the vertex it removes).
 Markdown on stdout, progress on stderr.
 """
 import argparse
@@ -108,6 +118,84 @@ def cube_mapped_sphere(path, n, seed=3):
             out.write('f ' + ' '.join('%d/%d' % (v + 1, t) for v, t in zip(fa, cs)) + '\n')
 
 
+def read_obj(path):
+    """Positions (as read) and triangles of an OBJ, each corner a (v, vt) pair of 0-based
+    indices (vt -1 if none); polygons fanned."""
+    pos, nvt, tris = [], 0, []
+
+    def index(t, n):
+        i = int(t)
+        return i - 1 if i > 0 else n + i
+    with open(path) as f:
+        for line in f:
+            s = line.split()
+            if not s:
+                continue
+            if s[0] == 'v':
+                pos.append(tuple(s[1:4]))
+            elif s[0] == 'vt':
+                nvt += 1
+            elif s[0] == 'f':
+                cs = []
+                for c in s[1:]:
+                    parts = c.split('/')
+                    vt = index(parts[1], nvt) if len(parts) > 1 and parts[1] else -1
+                    cs.append((index(parts[0], len(pos)), vt))
+                tris.extend((cs[0], cs[i], cs[i + 1]) for i in range(1, len(cs) - 1))
+    return pos, tris
+
+
+def seam_vertices(path):
+    """The input's seam vertices: (twins, locked). A seam edge has two faces whose
+    texture coordinate indices differ at either end (the indices, not the values: near
+    enough to the encoder's bit-for-bit test on these files)."""
+    _, tris = read_obj(path)
+    edges = {}
+    for t in tris:
+        for k in range(3):
+            a, b = t[k], t[(k + 1) % 3]
+            key = (min(a[0], b[0]), max(a[0], b[0]))
+            edges.setdefault(key, []).append({a[0]: a[1], b[0]: b[1]})
+    seam, boundary, wedges = {}, set(), {}
+    for (a, b), fs in edges.items():
+        if len(fs) != 2:
+            boundary.update((a, b))
+        elif fs[0] != fs[1]:
+            seam[a] = seam.get(a, 0) + 1
+            seam[b] = seam.get(b, 0) + 1
+    for t in tris:
+        for v, vt in t:
+            wedges.setdefault(v, set()).add(vt)
+    twins = sum(1 for v, n in seam.items() if n == 2 and len(wedges[v]) == 2 and v not in boundary)
+    return twins, len(seam) - twins
+
+
+def base_charts(path):
+    """The decoded base mesh (an OBJ of the cut): vertices, distinct positions, faces,
+    charts, one-triangle charts, vertices in one face only."""
+    pos, tris = read_obj(path)
+    parent = list(range(len(pos)))
+
+    def find(x):
+        while parent[x] != x:
+            parent[x] = parent[parent[x]]
+            x = parent[x]
+        return x
+    for t in tris:
+        for c in t[1:]:
+            parent[find(c[0])] = find(t[0][0])
+    faces = {}
+    for t in tris:
+        r = find(t[0][0])
+        faces[r] = faces.get(r, 0) + 1
+    valence = {}
+    for t in tris:
+        for v, _ in t:
+            valence[v] = valence.get(v, 0) + 1
+    return (len(pos), len(set(pos)), len(tris), len(faces),
+            sum(1 for n in faces.values() if n == 1), sum(1 for n in valence.values() if n == 1))
+
+
 def breakdown(w, o):
     """Where the bytes of the file with texture coordinates (`pomar info --json` w) go
     beyond those of the file without (o)."""
@@ -126,6 +214,7 @@ def breakdown(w, o):
         'cluster index': w['index_bytes'] - o['index_bytes'],
         'model tables': w['tables_bytes'] - o['tables_bytes'],
         'MATL + LSLS': sum(section(w, t) - section(o, t) for t in ('MATL', 'LSLS')),
+        'CERR + BCHK': sum(section(w, t) - section(o, t) for t in ('CERR', 'BCHK')),
         'header': w['header_bytes'] - o['header_bytes'],
     }
     rest = (w['total_bytes'] - o['total_bytes']) - sum(d.values())
@@ -157,7 +246,7 @@ def main():
         g = os.path.join(tmp, 'sphere.obj')
         cube_mapped_sphere(g, a.generated)
         meshes.append(('cube-mapped sphere', g))
-    rows, parts = [], []
+    rows, parts, bases = [], [], []
     for name, path in meshes:
         print('texture_bench: %s' % name, file=sys.stderr)
         plain = os.path.join(tmp, name.replace(' ', '_') + '_plain.obj')
@@ -175,6 +264,9 @@ def main():
         run(['draco_encoder', '-i', path, '-o', drc_with, '-qp', '12', '-qt', '12', '-cl', '10'])
         run(['draco_encoder', '-i', plain, '-o', drc_without, '-qp', '12', '-cl', '10'])
         parts.append((name, nv, breakdown(info_with, info_without)))
+        base_obj = os.path.join(tmp, 'base.obj')
+        run([pomar, 'decode', '-q', '--level', '0', with_uv, base_obj])
+        bases.append((name, seam_vertices(path), base_charts(base_obj)))
         pc = os.path.getsize(with_uv) - os.path.getsize(without)
         dc = os.path.getsize(drc_with) - os.path.getsize(drc_without)
         rows.append((name, nv, seams.group(1) if seams else '0', seams.group(2) if seams else '0',
@@ -191,13 +283,19 @@ def main():
               (name, nv, se, wc, bw, bu, pw, pu, dw, du, 8.0 * pc / nv, 8.0 * dc / nv,
                pc / dc if dc else float('nan')))
     keys = ['base mesh', 'ATTR', 'UV in levels', 'rest of levels', 'cluster index',
-            'model tables', 'MATL + LSLS', 'header']
+            'model tables', 'MATL + LSLS', 'CERR + BCHK', 'header']
     print()
     print('| mesh | clusters without / with | ' + ' | '.join(keys) + ' | total (bpv) |')
     print('|---|--:|' + '--:|' * len(keys) + '--:|')
     for name, nv, (clusters, d) in parts:
         print('| %s | %s | %s | %.2f |' % (name, clusters, ' | '.join('%+d' % d[k] for k in keys),
                                           8.0 * sum(d.values()) / nv))
+    print()
+    print('| mesh | seam vertices: twins / locked | base vertices (clusters) | their distinct '
+          'positions | base faces | charts | one-triangle charts | vertices in one face |')
+    print('|---|--:|--:|--:|--:|--:|--:|--:|')
+    for name, (twins, locked), b in bases:
+        print('| %s | %d / %d | %s |' % (name, twins, locked, ' | '.join('%d' % x for x in b)))
     shutil.rmtree(tmp)
 
 
