@@ -146,8 +146,8 @@ TEST(MemoryEstimate, LosslessStageIsAboveTheMeasuredPeaks) {
 
 TEST(MemoryEstimate, EachInputFormatIsTenToTwentyFivePercentAboveItsPeaks) {
   // Peak RSS (KiB) of `pomar encode` (two threads) by input format, measured with
-  // /usr/bin/time (bench/README.md, "Memory"): noisy spheres (F = 2V), 2-row strips (F = V) and, for OBJ with normals
-  // and texture coordinates ("f a/a/a"), a torus (F = 2V) and strips.
+  // /usr/bin/time (bench/README.md, "Memory"): noisy spheres (F = 2V), 2-row strips (F = V) and,
+  // for OBJ with normals and texture coordinates ("f a/a/a"), a torus (F = 2V) and strips.
   using In = EncodeInput;
   struct Peak {
     uint64_t v, f;
@@ -343,7 +343,8 @@ TEST(MemoryCheck, ExplicitLimitRefusesWithCountsAndSizes) {
   EXPECT_EQ(msg, "not enough memory to encode 50,000,000 vertices and 100,000,000 faces: needs "
                  "about " +
                      format_memory_size(need) +
-                     ", the limit is 1.0 GiB; use --max-memory to change the limit");
+                     ", the limit is 1.0 GiB; set the limit with pomar --max-memory or Python's "
+                     "memory_limit=");
   EXPECT_NO_THROW(check_encode_memory(50000000, 100000000, need));
   EXPECT_THROW(check_encode_memory(50000000, 100000000, need - 1), Error);
   // An explicit limit bounds the whole peak: what the caller holds does not count.
@@ -363,7 +364,7 @@ TEST(MemoryCheck, EncodeCheckUsesTheInputFormatsEstimate) {
   EXPECT_EQ(msg,
             "not enough memory to encode 1,000,000 vertices and 2,000,000 faces: needs about " +
                 format_memory_size(obj) + ", the limit is " + format_memory_size(ply) +
-                "; use --max-memory to change the limit");
+                "; set the limit with pomar --max-memory or Python's memory_limit=");
   EXPECT_NO_THROW(check_encode_memory(v, f, obj, 0, 0, 1, EncodeInput::Obj));
 }
 

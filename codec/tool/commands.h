@@ -38,7 +38,7 @@ struct DecodeArgs {
 };
 
 struct InfoArgs {
-  std::string in;
+  std::string in, max_memory = "auto";
   bool json = false, check = false;
 };
 

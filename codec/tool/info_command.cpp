@@ -8,6 +8,7 @@
 #include "commands.h"
 #include "console.h"
 #include "exit_codes.h"
+#include "pomar/limits.h"
 #include "pomar/mesh_io.h"
 #include "pomar/pomar.h"
 
@@ -100,9 +101,11 @@ nlohmann::json info_json(const pomar::FileInfo &i) {
 }
 
 /// info --check: every block's checksum; exit kExitDamaged if one fails.
-int run_check(const std::string &in) {
+int run_check(const std::string &in, const std::string &max_memory) {
+  const uint64_t memory_limit = pomar::parse_memory_size(max_memory);
   const std::vector<uint8_t> data = pomar::read_file(in);
-  const std::vector<pomar::DamagedBlock> damaged = pomar::check_blocks(data.data(), data.size());
+  const std::vector<pomar::DamagedBlock> damaged =
+      pomar::check_blocks(data.data(), data.size(), memory_limit);
   if (damaged.empty()) {
     std::printf("%s: every block passes its check\n", in.c_str());
     return 0;
@@ -190,6 +193,8 @@ int print_info(const std::string &in, bool json) {
 
 } // namespace
 
-int run_info(const InfoArgs &a) { return a.check ? run_check(a.in) : print_info(a.in, a.json); }
+int run_info(const InfoArgs &a) {
+  return a.check ? run_check(a.in, a.max_memory) : print_info(a.in, a.json);
+}
 
 } // namespace pomar::tool

@@ -187,6 +187,12 @@ CLI::App *add_info_command(CLI::App &app, InfoArgs &a) {
   inf->add_flag("--check", a.check,
                 "Check every block's checksum instead (no decoding); exit status 4 lists the "
                 "damaged or missing blocks");
+  inf->add_option("--max-memory", a.max_memory,
+                  "With --check: refuse (exit 7) a textured file whose base mesh, decoded to "
+                  "check its texture coordinates, would need more than SIZE (as for decode, e.g. "
+                  "512M, 'none'; default 'auto' = the memory available)")
+      ->type_name("SIZE")
+      ->capture_default_str();
   return inf;
 }
 

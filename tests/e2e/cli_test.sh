@@ -601,7 +601,7 @@ run encode "$SAMPLES/bunny.ply" "$WORK/mem/out.pomar" --max-memory 1M
 expect_rc 7
 expect_one_line_error
 expect_contains "$ERR" "not enough memory to encode 35,947 vertices and 69,451 faces" "stderr"
-expect_contains "$ERR" "the limit is 1.0 MiB; use --max-memory" "stderr"
+expect_contains "$ERR" "the limit is 1.0 MiB; set the limit with pomar --max-memory" "stderr"
 expect_dir_only "$WORK/mem"
 
 section "encode --max-memory: sizes that fit, 'none', bad sizes"

@@ -87,6 +87,12 @@ read -r status rss < <(probe "$POMAR" info "$f" --check)
 python3 -c 'import sys; sys.exit(0 if float(sys.argv[1]) <= float(sys.argv[2]) * 1024 else 1)' "$rss" "$need" ||
   fail "pomar info --check big_base_wedges: peak RSS $rss KiB over the estimate of $need MiB"
 echo "ok: info --check big_base_wedges: refused under 200 MB (needs about $need MiB), else exit 0 with peak RSS $rss KiB"
+# An explicit limit below the estimate refuses it the same way, naming the limit.
+status=$("$POMAR" info --check "$f" --max-memory 64M >/dev/null 2>"$TMP/err"; echo $?)
+[ "$status" = 7 ] || fail "info --check --max-memory 64M big_base_wedges: exit $status, expected 7"
+grep -q "the limit is 64.0 MiB; set the limit with pomar --max-memory" "$TMP/err" ||
+  fail "info --check --max-memory 64M big_base_wedges: $(cat "$TMP/err")"
+echo "ok: info --check --max-memory 64M refuses big_base_wedges, naming the limit"
 
 # Memory running out (no check, a 400 MB address space) is the memory kind's status, 7,
 # never 1: the base mesh of big_base_attributes needs more.

@@ -110,7 +110,8 @@ std::string format_memory_size(uint64_t bytes);
 
 /// Throws pomar::Error if `needed` bytes do not fit in `limit` (0 = automatic, see above):
 /// "not enough memory to <action> <V> vertices and <F> faces: needs about 18.2 GiB, 7.1 GiB
-/// available (MemAvailable); use --max-memory to change the limit". `held` is what the
+/// available (MemAvailable); set the limit with pomar --max-memory or Python's
+/// memory_limit=". `held` is what the
 /// caller already holds of `needed` (the input mesh): an automatic check compares the rest
 /// with what is available; an explicit limit bounds the whole peak.
 void check_memory(const char *action, uint64_t vertices, uint64_t faces, uint64_t needed,

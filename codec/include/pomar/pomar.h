@@ -438,6 +438,8 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options,
 /// cluster index must be intact: that throws). Returns the damaged or missing blocks,
 /// empty for an intact file. Cluster blocks carry an 8-bit check: a damaged block passes
 /// it with probability 1/256, which a decode (with its structural checks) may still catch.
-std::vector<DamagedBlock> check_blocks(const uint8_t *data, size_t size);
+/// Textured files need their base mesh decoded: `memory_limit` bounds that decode as
+/// DecodeOptions::memory_limit does (0 = the memory available).
+std::vector<DamagedBlock> check_blocks(const uint8_t *data, size_t size, uint64_t memory_limit = 0);
 
 } // namespace pomar

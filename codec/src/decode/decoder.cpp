@@ -106,7 +106,7 @@ std::string describe_damage(const std::vector<DamagedBlock> &blocks, size_t firs
   return out;
 }
 
-std::vector<DamagedBlock> check_blocks(const uint8_t *data, size_t size) {
+std::vector<DamagedBlock> check_blocks(const uint8_t *data, size_t size, uint64_t memory_limit) {
   const FileLayout layout = read_layout(data, size, size, true);
   const FileHeader &h = layout.header;
   read_base_mesh(data, layout, false);
@@ -122,7 +122,7 @@ std::vector<DamagedBlock> check_blocks(const uint8_t *data, size_t size) {
     if (attributes->wedge_pending) {
       FileInfo info = file_info(layout, size);
       describe_attributes(*attributes, info);
-      check_decode_memory(info, 0, 0); // (the base mesh: level 0)
+      check_decode_memory(info, 0, memory_limit); // (the base mesh: level 0)
       const auto kept = load_attribute_table(data, layout);
       LevelMesh lm = base_level_mesh(data, layout);
       init_attributes(*kept, lm);

@@ -447,11 +447,11 @@ void check_memory(const char *action, uint64_t vertices, uint64_t faces, uint64_
       return;
     have = "the limit is " + format_memory_size(limit);
   }
-  throw Error(Error::Kind::MemoryLimit, std::string("not enough memory to ") + action + " " +
-                                            grouped(vertices) + " vertices and " + grouped(faces) +
-                                            " faces: needs about " + format_memory_size(need) +
-                                            (need != needed ? " more" : "") + ", " + have +
-                                            "; use --max-memory to change the limit");
+  throw Error(Error::Kind::MemoryLimit,
+              std::string("not enough memory to ") + action + " " + grouped(vertices) +
+                  " vertices and " + grouped(faces) + " faces: needs about " +
+                  format_memory_size(need) + (need != needed ? " more" : "") + ", " + have +
+                  "; set the limit with pomar --max-memory or Python's memory_limit=");
 }
 
 void check_encode_memory(uint64_t vertices, uint64_t faces, uint64_t limit, uint64_t held,
