@@ -37,6 +37,7 @@ done
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 DATA=${POMAR_DATA:-/work/shared/data}
 GEN=$ROOT/build/bench/pomar_gen_mesh
+[ -x "$GEN" ] || GEN=$ROOT/build-test/bench/pomar_gen_mesh
 W=$(mktemp -d /tmp/encode_identity.XXXXXX)
 trap 'rm -rf "$W"' EXIT
 [ -n "$CACHE" ] || CACHE=$W/ref

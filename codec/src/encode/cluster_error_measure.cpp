@@ -25,9 +25,10 @@ V3 at(const std::vector<int32_t> &q, uint32_t v) {
   return {double(p[0]), double(p[1]), double(p[2])};
 }
 
-/// Squared distance from p to the triangle abc (the closest point by its Voronoi region).
-double distance2_to_triangle(V3 p, V3 a, V3 b, V3 c) {
-  const V3 ab = b - a, ac = c - a, ap = p - a;
+/// Squared distance from p to the triangle abc (the closest point by its Voronoi region),
+/// given ap = p - a.
+[[gnu::always_inline]] inline double distance2_to_triangle(V3 p, V3 ap, V3 a, V3 b, V3 c) {
+  const V3 ab = b - a, ac = c - a;
   const double d1 = dot(ab, ap), d2 = dot(ac, ap);
   if (d1 <= 0 && d2 <= 0)
     return norm2(ap);
@@ -57,19 +58,27 @@ double distance2_to_triangle(V3 p, V3 a, V3 b, V3 c) {
 
 /// Raise `worst` to the squared distance from p to the faces around vertex a of `mesh`
 /// if it is larger. The distance is only computed as far as it can raise it: a face (or
-/// a itself, a corner of each) within `worst` of p settles that it cannot.
-void raise_to_fan_distance(const LevelMesh &mesh, uint32_t a, V3 p, double &worst) {
-  const V3 pa = p - at(mesh.q, a);
+/// a itself, a corner of each) within `worst` of p settles that it cannot. The walk starts
+/// at corner `hint` if it is still a corner of a (the face that settled p's distance at the
+/// level before lies often near the one that settles it now; any start visits the same
+/// faces until one settles), and `hint` becomes the corner of the face that settled it.
+void raise_to_fan_distance(const LevelMesh &mesh, uint32_t a, V3 p, double &worst, uint32_t &hint) {
+  const V3 va = at(mesh.q, a);
+  const V3 pa = p - va;
   double best = norm2(pa);
   if (best <= worst)
     return;
   const CornerTable &ct = mesh.ct;
-  const uint32_t first = ct.VC[a];
+  const uint32_t first =
+      hint < ct.V.size() && ct.V[hint] == a ? hint : ct.VC[a]; // (VC: kNone if isolated)
   const auto face = [&](uint32_t c) {
-    const double d = distance2_to_triangle(p, at(mesh.q, a), at(mesh.q, ct.V[CornerTable::next(c)]),
+    const double d = distance2_to_triangle(p, pa, va, at(mesh.q, ct.V[CornerTable::next(c)]),
                                            at(mesh.q, ct.V[CornerTable::prev(c)]));
     best = std::min(best, d);
-    return d <= worst;
+    if (!(d <= worst)) // (NaN, from a degenerate face: does not settle it)
+      return false;
+    hint = c;
+    return true;
   };
   if (first != kNone) {
     uint32_t c = first;
@@ -125,6 +134,7 @@ ClusterErrorMeasure::ClusterErrorMeasure(const Rebuild &rb, size_t global, const
   parent_.resize(n);
   id_.resize(n);
   ancestor_.assign(n, kNone);
+  hint_.assign(n, kNone);
   q_.resize(3 * n);
   const auto put = [&](uint32_t v, uint32_t level, uint32_t parent) {
     const uint32_t i = count[cluster[v]]++;
@@ -157,11 +167,13 @@ void ClusterErrorMeasure::measure_cluster(const Rebuild &rb, uint32_t level, uin
   constexpr uint32_t kAhead = 8; // the fans read next are fetched meanwhile
   for (i = first; i < end; ++i) {
     if (i + kAhead < end) {
-      const uint32_t b = ancestor_[i + kAhead];
+      const uint32_t b = ancestor_[i + kAhead], h = hint_[i + kAhead];
       __builtin_prefetch(&mesh.ct.VC[b]);
       __builtin_prefetch(&mesh.q[3 * size_t(b)]);
+      if (h < mesh.ct.V.size())
+        __builtin_prefetch(&mesh.ct.V[h]);
     }
-    raise_to_fan_distance(mesh, ancestor_[i], at(q_, i), worst);
+    raise_to_fan_distance(mesh, ancestor_[i], at(q_, i), worst, hint_[i]);
   }
 }
 

@@ -38,10 +38,12 @@ private:
   // them, so a parent comes before its children): [start_[c], start_[c + 1]). Per entry:
   // the level that creates it, its parent's entry, its id (the input's until the level
   // that creates it is measured, the decoder's from then on) and its ancestor at the level
-  // being measured (a decoder id); and its position (read in entry order, level after level).
+  // being measured (a decoder id), the corner where the walk of its ancestor's fan starts
+  // (the one that settled its distance at the level before, if any); and its position
+  // (read in entry order, level after level).
   std::vector<uint32_t> start_, first_future_; // per cluster
   std::vector<uint16_t> created_;
-  std::vector<uint32_t> parent_, id_, ancestor_;
+  std::vector<uint32_t> parent_, id_, ancestor_, hint_;
   std::vector<int32_t> q_;
   std::vector<double> error_; // level-major, in the file's units
 };

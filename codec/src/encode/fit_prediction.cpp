@@ -173,10 +173,16 @@ NormalPredictor fit_normal_predictor(const Rebuild &rb, uint32_t level, bool clu
     return best;
   double best_bits = estimate_bits(samples, residuals(samples, best));
   std::vector<double> w(samples.size(), 1.0);
+  NormalPredictor last;
   for (int round = 0; round < 5; ++round) {
     NormalPredictor p;
     if (!fit(samples, w, p))
       break;
+    // The same coefficients as the round before: the same residuals, so the same weights
+    // and the same fit in every later round.
+    if (round > 0 && std::equal(p.c, p.c + kNormalFeatures, last.c))
+      break;
+    last = p;
     const std::vector<int64_t> r = residuals(samples, p);
     const double bits = estimate_bits(samples, r) * (1.0 + kMargin) + cost;
     if (bits < best_bits) {
