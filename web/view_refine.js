@@ -265,7 +265,7 @@ export function chooseLevels(state, view, {
   if (errorModel === 'stored' && !stored) errorModel = 'edge';
   if (errorModel === 'stored') {
     return chooseStored(state, view, { targetPixels, coarsenFraction, triangleBudget, occlusion, occlusionWidth,
-      maxEdgePixels, facingScale, contourScale, facingEdgeScale, contourEdgeScale });
+      maxEdgePixels, facingScale, contourScale, facingEdgeScale, contourEdgeScale, backface, backfaceMargin });
   }
   // The detail measured per cluster and level, kept for the decay (state.detailSeen, made
   // here when the caller keeps none).
@@ -384,10 +384,10 @@ export function viewScale(eye, b, c, facingScale, contourScale) {
  *  at the distance to its box (grown by its error at the current level), is within the
  *  target and whose longest edge (the current one, extrapolated with the level table's face
  *  counts) is within `maxEdgePixels`, and coarsens straight to the coarsest under
- *  `coarsenFraction` of both; outside the frustum: the base level; occluded: one level
- *  coarser per step. */
+ *  `coarsenFraction` of both; outside the frustum: the base level; occluded or (with
+ *  `backface`) back-facing, its box grown by its stored error: one level coarser per step. */
 function chooseStored(state, view, { targetPixels, coarsenFraction, triangleBudget, occlusion, occlusionWidth,
-  maxEdgePixels, facingScale, contourScale, facingEdgeScale, contourEdgeScale }) {
+  maxEdgePixels, facingScale, contourScale, facingEdgeScale, contourEdgeScale, backface, backfaceMargin }) {
   const { info, levels, clusterBounds: b } = state;
   const S = BOUNDS_STRIDE;
   const n = info.clusters;
@@ -410,7 +410,10 @@ function chooseStored(state, view, { targetPixels, coarsenFraction, triangleBudg
       wanted[c] = base;
       continue;
     }
-    if (buffer && occluded(buffer, view, lo, hi)) {
+    const centre = [0, 1, 2].map((k) => (lo[k] + hi[k]) / 2);
+    const radius = Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) / 2;
+    if ((backface && backFacing(view.eye, centre, radius, [b[S * c + 8], b[S * c + 9], b[S * c + 10]], b[S * c + 11],
+      backfaceMargin)) || (buffer && occluded(buffer, view, lo, hi))) {
       ++culled;
       if (l > base) {
         wanted[c] = l - 1;

@@ -261,6 +261,16 @@ check(choice.levels[0] === 2, `coarsened when the coarser level's facets are und
 choice = chooseLevels(state, view, { targetPixels: 3, occlusion: false, maxEdgePixels: 12 });
 check(choice.levels[0] === 3, `kept when they would be over half of it: ${choice.levels}`);
 
+// The stored model's back-face culling: the near cluster with facets over 8 px, its faces
+// turned away from the eye (normal cone axis -z, narrow).
+const turnedAway = [facets[0], facets[1], facets[2], facets[3], [0, 0, -1, 0.99]];
+const awayState = () => ({ info: storedInfo, levels: Int32Array.of(2, 2, 2), clusterBounds: bounds([turnedAway, far, behind]),
+  errorSeen: new Map() });
+choice = chooseLevels(awayState(), view, { targetPixels: 3, occlusion: false });
+check(choice.levels[0] === 3, `stored errors, back-facing, backface off: refined as any (${choice.levels})`);
+choice = chooseLevels(awayState(), view, { targetPixels: 3, occlusion: false, backface: true });
+check(choice.levels[0] === 2 && choice.culled >= 1, `backface on: culled, kept (${choice.levels}, ${choice.culled} culled)`);
+
 // ---- the stored error model seen edge-on or facing (facingScale, contourScale): two
 // clusters 1 unit ahead with the same stored error, 0.004 (2 px) at every level below the
 // finest, facets of 1 px; one faces the eye (normal cone axis +z), one is seen edge-on
