@@ -4,7 +4,9 @@
 //
 //   node bench/web_view_bench.mjs FILE.pomar [--closeup 0.1] [--target 3] [--size 800x457]
 //        [--clusters 1000,2000] [--maxGap B] [--maxRanges N] [--requestCost B] [--firstRequestBytes B]
-//        [--wholeBlockBytes B] [--estimateMargin F]
+//        [--wholeBlockBytes B] [--estimateMargin F] [--maxEdgePixels PX] [--facingScale K --contourScale K]
+//        [--facingEdgeScale K --contourEdgeScale K]
+//        [--overview-only] [--breakdown]
 //        [--backface] [--no-occlusion] [--errorModel auto|stored|edge|measured [--detailSafety K] [--maxTilt T]]
 //
 // Reports, each from a fresh stream: the base clustered mesh (open), the overview (whole
@@ -44,7 +46,7 @@ for (const name of ['maxGap', 'maxRanges', 'requestCost', 'firstRequestBytes', '
   if (opt(name) !== undefined) fetchOptions[name] = Number(opt(name));
 const settings = { targetPixels: Number(opt('target', 3)), backface: args.includes('--backface'),
   occlusion: !args.includes('--no-occlusion'), errorModel: opt('errorModel', 'auto') };
-for (const name of ['detailSafety', 'maxTilt']) if (opt(name) !== undefined) settings[name] = Number(opt(name));
+for (const name of ['detailSafety', 'maxTilt', 'maxEdgePixels', 'facingScale', 'contourScale', 'facingEdgeScale', 'contourEdgeScale']) if (opt(name) !== undefined) settings[name] = Number(opt(name));
 const M = await loadModuleInNode();
 const blob = new Blob([readFileSync(file)]);
 
@@ -66,20 +68,58 @@ function line(what, s, extra = '') {
 /** Refine for the camera until stable, as the viewer's loop does. */
 async function settle(s, camera) {
   let steps = 0;
+  const chooseMs = []; // the page's main-thread work per step (the decode runs in the worker)
   const convergence = new Convergence();
   const t0 = performance.now();
   for (; steps < 64; ++steps) {
     const v = viewOf(camera, width, height);
+    const tc = performance.now();
     const choice = chooseLevels({ info: s.stream.info, levels: s.stream.levels, clusterBounds: s.mesh.clusterBounds,
       errorSeen: s.errorSeen, detailSeen: s.detailSeen, mesh: s.mesh }, v, settings);
     if (process.env.DEBUG) console.log(steps, choice.refine, choice.coarsen, choice.hidden, choice.culled,
       `decay ${detailDecay(s.detailSeen).toFixed(3)}`);
+    chooseMs.push(performance.now() - tc);
+    s.asked = choice.levels;
     const wanted = choice.changed ? convergence.next(choice.levels, s.stream.levels, v) : null;
     if (!wanted) break;
     await s.stream.want(wanted);
     s.mesh = s.stream.decoder.mesh();
   }
-  return `, ${steps} steps, ${((performance.now() - t0) / 1000).toFixed(1)} s`;
+  chooseMs.sort((a, b) => a - b);
+  return `, ${steps} steps, ${((performance.now() - t0) / 1000).toFixed(1)} s, choice ${chooseMs[chooseMs.length >> 1].toFixed(0)} ms ` +
+    `median / ${chooseMs[chooseMs.length - 1].toFixed(0)} ms max a step`;
+}
+
+/** Where a settled view's bytes go: the global part; the region (the prefixes of the levels
+ *  the policy asks for); the rings (what the level map rule adds above them: clusters the
+ *  policy left lower, raised so that neighbours are at most one level apart); the rest
+ *  (bytes fetched that no block holds: gaps bridged between ranges, bytes past a prefix). */
+function breakdown(s) {
+  const st = s.stream;
+  const { baseLevel: base } = st.info;
+  let region = 0;
+  let regionClusters = 0;
+  let ring = 0;
+  let ringClusters = 0;
+  let ringOnly = 0;
+  for (let c = 0; c < st.info.clusters; ++c) {
+    const l = st.levels[c];
+    if (l <= base) continue;
+    const asked = Math.min(l, s.asked[c]);
+    const own = asked >= l ? st.have[c] : Math.min(st.have[c], st.need(c, asked));
+    region += own;
+    ring += st.have[c] - own;
+    if (asked > base) ++regionClusters;
+    if (asked < l) ++ringClusters;
+    if (asked <= base) ++ringOnly;
+  }
+  const f = st.file.stats.bytesFetched;
+  const g = st.info.globalBytes;
+  const p = (x) => `${(100 * x / st.file.size).toFixed(2)}%`;
+  console.log(`  breakdown: global part ${g} B (${p(g)}); region ${Math.round(region)} B (${p(region)}, ${regionClusters} ` +
+    `clusters asked above the base level); rings ${Math.round(ring)} B (${p(ring)}, ${ringClusters} clusters raised ` +
+    `above what was asked, ${ringOnly} of them asked at the base level); other ${Math.round(f - g - region - ring)} B ` +
+    `(${p(f - g - region - ring)})`);
 }
 
 let s = await fresh();
@@ -99,12 +139,14 @@ if (info.clusters) {
   frameMesh(camera, s.mesh.positions);
   line('overview', s, await settle(s, camera));
   s.stream.close();
+  if (args.includes('--overview-only')) process.exit(0);
   for (const fraction of opt('closeup', '0.1').split(',').map(Number)) {
     s = await fresh();
     const c = orbitCamera();
     frameMesh(c, s.mesh.positions);
     closeUp(c, s.mesh.positions, fraction);
     line(`close-up ${fraction}`, s, await settle(s, c));
+    if (args.includes('--breakdown')) breakdown(s);
     // The level map it converged to, asked at once from a fresh stream: the bytes the
     // fetch policy alone costs, without the steps of refinement.
     const final = s.stream.levels;

@@ -48,7 +48,7 @@ export class PomarModel {
   constructor(options) {
     this.options = { memoryBudget: 256 << 20, maxGap: 128, maxRanges: 100, maxRequestBytes: 1 << 20, maxInFlight: 4,
       requestCost: DEFAULT_REQUEST_COST, ...options };
-    this.firstDraw = null; // stats (bytesFetched, requests, decodeMs) of the first mesh drawn
+    this.firstDraw = null; // stats (bytesFetched, requests, decodeMs, openMs, pageMs) of the first mesh drawn
     this.worker = new Worker(new URL('./pomar_worker.js', import.meta.url), { type: 'module' });
     this.info = null;
     this.mesh = null;
@@ -64,7 +64,15 @@ export class PomarModel {
     this.worker.onerror = (e) => this.fail(0, `the decoder worker failed: ${e.message || 'cannot load it'}`);
   }
 
+  /** The stats of a first mesh, with when it came: `openMs` after open() was called and
+   *  `pageMs` after the page started loading (performance.now() of the page). */
+  drawnAt(stats) {
+    const now = performance.now();
+    return { ...stats, openMs: now - this.openedAt, pageMs: now };
+  }
+
   start(source) {
+    this.openedAt = performance.now();
     return new Promise((resolve, reject) => {
       this.waiters.push({ id: 0, resolve, reject });
       const { onMesh, onPreview, onWarning, onError, ...plain } = this.options;
@@ -75,11 +83,11 @@ export class PomarModel {
   receive(msg) {
     if (msg.type === 'preview') {
       // A first frame from the global levels at hand (positions and triangles only).
-      if (!this.firstDraw) this.firstDraw = { ...msg.stats };
+      if (!this.firstDraw) this.firstDraw = this.drawnAt(msg.stats);
       if (this.options.onPreview) this.options.onPreview(msg.mesh, msg.stats);
       return;
     }
-    if (!this.firstDraw && msg.type === 'opened') this.firstDraw = { ...msg.stats };
+    if (!this.firstDraw && msg.type === 'opened') this.firstDraw = this.drawnAt(msg.stats);
     if (msg.type === 'warning') {
       if (this.options.onWarning) this.options.onWarning(msg.message);
       return;

@@ -85,21 +85,26 @@ export function clusterError(b, c, l, { finest, errorModel, detailSafety = 1, de
   return Math.min(edge, detailSafety * decay * b[S * c + 12]);
 }
 
-/** Does the box [lo, hi] lie entirely outside one plane of the frustum of `viewProj`
- *  (column-major 4x4, clip = viewProj * [x,y,z,1])? */
-function outsideFrustum(viewProj, lo, hi) {
+/** The six planes of the clip volume of `viewProj` (column-major 4x4, clip = viewProj *
+ *  [x,y,z,1]; -w <= x,y,z <= w), 4 coefficients each, computed once per view. */
+function frustumPlanes(viewProj) {
   const m = viewProj;
-  // Planes of the clip volume: -w <= x,y,z <= w.
-  const planes = [];
+  const planes = new Float64Array(24);
+  let k = 0;
   for (let axis = 0; axis < 3; ++axis)
     for (const sign of [1, -1])
-      planes.push([0, 1, 2, 3].map((col) => m[4 * col + 3] + sign * m[4 * col + axis]));
-  for (const p of planes) {
+      for (let col = 0; col < 4; ++col) planes[k++] = m[4 * col + 3] + sign * m[4 * col + axis];
+  return planes;
+}
+
+/** Does the box [lo, hi] lie entirely outside one of the `planes` (frustumPlanes)? */
+function outsideFrustum(planes, lo, hi) {
+  for (let k = 0; k < 24; k += 4) {
     // The box corner furthest along the plane normal.
-    const x = p[0] >= 0 ? hi[0] : lo[0];
-    const y = p[1] >= 0 ? hi[1] : lo[1];
-    const z = p[2] >= 0 ? hi[2] : lo[2];
-    if (p[0] * x + p[1] * y + p[2] * z + p[3] < 0) return true;
+    const x = planes[k] >= 0 ? hi[0] : lo[0];
+    const y = planes[k + 1] >= 0 ? hi[1] : lo[1];
+    const z = planes[k + 2] >= 0 ? hi[2] : lo[2];
+    if (planes[k] * x + planes[k + 1] * y + planes[k + 2] * z + planes[k + 3] < 0) return true;
   }
   return false;
 }
@@ -179,21 +184,26 @@ export function occlusionBuffer(mesh, view, width) {
 
 /** Is the box [lo, hi] behind the depth buffer everywhere it could appear? */
 function occluded(buffer, view, lo, hi) {
-  const corners = [];
-  for (let k = 0; k < 8; ++k) corners.push(k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1], k & 4 ? hi[2] : lo[2]);
-  const s = project(view, corners, buffer.width, buffer.height);
+  const m = view.viewProj;
   let nearest = Infinity;
   let x0 = Infinity;
   let x1 = -Infinity;
   let y0 = Infinity;
   let y1 = -Infinity;
   for (let k = 0; k < 8; ++k) {
-    if (s[3 * k + 2] < view.near) return false;
-    nearest = Math.min(nearest, s[3 * k + 2]);
-    x0 = Math.min(x0, s[3 * k]);
-    x1 = Math.max(x1, s[3 * k]);
-    y0 = Math.min(y0, s[3 * k + 1]);
-    y1 = Math.max(y1, s[3 * k + 1]);
+    // The corner's screen position in the buffer's pixels (y down) and depth w, as project().
+    const x = k & 1 ? hi[0] : lo[0];
+    const y = k & 2 ? hi[1] : lo[1];
+    const z = k & 4 ? hi[2] : lo[2];
+    const w = m[3] * x + m[7] * y + m[11] * z + m[15];
+    if (w < view.near) return false;
+    const sx = ((m[0] * x + m[4] * y + m[8] * z + m[12]) / w * 0.5 + 0.5) * buffer.width;
+    const sy = (0.5 - (m[1] * x + m[5] * y + m[9] * z + m[13]) / w * 0.5) * buffer.height;
+    nearest = Math.min(nearest, w);
+    x0 = Math.min(x0, sx);
+    x1 = Math.max(x1, sx);
+    y0 = Math.min(y0, sy);
+    y1 = Math.max(y1, sy);
   }
   // Every pixel the box may touch, one more on each side.
   const i0 = Math.max(0, Math.floor(x0) - 1);
@@ -227,6 +237,7 @@ function viewFrame(state, view, occlusion, occlusionWidth) {
     pixelsPerUnit: view.height / (2 * Math.tan(view.fovY / 2)),
     buffer: occlusion && state.mesh && view.width ? occlusionBuffer(state.mesh, view, occlusionWidth) : null,
     wanted: Int32Array.from(state.levels),
+    planes: frustumPlanes(view.viewProj),
   };
 }
 
@@ -242,7 +253,7 @@ function viewFrame(state, view, occlusion, occlusionWidth) {
 export function chooseLevels(state, view, {
   targetPixels = 3, coarsenFraction = 0.5, triangleBudget = 2e6, backface = false, backfaceMargin = 0.3,
   occlusion = true, occlusionWidth = 128, errorModel = 'auto', detailSafety = 1, maxTilt = Infinity,
-  maxEdgePixels = 8,
+  maxEdgePixels = 8, facingScale = 1, contourScale = 1, facingEdgeScale = 1, contourEdgeScale = 1,
 } = {}) {
   const { info, levels, clusterBounds: b, errorSeen } = state;
   const S = BOUNDS_STRIDE;
@@ -254,7 +265,7 @@ export function chooseLevels(state, view, {
   if (errorModel === 'stored' && !stored) errorModel = 'edge';
   if (errorModel === 'stored') {
     return chooseStored(state, view, { targetPixels, coarsenFraction, triangleBudget, occlusion, occlusionWidth,
-      maxEdgePixels });
+      maxEdgePixels, facingScale, contourScale, facingEdgeScale, contourEdgeScale, backface, backfaceMargin });
   }
   // The detail measured per cluster and level, kept for the decay (state.detailSeen, made
   // here when the caller keeps none).
@@ -268,7 +279,7 @@ export function chooseLevels(state, view, {
     detailSeen.set(c, seen);
   }
   const model = { finest, base, errorModel, detailSafety, maxTilt, decay: detailDecay(detailSeen) };
-  const { faces, pixelsPerUnit, buffer, wanted } = viewFrame(state, view, occlusion, occlusionWidth);
+  const { faces, pixelsPerUnit, buffer, wanted, planes } = viewFrame(state, view, occlusion, occlusionWidth);
   let triangles = 0;
   for (let c = 0; c < n; ++c) triangles += b[S * c + 7];
   const candidates = [];
@@ -281,7 +292,7 @@ export function chooseLevels(state, view, {
     const hi = [b[S * c + 3], b[S * c + 4], b[S * c + 5]];
     const error = clusterError(b, c, l, model);
     errorSeen.set(`${c}:${l}`, error);
-    if (outsideFrustum(view.viewProj, lo, hi)) {
+    if (outsideFrustum(planes, lo, hi)) {
       if (l > base) ++hidden;
       wanted[c] = base;
       continue;
@@ -345,21 +356,44 @@ export function storedError(info, c, l) {
   return info.clusterErrors[(Math.max(l, info.baseLevel) - info.baseLevel) * info.clusters + c];
 }
 
+/** How much more error than the target cluster c tolerates from `eye` (it divides its
+ *  projected error and facet size): `facingScale` where its normal cone's axis points at the
+ *  eye, `contourScale` where the axis is square to the line of sight (a contour), in between
+ *  by the sine of the angle between them. A normal displacement shows on screen by that sine,
+ *  and a flat facet's tilt changes its brightness (the headlight's |n.l|) by it too. 1 for a
+ *  cluster without an axis. */
+export function viewScale(eye, b, c, facingScale, contourScale) {
+  if (facingScale === contourScale) return facingScale;
+  const S = BOUNDS_STRIDE;
+  const ax = b[S * c + 8];
+  const ay = b[S * c + 9];
+  const az = b[S * c + 10];
+  if (!(b[S * c + 11] > -1) || !(ax * ax + ay * ay + az * az > 0.5)) return 1;
+  const dx = (b[S * c] + b[S * c + 3]) / 2 - eye[0];
+  const dy = (b[S * c + 1] + b[S * c + 4]) / 2 - eye[1];
+  const dz = (b[S * c + 2] + b[S * c + 5]) / 2 - eye[2];
+  const d = Math.hypot(dx, dy, dz);
+  if (!(d > 0)) return 1;
+  const cos = Math.min(1, Math.abs(ax * dx + ay * dy + az * dz) / d);
+  const sin = Math.sqrt(1 - cos * cos);
+  return facingScale + (contourScale - facingScale) * sin;
+}
+
 /** chooseLevels with the file's stored errors (errorModel 'stored'): every level's error is
  *  known, so each cluster in view goes straight to the coarsest level whose error, projected
  *  at the distance to its box (grown by its error at the current level), is within the
  *  target and whose longest edge (the current one, extrapolated with the level table's face
  *  counts) is within `maxEdgePixels`, and coarsens straight to the coarsest under
- *  `coarsenFraction` of both; outside the frustum: the base level; occluded: one level
- *  coarser per step. */
+ *  `coarsenFraction` of both; outside the frustum: the base level; occluded or (with
+ *  `backface`) back-facing, its box grown by its stored error: one level coarser per step. */
 function chooseStored(state, view, { targetPixels, coarsenFraction, triangleBudget, occlusion, occlusionWidth,
-  maxEdgePixels }) {
+  maxEdgePixels, facingScale, contourScale, facingEdgeScale, contourEdgeScale, backface, backfaceMargin }) {
   const { info, levels, clusterBounds: b } = state;
   const S = BOUNDS_STRIDE;
   const n = info.clusters;
   const base = info.baseLevel;
   const finest = info.finestLevel;
-  const { faces, pixelsPerUnit, buffer, wanted } = viewFrame(state, view, occlusion, occlusionWidth);
+  const { faces, pixelsPerUnit, buffer, wanted, planes } = viewFrame(state, view, occlusion, occlusionWidth);
   let triangles = 0;
   for (let c = 0; c < n; ++c) triangles += b[S * c + 7];
   const candidates = [];
@@ -371,12 +405,15 @@ function chooseStored(state, view, { targetPixels, coarsenFraction, triangleBudg
     const grow = storedError(info, c, l);
     const lo = [b[S * c] - grow, b[S * c + 1] - grow, b[S * c + 2] - grow];
     const hi = [b[S * c + 3] + grow, b[S * c + 4] + grow, b[S * c + 5] + grow];
-    if (outsideFrustum(view.viewProj, lo, hi)) {
+    if (outsideFrustum(planes, lo, hi)) {
       if (l > base) ++hidden;
       wanted[c] = base;
       continue;
     }
-    if (buffer && occluded(buffer, view, lo, hi)) {
+    const centre = [0, 1, 2].map((k) => (lo[k] + hi[k]) / 2);
+    const radius = Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) / 2;
+    if ((backface && backFacing(view.eye, centre, radius, [b[S * c + 8], b[S * c + 9], b[S * c + 10]], b[S * c + 11],
+      backfaceMargin)) || (buffer && occluded(buffer, view, lo, hi))) {
       ++culled;
       if (l > base) {
         wanted[c] = l - 1;
@@ -384,10 +421,12 @@ function chooseStored(state, view, { targetPixels, coarsenFraction, triangleBudg
       }
       continue;
     }
-    const toPixels = pixelsPerUnit / Math.max(view.near, distanceToBox(view.eye, lo, hi));
+    const projected = pixelsPerUnit / Math.max(view.near, distanceToBox(view.eye, lo, hi));
+    const toPixels = projected / viewScale(view.eye, b, c, facingScale, contourScale);
     // The facets' size on screen (maxEdgePixels): the longest edge of the current level,
     // extrapolated to level k with the level table's face counts.
-    const edgePixels = (k) => b[S * c + 6] * toPixels * Math.sqrt(faces(l) / faces(k));
+    const edgeToPixels = projected / viewScale(view.eye, b, c, facingEdgeScale, contourEdgeScale);
+    const edgePixels = (k) => b[S * c + 6] * edgeToPixels * Math.sqrt(faces(l) / faces(k));
     let to = base;
     while (to < finest && (storedError(info, c, to) * toPixels > targetPixels || edgePixels(to) > maxEdgePixels)) ++to;
     if (to > l) {
@@ -424,10 +463,11 @@ export function sameLevels(a, b) {
 
 /** Damps a view's refinement until it converges. For one camera, it remembers the last
  *  level maps the model had: a cluster that the choice would send back to a level it had
- *  there keeps its current level (a cluster occluded only at its finer level, or coarsened
- *  on an extrapolated error it does not meet, would flip back and forth, and clusters
- *  flipping out of phase keep the whole map from ever repeating). `forget()` after any
- *  other request. */
+ *  there, or past it, keeps its current level (a cluster occluded only at its finer level,
+ *  or coarsened on an extrapolated error it does not meet, would flip back and forth, and
+ *  clusters flipping out of phase keep the whole map from ever repeating); so does a
+ *  cluster asked again at a level it was asked at and did not get (the level map rule
+ *  keeps it above: asking again changes nothing). `forget()` after any other request. */
 export class Convergence {
   constructor(depth = 4) {
     this.depth = depth;
@@ -437,15 +477,27 @@ export class Convergence {
   forget() {
     this.history = [];
     this.lastAsked = null;
+    this.refused = null; // per cluster, a level asked and not given (-1: none)
   }
   /** The level map to ask for `view` given chooseLevels' `choice` and the `current` levels,
    *  or null when there is nothing new to ask (converged). */
   next(choice, current, view) {
     if (!sameLevels(view.viewProj, this.viewProj)) this.forget();
+    if (!this.refused || this.refused.length !== current.length) this.refused = new Int32Array(current.length).fill(-1);
     this.viewProj = Array.from(view.viewProj);
     const wanted = Int32Array.from(choice);
-    for (let c = 0; c < wanted.length; ++c)
-      if (wanted[c] !== current[c] && this.history.some((h) => h[c] === wanted[c])) wanted[c] = current[c];
+    if (this.lastAsked)
+      for (let c = 0; c < wanted.length; ++c) if (this.lastAsked[c] !== current[c]) this.refused[c] = this.lastAsked[c];
+    for (let c = 0; c < wanted.length; ++c) {
+      const w = wanted[c];
+      const l = current[c];
+      if (w === l) continue;
+      // Back to a level it had, or past it (21 -> 22 -> 23, then 17: a cluster refined on
+      // facets extrapolated from one level's longest edge and coarsened on another's).
+      if (this.history.some((h) => (w < l ? h[c] < l && w <= h[c] : h[c] > l && w >= h[c]))) wanted[c] = l;
+      // Asked before and not given: the level map rule keeps it there (a raised neighbour).
+      else if (this.refused[c] === w) wanted[c] = l;
+    }
     this.history = [Int32Array.from(current), ...this.history].slice(0, this.depth);
     // The same map again: the level map rule keeps some clusters above what the view wants.
     if (sameLevels(wanted, this.lastAsked) || sameLevels(wanted, current)) return null;

@@ -225,7 +225,9 @@ def main():
     try:
         if r.get('firstDraw'):
             fd = r['firstDraw']
-            print(f"first draw {fd.get('decodeMs', 0):.0f} ms after the worker started, {fd['bytesFetched']} bytes in "
+            print(f"first draw {fd.get('decodeMs', 0):.0f} ms after the worker started, {fd.get('openMs', 0):.0f} ms "
+                  f"after the page opened the file, {fd.get('pageMs', 0):.0f} ms after the page began to load, "
+                  f"{fd['bytesFetched']} bytes in "
                   f"{fd['requests']} requests, {fd.get('triangles')} triangles; base clustered mesh drawn "
                   f"{r.get('firstFrameMs', 0):.0f} ms after the page opened the file")
         check(r.get('ok'), 'the scripted session ran to the end' + ('' if r.get('ok') else ': ' + str(r.get('exception'))))

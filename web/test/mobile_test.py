@@ -127,6 +127,7 @@ STATE = r'''(() => {
     bytesFetched: m.stats.bytesFetched, requests: m.stats.requests, fileBytes: m.stats.fileBytes,
     minLevel: Math.min(...m.levels), maxLevel: Math.max(...m.levels), finestClusters: finest,
     baseLevel: m.info.baseLevel, finestLevel: m.info.finestLevel, covered: covered / (px.length / 4),
+    firstDraw: m.firstDraw,
     distance: v.camera.distance, yaw: v.camera.yaw, target: v.camera.target.slice() });
 })()'''
 
@@ -211,6 +212,11 @@ def main():
         first = settled('open')
         print(f"file {first.get('fileBytes')} bytes; viewport {first['cssWidth']}x{first['cssHeight']} CSS px at "
               f"DPR {first['dpr']}, drawing buffer {first['width']}x{first['height']}, {first['touchPoints']} touch points")
+        fd = first.get('firstDraw') or {}
+        if fd:
+            print(f"first draw {fd.get('openMs', 0):.0f} ms after the viewer opened the file, {fd.get('pageMs', 0):.0f} ms "
+                  f"after the page began to load ({fd.get('bytesFetched')} bytes in {fd.get('requests')} requests, "
+                  f"{fd.get('triangles')} triangles)")
         check(not first['error'], 'the file opens: ' + (first['error'] or 'no error'))
         if first['error'] or not first.get('open'):
             return 1

@@ -1,7 +1,7 @@
 // Unit tests of the pure parts of web/: request coalescing (range_fetch.js) and the choice
 // of levels for a view (view_refine.js).   node web/test/unit_test.mjs
 import { coalesce, parseByteranges, RangeFile } from '../range_fetch.js';
-import { BOUNDS_STRIDE, Convergence, chooseLevels, detailDecay } from '../view_refine.js';
+import { BOUNDS_STRIDE, Convergence, chooseLevels, detailDecay, viewScale } from '../view_refine.js';
 import { checker } from './node_support.mjs';
 
 const result = checker();
@@ -225,6 +225,22 @@ check(conv.next(A, B, view) === null, 'back to a map it had: damped, nothing new
 check(same(Array.from(conv.next(Int32Array.of(2, 2, 4), B, view)), [2, 3, 4]),
   'only the clusters flipping back are damped');
 check(same(Array.from(conv.next(A, B, lookAlongMinusZ([0, 0, 1]))), [1, 2, 5]), 'another camera starts afresh');
+{
+  // Refined 21 -> 22 -> 23, then asked at 17: back past a level it had, damped.
+  const past = new Convergence();
+  const cam = lookAlongMinusZ([0, 0, 2]);
+  past.next(Int32Array.of(22, 5), Int32Array.of(21, 5), cam);
+  past.next(Int32Array.of(23, 5), Int32Array.of(22, 5), cam);
+  check(past.next(Int32Array.of(17, 5), Int32Array.of(23, 5), cam) === null,
+    'sent back past a level it had (21 -> 22 -> 23 -> 17): damped, nothing new to ask');
+  // Asked at 16, kept at 18 by the level map rule: asking 16 again is not new.
+  const kept = new Convergence();
+  check(same(Array.from(kept.next(Int32Array.of(16, 7), Int32Array.of(18, 6), cam)), [16, 7]), 'first ask as chosen');
+  check(kept.next(Int32Array.of(16, 7), Int32Array.of(18, 7), cam) === null,
+    'a level asked and not given (the level map rule), asked again: nothing new');
+  const moved = kept.next(Int32Array.of(16, 8), Int32Array.of(18, 7), cam);
+  check(moved && same(Array.from(moved), [18, 8]), `the refused one kept, another one still asked: ${moved}`);
+}
 
 // ---- the stored error model's facet size (maxEdgePixels): the near cluster's stored error
 // projects to 0.005 px, its longest edge (0.02 at distance 1, 500 px a unit) to 10 px.
@@ -244,5 +260,42 @@ choice = chooseLevels(state, view, { targetPixels: 3, occlusion: false, maxEdgeP
 check(choice.levels[0] === 2, `coarsened when the coarser level's facets are under half the bound: ${choice.levels}`);
 choice = chooseLevels(state, view, { targetPixels: 3, occlusion: false, maxEdgePixels: 12 });
 check(choice.levels[0] === 3, `kept when they would be over half of it: ${choice.levels}`);
+
+// The stored model's back-face culling: the near cluster with facets over 8 px, its faces
+// turned away from the eye (normal cone axis -z, narrow).
+const turnedAway = [facets[0], facets[1], facets[2], facets[3], [0, 0, -1, 0.99]];
+const awayState = () => ({ info: storedInfo, levels: Int32Array.of(2, 2, 2), clusterBounds: bounds([turnedAway, far, behind]),
+  errorSeen: new Map() });
+choice = chooseLevels(awayState(), view, { targetPixels: 3, occlusion: false });
+check(choice.levels[0] === 3, `stored errors, back-facing, backface off: refined as any (${choice.levels})`);
+choice = chooseLevels(awayState(), view, { targetPixels: 3, occlusion: false, backface: true });
+check(choice.levels[0] === 2 && choice.culled >= 1, `backface on: culled, kept (${choice.levels}, ${choice.culled} culled)`);
+
+// ---- the stored error model seen edge-on or facing (facingScale, contourScale): two
+// clusters 1 unit ahead with the same stored error, 0.004 (2 px) at every level below the
+// finest, facets of 1 px; one faces the eye (normal cone axis +z), one is seen edge-on
+// (axis +x: a contour).
+const angled = { ...info, clusters: 2, clusterErrors: new Float32Array(3 * 2).fill(0.004) };
+const facingBox = [[-0.1, -0.1, -1.1], [0.1, 0.1, -1], 0.002, 10, [0, 0, 1, 0.9]];
+const contourBox = [[-0.1, -0.1, -1.1], [0.1, 0.1, -1], 0.002, 10, [1, 0, 0, 0.9]];
+const angledState = () => ({ info: angled, levels: Int32Array.of(2, 2), clusterBounds: bounds([facingBox, contourBox]),
+  errorSeen: new Map() });
+const ab = bounds([facingBox, contourBox, [[-0.1, -0.1, -1.1], [0.1, 0.1, -1], 0.002, 10, [Math.SQRT1_2, 0, Math.SQRT1_2, 0.9]],
+  [[-0.1, -0.1, -1.1], [0.1, 0.1, -1], 0.002, 10]]);
+check(viewScale([0, 0, 0], ab, 0, 2, 0.5) === 2, `facing the eye: facingScale (${viewScale([0, 0, 0], ab, 0, 2, 0.5)})`);
+check(Math.abs(viewScale([0, 0, 0], ab, 1, 2, 0.5) - 0.5) < 1e-6, `edge-on: contourScale (${viewScale([0, 0, 0], ab, 1, 2, 0.5)})`);
+const tilted = viewScale([0, 0, 0], ab, 2, 2, 0.5);
+check(tilted > 0.5 && tilted < 2, `at about 45 degrees, in between: ${tilted}`);
+check(viewScale([0, 0, 0], ab, 3, 2, 0.5) === 1, 'no normal cone (a cone of every direction): 1');
+choice = chooseLevels(angledState(), view, { targetPixels: 3, occlusion: false });
+check(same(Array.from(choice.levels), [2, 2]), `2 px under the 3 px target, both kept (default scales 1): ${choice.levels}`);
+choice = chooseLevels(angledState(), view, { targetPixels: 3, occlusion: false, contourScale: 0.5 });
+check(same(Array.from(choice.levels), [2, 5]), `contourScale 0.5 (1.5 px on the contour): the edge-on one refined: ${choice.levels}`);
+choice = chooseLevels(angledState(), view, { targetPixels: 1.5, occlusion: false, facingScale: 2 });
+check(same(Array.from(choice.levels), [2, 5]), `target 1.5 px, facingScale 2: the facing one kept: ${choice.levels}`);
+choice = chooseLevels({ ...angledState(), levels: Int32Array.of(5, 5) }, view,
+  { targetPixels: 3, occlusion: false, facingScale: 4, contourScale: 1, coarsenFraction: 0.5 });
+check(choice.levels[0] === 2 && choice.levels[1] === 5,
+  `coarsened by the scaled error too (facing: 0.5 px under half of 3 px; edge-on: 2 px is not): ${choice.levels}`);
 
 result.done('unit tests');
