@@ -156,6 +156,51 @@ TEST(ClusterErrors, QuantizedCodesRoundUp) {
   EXPECT_EQ(q.bound(0, 7), 0.0); // the finest level
 }
 
+TEST(ClusterErrors, OctaveCodesRoundUpAndNeverGrowWithTheLevel) {
+  // Level-major, 3 levels x 4 clusters; cluster 3 grows with the level (not what the
+  // measure gives, but the codes must still bound it).
+  const std::vector<double> errors = {0, 1e-30, 0.5, 1.0, 0, 1e-9, 3.0, 2.0, 0, 0, 7.0, 4.0};
+  const ClusterErrors q = quantize_cluster_errors_octaves(5, 4, errors);
+  ASSERT_EQ(q.levels(), 3u);
+  EXPECT_EQ(q.version, 2);
+  for (uint32_t k = 0; k < 3; ++k)
+    for (uint32_t c = 0; c < 4; ++c) {
+      const double e = errors[4 * k + c], b = q.bound(c, int(5 + k));
+      EXPECT_GE(b, e) << k << " " << c;
+      if (e == 0) {
+        EXPECT_EQ(b, 0.0);
+      }
+      if (k + 1 < 3) {
+        EXPECT_GE(b, q.bound(c, int(6 + k))); // never grows with the level
+      }
+      // One octave at most, or the smallest nonzero bound, or the finer level's.
+      const double finer = k + 1 < 3 ? q.bound(c, int(6 + k)) : 0.0;
+      EXPECT_LE(b, std::max({2 * e, octave_error_bound(q.scale[0], 1), finer}));
+    }
+  EXPECT_EQ(q.bound(2, 8), 0.0); // the finest level
+  EXPECT_GE(octave_error_bound(q.scale[0], kOctaveCodes - 1), 7.0);
+  // Written and read back: the same codes.
+  const std::vector<uint8_t> body = write_cluster_errors(q);
+  EXPECT_EQ(body[0], 2);
+  FileLayout layout;
+  layout.header.global_levels = 5;
+  layout.header.clusters = 4;
+  layout.header.levels.resize(8);
+  layout.header.flags = kFlagClustered;
+  const ClusterErrors r = read_cluster_errors(body.data(), body.size(), layout);
+  EXPECT_EQ(r.version, 2);
+  EXPECT_EQ(r.code, q.code);
+  EXPECT_EQ(r.scale, q.scale);
+  // Version 1 codes still write and read as version 1.
+  const ClusterErrors v1 = quantize_cluster_errors(5, 4, errors);
+  const std::vector<uint8_t> body1 = write_cluster_errors(v1);
+  EXPECT_EQ(body1[0], 1);
+  const ClusterErrors r1 = read_cluster_errors(body1.data(), body1.size(), layout);
+  EXPECT_EQ(r1.code, v1.code);
+  for (uint32_t c = 0; c < 4; ++c)
+    EXPECT_EQ(r1.bound(c, 6), v1.bound(c, 6));
+}
+
 TEST(ClusterErrors, FilesWithoutTheSectionsStillOpenAndViewFallsBackToEdges) {
   const std::vector<uint8_t> plain = encode_with(sphere(), false, false);
   const FileLayout plain_layout = read_layout(plain.data(), plain.size());
@@ -315,8 +360,10 @@ std::vector<uint8_t> replaced(const std::vector<uint8_t> &f, uint32_t tag,
 
 void expect_refused(const std::vector<uint8_t> &f, const char *name) {
   try {
-    open(f);
-    ADD_FAILURE() << "opened a file with a damaged " << name;
+    // CERR is read when a stored error is first asked for, not at open (BLKO at open).
+    auto d = open(f);
+    d->cluster_error(0, d->base_clustered_level());
+    ADD_FAILURE() << "read a file with a damaged " << name;
   } catch (const Error &e) {
     EXPECT_EQ(e.kind(), Error::Kind::DamagedFile) << e.what();
     EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();

@@ -205,6 +205,11 @@ def test_selective_decoder(tmp_path, bunny):
         d.update()
         full = d.mesh()
         assert len(full.vertices) == info["vertices"] and d.damaged == []
+        # Everything but the stored errors (CERR), which only a view reads.
+        cerr = [s["bytes"] for s in pomar.info(data)["sections"] if s["name"] == "CERR"]
+        assert len(cerr) == 1
+        assert d.bytes_read == info["total_bytes"] - cerr[0]
+        assert d.cluster_error(0, d.base_clustered_level) > 0
         assert d.bytes_read == info["total_bytes"]
 
 

@@ -31,6 +31,11 @@ public:
   /// `mask` of its XXH32: ClusterIndex).
   void init(ByteSource *source, uint32_t id, uint64_t offset, uint32_t size, uint32_t check,
             uint32_t mask, ReadStats *stats);
+  /// A longer check for the block (a BCHK section read after init), before it is read.
+  void set_check(uint32_t check, uint32_t mask) {
+    check_ = check;
+    mask_ = mask;
+  }
   /// (Re)start the stream from its first byte; `whole` reads the block at once (it will be
   /// decoded to the end, or its check must pass first), otherwise bytes are read as the
   /// decoder needs them. Throws if the file ends before the block (truncated file).

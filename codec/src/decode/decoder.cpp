@@ -248,6 +248,16 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
       }
     }
   if (target > global && global_intact) { // clustered levels: every cluster at `target`
+    // The stored errors, which this decode does not use and a SelectiveDecoder reads only
+    // for a view: the whole file is at hand, so a damaged section is found here as before.
+    std::string errors_damage;
+    try {
+      load_cluster_errors(data, layout);
+    } catch (const Error &e) {
+      if (!options.skip_damaged)
+        throw;
+      errors_damage = e.what();
+    }
     // Checked above for the whole target level; the constructor's check is smaller.
     SelectiveOptions so;
     so.skip_damaged = options.skip_damaged;
@@ -259,6 +269,8 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options, Deco
     d.want_all(static_cast<int>(target));
     d.update(options.progress);
     r.damaged = d.damaged();
+    if (!errors_damage.empty())
+      r.damaged.push_back({"section CERR", errors_damage + " (not needed by the mesh)", -1});
     r.decode_rounds = d.decode_rounds();
     for (int l : d.levels()) {
       r.level = std::max(r.level, l);

@@ -36,7 +36,7 @@ namespace pomar {
 
 struct SelectiveDecoder::State {
   std::unique_ptr<ByteSource> source;
-  std::vector<uint8_t> global; // the file's prefix: header .. cluster index
+  std::vector<uint8_t> global; // the file's prefix: header .. cluster index (see lazy)
   FileLayout layout;
   FileInfo info;
   int global_levels = 0, finest = 0;
@@ -51,7 +51,19 @@ struct SelectiveDecoder::State {
   // Clustered part.
   std::vector<Models> level_models;
   ClusterIndex index;
-  ClusterErrors errors;              // the CERR section (empty without one)
+  ClusterErrors errors; // the CERR section (empty without one or until read)
+  // The per-cluster sections, read from the source when first needed rather than at open
+  // (their bytes in `global` stay zero until then): CERR when a view-dependent selection
+  // first asks for a stored error, BCHK before the first cluster block is read.
+  struct LazySection {
+    int index = -1;      // in the section table; -1: the file has none
+    bool read = false;   // its bytes are in `global`
+    bool loaded = false; // and were taken in (BCHK: the checks completed)
+  };
+  LazySection errors_section, checks_section;
+  const uint8_t *read_lazy(LazySection &section);
+  void load_errors();
+  void load_block_checks_once();
   std::vector<uint32_t> block_order; // the blocks' order in the file (BLKO; empty: id order)
   ClusterGraph graph;
   // (Cache-line aligned: the clusters of a batch are decoded on several threads, each
@@ -350,10 +362,34 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   check_decode_memory(file_info(s.layout, file_size),
                       s.layout.header.clustered() ? int(s.layout.header.global_levels) : 0,
                       options.memory_limit, AttributeMask(), s.threads);
-  // The global part (a truncated progressive file: what is there of it).
+  // The global part (a truncated progressive file: what is there of it), but for the
+  // per-cluster sections (read_lazy).
   s.global.resize(std::min<uint64_t>(s.layout.global_bytes, file_size));
-  s.source->read(hsize, s.global.size() - hsize, s.global.data() + hsize);
-  s.reads.bytes = s.global.size();
+  if (s.layout.header.clustered()) {
+    s.errors_section.index = find_section(s.layout, kClusterErrorsTag);
+    s.checks_section.index = find_section(s.layout, kBlockChecksTag);
+  }
+  {
+    std::vector<std::pair<uint64_t, uint64_t>> skip; // [begin, end) of the lazy bodies
+    for (const State::LazySection *l : {&s.errors_section, &s.checks_section})
+      if (l->index >= 0) {
+        const uint64_t at = s.layout.section_offset[size_t(l->index)];
+        skip.emplace_back(at, at + s.layout.header.sections[size_t(l->index)].bytes);
+      }
+    std::sort(skip.begin(), skip.end());
+    uint64_t at = hsize;
+    const uint64_t end = s.global.size();
+    for (const auto &[b, e] : skip) {
+      if (b > at && at < end)
+        s.source->read(at, std::min(b, end) - at, s.global.data() + at);
+      at = std::max(at, e);
+    }
+    if (at < end)
+      s.source->read(at, end - at, s.global.data() + at);
+    s.reads.bytes = s.global.size();
+    for (const auto &[b, e] : skip)
+      s.reads.bytes -= std::min(e, end) - std::min(b, end);
+  }
   s.info = file_info(s.layout, file_size);
   const FileHeader &h = s.layout.header;
   s.finest = static_cast<int>(h.levels.size());
@@ -387,7 +423,6 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
   for (size_t k = 0; k < s.level_models.size(); ++k) // (each clustered level's predictor)
     s.level_models[k].normal = normal[h.global_levels + k];
   s.index = read_cluster_index(s.global.data() + s.layout.index_offset, s.layout);
-  load_block_checks(s.global.data(), s.layout, s.index);
   s.info.cluster_block_bytes = s.index.size;
   decode_global_levels(s.global.data(), s.layout, 0, h.global_levels, s.mesh, s.global_models, {});
   const uint32_t n = h.clusters;
@@ -397,7 +432,6 @@ SelectiveDecoder::SelectiveDecoder(std::unique_ptr<ByteSource> source,
     s.block_order = morton_block_order(s.mesh.q, n, h.grid.bits);
     place_blocks(s.index, s.block_order, s.layout);
   }
-  s.errors = load_cluster_errors(s.global.data(), s.layout);
   s.snapshot = s.mesh;
   s.clusters.resize(n);
   for (uint32_t c = 0; c < n; ++c) {
@@ -589,6 +623,11 @@ void SelectiveDecoder::State::decode_target(const Progress &progress) {
   const std::vector<int> request = complete_level_map(wanted, graph.start, graph.adj, global_levels,
                                                       graph.link_start, graph.link);
   target = request;
+  for (size_t c = 0; c < target.size(); ++c)
+    if (target[c] > clusters[c].level) { // a block will be read: its check first
+      load_block_checks_once();
+      break;
+    }
   if (skip_damaged)
     cap_failing_blocks();
   limit_target(request);
@@ -808,10 +847,47 @@ std::vector<uint32_t> SelectiveDecoder::vertex_level() const {
 
 // ---------------------------------------------------------------- stored errors, blocks
 
-bool SelectiveDecoder::has_cluster_errors() const { return !s_->errors.empty(); }
+/// The body of a per-cluster section, read from the source (and checked) the first time.
+const uint8_t *SelectiveDecoder::State::read_lazy(LazySection &section) {
+  const size_t i = size_t(section.index);
+  const uint64_t at = layout.section_offset[i], bytes = layout.header.sections[i].bytes;
+  if (!section.read) {
+    if (at + bytes > global.size())
+      throw Error(Error::Kind::TruncatedFile,
+                  "truncated .pomar file: section " + section_name(layout.header.sections[i].tag) +
+                      " ends at byte " + std::to_string(at + bytes) + ", the file has " +
+                      std::to_string(global.size()));
+    source->read(at, bytes, global.data() + at);
+    reads.bytes += bytes;
+    section.read = true;
+  }
+  return section_body(global.data(), layout, i); // (checks the section's checksum)
+}
+
+void SelectiveDecoder::State::load_errors() {
+  if (errors_section.index < 0 || !errors.empty())
+    return;
+  const uint8_t *body = read_lazy(errors_section);
+  errors =
+      read_cluster_errors(body, layout.header.sections[size_t(errors_section.index)].bytes, layout);
+}
+
+void SelectiveDecoder::State::load_block_checks_once() {
+  if (checks_section.index < 0 || checks_section.loaded)
+    return;
+  const uint8_t *body = read_lazy(checks_section);
+  apply_block_checks(body, layout.header.sections[size_t(checks_section.index)].bytes, layout,
+                     index);
+  for (uint32_t c = 0; c < clusters.size(); ++c)
+    clusters[c].stream.set_check(index.check[c], index.check_mask);
+  checks_section.loaded = true;
+}
+
+bool SelectiveDecoder::has_cluster_errors() const { return s_->errors_section.index >= 0; }
 double SelectiveDecoder::cluster_error(uint32_t cluster, int level) const {
-  if (s_->errors.empty())
+  if (s_->errors_section.index < 0)
     return -1;
+  s_->load_errors();
   if (cluster >= s_->clusters.size())
     throw Error(Error::Kind::Usage, "cluster " + std::to_string(cluster) +
                                         " does not exist: the file has " +

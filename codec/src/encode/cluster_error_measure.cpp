@@ -203,7 +203,7 @@ std::vector<uint8_t> ClusterErrorMeasure::section() const {
     for (uint32_t c = 0; c < clusters_; ++c)
       error[size_t(k - 1) * clusters_ + c] =
           std::max(error[size_t(k - 1) * clusters_ + c], error[size_t(k) * clusters_ + c]);
-  return write_cluster_errors(quantize_cluster_errors(global_, clusters_, error));
+  return write_cluster_errors(quantize_cluster_errors_octaves(global_, clusters_, error));
 }
 
 } // namespace pomar

@@ -93,7 +93,7 @@ struct FileHeader {
 };
 
 /// Where each cluster's block is, and its check: the low byte of its XXH32 from the index,
-/// all 32 bits once a BCHK section completes it (format/block_checks.h); `check_mask` says
+/// 16 or 32 bits once a BCHK section completes it (format/block_checks.h); `check_mask` says
 /// which bits hold.
 struct ClusterIndex {
   std::vector<uint64_t> offset; // absolute file offsets
@@ -122,7 +122,7 @@ struct FileLayout {
 
 uint32_t checksum(const uint8_t *data, size_t size);
 /// A cluster block against its check: the bits of `mask` of its XXH32 (the index's low
-/// byte, or all 32 with a BCHK section).
+/// byte, or 16 or 32 bits with a BCHK section).
 inline bool passes_block_check(const uint8_t *block, size_t size, uint32_t check,
                                uint32_t mask = 0xFF) {
   return ((checksum(block, size) ^ check) & mask) == 0;
