@@ -178,11 +178,12 @@ struct EncodeOptions {
   /// together in the file. Off: the blocks in cluster id order. On by default.
   bool spatial_layout = true;
   /// Random-access files of version 5: store a geometric error per cluster and level
-  /// (section CERR, optional; about 3% of the file), bounded while the clustered levels are
+  /// (section CERR, optional; about 1% of the file: each bound a whole power of two, at most
+  /// twice the error), bounded while the clustered levels are
   /// coded, for view-dependent decoding (SelectiveDecoder::want_view). On by default.
   bool cluster_errors = true;
-  /// Random-access files of version 5: store the whole 32-bit checksum of every cluster
-  /// block (section BCHK, optional; 3 bytes per cluster), so that a damaged block is found
+  /// Random-access files of version 5: store 8 more bits of every cluster block's checksum
+  /// (section BCHK, optional; 1 byte per cluster: 16-bit checks), so that a damaged block is found
   /// by a region decode or `--skip-damaged` however its data decodes. On by default.
   bool block_checks = true;
   /// Measurement of a layout of tiers (bench/README.md, "Tiers of clustered levels: measured
@@ -436,8 +437,9 @@ Mesh decode(const uint8_t *data, size_t size, const DecodeOptions &options,
 
 /// Check every block's checksum without decoding (the header, base mesh, model tables and
 /// cluster index must be intact: that throws). Returns the damaged or missing blocks,
-/// empty for an intact file. Cluster blocks carry an 8-bit check: a damaged block passes
-/// it with probability 1/256, which a decode (with its structural checks) may still catch.
+/// empty for an intact file. Cluster blocks carry an 8-bit check in the index, 16 or 32 bits
+/// with a BCHK section: a damaged block passes it with probability 1/256 (2^-16, 2^-32),
+/// which a decode (with its structural checks) may still catch.
 /// Textured files need their base mesh decoded: `memory_limit` bounds that decode as
 /// DecodeOptions::memory_limit does (0 = the memory available).
 std::vector<DamagedBlock> check_blocks(const uint8_t *data, size_t size, uint64_t memory_limit = 0);
