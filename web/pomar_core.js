@@ -81,7 +81,12 @@ export class Decoder {
     this.tolerant = tolerant;
     this.h = withBytes(M, prefix, (p) => M._pw_open(p, prefix.length, fileSize, tolerant ? 1 : 0));
     if (!this.h) throw new PomarError(lastError(M));
-    this.refreshInfo();
+    try {
+      this.refreshInfo();
+    } catch (e) {
+      M._pw_close(this.h);
+      throw e;
+    }
     const n = this.info.clusters;
     this.blockOffset = new Float64Array(n);
     this.blockSize = new Float64Array(n);
@@ -99,9 +104,13 @@ export class Decoder {
     for (let i = 18; i + 1 < n; i += 2) levels.push({ vertices: d[i], faces: d[i + 1] });
     if (this.clusterErrors === undefined) {
       // The stored error bounds (section CERR), level-major from the base clustered level
-      // to the one below the finest; null when the file stores none.
-      const ptr = M._pw_cluster_errors(this.h);
-      this.clusterErrors = ptr ? new Float32Array(M.HEAPF32.buffer, ptr, d[0] * (d[2] - d[1])).slice() : null;
+      // to the one below the finest; null when the file stores none. A damaged section is
+      // an error, as for the rest of the global part.
+      const stored = M._pw_cluster_errors(this.h);
+      if (stored < 0) throw new PomarError(lastError(M));
+      this.clusterErrors = stored
+        ? new Float32Array(M.HEAPF32.buffer, M._pw_cluster_errors_data(this.h), d[0] * (d[2] - d[1])).slice()
+        : null;
     }
     this.info = {
       clusters: d[0], baseLevel: d[1], finestLevel: d[2], vertices: d[3], faces: d[4],

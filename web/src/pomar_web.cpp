@@ -451,20 +451,26 @@ EMSCRIPTEN_KEEPALIVE int pw_update(Handle *h, const int32_t *wanted) {
   });
 }
 
-/// The stored error bound of every cluster at every level from the base clustered level
-/// to the one below the finest (level-major: [(l - base) * clusters + c]; section CERR),
-/// or null when the file stores none.
-EMSCRIPTEN_KEEPALIVE const float *pw_cluster_errors(Handle *h) {
-  const uint32_t n = h->decoder->cluster_count();
-  if (!n || !h->decoder->has_cluster_errors())
-    return nullptr;
-  const int base = h->decoder->base_clustered_level(), finest = h->decoder->finest_level();
-  h->errors.resize(size_t(finest - base) * n);
-  for (int l = base; l < finest; ++l)
-    for (uint32_t c = 0; c < n; ++c)
-      h->errors[size_t(l - base) * n + c] = float(h->decoder->cluster_error(c, l));
-  return h->errors.data();
+/// Read the stored error bounds (section CERR, read here for the first time): 1 when the
+/// file stores them (then pw_cluster_errors_data), 0 when it stores none, -1 when the
+/// section is damaged (pw_last_error names it).
+EMSCRIPTEN_KEEPALIVE int pw_cluster_errors(Handle *h) {
+  return guarded([&] {
+    const uint32_t n = h->decoder->cluster_count();
+    if (!n || !h->decoder->has_cluster_errors())
+      return 0;
+    const int base = h->decoder->base_clustered_level(), finest = h->decoder->finest_level();
+    h->errors.resize(size_t(finest - base) * n);
+    for (int l = base; l < finest; ++l)
+      for (uint32_t c = 0; c < n; ++c)
+        h->errors[size_t(l - base) * n + c] = float(h->decoder->cluster_error(c, l));
+    return 1;
+  });
 }
+/// After pw_cluster_errors returned 1: the bound of every cluster at every level from the
+/// base clustered level to the one below the finest (level-major: [(l - base) * clusters
+/// + c]).
+EMSCRIPTEN_KEEPALIVE const float *pw_cluster_errors_data(Handle *h) { return h->errors.data(); }
 
 /// SelectiveDecoder::view_levels for the camera `cam` (eye xyz, view-projection 16
 /// column-major, vertical fov in radians, width, height, near: 23 floats) into pw_levels,
