@@ -160,7 +160,7 @@ ClusteredLevels encode_clustered_levels(Rebuild &rb, size_t global, FileHeader &
   // Ideal code lengths: [0] connectivity, [1] geometry, [2 + k] attribute code k.
   double bits[2 + kMaxAttributeCodes] = {};
   std::vector<SymbolRecorder> recordings(clusters);
-  LevelFreezer freezer;
+  LevelFreezer freezer(header.ranks_patches()); // (versions 1-4: their encoders' tables)
   EncoderCodec<RecorderStream> codec(rb.q, rb.dec_to_input, rb.input_to_dec);
   codec.set_attribute_codes(rb.attr_codes, rb.attr_codes_per_vertex);
   ParallelClusters parallel(rb, clusters, threads);

@@ -27,6 +27,10 @@ const uint32_t *log_frequencies() {
   return table.data();
 }
 
+/// A binary model's probability in the tables: an 8-bit code.
+uint32_t bit_code(uint32_t p0) { return std::min<uint32_t>(p0 >> 4, 255); }
+uint16_t bit_probability(uint32_t code) { return static_cast<uint16_t>(code * 16 + 8); }
+const uint32_t kHalfCode = bit_code(1u << (kBitModelBits - 1));
 } // namespace
 
 uint32_t log_code(uint32_t f) {
@@ -69,6 +73,98 @@ double data_bits(const uint32_t *counts, const uint16_t *freq, int n) {
     bits += counts[s] * std::log2(total / freq[s]);
   }
   return bits;
+}
+
+/// What the table writer spends on a step from log code `b` to log code `a` (zigzagged, in
+/// an adaptive model where most steps are 0): an estimate, the writer's models adapt.
+double step_bits(uint32_t a, uint32_t b) {
+  if (a == b)
+    return 0.5;
+  const uint32_t z = a > b ? 2 * (a - b) : 2 * (b - a) - 1;
+  return z < 63 ? 3.0 + 1.5 * std::log2(double(z)) : 14.0;
+}
+uint32_t code_of(uint16_t freq) { return freq ? log_code(freq) : 0; }
+
+/// The table bits of frequencies `x` after the previous level's `before` (steps from its
+/// codes), or of a model the previous level did not use (`before` null: the first and last
+/// non-zero symbols and the steps along the alphabet).
+double table_bits(const uint16_t *x, const uint16_t *before, int n) {
+  double bits = 2; // the "used" and "same as before" bits
+  if (before) {
+    for (int s = 0; s < n; ++s)
+      bits += step_bits(code_of(x[s]), code_of(before[s]));
+    return bits;
+  }
+  int first = 0, last = n - 1;
+  while (first < last && x[first] == 0)
+    ++first;
+  while (last > first && x[last] == 0)
+    --last;
+  bits += 8;
+  for (uint32_t s = uint32_t(first), ref = 48; s <= uint32_t(last); ++s) {
+    bits += step_bits(code_of(x[s]), ref);
+    ref = code_of(x[s]);
+  }
+  return bits;
+}
+
+/// Choose the frozen frequencies of a used model, `q` on entry the level's own (log-coded),
+/// `before` the previous level's (null if it did not use the model): the one that codes the
+/// level's `counts` with its table in the fewest bits of
+/// - the previous level's frequencies as they are (one bit in the tables): returns 1;
+/// - uniform frequencies (one bit: a model used a few times codes them cheaper so than its
+///   table costs): returns 2, `q` all 1;
+/// - the own frequencies, where there is a previous level each symbol keeping the previous
+///   frequency when the data bits its own saves do not pay for storing its step (one
+///   greedy pass in symbol order): returns 0, `q` those frequencies.
+int choose_frequencies(const uint32_t *counts, const uint16_t *before, int n, uint16_t *q) {
+  const auto valid = [&](const uint16_t *x) {
+    uint32_t t = 0;
+    for (int s = 0; s < n; ++s)
+      t += x[s];
+    return t != 0 && t <= FrequencyModel::kMaxTotal;
+  };
+  double best = data_bits(counts, q, n) + table_bits(q, before, n);
+  if (before) {
+    for (int s = 0; s < n; ++s) {
+      if (q[s] == before[s])
+        continue;
+      const uint16_t own = q[s];
+      q[s] = before[s];
+      const double bits = valid(q) ? data_bits(counts, q, n) + table_bits(q, before, n) : 1e300;
+      if (bits < best)
+        best = bits;
+      else
+        q[s] = own;
+    }
+  }
+  uint64_t events = 0;
+  for (int s = 0; s < n; ++s)
+    events += counts[s];
+  const double reuse = before ? data_bits(counts, before, n) + 1 : 1e300;
+  const double uniform = double(events) * std::log2(double(n)) + 1;
+  if (reuse <= best && reuse <= uniform)
+    return 1;
+  if (uniform < best) {
+    std::fill(q, q + n, uint16_t(1));
+    return 2;
+  }
+  return 0;
+}
+
+/// The choice of the encoders that wrote versions 1-4 (LevelFreezer::fewest_bits_ false):
+/// the previous level's frequencies when they code the level's counts within an estimate
+/// of what storing the own ones costs (returns 1), else the own (0).
+int reuse_previous_v4(const uint32_t *counts, const std::vector<uint16_t> &before, int n,
+                      const uint16_t *q) {
+  if (before.empty())
+    return 0;
+  int used_symbols = 0;
+  for (int i = 0; i < n; ++i)
+    used_symbols += q[i] != 0;
+  return data_bits(counts, before.data(), n) <= data_bits(counts, q, n) + 1.5 * used_symbols + 2
+             ? 1
+             : 0;
 }
 
 } // namespace
@@ -117,8 +213,9 @@ void LevelFreezer::freeze(Models &m, const ModelSlots &slots, std::vector<uint32
     const uint32_t *c = &counts[slots.first_symbol(slot)];
     used[slot] = std::any_of(c, c + slots.symbols(slot), [](uint32_t n) { return n != 0; });
   }
-  // A model whose previous-level table codes this level's symbols nearly as well as its
-  // own would (within what storing its own costs) reuses it.
+  // Each used model: the frequencies that code this level's symbols with their table in
+  // the fewest bits (choose_frequencies), or in versions 1-4 the previous level's when
+  // they code them nearly as well as the own would (reuse_previous_v4).
   std::vector<std::vector<uint16_t>> &previous = previous_;
   if (previous.size() < slots.slots())
     previous.resize(slots.slots());
@@ -138,18 +235,18 @@ void LevelFreezer::freeze(Models &m, const ModelSlots &slots, std::vector<uint32
         uint16_t q[FrequencyModel::kMaxSymbols];
         for (int i = 0; i < n; ++i)
           q[i] = static_cast<uint16_t>(f.freq(i) ? log_frequency(log_code(f.freq(i))) : 0);
-        if (!before.empty()) {
-          int used_symbols = 0;
-          for (int i = 0; i < n; ++i)
-            used_symbols += q[i] != 0;
-          const double own = data_bits(c, q, n) + 1.5 * used_symbols + 2;
-          if (data_bits(c, before.data(), n) <= own) {
-            f.freeze_with(before.data());
-            return;
-          }
+        const int choice =
+            fewest_bits_ ? choose_frequencies(c, before.empty() ? nullptr : before.data(), n, q)
+                         : reuse_previous_v4(c, before, n, q);
+        if (choice == 1) {
+          f.freeze_with(before.data());
+          return;
         }
         f.freeze_with(q);
-        before.assign(q, q + n);
+        if (choice == 2)
+          before.clear(); // uniform: stored as unused
+        else
+          before.assign(q, q + n);
       },
       [&](BitModel &b) {
         std::vector<uint16_t> &before = previous[slot];
@@ -160,17 +257,32 @@ void LevelFreezer::freeze(Models &m, const ModelSlots &slots, std::vector<uint32
           const uint64_t zeros = c[0], all = zeros + c[1];
           p0 = static_cast<uint32_t>((zeros << kBitModelBits) / all);
         }
-        p0 = std::min<uint32_t>(p0 >> 4, 255) * 16 + 8; // the 8-bit code the table keeps
-        if (in_use && !before.empty()) {
+        p0 = bit_probability(bit_code(p0)); // what the table keeps
+        const uint32_t half = bit_probability(kHalfCode);
+        if (in_use && !fewest_bits_ && !before.empty()) {
           auto bits = [&](double p) {
             return -(c[0] * std::log2(p / 4096.0) + c[1] * std::log2(1 - p / 4096.0));
           };
           if (bits(before[0]) <= bits(p0) + 6)
             p0 = before[0];
+        } else if (in_use && fewest_bits_) {
+          // The fewest bits of data and table: the level's own probability, the previous
+          // level's ("same": one bit), or 1/2 (stored as unused: one bit).
+          auto bits = [&](double p) {
+            return -(c[0] * std::log2(p / 4096.0) + c[1] * std::log2(1 - p / 4096.0));
+          };
+          const uint32_t ref = before.empty() ? 128 : bit_code(before[0]);
+          double best = bits(p0) + 2 + step_bits(bit_code(p0), ref);
+          if (!before.empty() && bits(before[0]) + 2 <= best) {
+            p0 = before[0];
+            best = bits(before[0]) + 2;
+          }
+          if (double(c[0] + c[1]) + 1 < best)
+            p0 = half;
         }
         b.p0 = static_cast<uint16_t>(p0);
         b.frozen = true;
-        if (!in_use)
+        if (!in_use || (fewest_bits_ && p0 == half)) // (1/2 is stored as unused)
           before.clear();
         else
           before.assign(1, b.p0);
@@ -223,10 +335,6 @@ void code_recording(const SymbolRecorder &r, const ModelSlots &slots, RangeEncod
 // - a binary model: its 8-bit probability code, as a step from the previous level's.
 // Unused models are uniform (frequency models) or p0 = 1/2 (binary models).
 namespace {
-
-uint32_t bit_code(uint32_t p0) { return std::min<uint32_t>(p0 >> 4, 255); }
-uint16_t bit_probability(uint32_t code) { return static_cast<uint16_t>(code * 16 + 8); }
-const uint32_t kHalfCode = bit_code(1u << (kBitModelBits - 1));
 
 struct TableModels {
   BitModel used[4];

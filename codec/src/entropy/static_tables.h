@@ -114,10 +114,14 @@ void count_symbols(const SymbolRecorder &recording, const ModelSlots &slots, uin
 
 /// Freezes the models of the clustered levels, level after level, each on the symbols its
 /// level recorded (so the encoder can code and forget a level before recording the next).
-/// A model whose previous-level frequencies code this level nearly as well as its own
-/// would (within what storing its own costs) reuses them: call freeze() in level order.
+/// A model may reuse the previous level's frequencies: call freeze() in level order.
 class LevelFreezer {
 public:
+  /// `fewest_bits` (version 5 files): each model's frequencies are those that code the
+  /// level's symbols with their table in the fewest bits (the level's own, mixed with the
+  /// previous level's symbol by symbol, the previous level's, or uniform); false (versions
+  /// 1-4): the own or the previous level's, as the encoders that wrote those versions chose.
+  explicit LevelFreezer(bool fewest_bits = true) : fewest_bits_(fewest_bits) {}
   /// Freeze the level's models on how often each of their symbols was recorded: `counts`
   /// (at ModelSlots::first_symbol(slot) + symbol: count_symbols over the level's
   /// recordings, in any order).
@@ -126,6 +130,7 @@ public:
   const std::vector<uint32_t> &counts() const { return counts_; }
 
 private:
+  bool fewest_bits_;
   std::vector<uint32_t> counts_;
   std::vector<std::vector<uint16_t>>
       previous_; // per model slot: frozen frequencies (empty: unused)
