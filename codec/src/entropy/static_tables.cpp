@@ -79,9 +79,9 @@ double data_bits(const uint32_t *counts, const uint16_t *freq, int n) {
 /// an adaptive model where most steps are 0): an estimate, the writer's models adapt.
 double step_bits(uint32_t a, uint32_t b) {
   if (a == b)
-    return 0.5;
+    return 0.2;
   const uint32_t z = a > b ? 2 * (a - b) : 2 * (b - a) - 1;
-  return z < 63 ? 3.0 + 1.5 * std::log2(double(z)) : 14.0;
+  return z < 63 ? 2.0 + std::log2(double(z)) : 14.0;
 }
 uint32_t code_of(uint16_t freq) { return freq ? log_code(freq) : 0; }
 
