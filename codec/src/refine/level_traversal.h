@@ -336,32 +336,40 @@ void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v,
 /// Queue v's neighbours clockwise, starting with the one back to `from`; returns how many
 /// of them were split earlier in this traversal (for sv_context: one pass over the ring's
 /// marks; v's own coding, which follows, changes neither the queue nor those marks).
-/// `marks.vertex(n)` is where n's marks are, nullptr for a vertex the traversal does not
-/// visit (another cluster's: never queued nor split here).
+/// `marks.with_vertex(n, f)` hands f n's marks, and does nothing for a vertex the traversal
+/// does not visit (another cluster's: never queued nor split here).
 template <class Marks>
 uint32_t queue_neighbours(TraversalScratch &s, uint32_t v, uint32_t from, const Ring &ring,
                           const Marks &marks) {
   const uint32_t m = ring.size(), stamp = s.stamp; // (a local: the mark stores could alias it)
   if (m == 0)
     return 0;
-  const int at = ring.index_of(from);
-  const uint32_t start = at < 0 ? 0 : uint32_t(at);
+  const uint32_t *neighbour = ring.neighbour.data();
+  uint32_t start = 0;
+  for (uint32_t i = 0; i < m; ++i)
+    if (neighbour[i] == from) {
+      start = i;
+      break;
+    }
+  // (Room for every neighbour first: the loops write the queue through a local pointer.)
+  uint32_t queued = s.queue.size();
+  std::pair<uint32_t, uint32_t> *queue = s.queue.grow_to(size_t(queued) + m);
   uint32_t split = 0;
   const auto visit = [&](uint32_t n) {
-    VertexMarks *mark = marks.vertex(n);
-    if (!mark)
-      return;
-    split += mark->split == stamp;
-    if (mark->queued != stamp) {
-      mark->queued = stamp;
-      s.queue.emplace_back(n, v);
-    }
+    marks.with_vertex(n, [&](VertexMarks &mark) {
+      split += mark.split == stamp;
+      if (mark.queued != stamp) {
+        mark.queued = stamp;
+        queue[queued++] = {n, v};
+      }
+    });
   };
   // Clockwise: start, start - 1, ..., 0, then m - 1, ..., start + 1.
   for (uint32_t i = start + 1; i-- > 0;)
-    visit(ring.neighbour[i]);
+    visit(neighbour[i]);
   for (uint32_t i = m; i-- > start + 1;)
-    visit(ring.neighbour[i]);
+    visit(neighbour[i]);
+  s.queue.resize(queued);
   return split;
 }
 
@@ -402,7 +410,7 @@ void traverse_level(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t
     if (mark.queued == s.stamp)
       continue;
     mark.queued = s.stamp;
-    s.queue.emplace_back(b, a);
+    s.queue.push_back({b, a});
     while (head < s.queue.size()) {
       prefetch_ahead(mesh, s, head);
       const auto [v, from] = s.queue[head++];
@@ -432,13 +440,14 @@ void traverse_cluster(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32
     if (mesh.key(n) < mesh.key(from))
       from = n;
   marks.vertex(root)->queued = s.stamp;
-  s.queue.emplace_back(root, from);
+  s.queue.push_back({root, from});
   const uint32_t *claimed = s.claimed.data();
   const uint16_t *face_claim = mesh.face_claim.data();
   for (size_t head = 0; head < s.queue.size();) {
     prefetch_ahead(mesh, s, head);
     const auto [v, came_from] = s.queue[head++];
-    get_view_ring(mesh, v, level, s.ring);
+    if (head > 1) // (the root's ring is s.ring already)
+      get_view_ring(mesh, v, level, s.ring);
     const uint32_t *corner = s.ring.corner.data(), faces = s.ring.faces();
     if (s.defer_claims) { // (what sv_context and code_vertex read)
       for (uint32_t i = 0; i < faces; ++i)
