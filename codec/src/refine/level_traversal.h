@@ -251,15 +251,13 @@ void code_patch_rank(Codec &codec, TraversalScratch &s, uint32_t v, const Ring &
   patch_symbols(ring, s.spokes.data(), s.placements.il[k], faces, key, j, sym);
 }
 
-/// Code (or decode) s_v at v and, for a split vertex, the split: symbols, patch, claim of
-/// its faces, prediction and position. `ring` is v's ring as the level sees it.
+/// The split at split vertex v (code_vertex's, once s_v said so): symbols, patch, claim of
+/// its faces, prediction and position. (A call: most vertices are not split, and their
+/// visit, inlined in the traversal, does not pay for this one's frame.)
 template <class Codec, class Key, class Marks>
-void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v, const Ring &ring,
-                 uint32_t level, const Key &key, const Marks &marks, uint32_t split_neighbours,
-                 SplitList &splits) {
-  const int context = sv_context(marks, ring, split_neighbours);
-  if (context < 0 || !codec.split_flag(v, context))
-    return;
+[[gnu::noinline]] void code_split(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v,
+                                  const Ring &ring, uint32_t level, const Key &key,
+                                  const Marks &marks, SplitList &splits) {
   marks.vertex(v)->split = s.stamp;
   load_spokes(mesh.q, v, ring, s.spokes);
   SplitSymbols sym;
@@ -287,26 +285,36 @@ void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v,
   // independent); a stream that says otherwise is damaged. (Deferred claims: the faces
   // other clusters hold are checked when the cluster is admitted, LevelStep::
   // admit_cluster_level, and LevelMesh::face_claim is not read here: it may be written
-  // meanwhile.)
-  const uint32_t m = ring.size();
-  for (uint32_t t = 0, i = p.first_face; t < p.faces; ++t, i = i + 1 == m ? 0 : i + 1) {
-    const uint32_t f = ring.corner[i] / 3;
-    if ((!s.defer_claims && mesh.face_claim[f] == level) || marks.claimed(f))
-      codec.corrupt(kSharedFace);
-    if (!s.defer_claims)
-      mesh.face_claim[f] = static_cast<uint16_t>(level);
-    marks.claim(f);
-    s.claims.push_back(f);
-  }
-  // The split walks the patch faces counter-clockwise in the actual mesh: they must be the
-  // ring's faces (true for valid data; a damaged stream could point across a boundary or a
-  // face the view skipped).
-  for (uint32_t t = 0, i = p.first_face, c = ring.corner[i]; t < p.faces;
+  // meanwhile.) The split walks the patch faces counter-clockwise in the actual mesh: they
+  // must also be the ring's faces (true for valid data; a damaged stream could point
+  // across a boundary or a face the view skipped), which the same pass follows, reported
+  // once every face is claimed. (Locals: the claims' push_back could reallocate, and the
+  // arrays would be read again at every face.)
+  const uint32_t m = ring.size(), stamp = s.stamp;
+  const uint32_t *corner = ring.corner.data(), *O = mesh.ct.O.data();
+  uint32_t *claimed = s.claimed.data(); // (marks.claimed and marks.claim: by face id)
+  uint16_t *face_claim = s.defer_claims ? nullptr : mesh.face_claim.data();
+  bool matches = true;
+  for (uint32_t t = 0, i = p.first_face, c = corner[i]; t < p.faces;
        ++t, i = i + 1 == m ? 0 : i + 1) {
-    if (c != ring.corner[i])
-      codec.corrupt("a vertex split does not match the mesh");
-    c = mesh.ct.swing_ccw(c);
+    const uint32_t f = corner[i] / 3;
+    if ((face_claim && face_claim[f] == level) || claimed[f] == stamp)
+      codec.corrupt(kSharedFace);
+    if (face_claim)
+      face_claim[f] = static_cast<uint16_t>(level);
+    claimed[f] = stamp;
+    s.claims.push_back(f);
+    if (matches) {
+      if (c != corner[i]) {
+        matches = false;
+      } else { // swing_ccw
+        const uint32_t o = O[CornerTable::next(c)];
+        c = o == kNone ? kNone : CornerTable::next(o);
+      }
+    }
   }
+  if (!matches)
+    codec.corrupt("a vertex split does not match the mesh");
   PendingSplit ps;
   ps.op = {v, ring.corner[p.first_face], p.faces, p.il != kNone, p.ir != kNone};
   Prediction prediction;
@@ -331,6 +339,18 @@ void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v,
       codec.skip_attributes(mesh.attr_skipped);
   }
   splits.split.push_back(ps);
+}
+
+/// Code (or decode) s_v at v and, for a split vertex, the split (code_split). `ring` is v's
+/// ring as the level sees it.
+template <class Codec, class Key, class Marks>
+[[gnu::always_inline]] inline void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s,
+                                               uint32_t v, const Ring &ring, uint32_t level,
+                                               const Key &key, const Marks &marks,
+                                               uint32_t split_neighbours, SplitList &splits) {
+  const int context = sv_context(marks, ring, split_neighbours);
+  if (context >= 0 && codec.split_flag(v, context))
+    code_split(mesh, codec, s, v, ring, level, key, marks, splits);
 }
 
 /// Queue v's neighbours clockwise, starting with the one back to `from`; returns how many
