@@ -59,9 +59,8 @@ public:
   const NormalPredictor &normal_predictor() const { return m_->normal; }
   void geometry(uint32_t, const Prediction &p, int32_t position[3]) {
     int64_t r[3];
-    r[0] = get_residual(*geom_, m_->geom, 0, p.context) + p.offset[0];
-    r[1] = get_residual(*geom_, m_->geom, 0, p.context) + p.offset[1];
-    r[2] = get_residual(*geom_, m_->geom, 1, p.context) + p.offset[2];
+    for (int k = 0; k < 3; ++k) // t1 and t2 share a model, n has its own
+      r[k] = get_residual(*geom_, m_->geom, k == 2, p.context) + p.offset[k];
     to_global(p.frame, r);
     for (int k = 0; k < 3; ++k) {
       const int64_t v = p.barycentre[k] + r[k];

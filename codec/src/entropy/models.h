@@ -244,7 +244,10 @@ inline uint32_t get_small(RangeDecoder &rc, FrequencyModel &m) {
   return v > 0xFFFFFFFEu ? 0xFFFFFFFFu : static_cast<uint32_t>(v);
 }
 
-inline int64_t get_signed(RangeDecoder &rc, FrequencyModel &classes, BitModel *top) {
+/// (Always inlined: it runs three times per split, and its callers' loops (the position's
+/// components, the attribute codes) hold one copy each.)
+[[gnu::always_inline]] inline int64_t get_signed(RangeDecoder &rc, FrequencyModel &classes,
+                                                 BitModel *top) {
   const int n = rc.decode(classes);
   if (n == 0)
     return 0;

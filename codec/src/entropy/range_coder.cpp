@@ -39,6 +39,18 @@ void FrequencyModel::freeze() {
   cum_[0] = 0;
   for (int i = 0; i < n_; ++i)
     cum_[i + 1] = cum_[i] + freq_[i];
+  // The targets are below total_ <= 2^16: 2^kBucketBits buckets of 2^bucket_shift_.
+  int shift = 0;
+  while ((total_ - 1) >> shift >= (1u << kBucketBits))
+    ++shift;
+  bucket_shift_ = static_cast<uint8_t>(shift);
+  int s = 0;
+  for (uint32_t b = 0; b < (1u << kBucketBits); ++b) {
+    const uint32_t target = b << shift;
+    while (s < n_ - 1 && cum_[s + 1] <= target)
+      ++s;
+    bucket_[b] = static_cast<uint8_t>(s);
+  }
 }
 
 bool FrequencyModel::freeze_with(const uint16_t *freq) {

@@ -52,11 +52,12 @@ public:
     return c;
   }
   /// Find the symbol whose cumulative interval holds `target` (< total()); sets its
-  /// cumulative start. (A frozen model looks it up in its cumulative table, whose last
-  /// entry, the total, stops the scan.)
+  /// cumulative start. (A frozen model starts at the symbol of the target's bucket and
+  /// scans its cumulative table, whose last entry, the total, stops the scan.)
   int find(uint32_t target, uint32_t *start) const {
     int s = 0;
     if (frozen_) {
+      s = bucket_[target >> bucket_shift_];
       while (cum_[s + 1] <= target)
         ++s;
       *start = cum_[s];
@@ -96,7 +97,13 @@ private:
   uint32_t total_;
   bool frozen_ = false;
   uint16_t freq_[kMaxSymbols];
-  uint32_t cum_[kMaxSymbols + 1] = {}; // a frozen model's: cum_[s] = cumulative(s), cum_[n_] = total_
+  uint32_t cum_[kMaxSymbols + 1] =
+      {}; // a frozen model's: cum_[s] = cumulative(s), cum_[n_] = total_
+  // A frozen model's buckets: the targets [b << bucket_shift_, (b + 1) << bucket_shift_)
+  // start at or after symbol bucket_[b], the symbol of target b << bucket_shift_.
+  static constexpr int kBucketBits = 6;
+  uint8_t bucket_shift_ = 0;
+  uint8_t bucket_[1 << kBucketBits] = {};
 };
 
 // The per-symbol functions of both coders are defined in this header: they run a few

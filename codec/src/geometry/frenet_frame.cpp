@@ -20,8 +20,9 @@ int64_t fixed_round(double x) {
   return static_cast<double>(t) > y ? t - 1 : t;
 }
 
-/// Rotation in its plane (x,y) that maps direction (a,b) onto the positive x axis.
-Givens givens_from_pair(double a, double b) {
+/// Rotation in its plane (x,y) that maps direction (a,b) onto the positive x axis. (Always
+/// inlined: make_frenet_frame calls it three times per split.)
+[[gnu::always_inline]] inline Givens givens_from_pair(double a, double b) {
   Givens g;
   if (a == 0.0 && b == 0.0)
     return g;

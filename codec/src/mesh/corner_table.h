@@ -55,29 +55,30 @@ struct CornerTable {
   }
 };
 
-/// The growable array of a Ring: storage that only grows (a ring reused vertex after
-/// vertex stops allocating once it has seen the largest fan) and a count. The walks that
-/// fill a ring write through `grow_to` + `data()` and set the count once (no per-element
-/// capacity bookkeeping); the rest reads it like a vector.
-class RingArray {
+/// A growable array of trivially copyable elements: storage that only grows (an array
+/// reused vertex after vertex stops allocating once it has seen the largest count) and a
+/// count. The walks that fill one write through `grow_to` + `data()` and set the count
+/// once (no per-element capacity bookkeeping); the rest reads it like a vector. (A ring's
+/// arrays, RingArray; the traversal's queue, refine/traversal_marks.h.)
+template <class T> class GrowArray {
 public:
   uint32_t size() const { return n_; }
   bool empty() const { return n_ == 0; }
-  const uint32_t *begin() const { return buf_.data(); }
-  const uint32_t *end() const { return buf_.data() + n_; }
-  uint32_t *data() { return buf_.data(); }
-  const uint32_t *data() const { return buf_.data(); }
-  uint32_t operator[](size_t i) const { return buf_[i]; }
-  uint32_t &operator[](size_t i) { return buf_[i]; }
-  uint32_t back() const { return buf_[n_ - 1]; }
+  const T *begin() const { return buf_.data(); }
+  const T *end() const { return buf_.data() + n_; }
+  T *data() { return buf_.data(); }
+  const T *data() const { return buf_.data(); }
+  const T &operator[](size_t i) const { return buf_[i]; }
+  T &operator[](size_t i) { return buf_[i]; }
+  const T &back() const { return buf_[n_ - 1]; }
   void clear() { n_ = 0; }
   void pop_back() { --n_; }
-  void push_back(uint32_t x) {
+  void push_back(const T &x) {
     grow_to(n_ + 1);
     buf_[n_++] = x;
   }
   /// Room for at least `n` elements (the count is unchanged); returns the storage.
-  uint32_t *grow_to(size_t n) {
+  T *grow_to(size_t n) {
     if (n > cap_) {
       buf_.resize(std::max<size_t>(2 * buf_.size(), std::max<size_t>(n, 32)));
       cap_ = buf_.size();
@@ -92,10 +93,11 @@ public:
   size_t capacity() const { return cap_; }
 
 private:
-  std::vector<uint32_t> buf_;
+  std::vector<T> buf_;
   uint32_t n_ = 0;
   size_t cap_ = 0; // buf_.size(), kept beside it (read by every walk)
 };
+using RingArray = GrowArray<uint32_t>;
 
 /// The one-ring of a vertex in counter-clockwise order. For a closed ring there are as
 /// many faces as neighbours; an open ring (boundary vertex) has one face less and a gap
@@ -115,14 +117,20 @@ struct Ring {
   }
 };
 
+/// next(c) - c and prev(c) - c by c % 3 (the walks step without branches).
+inline constexpr int32_t kNextStep[3] = {1, 1, -2}, kPrevStep[3] = {2, -1, -1};
+
 /// One counter-clockwise walk round a fan from its corner `first`, in one pass: each face
 /// (corner c) gives its corner and the name of its second neighbour V[prev(c)], through
 /// `name` (the vertex itself for the mesh; the level-(l-1) view maps new vertices to
 /// their parents, refine/level_traversal.h). A face whose two neighbours get one name is
-/// left out. Returns false if the walk ran into the fan's boundary: the ring is whole
-/// only if `first` was the fan's clockwise end.
+/// left out. Returns kOpen if the walk ran into the fan's boundary (the ring is whole
+/// only if `first` was the fan's clockwise end), kNoRoom if the fan is larger than the
+/// ring's room (walk_fan grows it and walks again).
+enum class FanWalk { kClosed, kOpen, kNoRoom };
 template <class Name>
-bool walk_fan(const CornerTable &ct, uint32_t first, const Name &name_of, Ring &ring) {
+[[gnu::always_inline]] inline FanWalk walk_fan_once(const CornerTable &ct, uint32_t first,
+                                                    const Name &name_of, Ring &ring) {
   // (Locals, the naming function's copy too: the stores below are uint32_t and could
   // alias what the caller holds, which would then be read again at every face.)
   const Name name = name_of;
@@ -139,10 +147,8 @@ bool walk_fan(const CornerTable &ct, uint32_t first, const Name &name_of, Ring &
   // = V[o]. So each step takes one `% 3`, of o.
   uint32_t c = first, b = V[CornerTable::prev(first)], o = O[CornerTable::next(first)];
   for (;;) {
-    if (kept == room) { // a fan larger than any seen so far: walk it again with room
-      ring.corner.grow_to(room + 1);
-      return walk_fan(ct, first, name, ring);
-    }
+    if (kept == room) // a fan larger than any seen so far: walk it again with room
+      return FanWalk::kNoRoom;
     // The face beyond edge (a, b) is in the fans of a and b, which a breadth-first walk
     // visits soon: fetch it now.
     const uint32_t across = O[c]; // (ct.prefetch, on the local arrays)
@@ -161,17 +167,34 @@ bool walk_fan(const CornerTable &ct, uint32_t first, const Name &name_of, Ring &
       break;
     }
     const uint32_t k = o % 3;
-    c = k == 2 ? o - 2 : o + 1; // next(o)
+    c = o + kNextStep[k]; // next(o)
     if (c == first)
       break;
     b = V[o];
-    o = O[k == 0 ? o + 2 : o - 1]; // O[next(c)] = O[prev(o)]
+    o = O[o + kPrevStep[k]]; // O[next(c)] = O[prev(o)]
   }
   ring.corner.resize(kept);
   // (a closed fan's wrap-around repeats the first neighbour)
   ring.neighbour.resize(closed && kept > 0 ? kept : kept + 1);
   ring.closed = closed;
-  return closed;
+  return closed ? FanWalk::kClosed : FanWalk::kOpen;
+}
+/// walk_fan_once until the ring has room; false if the walk ran into the fan's boundary.
+/// (Always inlined: a call per ring cost about 20 instructions of the walk's 400, and
+/// get_named_ring's first walk is the traversals' inner loop.)
+template <class Name>
+[[gnu::always_inline]] inline bool walk_fan(const CornerTable &ct, uint32_t first, const Name &name,
+                                            Ring &ring) {
+  FanWalk r;
+  while ((r = walk_fan_once(ct, first, name, ring)) == FanWalk::kNoRoom)
+    ring.corner.grow_to(ring.corner.capacity() + 1);
+  return r == FanWalk::kClosed;
+}
+/// walk_fan, called (an open fan's second walk, from its clockwise end).
+template <class Name>
+[[gnu::noinline]] bool walk_fan_again(const CornerTable &ct, uint32_t first, const Name &name,
+                                      Ring &ring) {
+  return walk_fan(ct, first, name, ring);
 }
 
 /// The one-ring of vertex v with neighbours named by `name` (see walk_fan); empty if v
@@ -192,7 +215,7 @@ void get_named_ring(const CornerTable &ct, uint32_t v, const Name &name, Ring &r
   for (uint32_t b = ct.swing_cw(start); b != kNone; b = ct.swing_cw(b))
     first = b;
   if (first != start)
-    walk_fan(ct, first, name, ring);
+    walk_fan_again(ct, first, name, ring);
 }
 
 /// Fill `ring` with the one-ring of vertex v (empty if v has no face).

@@ -251,15 +251,13 @@ void code_patch_rank(Codec &codec, TraversalScratch &s, uint32_t v, const Ring &
   patch_symbols(ring, s.spokes.data(), s.placements.il[k], faces, key, j, sym);
 }
 
-/// Code (or decode) s_v at v and, for a split vertex, the split: symbols, patch, claim of
-/// its faces, prediction and position. `ring` is v's ring as the level sees it.
+/// The split at split vertex v (code_vertex's, once s_v said so): symbols, patch, claim of
+/// its faces, prediction and position. (A call: most vertices are not split, and their
+/// visit, inlined in the traversal, does not pay for this one's frame.)
 template <class Codec, class Key, class Marks>
-void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v, const Ring &ring,
-                 uint32_t level, const Key &key, const Marks &marks, uint32_t split_neighbours,
-                 SplitList &splits) {
-  const int context = sv_context(marks, ring, split_neighbours);
-  if (context < 0 || !codec.split_flag(v, context))
-    return;
+[[gnu::noinline]] void code_split(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v,
+                                  const Ring &ring, uint32_t level, const Key &key,
+                                  const Marks &marks, SplitList &splits) {
   marks.vertex(v)->split = s.stamp;
   load_spokes(mesh.q, v, ring, s.spokes);
   SplitSymbols sym;
@@ -287,26 +285,36 @@ void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v,
   // independent); a stream that says otherwise is damaged. (Deferred claims: the faces
   // other clusters hold are checked when the cluster is admitted, LevelStep::
   // admit_cluster_level, and LevelMesh::face_claim is not read here: it may be written
-  // meanwhile.)
-  const uint32_t m = ring.size();
-  for (uint32_t t = 0, i = p.first_face; t < p.faces; ++t, i = i + 1 == m ? 0 : i + 1) {
-    const uint32_t f = ring.corner[i] / 3;
-    if ((!s.defer_claims && mesh.face_claim[f] == level) || marks.claimed(f))
-      codec.corrupt(kSharedFace);
-    if (!s.defer_claims)
-      mesh.face_claim[f] = static_cast<uint16_t>(level);
-    marks.claim(f);
-    s.claims.push_back(f);
-  }
-  // The split walks the patch faces counter-clockwise in the actual mesh: they must be the
-  // ring's faces (true for valid data; a damaged stream could point across a boundary or a
-  // face the view skipped).
-  for (uint32_t t = 0, i = p.first_face, c = ring.corner[i]; t < p.faces;
+  // meanwhile.) The split walks the patch faces counter-clockwise in the actual mesh: they
+  // must also be the ring's faces (true for valid data; a damaged stream could point
+  // across a boundary or a face the view skipped), which the same pass follows, reported
+  // once every face is claimed. (Locals: the claims' push_back could reallocate, and the
+  // arrays would be read again at every face.)
+  const uint32_t m = ring.size(), stamp = s.stamp;
+  const uint32_t *corner = ring.corner.data(), *O = mesh.ct.O.data();
+  uint32_t *claimed = s.claimed.data(); // (marks.claimed and marks.claim: by face id)
+  uint16_t *face_claim = s.defer_claims ? nullptr : mesh.face_claim.data();
+  bool matches = true;
+  for (uint32_t t = 0, i = p.first_face, c = corner[i]; t < p.faces;
        ++t, i = i + 1 == m ? 0 : i + 1) {
-    if (c != ring.corner[i])
-      codec.corrupt("a vertex split does not match the mesh");
-    c = mesh.ct.swing_ccw(c);
+    const uint32_t f = corner[i] / 3;
+    if ((face_claim && face_claim[f] == level) || claimed[f] == stamp)
+      codec.corrupt(kSharedFace);
+    if (face_claim)
+      face_claim[f] = static_cast<uint16_t>(level);
+    claimed[f] = stamp;
+    s.claims.push_back(f);
+    if (matches) {
+      if (c != corner[i]) {
+        matches = false;
+      } else { // swing_ccw
+        const uint32_t o = O[CornerTable::next(c)];
+        c = o == kNone ? kNone : CornerTable::next(o);
+      }
+    }
   }
+  if (!matches)
+    codec.corrupt("a vertex split does not match the mesh");
   PendingSplit ps;
   ps.op = {v, ring.corner[p.first_face], p.faces, p.il != kNone, p.ir != kNone};
   Prediction prediction;
@@ -333,35 +341,55 @@ void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t v,
   splits.split.push_back(ps);
 }
 
+/// Code (or decode) s_v at v and, for a split vertex, the split (code_split). `ring` is v's
+/// ring as the level sees it.
+template <class Codec, class Key, class Marks>
+[[gnu::always_inline]] inline void code_vertex(LevelMesh &mesh, Codec &codec, TraversalScratch &s,
+                                               uint32_t v, const Ring &ring, uint32_t level,
+                                               const Key &key, const Marks &marks,
+                                               uint32_t split_neighbours, SplitList &splits) {
+  const int context = sv_context(marks, ring, split_neighbours);
+  if (context >= 0 && codec.split_flag(v, context))
+    code_split(mesh, codec, s, v, ring, level, key, marks, splits);
+}
+
 /// Queue v's neighbours clockwise, starting with the one back to `from`; returns how many
 /// of them were split earlier in this traversal (for sv_context: one pass over the ring's
 /// marks; v's own coding, which follows, changes neither the queue nor those marks).
-/// `marks.vertex(n)` is where n's marks are, nullptr for a vertex the traversal does not
-/// visit (another cluster's: never queued nor split here).
+/// `marks.with_vertex(n, f)` hands f n's marks, and does nothing for a vertex the traversal
+/// does not visit (another cluster's: never queued nor split here).
 template <class Marks>
 uint32_t queue_neighbours(TraversalScratch &s, uint32_t v, uint32_t from, const Ring &ring,
                           const Marks &marks) {
   const uint32_t m = ring.size(), stamp = s.stamp; // (a local: the mark stores could alias it)
   if (m == 0)
     return 0;
-  const int at = ring.index_of(from);
-  const uint32_t start = at < 0 ? 0 : uint32_t(at);
+  const uint32_t *neighbour = ring.neighbour.data();
+  uint32_t start = 0;
+  for (uint32_t i = 0; i < m; ++i)
+    if (neighbour[i] == from) {
+      start = i;
+      break;
+    }
+  // (Room for every neighbour first: the loops write the queue through a local pointer.)
+  uint32_t queued = s.queue.size();
+  std::pair<uint32_t, uint32_t> *queue = s.queue.grow_to(size_t(queued) + m);
   uint32_t split = 0;
   const auto visit = [&](uint32_t n) {
-    VertexMarks *mark = marks.vertex(n);
-    if (!mark)
-      return;
-    split += mark->split == stamp;
-    if (mark->queued != stamp) {
-      mark->queued = stamp;
-      s.queue.emplace_back(n, v);
-    }
+    marks.with_vertex(n, [&](VertexMarks &mark) {
+      split += mark.split == stamp;
+      if (mark.queued != stamp) {
+        mark.queued = stamp;
+        queue[queued++] = {n, v};
+      }
+    });
   };
   // Clockwise: start, start - 1, ..., 0, then m - 1, ..., start + 1.
   for (uint32_t i = start + 1; i-- > 0;)
-    visit(ring.neighbour[i]);
+    visit(neighbour[i]);
   for (uint32_t i = m; i-- > start + 1;)
-    visit(ring.neighbour[i]);
+    visit(neighbour[i]);
+  s.queue.resize(queued);
   return split;
 }
 
@@ -402,7 +430,7 @@ void traverse_level(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32_t
     if (mark.queued == s.stamp)
       continue;
     mark.queued = s.stamp;
-    s.queue.emplace_back(b, a);
+    s.queue.push_back({b, a});
     while (head < s.queue.size()) {
       prefetch_ahead(mesh, s, head);
       const auto [v, from] = s.queue[head++];
@@ -432,13 +460,14 @@ void traverse_cluster(LevelMesh &mesh, Codec &codec, TraversalScratch &s, uint32
     if (mesh.key(n) < mesh.key(from))
       from = n;
   marks.vertex(root)->queued = s.stamp;
-  s.queue.emplace_back(root, from);
+  s.queue.push_back({root, from});
   const uint32_t *claimed = s.claimed.data();
   const uint16_t *face_claim = mesh.face_claim.data();
   for (size_t head = 0; head < s.queue.size();) {
     prefetch_ahead(mesh, s, head);
     const auto [v, came_from] = s.queue[head++];
-    get_view_ring(mesh, v, level, s.ring);
+    if (head > 1) // (the root's ring is s.ring already)
+      get_view_ring(mesh, v, level, s.ring);
     const uint32_t *corner = s.ring.corner.data(), faces = s.ring.faces();
     if (s.defer_claims) { // (what sv_context and code_vertex read)
       for (uint32_t i = 0; i < faces; ++i)

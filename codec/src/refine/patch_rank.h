@@ -40,8 +40,7 @@ inline constexpr Log2Table kLog2Table{};
 
 /// log2(x) in 1/256 units (x >= 1; 0 for x = 0), from the top 9 bits of x.
 inline int32_t log2_q8(uint64_t x) {
-  if (x == 0)
-    return 0;
+  x += x == 0;                      // (log2_q8(1) is 0 too: no branch)
   const int z = __builtin_clzll(x); // x << z: the top bit at 63, then the 8 bits below it
   return (63 - z) * 256 + kLog2Table.q8[(x << z) >> 55 & 255];
 }

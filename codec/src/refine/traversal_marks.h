@@ -33,13 +33,14 @@ struct TraversalScratch {
   std::vector<VertexMarks> marks; // a global level's, by vertex id
   // A cluster's, by the vertex's rank in its cluster (LevelMesh::Lineage::local): as many
   // entries as the largest cluster has vertices.
-  std::vector<VertexMarks> local_marks;
+  // (Its capacity is the room: read at every neighbour, kept beside the storage.)
+  GrowArray<VertexMarks> local_marks;
   std::vector<uint32_t> claimed; // by face id: the stamp of the traversal that claimed it
   std::vector<uint32_t> claims;  // the faces this traversal's patches hold, in claim order
   // Leave LevelMesh::face_claim to the caller (clusters traversed in parallel: the caller
   // checks and writes their claims in cluster order, refine/level_step.h).
   bool defer_claims = false;
-  std::vector<std::pair<uint32_t, uint32_t>> queue; // (vertex, came from)
+  GrowArray<std::pair<uint32_t, uint32_t>> queue; // (vertex, came from)
   Ring ring;
   std::vector<Spoke> spokes;    // of the split vertex being coded
   std::vector<uint32_t> ranked; // its ring's edges, longest first
@@ -65,9 +66,9 @@ struct TraversalScratch {
   /// The marks of the cluster vertex of rank `local` (grown on first use; new entries
   /// carry stamp 0, which no traversal has).
   VertexMarks &local_mark(uint32_t local) {
-    if (local >= local_marks.size())
-      local_marks.resize(std::max<size_t>(2 * local_marks.size(), size_t(local) + 64));
-    return local_marks[local];
+    if (local >= local_marks.capacity())
+      local_marks.grow_to(std::max<size_t>(2 * local_marks.capacity(), size_t(local) + 64));
+    return local_marks.data()[local];
   }
 };
 
@@ -81,6 +82,8 @@ struct FaceClaims {
 /// A global level's marks: by id (every vertex is visited).
 struct GlobalMarks : FaceClaims {
   VertexMarks *vertex(uint32_t v) const { return &s.marks[v]; }
+  /// f(v's marks) (every vertex has them).
+  template <class F> void with_vertex(uint32_t v, F &&f) const { f(s.marks[v]); }
 };
 
 /// A cluster's marks: by rank in the cluster for the cluster's own vertices, nullptr for
@@ -91,6 +94,12 @@ struct ClusterMarks : FaceClaims {
   VertexMarks *vertex(uint32_t v) const {
     const LevelMesh::Lineage &l = lineage[v];
     return l.cluster == cluster ? &s.local_mark(l.local) : nullptr;
+  }
+  /// f(v's marks) if v is the cluster's, else nothing.
+  template <class F> void with_vertex(uint32_t v, F &&f) const {
+    const LevelMesh::Lineage &l = lineage[v];
+    if (l.cluster == cluster)
+      f(s.local_mark(l.local));
   }
 };
 
