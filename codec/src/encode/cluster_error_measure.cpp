@@ -62,6 +62,8 @@ V3 at(const std::vector<int32_t> &q, uint32_t v) {
 /// at corner `hint` if it is still a corner of a (the face that settled p's distance at the
 /// level before lies often near the one that settles it now; any start visits the same
 /// faces until one settles), and `hint` becomes the corner of the face that settled it.
+/// Consecutive faces of the fan share an edge from a: each face's far vertex there is read
+/// once, for both faces.
 void raise_to_fan_distance(const LevelMesh &mesh, uint32_t a, V3 p, double &worst, uint32_t &hint) {
   const V3 va = at(mesh.q, a);
   const V3 pa = p - va;
@@ -69,28 +71,40 @@ void raise_to_fan_distance(const LevelMesh &mesh, uint32_t a, V3 p, double &wors
   if (best <= worst)
     return;
   const CornerTable &ct = mesh.ct;
+  const uint32_t *V = ct.V.data();
   const uint32_t first =
-      hint < ct.V.size() && ct.V[hint] == a ? hint : ct.VC[a]; // (VC: kNone if isolated)
-  const auto face = [&](uint32_t c) {
-    const double d = distance2_to_triangle(p, pa, va, at(mesh.q, ct.V[CornerTable::next(c)]),
-                                           at(mesh.q, ct.V[CornerTable::prev(c)]));
-    best = std::min(best, d);
-    if (!(d <= worst)) // (NaN, from a degenerate face: does not settle it)
-      return false;
-    hint = c;
-    return true;
-  };
+      hint < ct.V.size() && V[hint] == a ? hint : ct.VC[a]; // (VC: kNone if isolated)
   if (first != kNone) {
+    // Counter-clockwise, face c = (a, b, d) is followed by the face across (a, d), whose b
+    // is d.
+    const V3 b_first = at(mesh.q, V[CornerTable::next(first)]);
+    V3 b = b_first;
     uint32_t c = first;
     do {
-      if (face(c))
+      const V3 d = at(mesh.q, V[CornerTable::prev(c)]);
+      const double e = distance2_to_triangle(p, pa, va, b, d);
+      best = std::min(best, e);
+      if (e <= worst) { // (not NaN, from a degenerate face: that does not settle it)
+        hint = c;
         return;
+      }
+      b = d;
       c = ct.swing_ccw(c);
     } while (c != kNone && c != first);
-    if (c == kNone) // an open fan: the faces clockwise of the first
-      for (c = ct.swing_cw(first); c != kNone; c = ct.swing_cw(c))
-        if (face(c))
+    if (c == kNone) { // an open fan: the faces clockwise of the first, each (a, b, d) with
+                      // d the b of the face before
+      V3 d = b_first;
+      for (c = ct.swing_cw(first); c != kNone; c = ct.swing_cw(c)) {
+        b = at(mesh.q, V[CornerTable::next(c)]);
+        const double e = distance2_to_triangle(p, pa, va, b, d);
+        best = std::min(best, e);
+        if (e <= worst) {
+          hint = c;
           return;
+        }
+        d = b;
+      }
+    }
   }
   worst = best;
 }

@@ -11,6 +11,17 @@
 namespace pomar {
 namespace {
 
+/// The normal component of v in `frame`: to_local's third, which its last rotation (in the
+/// tangent plane) leaves as it is.
+[[gnu::always_inline]] inline int64_t height(const FrenetFrame &frame, const int64_t v[3]) {
+  using namespace frenet_detail;
+  int64_t w[3] = {v[0], v[1], v[2]};
+  apply<kPlane[0][0], kPlane[0][1]>(frame.g[0], w);
+  apply<kPlane[1][0], kPlane[1][1]>(frame.g[1], w);
+  return w[2];
+}
+static_assert(kPlane[2][0] != 2 && kPlane[2][1] != 2, "the last rotation keeps the normal");
+
 /// One split of the level as the decoder will see it: the predictor's vectors and frame,
 /// the features the fit uses (the vectors' heights), the normal component of the residual
 /// to the barycentre, the curvature term's offset and the model context.
@@ -56,16 +67,12 @@ void collect(const Rebuild &rb, uint32_t level, const Key &key, std::vector<Norm
     NormalSample s;
     normal_vectors(at, ring, spokes.data(), p, pred, s.x);
     s.frame = pred.frame;
-    for (int k = 0; k < kNormalFeatures; ++k) {
-      int64_t h[3] = {s.x[k][0], s.x[k][1], s.x[k][2]};
-      to_local(pred.frame, h);
-      s.f[k] = double(h[2]);
-    }
+    for (int k = 0; k < kNormalFeatures; ++k)
+      s.f[k] = double(height(pred.frame, s.x[k]));
     int64_t res[3];
     for (int k = 0; k < 3; ++k)
       res[k] = int64_t(rb.q[3 * size_t(c.v_from) + k]) - pred.barycentre[k];
-    to_local(pred.frame, res);
-    s.target = res[2];
+    s.target = height(pred.frame, res);
     s.legacy = pred.offset[2];
     s.context = pred.context;
     out.push_back(s);
@@ -94,9 +101,16 @@ double estimate_bits(const std::vector<NormalSample> &samples, const std::vector
 
 std::vector<int64_t> residuals(const std::vector<NormalSample> &samples, const NormalPredictor &p) {
   std::vector<int64_t> r(samples.size());
-  for (size_t i = 0; i < samples.size(); ++i)
-    r[i] = samples[i].target -
-           (p.linear ? normal_offset(p, samples[i].frame, samples[i].x) : samples[i].legacy);
+  for (size_t i = 0; i < samples.size(); ++i) {
+    const NormalSample &s = samples[i];
+    if (!p.linear) {
+      r[i] = s.target - s.legacy;
+      continue;
+    }
+    int64_t v[3]; // (normal_offset's terms)
+    combine_normal_vectors(p, s.x, v);
+    r[i] = s.target - linear_normal_offset(height(s.frame, v));
+  }
   return r;
 }
 
