@@ -125,54 +125,6 @@ std::vector<int> to_levels(const Handle &h, const int32_t *wanted) {
   return std::vector<int>(wanted, wanted + h.decoder->cluster_count());
 }
 
-/// Per vertex, how far it stands off the surface its neighbours span: the distance from
-/// its position to the plane through the centroid of its neighbours whose normal is the
-/// area-weighted normal of the faces around it (-1 where that normal is zero). A vertex
-/// created by a vertex split at level l lands next to v_to, inside the fan that v_to had at
-/// level l-1; its neighbours are (mostly) vertices of that fan, so this is the offset the
-/// split added to the coarser surface there: on a smooth patch about e^2/2R (edge e,
-/// radius of curvature R), plus the scan's noise. Unlike the distance to v_to, it does not
-/// grow with the edge length on a flat patch; unlike the distance to the coarser faces
-/// themselves, it needs only the current mesh.
-std::vector<float> detail_of(const pomar::Mesh &mesh) {
-  const std::vector<float> &p = mesh.positions;
-  const std::vector<uint32_t> &t = mesh.triangles;
-  const size_t nv = mesh.vertex_count();
-  std::vector<double> centroid(3 * nv, 0.0), normal(3 * nv, 0.0);
-  std::vector<uint32_t> count(nv, 0);
-  for (size_t f = 0; f < mesh.triangle_count(); ++f) {
-    const uint32_t *v = &t[3 * f];
-    double e[2][3], n[3];
-    for (int k = 0; k < 2; ++k)
-      for (int j = 0; j < 3; ++j)
-        e[k][j] = double(p[3 * v[k + 1] + j]) - p[3 * v[0] + j];
-    n[0] = e[0][1] * e[1][2] - e[0][2] * e[1][1];
-    n[1] = e[0][2] * e[1][0] - e[0][0] * e[1][2];
-    n[2] = e[0][0] * e[1][1] - e[0][1] * e[1][0];
-    for (int k = 0; k < 3; ++k) {
-      // Each corner sees the other two; an inner neighbour is counted twice (once per
-      // face of the edge), a border one once: the centroid leans a little inwards.
-      for (int j = 0; j < 3; ++j) {
-        centroid[3 * v[k] + j] += double(p[3 * v[(k + 1) % 3] + j]) + p[3 * v[(k + 2) % 3] + j];
-        normal[3 * v[k] + j] += n[j];
-      }
-      count[v[k]] += 2;
-    }
-  }
-  std::vector<float> out(nv, -1.f);
-  for (size_t v = 0; v < nv; ++v) {
-    const double *n = &normal[3 * v];
-    const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    if (!(length > 0) || count[v] == 0)
-      continue;
-    double d = 0;
-    for (int j = 0; j < 3; ++j)
-      d += (double(p[3 * v + j]) - centroid[3 * v + j] / count[v]) * n[j];
-    out[v] = float(std::abs(d) / length);
-  }
-  return out;
-}
-
 /// The extracted mesh's per-corner texture coordinates as one (u, v) per vertex, the value
 /// of its corners, when all the corners of every vertex agree (the cut mesh: each vertex is
 /// one wedge). Otherwise (a welded mesh: a vertex on a seam has corners in two charts) no
@@ -616,115 +568,181 @@ EMSCRIPTEN_KEEPALIVE const char *pw_texture_file(Handle *h, int i) {
 ///  12   the detail of its newest vertices: over the cluster's vertices created at the
 ///       highest level any of them has, the largest distance from a vertex to the plane of
 ///       its neighbours (through their centroid, normal to the area-weighted normal of the
-///       faces around the vertex; see detail_of);
+///       faces around the vertex; see the function);
 ///  13   how many vertices that is (0: none measured, e.g. no vertex with a defined plane).
 ///       At the base clustered level a cluster is one vertex (from a global level): its
 ///       detail is that vertex's offset from its neighbours in the base clustered mesh.
 constexpr size_t kBoundsStride = 14;
 
+/// A face's corner positions, read once as doubles, and its normal times twice its area.
+struct FaceGeometry {
+  double q[3][3];
+  double normal[3];
+};
+inline FaceGeometry face_geometry(const float *p, const uint32_t *v) {
+  FaceGeometry g;
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 3; ++j)
+      g.q[k][j] = p[3 * v[k] + j];
+  double e[2][3];
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 3; ++j)
+      e[k][j] = g.q[k + 1][j] - g.q[0][j];
+  g.normal[0] = e[0][1] * e[1][2] - e[0][2] * e[1][1];
+  g.normal[1] = e[0][2] * e[1][0] - e[0][0] * e[1][2];
+  g.normal[2] = e[0][0] * e[1][1] - e[0][1] * e[1][0];
+  return g;
+}
+
 EMSCRIPTEN_KEEPALIVE const float *pw_cluster_bounds(Handle *h) {
+  const pomar::Mesh &mesh = h->mesh;
   const uint32_t n = std::max<uint32_t>(1, h->decoder->cluster_count());
+  const size_t nv = mesh.vertex_count(), nf = mesh.triangle_count();
   h->bounds.assign(size_t(n) * kBoundsStride, 0.f);
-  auto at = [&](uint32_t c) { return &h->bounds[kBoundsStride * size_t(c)]; };
+  float *const bounds = h->bounds.data();
+  auto at = [bounds](uint32_t c) { return bounds + kBoundsStride * size_t(c); };
+  const float *const p = mesh.positions.data();
+  const uint32_t *const t = mesh.triangles.data();
+  // Each vertex's cluster (pw_extract sets one per vertex; none before the first extract).
+  std::vector<uint32_t> no_clusters;
+  if (h->vertex_cluster.size() != nv)
+    no_clusters.assign(nv, 0);
+  const uint32_t *const cluster =
+      h->vertex_cluster.size() == nv ? h->vertex_cluster.data() : no_clusters.data();
+
   for (uint32_t c = 0; c < n; ++c)
     for (int k = 0; k < 3; ++k) {
       at(c)[k] = 3.4e38f;
       at(c)[3 + k] = -3.4e38f;
     }
-  const std::vector<float> &p = h->mesh.positions;
-  auto cluster = [&](uint32_t v) { return h->vertex_cluster.empty() ? 0u : h->vertex_cluster[v]; };
-  for (uint32_t v = 0; v < h->mesh.vertex_count(); ++v) {
-    float *b = at(cluster(v));
+  for (size_t v = 0; v < nv; ++v) {
+    float *b = at(cluster[v]);
     for (int k = 0; k < 3; ++k) {
       b[k] = std::min(b[k], p[3 * v + k]);
       b[3 + k] = std::max(b[3 + k], p[3 * v + k]);
     }
   }
-  // Edges inside a cluster measure it; a cluster with none (a single vertex, as at the base
-  // clustered level) takes the edges around it. Edges across a border do not count where
-  // a cluster has inner edges: they belong to the coarser neighbour as much as to it.
-  const std::vector<uint32_t> &t = h->mesh.triangles;
-  std::vector<float> around(n, 0.f);
-  // The face's normal times twice its area, and the distinct clusters of its corners.
-  auto face = [&](size_t f, double normal[3], uint32_t clusters[3]) {
-    double e[2][3];
-    for (int k = 0; k < 2; ++k)
-      for (int j = 0; j < 3; ++j)
-        e[k][j] = double(p[3 * t[3 * f + k + 1] + j]) - p[3 * t[3 * f] + j];
-    normal[0] = e[0][1] * e[1][2] - e[0][2] * e[1][1];
-    normal[1] = e[0][2] * e[1][0] - e[0][0] * e[1][2];
-    normal[2] = e[0][0] * e[1][1] - e[0][1] * e[1][0];
-    int count = 0;
+
+  // One pass over the faces gathers what the entries need of each face:
+  //  - the squared length of its edges: inside a cluster they measure it; a cluster with
+  //    none (a single vertex, as at the base clustered level) takes the edges around it.
+  //    Edges across a border do not count where a cluster has inner edges: they belong to
+  //    the coarser neighbour as much as to it. (The root is taken once, of the longest.)
+  //  - its normal times twice its area, summed per distinct cluster of its corners (the
+  //    cone's axis; a second pass, once the axes are known, measures the cone's width;
+  //  - per vertex, for its detail (entry 12): the sum of its neighbours' positions and of
+  //    the normals of the faces around it. Each corner sees the other two: an inner
+  //    neighbour is counted twice (once per face of the edge), a border one once, so the
+  //    centroid leans a little inwards.
+  const bool with_detail = !h->vertex_level.empty();
+  std::vector<double> inner2(n, 0.0), around2(n, 0.0);
+  std::vector<double> centroid, vertex_normal;
+  std::vector<uint32_t> count;
+  if (with_detail) {
+    centroid.assign(3 * nv, 0.0);
+    vertex_normal.assign(3 * nv, 0.0);
+    count.assign(nv, 0);
+  }
+  for (size_t f = 0; f < nf; ++f) {
+    const uint32_t *v = &t[3 * f];
+    const uint32_t c[3] = {cluster[v[0]], cluster[v[1]], cluster[v[2]]};
+    const FaceGeometry g = face_geometry(p, v);
+    const auto &q = g.q;
+    const double *normal = g.normal;
+    at(c[0])[7] += 1;
     for (int k = 0; k < 3; ++k) {
-      const uint32_t c = cluster(t[3 * f + k]);
-      if (std::find(clusters, clusters + count, c) == clusters + count)
-        clusters[count++] = c;
-    }
-    return count;
-  };
-  for (size_t f = 0; f < h->mesh.triangle_count(); ++f) {
-    at(cluster(t[3 * f]))[7] += 1;
-    for (int k = 0; k < 3; ++k) {
-      const uint32_t a = t[3 * f + k], b = t[3 * f + (k + 1) % 3];
+      const int l = k == 2 ? 0 : k + 1;
       double d2 = 0;
-      for (int j = 0; j < 3; ++j) {
-        const double d = double(p[3 * a + j]) - p[3 * b + j];
-        d2 += d * d;
-      }
-      const float len = float(std::sqrt(d2));
-      if (cluster(a) == cluster(b)) {
-        at(cluster(a))[6] = std::max(at(cluster(a))[6], len);
+      for (int j = 0; j < 3; ++j)
+        d2 += (q[k][j] - q[l][j]) * (q[k][j] - q[l][j]);
+      if (c[k] == c[l]) {
+        inner2[c[k]] = std::max(inner2[c[k]], d2);
       } else {
-        around[cluster(a)] = std::max(around[cluster(a)], len);
-        around[cluster(b)] = std::max(around[cluster(b)], len);
+        around2[c[k]] = std::max(around2[c[k]], d2);
+        around2[c[l]] = std::max(around2[c[l]], d2);
       }
     }
-    double normal[3];
-    uint32_t clusters[3];
-    const int count = face(f, normal, clusters);
-    for (int i = 0; i < count; ++i)
-      for (int k = 0; k < 3; ++k)
-        at(clusters[i])[8 + k] += float(normal[k]);
+    const bool second = c[1] != c[0], third = c[2] != c[0] && c[2] != c[1];
+    for (int j = 0; j < 3; ++j) {
+      at(c[0])[8 + j] += float(normal[j]);
+      if (second)
+        at(c[1])[8 + j] += float(normal[j]);
+      if (third)
+        at(c[2])[8 + j] += float(normal[j]);
+    }
+    if (with_detail)
+      for (int k = 0; k < 3; ++k) {
+        const int l = k == 2 ? 0 : k + 1, m = l == 2 ? 0 : l + 1;
+        double *sum = &centroid[3 * v[k]], *around = &vertex_normal[3 * v[k]];
+        for (int j = 0; j < 3; ++j) {
+          sum[j] += q[l][j] + q[m][j];
+          around[j] += normal[j];
+        }
+        count[v[k]] += 2;
+      }
   }
   for (uint32_t c = 0; c < n; ++c) {
     float *b = at(c);
+    b[6] = float(std::sqrt(inner2[c]));
     if (b[6] == 0)
-      b[6] = around[c];
+      b[6] = float(std::sqrt(around2[c]));
     const double length =
         std::sqrt(double(b[8]) * b[8] + double(b[9]) * b[9] + double(b[10]) * b[10]);
     for (int k = 0; k < 3; ++k)
       b[8 + k] = length > 0 ? float(b[8 + k] / length) : 0.f;
     b[11] = length > 0 ? 1.f : -1.f;
   }
-  // The detail of each cluster's newest vertices (entries 12, 13).
-  if (!h->vertex_level.empty()) {
-    const std::vector<float> detail = detail_of(h->mesh);
+
+  // The detail of each cluster's newest vertices (entries 12, 13). A vertex's detail is how
+  // far it stands off the surface its neighbours span: the distance from its position to
+  // the plane through the centroid of its neighbours whose normal is the area-weighted
+  // normal of the faces around it (none where that normal is zero). A vertex created by a
+  // vertex split at level l lands next to v_to, inside the fan that v_to had at level l-1;
+  // its neighbours are (mostly) vertices of that fan, so this is the offset the split added
+  // to the coarser surface there: on a smooth patch about e^2/2R (edge e, radius of
+  // curvature R), plus the scan's noise. Unlike the distance to v_to, it does not grow with
+  // the edge length on a flat patch; unlike the distance to the coarser faces themselves,
+  // it needs only the current mesh.
+  if (with_detail) {
+    std::vector<float> detail(nv, -1.f);
     std::vector<uint32_t> newest(n, 0);
-    for (uint32_t v = 0; v < h->mesh.vertex_count(); ++v)
+    for (size_t v = 0; v < nv; ++v) {
+      const double *nrm = &vertex_normal[3 * v];
+      const double length = std::sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+      if (!(length > 0) || count[v] == 0)
+        continue;
+      double d = 0;
+      for (int j = 0; j < 3; ++j)
+        d += (double(p[3 * v + j]) - centroid[3 * v + j] / count[v]) * nrm[j];
+      detail[v] = float(std::abs(d) / length);
       if (detail[v] >= 0)
-        newest[cluster(v)] = std::max(newest[cluster(v)], h->vertex_level[v]);
-    for (uint32_t v = 0; v < h->mesh.vertex_count(); ++v) {
-      float *b = at(cluster(v));
-      if (detail[v] >= 0 && h->vertex_level[v] == newest[cluster(v)]) {
+        newest[cluster[v]] = std::max(newest[cluster[v]], h->vertex_level[v]);
+    }
+    for (size_t v = 0; v < nv; ++v) {
+      float *b = at(cluster[v]);
+      if (detail[v] >= 0 && h->vertex_level[v] == newest[cluster[v]]) {
         b[12] = std::max(b[12], detail[v]);
         b[13] += 1;
       }
     }
   }
+
   // The cone's width: the face normal furthest from the axis (zero-area faces have none).
-  for (size_t f = 0; f < h->mesh.triangle_count(); ++f) {
-    double normal[3];
-    uint32_t clusters[3];
-    const int count = face(f, normal, clusters);
+  for (size_t f = 0; f < nf; ++f) {
+    const FaceGeometry g = face_geometry(p, &t[3 * f]);
+    const double *normal = g.normal;
     const double length =
         std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
     if (!(length > 0))
       continue;
-    for (int i = 0; i < count; ++i) {
-      float *b = at(clusters[i]);
-      const double cosine = (normal[0] * b[8] + normal[1] * b[9] + normal[2] * b[10]) / length;
-      b[11] = std::min(b[11], float(cosine));
-    }
+    const uint32_t c[3] = {cluster[t[3 * f]], cluster[t[3 * f + 1]], cluster[t[3 * f + 2]]};
+    const bool distinct[3] = {true, c[1] != c[0], c[2] != c[0] && c[2] != c[1]};
+    for (int i = 0; i < 3; ++i)
+      if (distinct[i]) {
+        float *b = at(c[i]);
+        const double cosine = (normal[0] * b[8] + normal[1] * b[9] + normal[2] * b[10]) / length;
+        b[11] = std::min(b[11], float(cosine));
+      }
   }
   return h->bounds.data();
 }
